@@ -1,0 +1,3 @@
+//! marbre: an interactive ray tracer for procedural textures.
+
+pub mod noise;

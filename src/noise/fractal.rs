@@ -1,0 +1,162 @@
+//! Fractal sums of a lattice noise: fBm, turbulence and marble.
+
+use super::{HashKind, NoiseKind, gradient::gradient_noise, perlin::improved_noise_f32};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// The knobs of a fractal sum. Octave `i` is `amplitude · persistenceⁱ ·
+/// noise(p · frequency · lacunarityⁱ)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FractalParams {
+    /// Number of octaves, 0 to [`FractalParams::MAX_OCTAVES`]. A fractional
+    /// part weights the last octave, so the image changes smoothly while the
+    /// slider moves.
+    pub octaves: f32,
+    pub frequency: f32,
+    pub amplitude: f32,
+    pub persistence: f32,
+    pub lacunarity: f32,
+}
+
+impl FractalParams {
+    pub const MAX_OCTAVES: f32 = 16.0;
+}
+
+impl Default for FractalParams {
+    fn default() -> Self {
+        Self {
+            octaves: 6.0,
+            frequency: 1.0,
+            amplitude: 1.0,
+            persistence: 0.5,
+            lacunarity: 2.0,
+        }
+    }
+}
+
+/// A complete noise binding: which lattice noise, which hash, which sum.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NoiseSettings {
+    pub kind: NoiseKind,
+    pub hash: HashKind,
+    pub fractal: FractalParams,
+}
+
+/// One octave of the chosen lattice noise.
+pub fn noise(p: Vec3, kind: NoiseKind, hash: HashKind) -> f32 {
+    match kind {
+        NoiseKind::Gradient => gradient_noise(p, hash),
+        NoiseKind::Perlin => improved_noise_f32(p.x, p.y, p.z),
+    }
+}
+
+/// Sums `shape(noise)` over the octaves; `shape` is the identity for fBm and
+/// `abs` for turbulence.
+fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: impl Fn(f32) -> f32) -> f32 {
+    let f = &s.fractal;
+    let octaves = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES);
+    let whole = octaves.ceil() as u32;
+    let mut frequency = f.frequency;
+    let mut amplitude = f.amplitude;
+    let mut sum = 0.0;
+    for i in 0..whole {
+        // The last octave fades in with the fractional part of `octaves`.
+        let weight = (octaves - i as f32).min(1.0);
+        sum += weight * amplitude * shape(noise(p * frequency, s.kind, s.hash));
+        frequency *= f.lacunarity;
+        amplitude *= f.persistence;
+    }
+    sum
+}
+
+/// Fractional Brownian motion: a sum of octaves of signed noise.
+pub fn fbm(p: Vec3, s: &NoiseSettings) -> f32 {
+    fractal_sum(p, s, |n| n)
+}
+
+/// Turbulence: a sum of octaves of |noise|, with creases where noise crosses 0.
+pub fn turbulence(p: Vec3, s: &NoiseSettings) -> f32 {
+    fractal_sum(p, s, f32::abs)
+}
+
+/// The lab's marble: `sin(p.x · stripe_frequency + fbm(p))`, in [-1, 1].
+pub fn marble(p: Vec3, s: &NoiseSettings, stripe_frequency: f32) -> f32 {
+    (p.x * stripe_frequency + fbm(p, s)).sin()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(kind: NoiseKind, octaves: f32, amplitude: f32) -> NoiseSettings {
+        NoiseSettings {
+            kind,
+            hash: HashKind::Pcg,
+            fractal: FractalParams {
+                octaves,
+                amplitude,
+                ..FractalParams::default()
+            },
+        }
+    }
+
+    fn points() -> impl Iterator<Item = Vec3> {
+        (0..500).map(|k| {
+            let k = k as f32;
+            Vec3::new(k * 0.37, k * 0.11 - 20.0, 3.0 - k * 0.053)
+        })
+    }
+
+    #[test]
+    fn zero_octaves_give_zero() {
+        for kind in NoiseKind::ALL {
+            let s = settings(kind, 0.0, 1.0);
+            for p in points() {
+                assert_eq!(fbm(p, &s), 0.0);
+                assert_eq!(turbulence(p, &s), 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn fbm_is_linear_in_amplitude() {
+        for kind in NoiseKind::ALL {
+            let one = settings(kind, 5.0, 1.0);
+            let three = settings(kind, 5.0, 3.0);
+            for p in points() {
+                let (a, b) = (fbm(p, &one), fbm(p, &three));
+                assert!((3.0 * a - b).abs() <= 1e-5 * (1.0 + b.abs()), "{a} {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn one_octave_is_the_plain_noise() {
+        let s = settings(NoiseKind::Perlin, 1.0, 1.0);
+        for p in points() {
+            assert_eq!(fbm(p, &s), noise(p, NoiseKind::Perlin, HashKind::Pcg));
+        }
+    }
+
+    #[test]
+    fn fractional_octaves_interpolate_between_whole_ones() {
+        let lo = settings(NoiseKind::Gradient, 3.0, 1.0);
+        let mid = settings(NoiseKind::Gradient, 3.25, 1.0);
+        let hi = settings(NoiseKind::Gradient, 4.0, 1.0);
+        for p in points() {
+            let expected = 0.75 * fbm(p, &lo) + 0.25 * fbm(p, &hi);
+            assert!((fbm(p, &mid) - expected).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn turbulence_is_non_negative_and_marble_is_a_sine() {
+        let s = settings(NoiseKind::Gradient, 6.0, 1.0);
+        for p in points() {
+            assert!(turbulence(p, &s) >= 0.0);
+            assert!(marble(p, &s, 4.0).abs() <= 1.0);
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! The lab's gradient noise: hashed corner gradients, dot products with the
+//! offset to each corner, and trilinear interpolation by the smoothstep
+//! `u = f²(3 − 2f)`.
+
+use super::hash::{HashKind, gradient_pcg, gradient_sin};
+use glam::{IVec3, Vec3};
+
+/// A provable bound on |gradient_noise|: each corner value is
+/// |g|·|f − c| ≤ √3·√3 = 3, and the interpolation is a convex combination.
+/// The values actually observed stay far inside it (see the tests).
+pub const GRADIENT_NOISE_BOUND: f32 = 3.0;
+
+fn corner_gradient(cell: IVec3, hash: HashKind) -> Vec3 {
+    match hash {
+        HashKind::Pcg => gradient_pcg(cell),
+        HashKind::Sin => gradient_sin(cell.as_vec3()),
+    }
+}
+
+/// Gradient noise at `p`; zero at every lattice point.
+pub fn gradient_noise(p: Vec3, hash: HashKind) -> f32 {
+    let i = p.floor();
+    let f = p - i;
+    let cell = i.as_ivec3();
+    let u = f * f * (Vec3::splat(3.0) - 2.0 * f);
+    let corner = |dx: i32, dy: i32, dz: i32| {
+        let c = IVec3::new(dx, dy, dz);
+        corner_gradient(cell + c, hash).dot(f - c.as_vec3())
+    };
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u.x);
+    let x10 = lerp(corner(0, 1, 0), corner(1, 1, 0), u.x);
+    let x01 = lerp(corner(0, 0, 1), corner(1, 0, 1), u.x);
+    let x11 = lerp(corner(0, 1, 1), corner(1, 1, 1), u.x);
+    let y0 = lerp(x00, x10, u.y);
+    let y1 = lerp(x01, x11, u.y);
+    lerp(y0, y1, u.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_points(n: usize, scale: f32) -> impl Iterator<Item = Vec3> {
+        // A low-discrepancy (R3) sequence: deterministic and well spread.
+        let a = Vec3::new(0.819_172_5, 0.671_043_5, 0.549_700_5);
+        (0..n).map(move |k| {
+            let v = a * k as f32;
+            (v - v.floor() - 0.5) * 2.0 * scale
+        })
+    }
+
+    #[test]
+    fn zero_at_every_lattice_point() {
+        for hash in HashKind::ALL {
+            for x in -4..4 {
+                for y in -4..4 {
+                    for z in -4..4 {
+                        let p = Vec3::new(x as f32, y as f32, z as f32);
+                        assert_eq!(gradient_noise(p, hash), 0.0, "{p} {hash:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn continuous_across_cell_faces() {
+        // Points 1e-6 either side of a face differ by at most the gradient
+        // bound times the distance (≤ 3·2e-6·few); a discontinuity would show
+        // a jump of order 0.1.
+        for hash in HashKind::ALL {
+            for p in sample_points(2000, 8.0) {
+                for axis in 0..3 {
+                    let mut lo = p;
+                    let mut hi = p;
+                    let face = p[axis].round();
+                    lo[axis] = face - 1e-6 * face.abs().max(1.0);
+                    hi[axis] = face + 1e-6 * face.abs().max(1.0);
+                    let jump = (gradient_noise(lo, hash) - gradient_noise(hi, hash)).abs();
+                    assert!(jump < 1e-4, "jump {jump} at {p} axis {axis} {hash:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn range_over_a_million_samples() {
+        for hash in HashKind::ALL {
+            let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+            for p in sample_points(1_000_000, 50.0) {
+                let v = gradient_noise(p, hash);
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            assert!(lo >= -GRADIENT_NOISE_BOUND && hi <= GRADIENT_NOISE_BOUND);
+            // Not degenerate: it uses a good part of its range, both signs.
+            assert!(lo < -0.5 && hi > 0.5, "{hash:?}: [{lo}, {hi}]");
+        }
+    }
+}

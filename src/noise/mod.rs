@@ -1,0 +1,43 @@
+//! CPU reference of every noise function the shaders evaluate.
+//!
+//! The WGSL in `shaders/noise_*.wgsl` and `shaders/fractal.wgsl` mirrors these
+//! functions operation for operation, so that the parity tests (GPU against CPU)
+//! and the `marbre noise --cpu` command can check the shader against a trusted
+//! implementation. The CPU side is the reference: when the two disagree, the
+//! shader is wrong.
+
+pub mod fractal;
+pub mod gradient;
+pub mod hash;
+pub mod perlin;
+
+pub use fractal::{FractalParams, NoiseSettings, fbm, marble, noise, turbulence};
+pub use gradient::gradient_noise;
+pub use hash::HashKind;
+pub use perlin::{improved_noise, improved_noise_f32};
+
+use serde::{Deserialize, Serialize};
+
+/// Which lattice noise a fractal sum is built from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum NoiseKind {
+    /// The lab's gradient noise: hashed corner gradients in [-1, 1]³ and a
+    /// cubic (smoothstep) interpolation.
+    #[default]
+    Gradient,
+    /// Ken Perlin's improved noise (2002): permutation table, 12 edge
+    /// gradients and a quintic fade. Its hash is the permutation table, so it
+    /// ignores [`HashKind`].
+    Perlin,
+}
+
+impl NoiseKind {
+    pub const ALL: [NoiseKind; 2] = [NoiseKind::Gradient, NoiseKind::Perlin];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            NoiseKind::Gradient => "gradient (lab)",
+            NoiseKind::Perlin => "Perlin improved",
+        }
+    }
+}
