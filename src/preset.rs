@@ -1,0 +1,209 @@
+//! Preset files: a [`Scene`] in RON, versioned, with precise errors.
+
+use crate::atomic_write::write_atomic;
+use crate::scene::{EnvSource, Scene};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The format this build writes. Older files load through `#[serde(default)]`
+/// on every struct; newer ones are refused rather than half-understood.
+pub const FORMAT_VERSION: u32 = 1;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Preset {
+    pub format_version: u32,
+    pub description: String,
+    pub scene: Scene,
+}
+
+impl Default for Preset {
+    fn default() -> Self {
+        Self {
+            format_version: FORMAT_VERSION,
+            description: String::new(),
+            scene: Scene::default(),
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not UTF-8 text (byte {offset}); a preset is a RON text file")]
+    NotText { path: PathBuf, offset: usize },
+    #[error("{path}:{line}:{column}: {field}{message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        /// `in field `a.b.c`: `, or empty when the error is outside any field.
+        field: String,
+        message: String,
+    },
+    #[error(
+        "{path}: format version {found} is newer than this build understands ({FORMAT_VERSION}); update marbre"
+    )]
+    FutureVersion { path: PathBuf, found: u32 },
+    #[error("{path}: cannot save: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot serialise the scene: {0}")]
+    Serialise(#[from] ron::Error),
+}
+
+/// A loaded preset and the notes about values clamped into range.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub preset: Preset,
+    pub notes: Vec<String>,
+}
+
+/// Parses preset text. `path` is used in messages and to resolve the relative
+/// paths inside the file.
+pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
+    let mut de =
+        ron::Deserializer::from_str(text).map_err(|e| syntax_error(path, &e, String::new()))?;
+    let mut preset: Preset = match serde_path_to_error::deserialize(&mut de) {
+        Ok(p) => p,
+        Err(e) => {
+            let field = e.path().to_string();
+            let field = if field == "." || field.is_empty() {
+                String::new()
+            } else {
+                format!("in field `{field}`: ")
+            };
+            let spanned = de.span_error(e.into_inner());
+            return Err(syntax_error(path, &spanned, field));
+        }
+    };
+    if let Err(e) = de.end() {
+        return Err(syntax_error(path, &de.span_error(e), String::new()));
+    }
+    if preset.format_version > FORMAT_VERSION {
+        return Err(PresetError::FutureVersion {
+            path: path.to_owned(),
+            found: preset.format_version,
+        });
+    }
+    preset.format_version = FORMAT_VERSION;
+    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source
+        && env.is_relative()
+    {
+        *env = path.parent().unwrap_or(Path::new(".")).join(&*env);
+    }
+    let notes = preset.scene.sanitize();
+    Ok(Loaded { preset, notes })
+}
+
+fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> PresetError {
+    PresetError::Syntax {
+        path: path.to_owned(),
+        line: e.span.start.line,
+        column: e.span.start.col,
+        field,
+        message: e.code.to_string(),
+    }
+}
+
+/// Reads and parses a preset file.
+pub fn load(path: &Path) -> Result<Loaded, PresetError> {
+    let bytes = std::fs::read(path).map_err(|source| PresetError::Read {
+        path: path.to_owned(),
+        source,
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| PresetError::NotText {
+        path: path.to_owned(),
+        offset: e.utf8_error().valid_up_to(),
+    })?;
+    parse(&text, path)
+}
+
+/// Serialises a preset as it would be saved at `path`: paths inside it are
+/// written relative to the file's folder, so a preset folder can be moved.
+pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
+    let mut preset = preset.clone();
+    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source {
+        let dir = absolute(path.parent().unwrap_or(Path::new(".")));
+        if let Some(rel) = pathdiff::diff_paths(absolute(env), dir) {
+            *env = rel;
+        }
+    }
+    let config = ron::ser::PrettyConfig::new()
+        .depth_limit(8)
+        .struct_names(false)
+        .indentor("    ".to_string());
+    Ok(ron::ser::to_string_pretty(&preset, config)? + "\n")
+}
+
+/// Saves atomically: a crash mid-save never destroys the previous file.
+pub fn save(preset: &Preset, path: &Path) -> Result<(), PresetError> {
+    let text = to_text(preset, path)?;
+    write_atomic(path, text.as_bytes()).map_err(|source| PresetError::Write {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+fn absolute(p: &Path) -> PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trips_the_default_scene() {
+        let p = Preset::default();
+        let text = to_text(&p, Path::new("x.ron")).unwrap();
+        let back = parse(&text, Path::new("x.ron")).unwrap();
+        assert_eq!(back.preset, p);
+    }
+
+    #[test]
+    fn a_bad_field_names_its_line_column_and_path() {
+        let text = "(\n  format_version: 1,\n  scene: (\n    camera: (distance: \"far\"),\n  ),\n)\n";
+        let err = parse(text, Path::new("bad.ron")).unwrap_err().to_string();
+        assert!(err.starts_with("bad.ron:4:"), "{err}");
+        assert!(err.contains("scene.camera.distance"), "{err}");
+    }
+
+    #[test]
+    fn a_truncated_file_is_an_error_with_a_position() {
+        let text = to_text(&Preset::default(), Path::new("x.ron")).unwrap();
+        let cut = &text[..text.len() / 2];
+        let err = parse(cut, Path::new("cut.ron")).unwrap_err();
+        assert!(matches!(err, PresetError::Syntax { line, .. } if line > 1), "{err}");
+    }
+
+    #[test]
+    fn missing_fields_take_their_defaults() {
+        let loaded = parse("(scene: (spheres: [(radius: 2.0)]))", Path::new("old.ron")).unwrap();
+        assert_eq!(loaded.preset.scene.spheres[0].radius, 2.0);
+        assert_eq!(loaded.preset.scene.spheres[0].name, "sphere");
+    }
+
+    #[test]
+    fn a_future_version_is_refused() {
+        let err = parse("(format_version: 99)", Path::new("new.ron")).unwrap_err();
+        assert!(matches!(err, PresetError::FutureVersion { found: 99, .. }));
+    }
+
+    #[test]
+    fn out_of_range_values_are_clamped_with_a_note() {
+        let loaded = parse(
+            "(scene: (render: (samples_per_frame: 1000)))",
+            Path::new("x.ron"),
+        )
+        .unwrap();
+        assert_eq!(loaded.preset.scene.render.samples_per_frame, 64);
+        assert_eq!(loaded.notes.len(), 1);
+    }
+}

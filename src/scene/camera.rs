@@ -1,0 +1,128 @@
+//! An orbit camera, as in Blender or a turntable: it looks at a target from a
+//! distance, and the mouse turns it around that target.
+
+use glam::{Mat3, Vec3};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OrbitCamera {
+    pub target: Vec3,
+    pub distance: f32,
+    /// Rotation about the vertical axis, degrees.
+    pub yaw_degrees: f32,
+    /// Elevation above the horizontal, degrees, kept inside (-89, 89).
+    pub pitch_degrees: f32,
+    /// Vertical field of view, degrees.
+    pub fov_degrees: f32,
+}
+
+impl Default for OrbitCamera {
+    fn default() -> Self {
+        Self {
+            target: Vec3::new(0.0, 0.8, 0.0),
+            distance: 9.0,
+            yaw_degrees: 0.0,
+            pitch_degrees: 15.0,
+            fov_degrees: 40.0,
+        }
+    }
+}
+
+/// A camera frame: position and the orthonormal basis the shader needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraFrame {
+    pub position: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    pub forward: Vec3,
+    /// tan(fov/2): the half-height of the image plane at distance 1.
+    pub tan_half_fov: f32,
+}
+
+impl OrbitCamera {
+    pub const MIN_DISTANCE: f32 = 0.05;
+
+    pub fn frame(&self) -> CameraFrame {
+        let yaw = self.yaw_degrees.to_radians();
+        let pitch = self.pitch_degrees.clamp(-89.0, 89.0).to_radians();
+        // The camera sits on +z at yaw 0, looking towards -z.
+        let rotation = Mat3::from_rotation_y(yaw) * Mat3::from_rotation_x(-pitch);
+        let back = rotation * Vec3::Z;
+        let forward = -back;
+        let right = (rotation * Vec3::X).normalize();
+        let up = right.cross(forward).normalize();
+        CameraFrame {
+            position: self.target + back * self.distance,
+            right,
+            up,
+            forward,
+            tan_half_fov: (self.fov_degrees.clamp(1.0, 170.0).to_radians() * 0.5).tan(),
+        }
+    }
+
+    /// Turns the camera by a mouse drag, in degrees.
+    pub fn orbit(&mut self, dyaw: f32, dpitch: f32) {
+        self.yaw_degrees = (self.yaw_degrees + dyaw).rem_euclid(360.0);
+        self.pitch_degrees = (self.pitch_degrees + dpitch).clamp(-89.0, 89.0);
+    }
+
+    /// Moves the target in the image plane; `dx`, `dy` are fractions of the
+    /// view height, so a drag moves the scene with the mouse.
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        let f = self.frame();
+        let scale = 2.0 * self.distance * f.tan_half_fov;
+        self.target += (-f.right * dx + f.up * dy) * scale;
+    }
+
+    /// Zooms by a factor per wheel notch, never through the target.
+    pub fn zoom(&mut self, notches: f32) {
+        self.distance = (self.distance * 0.9f32.powf(notches)).max(Self::MIN_DISTANCE);
+    }
+
+    pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
+        let d = Self::default();
+        if !self.target.is_finite() {
+            notes.push("camera: non-finite target reset".into());
+            self.target = d.target;
+        }
+        if !(self.distance.is_finite() && self.distance >= Self::MIN_DISTANCE) {
+            notes.push(format!("camera: distance {} reset", self.distance));
+            self.distance = d.distance;
+        }
+        if !(self.fov_degrees.is_finite() && (1.0..=170.0).contains(&self.fov_degrees)) {
+            notes.push(format!("camera: field of view {} clamped", self.fov_degrees));
+            self.fov_degrees = self.fov_degrees.clamp(1.0, 170.0);
+            if !self.fov_degrees.is_finite() {
+                self.fov_degrees = d.fov_degrees;
+            }
+        }
+        if !self.yaw_degrees.is_finite() || !self.pitch_degrees.is_finite() {
+            notes.push("camera: non-finite angles reset".into());
+            self.yaw_degrees = d.yaw_degrees;
+            self.pitch_degrees = d.pitch_degrees;
+        }
+        self.pitch_degrees = self.pitch_degrees.clamp(-89.0, 89.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_and_looks_at_the_target() {
+        let mut c = OrbitCamera::default();
+        for (yaw, pitch) in [(0.0, 0.0), (37.0, 20.0), (200.0, -80.0)] {
+            c.yaw_degrees = yaw;
+            c.pitch_degrees = pitch;
+            let f = c.frame();
+            assert!((f.forward.length() - 1.0).abs() < 1e-5);
+            assert!(f.right.dot(f.forward).abs() < 1e-5);
+            assert!(f.up.dot(f.forward).abs() < 1e-5);
+            assert!(f.up.y > 0.0, "up points up");
+            let to_target = (c.target - f.position).normalize();
+            assert!(to_target.dot(f.forward) > 0.9999);
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! The scene model: everything a preset stores and the panel edits.
+//!
+//! This is the single source of truth. The GPU side derives from it a
+//! [`crate::gpu::features::FeatureSet`] (which shader to build) and flat
+//! buffers (what to feed it), so any edit is a change here followed by a
+//! re-derivation.
+
+pub mod camera;
+pub mod environment;
+pub mod material;
+pub mod render_settings;
+
+pub use camera::OrbitCamera;
+pub use environment::{EnvSource, Environment};
+pub use material::{ColorTexture, Material, Pattern, ScalarTexture};
+pub use render_settings::{RenderSettings, ToneMap};
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Sphere {
+    pub name: String,
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: Material,
+}
+
+impl Default for Sphere {
+    fn default() -> Self {
+        Self {
+            name: "sphere".into(),
+            center: Vec3::new(0.0, 1.0, 0.0),
+            radius: 1.0,
+            material: Material::default(),
+        }
+    }
+}
+
+/// The infinite horizontal plane `y = height`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Ground {
+    pub height: f32,
+    pub material: Material,
+}
+
+impl Default for Ground {
+    fn default() -> Self {
+        Self {
+            height: 0.0,
+            material: Material::default(),
+        }
+    }
+}
+
+/// An isotropic point light of `intensity · color` watts per steradian.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub color: Vec3,
+    pub intensity: f32,
+}
+
+impl Default for PointLight {
+    fn default() -> Self {
+        Self {
+            position: Vec3::new(4.0, 6.0, 3.0),
+            color: Vec3::ONE,
+            intensity: 40.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
+pub struct Scene {
+    pub camera: OrbitCamera,
+    pub spheres: Vec<Sphere>,
+    pub ground: Option<Ground>,
+    pub point_light: Option<PointLight>,
+    pub environment: Environment,
+    pub render: RenderSettings,
+}
+
+impl Scene {
+    /// Every material in GPU order: the spheres', then the ground's.
+    pub fn materials(&self) -> impl Iterator<Item = &Material> {
+        self.spheres
+            .iter()
+            .map(|s| &s.material)
+            .chain(self.ground.iter().map(|g| &g.material))
+    }
+
+    /// Values no control can produce (a NaN radius, 40 octaves) are clamped
+    /// into range; each clamp is reported so a preset author can see it.
+    pub fn sanitize(&mut self) -> Vec<String> {
+        let mut notes = Vec::new();
+        for s in &mut self.spheres {
+            if !(s.radius.is_finite() && s.radius > 0.0) {
+                notes.push(format!("sphere `{}`: radius {} set to 1", s.name, s.radius));
+                s.radius = 1.0;
+            }
+            if !s.center.is_finite() {
+                notes.push(format!("sphere `{}`: non-finite centre set to 0", s.name));
+                s.center = Vec3::ZERO;
+            }
+            s.material.sanitize(&format!("sphere `{}`", s.name), &mut notes);
+        }
+        if let Some(g) = &mut self.ground {
+            if !g.height.is_finite() {
+                notes.push("ground: non-finite height set to 0".into());
+                g.height = 0.0;
+            }
+            g.material.sanitize("ground", &mut notes);
+        }
+        self.render.sanitize(&mut notes);
+        self.camera.sanitize(&mut notes);
+        notes
+    }
+}

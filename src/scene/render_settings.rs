@@ -1,0 +1,84 @@
+//! How the image is sampled and displayed.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ToneMap {
+    /// The Narkowicz fit of the ACES filmic curve.
+    #[default]
+    Aces,
+    /// `x / (1 + x)`.
+    Reinhard,
+    /// Clamp to [0, 1]: what the linear radiance looks like untouched.
+    Clamp,
+}
+
+impl ToneMap {
+    pub const ALL: [ToneMap; 3] = [ToneMap::Aces, ToneMap::Reinhard, ToneMap::Clamp];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ToneMap::Aces => "ACES (filmic)",
+            ToneMap::Reinhard => "Reinhard",
+            ToneMap::Clamp => "clamp",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RenderSettings {
+    /// Jittered samples traced per pixel each frame.
+    pub samples_per_frame: u32,
+    /// Average frames while nothing changes; off shows each frame alone.
+    pub accumulate: bool,
+    /// Exposure in stops: the radiance is scaled by 2^exposure.
+    pub exposure: f32,
+    pub tone_map: ToneMap,
+    /// Resolution scale used while the camera is being dragged, so the view
+    /// stays responsive; full resolution comes back when the mouse is still.
+    pub interactive_scale: f32,
+    /// Path length: 1 is direct light only (point light and environment),
+    /// each more bounce adds one more reflection.
+    pub max_bounces: u32,
+}
+
+impl RenderSettings {
+    pub const MAX_SAMPLES_PER_FRAME: u32 = 64;
+    pub const MAX_BOUNCES: u32 = 8;
+
+    pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
+        let d = Self::default();
+        let spp = self.samples_per_frame.clamp(1, Self::MAX_SAMPLES_PER_FRAME);
+        if spp != self.samples_per_frame {
+            notes.push(format!("render: samples per frame {} clamped to {spp}", self.samples_per_frame));
+            self.samples_per_frame = spp;
+        }
+        let b = self.max_bounces.clamp(1, Self::MAX_BOUNCES);
+        if b != self.max_bounces {
+            notes.push(format!("render: max bounces {} clamped to {b}", self.max_bounces));
+            self.max_bounces = b;
+        }
+        if !self.exposure.is_finite() || self.exposure.abs() > 20.0 {
+            notes.push(format!("render: exposure {} clamped", self.exposure));
+            self.exposure = if self.exposure.is_finite() { self.exposure.clamp(-20.0, 20.0) } else { d.exposure };
+        }
+        if !(self.interactive_scale.is_finite() && (0.1..=1.0).contains(&self.interactive_scale)) {
+            notes.push(format!("render: interactive scale {} reset", self.interactive_scale));
+            self.interactive_scale = d.interactive_scale;
+        }
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            samples_per_frame: 1,
+            accumulate: true,
+            exposure: 0.0,
+            tone_map: ToneMap::Aces,
+            interactive_scale: 0.5,
+            max_bounces: 3,
+        }
+    }
+}
