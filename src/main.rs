@@ -1,1 +1,66 @@
-fn main() {}
+//! The `marbre` command line: the viewer, and headless tools around the same
+//! renderer. The names of commands and flags are a contract: scripts and
+//! tests rely on them.
+
+use clap::{Args, Parser, Subcommand};
+use marbre::commands::{bench, noise, render};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "marbre", version, about = "Interactive ray tracer for procedural textures")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    viewer: ViewerArgs,
+}
+
+#[derive(Args)]
+struct ViewerArgs {
+    /// Preset to open (default: presets/default.ron).
+    #[arg(long)]
+    preset: Option<PathBuf>,
+    /// Environment map to use instead of the preset's.
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Render this many frames, then exit (for tests and scripts).
+    #[arg(long)]
+    exit_after_frames: Option<u64>,
+    /// Save the whole window, UI included, as PNG just before exiting.
+    #[arg(long)]
+    window_screenshot: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a preset offscreen to PNG (tone-mapped) or EXR (linear radiance).
+    Render(render::RenderArgs),
+    /// Evaluate noise at `x,y,z` lines read from stdin, one value per line.
+    Noise(noise::NoiseArgs),
+    /// Time every shipped preset at several resolutions.
+    Bench(bench::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Noise(args)) => noise::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        None => marbre::app::run(marbre::app::ViewerOptions {
+            preset: cli.viewer.preset,
+            env: cli.viewer.env,
+            exit_after_frames: cli.viewer.exit_after_frames,
+            window_screenshot: cli.viewer.window_screenshot,
+        }),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("marbre: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,19 @@
+// Constants and small helpers shared by every entry point.
+
+const PI: f32 = 3.14159265358979;
+const TWO_PI: f32 = 6.28318530717959;
+const INV_PI: f32 = 0.318309886183791;
+
+fn luminance(c: vec3f) -> f32 {
+    return dot(c, vec3f(0.2126, 0.7152, 0.0722));
+}
+
+// True for NaN and ±Inf. Tested on the bit pattern: WGSL lets compilers assume
+// finite maths, so `x != x` may be folded to false.
+fn is_non_finite(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) == 0x7f800000u;
+}
+
+fn any_non_finite(v: vec3f) -> bool {
+    return is_non_finite(v.x) || is_non_finite(v.y) || is_non_finite(v.z);
+}

@@ -1,0 +1,58 @@
+// Display pass: exposure, tone mapping and (for non-sRGB targets) encoding,
+// from the accumulation target onto the window or an offscreen image.
+
+struct Display {
+    exposure_scale: f32,
+    tone_map: u32,          // 0 ACES, 1 Reinhard, 2 clamp
+    encode_srgb: u32,       // 1 when the target format does not encode
+    _pad: u32,
+    // Maps a target pixel to an accumulation texel: texel = (pixel - origin) * scale.
+    origin: vec2f,
+    scale: vec2f,
+}
+
+@group(0) @binding(0) var<uniform> display: Display;
+@group(0) @binding(1) var radiance: texture_2d<f32>;
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// Narkowicz's fit of the ACES filmic curve.
+fn aces(x: vec3f) -> vec3f {
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3f(0.0), vec3f(1.0));
+}
+
+fn srgb_encode(c: vec3f) -> vec3f {
+    let lo = c * 12.92;
+    let hi = 1.055 * pow(c, vec3f(1.0 / 2.4)) - 0.055;
+    return select(hi, lo, c <= vec3f(0.0031308));
+}
+
+fn tone_map(c: vec3f) -> vec3f {
+    switch display.tone_map {
+        case 0u: {
+            return aces(c);
+        }
+        case 1u: {
+            return c / (1.0 + c);
+        }
+        default: {
+            return clamp(c, vec3f(0.0), vec3f(1.0));
+        }
+    }
+}
+
+@fragment
+fn fs_display(@builtin(position) position: vec4f) -> @location(0) vec4f {
+    let size = vec2i(textureDimensions(radiance));
+    let texel = clamp(vec2i(floor((position.xy - display.origin) * display.scale)), vec2i(0), size - 1);
+    let c = max(textureLoad(radiance, texel, 0).rgb * display.exposure_scale, vec3f(0.0));
+    var mapped = tone_map(c);
+    if display.encode_srgb != 0u {
+        mapped = srgb_encode(mapped);
+    }
+    return vec4f(mapped, 1.0);
+}

@@ -1,0 +1,90 @@
+// The per-frame trace pass: a full-screen triangle whose fragment shader
+// traces `samples_per_frame` jittered paths per pixel and folds them into the
+// running mean held in the accumulation target.
+
+@group(0) @binding(5) var previous: texture_2d<f32>;
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+fn camera_ray(pixel: vec2f) -> vec3f {
+    let ndc = vec2f(pixel.x / frame.render_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.render_size.y * 2.0);
+    let x = ndc.x * frame.tan_half_fov * frame.aspect;
+    let y = ndc.y * frame.tan_half_fov;
+    return normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up);
+}
+
+#if POINT_LIGHT
+fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
+    let to_light = frame.light_pos - hit.p;
+    let dist2 = dot(to_light, to_light);
+    let wi = to_light * inverseSqrt(dist2);
+    let f_cos = eval_bsdf_cos(s, hit.n, wo, wi);
+    if all(f_cos == vec3f(0.0)) {
+        return vec3f(0.0);
+    }
+    let origin = offset_ray(hit.p, hit.n);
+    let to_light_from_origin = frame.light_pos - origin;
+    if occluded(origin, wi, length(to_light_from_origin)) {
+        return vec3f(0.0);
+    }
+    return (1.0 - s.mirror) * f_cos * frame.light_power / dist2;
+}
+#endif
+
+fn trace_path(pixel: vec2f) -> vec3f {
+    var o = frame.cam_pos;
+    var d = camera_ray(pixel);
+    var throughput = vec3f(1.0);
+    var radiance = vec3f(0.0);
+    for (var depth = 0u; depth <= frame.max_bounces; depth++) {
+        let hit = intersect_scene(o, d);
+        if hit.t >= NO_HIT {
+            if depth > 0u || frame.background_visible != 0u {
+                radiance += throughput * environment(d);
+            }
+            break;
+        }
+        if depth == frame.max_bounces {
+            break;
+        }
+        let s = surface_at(hit);
+        let wo = -d;
+#if POINT_LIGHT
+        radiance += throughput * point_light(hit, s, wo);
+#endif
+        let bs = sample_bsdf(s, hit.n, wo);
+        if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
+            break;
+        }
+        throughput *= bs.weight;
+        o = offset_ray(hit.p, hit.n);
+        d = bs.wi;
+    }
+    return radiance;
+}
+
+@fragment
+fn fs_trace(@builtin(position) position: vec4f) -> @location(0) vec4f {
+    let pixel = vec2u(position.xy);
+    let spp = frame.samples_per_frame;
+    var sum = vec3f(0.0);
+    for (var k = 0u; k < spp; k++) {
+        rng_seed(pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
+        let jitter = vec2f(rand(), rand());
+        let l = trace_path(vec2f(pixel) + jitter);
+        // A non-finite sample never reaches the accumulation target.
+        if !any_non_finite(l) {
+            sum += l;
+        }
+    }
+    let mean = sum / f32(spp);
+    let n = f32(frame.accumulated);
+    let prev = textureLoad(previous, pixel, 0).xyz;
+    // A running mean: its rounding error does not grow with the frame count.
+    let blended = prev + (mean - prev) * (f32(spp) / (n + f32(spp)));
+    return vec4f(blended, 1.0);
+}

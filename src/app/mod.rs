@@ -1,0 +1,94 @@
+//! The desktop viewer: a winit window, the progressive renderer every frame,
+//! and the egui panel on top.
+//!
+//! Data flow per frame: winit events → egui input → panel edits the `Scene`
+//! → the renderer re-derives buffers (or the pipeline, when the feature set
+//! changes) → trace pass → display pass → egui pass → present.
+
+mod camera_input;
+mod screenshots;
+mod viewer;
+
+use anyhow::Result;
+use std::path::PathBuf;
+use std::sync::Arc;
+use viewer::Viewer;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::window::{Window, WindowId};
+
+/// What the command line asks of the viewer.
+#[derive(Debug, Clone, Default)]
+pub struct ViewerOptions {
+    pub preset: Option<PathBuf>,
+    pub env: Option<PathBuf>,
+    pub exit_after_frames: Option<u64>,
+    pub window_screenshot: Option<PathBuf>,
+}
+
+struct App {
+    options: ViewerOptions,
+    viewer: Option<Viewer>,
+    /// A start-up failure, reported after the loop exits.
+    error: Option<anyhow::Error>,
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.viewer.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title("marbre")
+            .with_inner_size(winit::dpi::PhysicalSize::new(1280, 720));
+        let result = event_loop
+            .create_window(attributes)
+            .map_err(anyhow::Error::from)
+            .and_then(|w| Viewer::new(Arc::new(w), self.options.clone()));
+        match result {
+            Ok(v) => self.viewer = Some(v),
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(viewer) = &mut self.viewer else {
+            return;
+        };
+        match viewer.handle_event(&event) {
+            Ok(true) => {}
+            Ok(false) => event_loop.exit(),
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(v) = &self.viewer {
+            v.request_redraw();
+        }
+    }
+}
+
+/// Opens the window and runs until it is closed (or the frame limit is hit).
+pub fn run(options: ViewerOptions) -> Result<()> {
+    let event_loop = EventLoop::new()?;
+    // Progressive rendering: draw continuously while there is work to do.
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        options,
+        viewer: None,
+        error: None,
+    };
+    event_loop.run_app(&mut app)?;
+    match app.error {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,20 @@
+//! F12 screenshots: the rendered image as PNG (tone-mapped) and EXR (linear
+//! radiance), with timestamped names, without the UI.
+
+use crate::gpu::{GpuContext, Renderer};
+use crate::image_io;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+pub const FOLDER: &str = "screenshots";
+
+/// Writes both files and returns their paths.
+pub fn save(ctx: &GpuContext, renderer: &mut Renderer, folder: &Path) -> Result<[PathBuf; 2]> {
+    let stamp = chrono::Local::now().format("%Y%m%d-%H%M%S%.3f");
+    let png = folder.join(format!("marbre-{stamp}.png"));
+    let exr = folder.join(format!("marbre-{stamp}.exr"));
+    image_io::save_png(&renderer.read_display(ctx)?, &png)?;
+    let (w, h, pixels) = renderer.read_radiance(ctx)?;
+    image_io::save_exr(w, h, &pixels, &exr)?;
+    Ok([png, exr])
+}

@@ -1,0 +1,428 @@
+//! One window's state: surface, renderer, egui, the scene being edited.
+
+use super::{ViewerOptions, camera_input, screenshots};
+use crate::commands::session::{load_scene, preset_or_default};
+use crate::envmap;
+use crate::gpu::{GpuContext, Renderer, Viewport, readback::read_texture};
+use crate::panel::{self, PanelAction, PanelState, Stats};
+use crate::preset::{self, Preset};
+use crate::scene::{EnvSource, OrbitCamera, Scene};
+use anyhow::{Context as _, Result};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+use winit::event::{ElementState, KeyEvent, WindowEvent};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::Window;
+
+/// Width of the side panel, in points, when the window opens.
+const PANEL_WIDTH: f32 = 380.0;
+
+pub struct Viewer {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    ctx: GpuContext,
+    renderer: Renderer,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    scene: Scene,
+    /// The preset's description, kept so that saving does not lose it.
+    description: String,
+    panel: PanelState,
+    options: ViewerOptions,
+    frames: u64,
+    last_frame: Instant,
+    fps: f32,
+    ms_per_frame: f32,
+    screenshot_requested: bool,
+}
+
+impl Viewer {
+    pub fn new(window: Arc<Window>, options: ViewerOptions) -> Result<Self> {
+        let preset_path = preset_or_default(options.preset.as_deref());
+        let loaded = load_scene(&preset_path, options.env.as_deref())?;
+        let description = preset::load(&preset_path).map(|l| l.preset.description).unwrap_or_default();
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
+        let surface = instance.create_surface(window.clone()).context("creating the window surface")?;
+        let ctx = GpuContext::for_surface(instance, &surface)?;
+        let size = window.inner_size();
+        let caps = surface.get_capabilities(&ctx.adapter);
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(wgpu::TextureFormat::is_srgb)
+            .unwrap_or(caps.formats[0]);
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: wgpu::PresentMode::AutoVsync,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes[0],
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        surface.configure(&ctx.device, &config);
+        let renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), (config.width, config.height))?;
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(ctx.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(&ctx.device, format, Default::default());
+        let env_path = match &loaded.scene.environment.source {
+            EnvSource::LatLong { path } => path.display().to_string(),
+            _ => String::new(),
+        };
+        let mut panel = PanelState::new(preset_path.display().to_string(), env_path);
+        panel.info(format!("loaded {}", preset_path.display()));
+        for note in &loaded.notes {
+            panel.info(note.clone());
+        }
+        Ok(Self {
+            window,
+            surface,
+            config,
+            ctx,
+            renderer,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            scene: loaded.scene,
+            description,
+            panel,
+            options,
+            frames: 0,
+            last_frame: Instant::now(),
+            fps: 0.0,
+            ms_per_frame: 0.0,
+            screenshot_requested: false,
+        })
+    }
+
+    pub fn request_redraw(&self) {
+        self.window.request_redraw();
+    }
+
+    /// Handles one window event; `Ok(false)` asks the loop to exit.
+    pub fn handle_event(&mut self, event: &WindowEvent) -> Result<bool> {
+        let consumed = self.egui_state.on_window_event(&self.window, event).consumed;
+        match event {
+            WindowEvent::CloseRequested => return Ok(false),
+            WindowEvent::Resized(size) => {
+                self.config.width = size.width.max(1);
+                self.config.height = size.height.max(1);
+                // A minimised window has zero size: keep the last valid one.
+                if size.width > 0 && size.height > 0 {
+                    self.surface.configure(&self.ctx.device, &self.config);
+                }
+            }
+            WindowEvent::DroppedFile(path) => self.load_dropped(path),
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        logical_key: Key::Named(NamedKey::F12),
+                        state: ElementState::Pressed,
+                        ..
+                    },
+                ..
+            } if !consumed => self.screenshot_requested = true,
+            WindowEvent::RedrawRequested => return self.redraw(),
+            _ => {}
+        }
+        Ok(true)
+    }
+
+    fn load_dropped(&mut self, path: &Path) {
+        let is_preset = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+        if is_preset {
+            self.load_preset(path);
+        } else {
+            self.load_environment(path);
+        }
+    }
+
+    fn load_preset(&mut self, path: &Path) {
+        match load_scene(path, None) {
+            Ok(loaded) => {
+                if let Err(e) = self.apply_scene(loaded.scene.clone(), loaded.env.as_ref()) {
+                    self.panel.error(format!("{}: {e:#}", path.display()));
+                    return;
+                }
+                self.description = preset::load(path).map(|l| l.preset.description).unwrap_or_default();
+                self.panel.preset_path = path.display().to_string();
+                if let EnvSource::LatLong { path } = &self.scene.environment.source {
+                    self.panel.env_path = path.display().to_string();
+                }
+                self.panel.info(format!("loaded {}", path.display()));
+                for note in loaded.notes {
+                    self.panel.info(note);
+                }
+            }
+            // The scene on screen stays as it was.
+            Err(e) => self.panel.error(format!("{e:#}")),
+        }
+    }
+
+    fn load_environment(&mut self, path: &Path) {
+        match envmap::load(path) {
+            Ok(l) => {
+                let mut scene = self.scene.clone();
+                scene.environment.source = EnvSource::LatLong { path: path.to_owned() };
+                if let Err(e) = self.apply_scene(scene, Some(&l.image)) {
+                    self.panel.error(format!("{}: {e:#}", path.display()));
+                    return;
+                }
+                self.panel.env_path = path.display().to_string();
+                self.panel.info(format!("environment {}", path.display()));
+                for note in l.notes {
+                    self.panel.info(note);
+                }
+            }
+            Err(e) => self.panel.error(format!("{e:#}")),
+        }
+    }
+
+    /// Installs a whole new scene and environment; on failure nothing changes.
+    fn apply_scene(&mut self, scene: Scene, env: Option<&envmap::EnvImage>) -> Result<()> {
+        self.renderer.set_scene(&self.ctx, &scene)?;
+        self.renderer.set_environment(&self.ctx, env);
+        self.scene = scene;
+        Ok(())
+    }
+
+    fn save_preset(&mut self, path: &Path) {
+        let preset = Preset {
+            description: self.description.clone(),
+            scene: self.scene.clone(),
+            ..Preset::default()
+        };
+        match preset::save(&preset, path) {
+            Ok(()) => {
+                self.panel.preset_path = path.display().to_string();
+                self.panel.info(format!("saved {}", path.display()));
+            }
+            Err(e) => self.panel.error(e.to_string()),
+        }
+    }
+
+    fn take_screenshot(&mut self) {
+        match screenshots::save(&self.ctx, &mut self.renderer, Path::new(screenshots::FOLDER)) {
+            Ok([png, exr]) => self
+                .panel
+                .info(format!("saved {} and {}", png.display(), exr.display())),
+            Err(e) => self.panel.error(format!("screenshot failed: {e:#}")),
+        }
+    }
+
+    fn handle_actions(&mut self, actions: Vec<PanelAction>) {
+        for action in actions {
+            match action {
+                PanelAction::LoadPreset(p) => self.load_preset(&p),
+                PanelAction::SavePreset => {
+                    let path = PathBuf::from(&self.panel.preset_path);
+                    self.save_preset(&path);
+                }
+                PanelAction::SavePresetAs(p) => self.save_preset(&p),
+                PanelAction::LoadEnvironment(p) => self.load_environment(&p),
+                PanelAction::Screenshot => self.screenshot_requested = true,
+                PanelAction::ResetCamera => self.scene.camera = OrbitCamera::default(),
+            }
+        }
+    }
+
+    fn stats(&self) -> Stats {
+        let info = self.ctx.adapter.get_info();
+        Stats {
+            fps: self.fps,
+            ms_per_frame: self.ms_per_frame,
+            ms_is_gpu: false,
+            samples: self.renderer.accumulated_samples(),
+            adapter: info.name,
+            backend: format!("{:?}", info.backend),
+            features: self.renderer.features().0.iter().map(|f| format!("{f:?}")).collect(),
+            resolution: self.renderer.render_size(),
+        }
+    }
+
+    /// Runs the UI for one frame; returns the image rectangle in points and
+    /// whether the camera is being dragged.
+    fn run_ui(&mut self) -> (egui::FullOutput, egui::Rect, bool) {
+        let raw_input = self.egui_state.take_egui_input(&self.window);
+        let stats = self.stats();
+        let mut actions = Vec::new();
+        let mut image_rect = egui::Rect::NOTHING;
+        let mut dragging = false;
+        let (scene, panel_state) = (&mut self.scene, &mut self.panel);
+        let output = self.egui_ctx.run_ui(raw_input, |ui| {
+            egui::Panel::right("marbre-panel")
+                .default_size(PANEL_WIDTH)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        actions = panel::draw(ui, scene, panel_state, &stats);
+                    });
+                });
+            image_rect = ui.available_rect_before_wrap();
+            let response = ui.allocate_rect(image_rect, egui::Sense::click_and_drag());
+            dragging = camera_input::apply(ui, &response, &mut scene.camera);
+        });
+        self.handle_actions(actions);
+        (output, image_rect, dragging)
+    }
+
+    fn redraw(&mut self) -> Result<bool> {
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f32();
+        self.last_frame = now;
+        self.ms_per_frame = 0.9 * self.ms_per_frame + 0.1 * dt * 1000.0;
+        self.fps = 1000.0 / self.ms_per_frame.max(1e-3);
+
+        let before = self.scene.clone();
+        let (output, image_rect, dragging) = self.run_ui();
+        self.egui_state.handle_platform_output(&self.window, output.platform_output.clone());
+        if self.scene != before
+            && let Err(e) = self.renderer.set_scene(&self.ctx, &self.scene)
+        {
+            // Keep what is on screen; show why the edit was refused.
+            self.panel.error(format!("{e:#}"));
+            self.scene = self.renderer.scene().clone();
+        }
+        if self.config.width == 0 || self.config.height == 0 {
+            return Ok(true);
+        }
+        let ppp = output.pixels_per_point;
+        let viewport = Viewport {
+            x: (image_rect.min.x * ppp).round().max(0.0),
+            y: (image_rect.min.y * ppp).round().max(0.0),
+            width: (image_rect.width() * ppp).round().max(1.0),
+            height: (image_rect.height() * ppp).round().max(1.0),
+        };
+        self.renderer.resize(&self.ctx, (viewport.width as u32, viewport.height as u32));
+        self.renderer
+            .set_render_scale(if dragging { self.scene.render.interactive_scale } else { 1.0 });
+
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.ctx.device, &self.config);
+                return Ok(true);
+            }
+            _ => return Ok(true),
+        };
+        let target = frame.texture.create_view(&Default::default());
+        let is_last = self.options.exit_after_frames.is_some_and(|n| self.frames + 1 >= n);
+        let capture = if is_last && self.options.window_screenshot.is_some() {
+            Some(self.capture_texture())
+        } else {
+            None
+        };
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        self.renderer.trace(&self.ctx, &mut encoder, None);
+        let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                self.egui_renderer.update_texture(&self.ctx.device, &self.ctx.queue, *id, delta);
+            }
+        }
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: ppp,
+        };
+        let extra = self.egui_renderer.update_buffers(
+            &self.ctx.device,
+            &self.ctx.queue,
+            &mut encoder,
+            &paint_jobs,
+            &screen,
+        );
+        let background = wgpu::LoadOp::Clear(wgpu::Color {
+            r: 0.02,
+            g: 0.02,
+            b: 0.02,
+            a: 1.0,
+        });
+        let views: Vec<&wgpu::TextureView> =
+            std::iter::once(&target).chain(capture.as_ref().map(|(_, v)| v)).collect();
+        for view in views {
+            self.renderer
+                .display(&self.ctx, &mut encoder, view, self.config.format, viewport, background)?;
+            let mut pass = encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("egui"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    ..Default::default()
+                })
+                .forget_lifetime();
+            self.egui_renderer.render(&mut pass, &paint_jobs, &screen);
+        }
+        self.ctx
+            .queue
+            .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
+        self.ctx.queue.present(frame);
+        for id in &output.textures_delta.free {
+            self.egui_renderer.free_texture(id);
+        }
+        self.frames += 1;
+        if self.screenshot_requested {
+            self.screenshot_requested = false;
+            self.take_screenshot();
+        }
+        if let (Some((texture, _)), Some(path)) = (capture, self.options.window_screenshot.clone()) {
+            self.save_window_capture(&texture, &path)?;
+        }
+        Ok(!is_last)
+    }
+
+    /// An offscreen twin of the swapchain image, so the final frame (UI
+    /// included) can be read back: swapchain images may not be copyable.
+    fn capture_texture(&self) -> (wgpu::Texture, wgpu::TextureView) {
+        let texture = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("window capture"),
+            size: wgpu::Extent3d {
+                width: self.config.width,
+                height: self.config.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.config.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        (texture, view)
+    }
+
+    fn save_window_capture(&self, texture: &wgpu::Texture, path: &Path) -> Result<()> {
+        let mut bytes = read_texture(&self.ctx.device, &self.ctx.queue, texture, 4)?;
+        if matches!(
+            self.config.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        ) {
+            for px in bytes.chunks_exact_mut(4) {
+                px.swap(0, 2);
+            }
+        }
+        let image = image::RgbaImage::from_raw(self.config.width, self.config.height, bytes)
+            .context("window capture has the wrong size")?;
+        crate::image_io::save_png(&image, path)
+            .with_context(|| format!("saving the window screenshot {}", path.display()))
+    }
+}

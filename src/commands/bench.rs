@@ -1,0 +1,71 @@
+//! `marbre bench`: milliseconds per frame for every shipped preset.
+
+use super::session::load_scene;
+use crate::gpu::{GpuContext, Renderer};
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Folder of presets to time.
+    #[arg(long, default_value = "presets")]
+    pub presets: PathBuf,
+    /// Frames timed per measurement, after warm-up.
+    #[arg(long, default_value_t = 30)]
+    pub frames: u32,
+    /// Sizes to time, WIDTHxHEIGHT.
+    #[arg(long, value_delimiter = ',', default_values = ["1280x720", "640x360"], value_parser = super::render::parse_size)]
+    pub sizes: Vec<(u32, u32)>,
+}
+
+/// Wall-clock time per frame, each frame waited for: trace plus GPU sync.
+fn time_frames(ctx: &GpuContext, renderer: &mut Renderer, frames: u32) -> Result<f64> {
+    let frame = |renderer: &mut Renderer| -> Result<()> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    };
+    // Warm-up: the first draw compiles the pipeline on many drivers.
+    for _ in 0..3 {
+        frame(renderer)?;
+    }
+    let start = Instant::now();
+    for _ in 0..frames {
+        frame(renderer)?;
+    }
+    Ok(start.elapsed().as_secs_f64() * 1000.0 / f64::from(frames.max(1)))
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let ctx = GpuContext::headless()?;
+    let mut presets: Vec<PathBuf> = std::fs::read_dir(&args.presets)
+        .with_context(|| format!("reading {}", args.presets.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    presets.sort();
+    println!("adapter: {}", ctx.describe());
+    println!("frames per measurement: {}, 1 sample per pixel per frame", args.frames);
+    let header: Vec<String> = args.sizes.iter().map(|(w, h)| format!("{w}x{h} ms (fps)")).collect();
+    println!("| preset | features | {} |", header.join(" | "));
+    println!("|---|---|{}", "---|".repeat(args.sizes.len()));
+    for path in presets {
+        let mut loaded = load_scene(&path, None)?;
+        loaded.scene.render.samples_per_frame = 1;
+        let mut cells = Vec::new();
+        let mut features = 0;
+        for &size in &args.sizes {
+            let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size)?;
+            features = renderer.features().0.len();
+            let ms = time_frames(&ctx, &mut renderer, args.frames)?;
+            cells.push(format!("{ms:.1} ({:.0})", 1000.0 / ms));
+        }
+        let name = path.file_stem().unwrap_or_default().to_string_lossy();
+        println!("| {name} | {features} | {} |", cells.join(" | "));
+    }
+    Ok(())
+}

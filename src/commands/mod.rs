@@ -1,0 +1,6 @@
+//! The headless commands: each is a thin layer over the library.
+
+pub mod bench;
+pub mod noise;
+pub mod render;
+pub mod session;

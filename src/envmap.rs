@@ -1,0 +1,1078 @@
+//! Latitude-longitude (equirectangular) environment maps, loaded on the CPU.
+//!
+//! [`load`] reads an OpenEXR (`.exr`, through the `exr` crate), Radiance
+//! (`.hdr`), PNG or JPEG file (through `image`) into an [`EnvImage`]: linear
+//! radiance, RGBA f32, row-major, row 0 at the top of the picture (the sky),
+//! alpha always 1. The GPU copy is an `Rgba16Float` texture, built from
+//! [`EnvImage::to_rgba16f`].
+//!
+//! Real-world maps are not clean: lossy compression leaves negative values,
+//! and a sun can be brighter than a half float can hold. Every image is
+//! therefore sanitised at load time (see [`EnvImage::sanitize`]): NaN, ±Inf
+//! and negative values become 0 and values above [`F16_MAX`] are clamped to
+//! it. Each kind of repair is reported as one human-readable line in
+//! [`EnvLoad::notes`].
+//!
+//! # Mapping
+//!
+//! A direction `d` (unit length) is mapped to the lab's `(u, v)` by
+//! [`direction_to_uv`]:
+//!
+//! ```text
+//! u = (atan2(d.x, d.z) + π) / (2π)      +z → 0.5, +x → 0.75, -x → 0.25, -z → 0 or 1 (the seam)
+//! v = acos(-d.y) / π                    straight down → 0, horizon → 0.5, straight up → 1
+//! ```
+//!
+//! The lab's `v` grows upwards, but row 0 of an image file is its top (the
+//! sky), so the texture coordinate that addresses the image is
+//! `(u, 1 - v)`: [`uv_to_texel_uv`]. The shader must do the same two steps.
+
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+use half::f16;
+use thiserror::Error;
+
+/// The largest finite half float. The GPU texture is `Rgba16Float`, so
+/// anything brighter would become +Inf there.
+pub const F16_MAX: f32 = 65504.0;
+
+/// The extensions [`load`] understands (lower case, without the dot).
+pub const SUPPORTED_EXTENSIONS: [&str; 5] = ["exr", "hdr", "png", "jpg", "jpeg"];
+
+/// A lat-long environment map in linear radiance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvImage {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major, `width * height` texels, row 0 = top of the image (the sky,
+    /// texel-space v = 0, lab v = 1). Linear RGB, alpha 1.
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// The result of [`load`]: the sanitised image and one note per kind of
+/// repair made to it (empty for a clean file).
+#[derive(Debug, Clone)]
+pub struct EnvLoad {
+    pub image: EnvImage,
+    pub notes: Vec<String>,
+}
+
+/// How many channel values [`EnvImage::sanitize`] repaired, by kind. Only the
+/// colour channels are counted; alpha is forced to 1.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SanitizeCounts {
+    /// NaN values, set to 0.
+    pub nan: usize,
+    /// +Inf and -Inf values, set to 0.
+    pub infinite: usize,
+    /// Finite negative values, set to 0.
+    pub negative: usize,
+    /// Finite values above [`F16_MAX`], clamped to it.
+    pub clamped: usize,
+}
+
+impl SanitizeCounts {
+    /// Total number of repaired values.
+    pub fn total(&self) -> usize {
+        self.nan + self.infinite + self.negative + self.clamped
+    }
+
+    /// One line per non-zero kind, each starting with `file_name`, e.g.
+    /// `"sky.exr: 1234 negative values set to 0"`.
+    pub fn notes(&self, file_name: &str) -> Vec<String> {
+        let mut notes = Vec::new();
+        let mut push = |n: usize, what: &str| {
+            if n > 0 {
+                let s = if n == 1 { "" } else { "s" };
+                notes.push(format!("{file_name}: {n} {}", what.replace("{s}", s)));
+            }
+        };
+        push(self.nan, "NaN value{s} set to 0");
+        push(self.infinite, "infinite value{s} set to 0");
+        push(self.negative, "negative value{s} set to 0");
+        push(
+            self.clamped,
+            "value{s} above 65504 (the half-float maximum) clamped to 65504",
+        );
+        notes
+    }
+}
+
+/// Why an environment map could not be loaded. Every variant names the file.
+#[derive(Debug, Error)]
+pub enum EnvMapError {
+    /// The file is missing or unreadable.
+    #[error("environment map {}: cannot read the file: {source}", .path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The extension is not one [`load`] understands.
+    #[error(
+        "environment map {}: unsupported file type {}; supported: .exr, .hdr, .png, .jpg, .jpeg",
+        .path.display(),
+        if .extension.is_empty() { "(no extension)".to_string() } else { format!(".{}", .extension) }
+    )]
+    UnsupportedExtension { path: PathBuf, extension: String },
+    /// The decoder rejected the file; `message` is the decoder's own.
+    #[error("environment map {}: cannot decode {format}: {message}", .path.display())]
+    Decode {
+        path: PathBuf,
+        format: &'static str,
+        message: String,
+    },
+    /// An OpenEXR file with DWAA/DWAB compression that the `exr` crate failed
+    /// to decode (older `exr` versions could not read DWA at all).
+    #[error(
+        "environment map {}: cannot decode OpenEXR with {compression} compression: {message}; \
+         re-save the file with ZIP or PIZ compression",
+        .path.display()
+    )]
+    ExrCompression {
+        path: PathBuf,
+        compression: String,
+        message: String,
+    },
+    /// The image has no texels.
+    #[error("environment map {}: the image is empty ({width}x{height})", .path.display())]
+    Empty {
+        path: PathBuf,
+        width: u32,
+        height: u32,
+    },
+}
+
+impl EnvMapError {
+    /// The file the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            EnvMapError::Io { path, .. }
+            | EnvMapError::UnsupportedExtension { path, .. }
+            | EnvMapError::Decode { path, .. }
+            | EnvMapError::ExrCompression { path, .. }
+            | EnvMapError::Empty { path, .. } => path,
+        }
+    }
+}
+
+impl EnvImage {
+    /// A uniform map, for tests and as a stand-in when no file is loaded.
+    pub fn constant(width: u32, height: u32, rgb: [f32; 3]) -> EnvImage {
+        let texel = [rgb[0], rgb[1], rgb[2], 1.0];
+        EnvImage {
+            width,
+            height,
+            pixels: vec![texel; width as usize * height as usize],
+        }
+    }
+
+    /// The texel at column `x`, row `y` (row 0 = top).
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.pixels[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Makes every colour value finite, non-negative and at most
+    /// [`F16_MAX`], and alpha 1: NaN, ±Inf and negative values become 0,
+    /// larger values are clamped. Returns what was repaired.
+    pub fn sanitize(&mut self) -> SanitizeCounts {
+        let mut counts = SanitizeCounts::default();
+        for px in &mut self.pixels {
+            for c in &mut px[..3] {
+                let v = *c;
+                if v.is_nan() {
+                    counts.nan += 1;
+                    *c = 0.0;
+                } else if v.is_infinite() {
+                    counts.infinite += 1;
+                    *c = 0.0;
+                } else if v < 0.0 {
+                    counts.negative += 1;
+                    *c = 0.0;
+                } else if v > F16_MAX {
+                    counts.clamped += 1;
+                    *c = F16_MAX;
+                } else if v == 0.0 {
+                    // Normalise -0.0 so the texture holds a plain zero.
+                    *c = 0.0;
+                }
+            }
+            px[3] = 1.0;
+        }
+        counts
+    }
+
+    /// The texels as half floats, RGBA interleaved, row 0 first: the data
+    /// of an `Rgba16Float` texture of `width` x `height`. Values are expected
+    /// to be sanitised (as [`load`] does); anything above [`F16_MAX`] would
+    /// become +Inf.
+    pub fn to_rgba16f(&self) -> Vec<f16> {
+        self.pixels
+            .iter()
+            .flat_map(|px| px.iter().map(|&c| f16::from_f32(c)))
+            .collect()
+    }
+
+    /// The largest colour value (0 for an empty image).
+    pub fn max_value(&self) -> f32 {
+        self.pixels
+            .iter()
+            .flat_map(|px| px[..3].iter().copied())
+            .fold(0.0, f32::max)
+    }
+}
+
+/// A uniform map; same as [`EnvImage::constant`].
+pub fn constant(width: u32, height: u32, rgb: [f32; 3]) -> EnvImage {
+    EnvImage::constant(width, height, rgb)
+}
+
+/// Loads and sanitises a lat-long environment map. The format is chosen by
+/// extension (case-insensitive): `.exr` (any compression the `exr` crate
+/// reads; RGB(A) or luminance-only `Y`), `.hdr` (Radiance RGBE), `.png` and
+/// `.jpg`/`.jpeg`. PNG and JPEG are taken as sRGB-encoded (8 or 16 bits) and
+/// decoded to linear with the exact sRGB EOTF; grey images become RGB; alpha
+/// is dropped.
+pub fn load(path: &Path) -> Result<EnvLoad, EnvMapError> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !SUPPORTED_EXTENSIONS.contains(&extension.as_str()) {
+        return Err(EnvMapError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            extension,
+        });
+    }
+    let bytes = std::fs::read(path).map_err(|source| EnvMapError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut image = match extension.as_str() {
+        "exr" => decode_exr(path, &bytes)?,
+        "hdr" => decode_with_image(path, &bytes, image::ImageFormat::Hdr, "Radiance HDR")?,
+        "png" => decode_with_image(path, &bytes, image::ImageFormat::Png, "PNG")?,
+        _ => decode_with_image(path, &bytes, image::ImageFormat::Jpeg, "JPEG")?,
+    };
+    if image.width == 0 || image.height == 0 || image.pixels.is_empty() {
+        return Err(EnvMapError::Empty {
+            path: path.to_path_buf(),
+            width: image.width,
+            height: image.height,
+        });
+    }
+    let counts = image.sanitize();
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string());
+    Ok(EnvLoad {
+        image,
+        notes: counts.notes(&file_name),
+    })
+}
+
+fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvImage, EnvMapError> {
+    use exr::prelude::*;
+
+    let rgba = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |resolution, _| {
+                (
+                    resolution.width(),
+                    vec![[0.0f32, 0.0, 0.0, 1.0]; resolution.width() * resolution.height()],
+                )
+            },
+            |(w, px): &mut (usize, Vec<[f32; 4]>),
+             pos: Vec2<usize>,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = [r, g, b, 1.0];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes));
+
+    let layer_size = |size: Vec2<usize>| (size.width() as u32, size.height() as u32);
+    match rgba {
+        Ok(img) => {
+            let (width, height) = layer_size(img.layer_data.size);
+            Ok(EnvImage {
+                width,
+                height,
+                pixels: img.layer_data.channel_data.pixels.1,
+            })
+        }
+        Err(rgba_err) => {
+            // A luminance-only file has no R, G, B: read its Y channel.
+            let grey = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .specific_channels()
+                .required("Y")
+                .collect_pixels(
+                    |resolution, _| {
+                        (
+                            resolution.width(),
+                            vec![[0.0f32, 0.0, 0.0, 1.0]; resolution.width() * resolution.height()],
+                        )
+                    },
+                    |(w, px): &mut (usize, Vec<[f32; 4]>), pos: Vec2<usize>, (y,): (f32,)| {
+                        px[pos.y() * *w + pos.x()] = [y, y, y, 1.0];
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(Cursor::new(bytes));
+            match grey {
+                Ok(img) => {
+                    let (width, height) = layer_size(img.layer_data.size);
+                    Ok(EnvImage {
+                        width,
+                        height,
+                        pixels: img.layer_data.channel_data.pixels.1,
+                    })
+                }
+                Err(_) => Err(exr_error(path, bytes, rgba_err)),
+            }
+        }
+    }
+}
+
+/// Turns an `exr` failure into an [`EnvMapError`], pointing at DWA
+/// compression when the header declares it.
+fn exr_error(path: &Path, bytes: &[u8], err: exr::error::Error) -> EnvMapError {
+    use exr::compression::Compression;
+
+    let message = match &err {
+        exr::error::Error::Aborted => "reading was aborted".to_string(),
+        exr::error::Error::NotSupported(m) => format!("not supported: {m}"),
+        exr::error::Error::Invalid(m) => format!("invalid file: {m}"),
+        exr::error::Error::Io(e) => format!("I/O error: {e}"),
+    };
+    let dwa = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .ok()
+        .and_then(|meta| {
+            meta.headers.iter().find_map(|h| match h.compression {
+                Compression::DWAA(_) => Some("DWAA"),
+                Compression::DWAB(_) => Some("DWAB"),
+                _ => None,
+            })
+        })
+        .or_else(|| {
+            let m = message.to_ascii_lowercase();
+            m.contains("dwa").then_some("DWA")
+        });
+    match dwa {
+        Some(compression) => EnvMapError::ExrCompression {
+            path: path.to_path_buf(),
+            compression: compression.to_string(),
+            message,
+        },
+        None => EnvMapError::Decode {
+            path: path.to_path_buf(),
+            format: "OpenEXR",
+            message,
+        },
+    }
+}
+
+fn decode_with_image(
+    path: &Path,
+    bytes: &[u8],
+    format: image::ImageFormat,
+    format_name: &'static str,
+) -> Result<EnvImage, EnvMapError> {
+    use image::DynamicImage as D;
+
+    let decode_err = |message: String| EnvMapError::Decode {
+        path: path.to_path_buf(),
+        format: format_name,
+        message,
+    };
+    let mut reader = image::ImageReader::with_format(Cursor::new(bytes), format);
+    // The default 512 MiB cap rejects 16k maps; stay bounded but roomier.
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(4 << 30);
+    reader.limits(limits);
+    let decoded = reader.decode().map_err(|e| decode_err(e.to_string()))?;
+    let (width, height) = (decoded.width(), decoded.height());
+
+    let pixels: Vec<[f32; 4]> = match &decoded {
+        // Radiance HDR (and any other float source) is already linear.
+        D::ImageRgb32F(img) => img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+        D::ImageRgba32F(img) => img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+        D::ImageLuma8(img) => img
+            .pixels()
+            .map(|p| grey(SRGB8_TO_LINEAR[p[0] as usize]))
+            .collect(),
+        D::ImageLumaA8(img) => img
+            .pixels()
+            .map(|p| grey(SRGB8_TO_LINEAR[p[0] as usize]))
+            .collect(),
+        D::ImageRgb8(img) => img.pixels().map(|p| srgb8(p[0], p[1], p[2])).collect(),
+        D::ImageRgba8(img) => img.pixels().map(|p| srgb8(p[0], p[1], p[2])).collect(),
+        D::ImageLuma16(img) => img.pixels().map(|p| grey(srgb16(p[0]))).collect(),
+        D::ImageLumaA16(img) => img.pixels().map(|p| grey(srgb16(p[0]))).collect(),
+        D::ImageRgb16(img) => img
+            .pixels()
+            .map(|p| [srgb16(p[0]), srgb16(p[1]), srgb16(p[2]), 1.0])
+            .collect(),
+        D::ImageRgba16(img) => img
+            .pixels()
+            .map(|p| [srgb16(p[0]), srgb16(p[1]), srgb16(p[2]), 1.0])
+            .collect(),
+        other => {
+            // A layout this code does not know yet (DynamicImage is
+            // non-exhaustive): an integer image is sRGB, a float one linear.
+            let rgb = other.to_rgb32f();
+            let color = other.color();
+            let linear = color.bytes_per_pixel() / color.channel_count().max(1) >= 4;
+            rgb.pixels()
+                .map(|p| {
+                    if linear {
+                        [p[0], p[1], p[2], 1.0]
+                    } else {
+                        [
+                            srgb_to_linear(p[0]),
+                            srgb_to_linear(p[1]),
+                            srgb_to_linear(p[2]),
+                            1.0,
+                        ]
+                    }
+                })
+                .collect()
+        }
+    };
+    if pixels.len() != width as usize * height as usize {
+        return Err(decode_err(format!(
+            "decoder returned {} texels for {width}x{height}",
+            pixels.len()
+        )));
+    }
+    Ok(EnvImage {
+        width,
+        height,
+        pixels,
+    })
+}
+
+fn grey(v: f32) -> [f32; 4] {
+    [v, v, v, 1.0]
+}
+
+fn srgb8(r: u8, g: u8, b: u8) -> [f32; 4] {
+    [
+        SRGB8_TO_LINEAR[r as usize],
+        SRGB8_TO_LINEAR[g as usize],
+        SRGB8_TO_LINEAR[b as usize],
+        1.0,
+    ]
+}
+
+fn srgb16(v: u16) -> f32 {
+    srgb_to_linear(f32::from(v) / 65535.0)
+}
+
+/// The exact sRGB EOTF (IEC 61966-2-1): encoded value in [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    let c = f64::from(c);
+    let l = if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    };
+    l as f32
+}
+
+/// [`srgb_to_linear`] of `i / 255` for every 8-bit code.
+static SRGB8_TO_LINEAR: std::sync::LazyLock<[f32; 256]> =
+    std::sync::LazyLock::new(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)));
+
+/// The lab's lat-long mapping of a unit direction:
+/// `u = (atan2(d.x, d.z) + π) / (2π)`, `v = acos(-d.y) / π`.
+///
+/// `u` is 0.5 towards +z, 0.75 towards +x, 0.25 towards -x, and 0 or 1
+/// towards -z (the seam, where `u` wraps; texture sampling must repeat in u).
+/// `v` is 0 looking straight down and 1 straight up. `d.y` is clamped to
+/// [-1, 1] before the `acos` so a slightly non-unit vector cannot give NaN,
+/// and at the poles (`d.x == 0 && d.z == 0`, where the azimuth is undefined)
+/// `u` is 0.5. The result is finite for every finite `d`.
+///
+/// Note that `v` grows upwards while image rows grow downwards: use
+/// [`uv_to_texel_uv`] to address an [`EnvImage`] or its texture.
+pub fn direction_to_uv(d: Vec3) -> Vec2 {
+    use std::f32::consts::PI;
+    let u = if d.x == 0.0 && d.z == 0.0 {
+        0.5
+    } else {
+        (d.x.atan2(d.z) + PI) / (2.0 * PI)
+    };
+    let v = (-d.y.clamp(-1.0, 1.0)).acos() / PI;
+    Vec2::new(u, v)
+}
+
+/// From the lab's `(u, v)` ([`direction_to_uv`], v = 1 up) to texture
+/// coordinates of an [`EnvImage`] whose row 0 is the top of the picture (the
+/// sky): `(u, 1 - v)`. So straight up reads row 0, straight down the last
+/// row, the horizon the middle.
+pub fn uv_to_texel_uv(uv: Vec2) -> Vec2 {
+    Vec2::new(uv.x, 1.0 - uv.y)
+}
+
+/// Applies a map rotation of `degrees` about +y to a lookup direction: the
+/// direction is rotated about +y by **-degrees**, so the map itself appears
+/// turned by +degrees (right-handed, about +y: what was seen towards +z is
+/// seen towards +x after +90°). Increasing the rotation turns the map.
+pub fn rotate_y(d: Vec3, degrees: f32) -> Vec3 {
+    let (s, c) = (-degrees.to_radians()).sin_cos();
+    Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
+}
+
+/// The texel (column, row) of `image` nearest to direction `d`, with the
+/// given map rotation: the CPU twin of the shader's lookup, for tests.
+pub fn texel_for_direction(image: &EnvImage, d: Vec3, rotation_degrees: f32) -> (u32, u32) {
+    let t = uv_to_texel_uv(direction_to_uv(rotate_y(d, rotation_degrees)));
+    let x = ((t.x * image.width as f32).floor() as i64).rem_euclid(i64::from(image.width.max(1)));
+    let y = ((t.y * image.height as f32).floor() as i64).clamp(0, i64::from(image.height) - 1);
+    (x as u32, y.max(0) as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f32::consts::PI;
+
+    /// A fresh, empty directory for one test, removed on drop.
+    struct TempDir(PathBuf);
+
+    impl TempDir {
+        fn new(name: &str) -> TempDir {
+            let dir =
+                std::env::temp_dir().join(format!("marbre-envmap-{}-{name}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir_all(&dir).unwrap();
+            TempDir(dir)
+        }
+
+        fn path(&self, file: &str) -> PathBuf {
+            self.0.join(file)
+        }
+    }
+
+    impl Drop for TempDir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    /// A map shipped in `envmaps/`, else the shared copy; `None` if neither.
+    fn shipped_map(name: &str) -> Option<PathBuf> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        [
+            root.join("envmaps").join(name),
+            root.join("../shared/envmaps").join(name),
+        ]
+        .into_iter()
+        .find(|p| p.is_file())
+    }
+
+    fn assert_clean(image: &EnvImage) {
+        assert_eq!(image.pixels.len(), (image.width * image.height) as usize);
+        for px in &image.pixels {
+            for &c in &px[..3] {
+                assert!(c.is_finite() && c >= 0.0 && c <= F16_MAX, "bad value {c}");
+            }
+            assert_eq!(px[3], 1.0);
+        }
+    }
+
+    fn close(a: f32, b: f32, tol: f32) -> bool {
+        (a - b).abs() <= tol
+    }
+
+    /// Circular distance between two u values (u wraps at 1).
+    fn u_dist(a: f32, b: f32) -> f32 {
+        let d = (a - b).rem_euclid(1.0);
+        d.min(1.0 - d)
+    }
+
+    #[test]
+    fn sanitize_counts_each_kind() {
+        let mut img = EnvImage {
+            width: 3,
+            height: 1,
+            pixels: vec![
+                [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.5],
+                [-1.0, -0.0, 70000.0, 1.0],
+                [F16_MAX, 1.0, 1e30, f32::NAN],
+            ],
+        };
+        let counts = img.sanitize();
+        assert_eq!(
+            counts,
+            SanitizeCounts {
+                nan: 1,
+                infinite: 2,
+                negative: 1,
+                clamped: 2
+            }
+        );
+        assert_eq!(counts.total(), 6);
+        assert_clean(&img);
+        assert_eq!(img.pixels[1], [0.0, 0.0, F16_MAX, 1.0]);
+        assert!(img.pixels[1][1].is_sign_positive());
+        assert_eq!(img.pixels[2], [F16_MAX, 1.0, F16_MAX, 1.0]);
+        let notes = counts.notes("x.exr");
+        assert_eq!(
+            notes,
+            vec![
+                "x.exr: 1 NaN value set to 0",
+                "x.exr: 2 infinite values set to 0",
+                "x.exr: 1 negative value set to 0",
+                "x.exr: 2 values above 65504 (the half-float maximum) clamped to 65504",
+            ]
+        );
+        assert!(SanitizeCounts::default().notes("x.exr").is_empty());
+    }
+
+    #[test]
+    fn exr_with_bad_values_is_sanitised_and_reported() {
+        let dir = TempDir::new("bad-exr");
+        let path = dir.path("bad.exr");
+        // 4x2: row 0 holds the bad values, row 1 is clean.
+        let (w, h) = (4usize, 2usize);
+        let texel = move |x: usize, y: usize| -> (f32, f32, f32, f32) {
+            match (x, y) {
+                (0, 0) => (f32::NAN, f32::NAN, 1.0, 1.0),
+                (1, 0) => (f32::INFINITY, f32::NEG_INFINITY, 2.0, 1.0),
+                (2, 0) => (-0.25, -3894.0, -1e-6, 1.0),
+                (3, 0) => (1e6, 70000.0, 29856.0, 1.0),
+                _ => (x as f32, y as f32, 0.5, 0.25),
+            }
+        };
+        exr::prelude::write_rgba_file(&path, w, h, texel).unwrap();
+
+        let loaded = load(&path).unwrap();
+        let img = &loaded.image;
+        assert_eq!((img.width, img.height), (4, 2));
+        assert_clean(img);
+        assert_eq!(img.texel(0, 0), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(img.texel(1, 0), [0.0, 0.0, 2.0, 1.0]);
+        assert_eq!(img.texel(2, 0), [0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(img.texel(3, 0), [F16_MAX, F16_MAX, 29856.0, 1.0]);
+        // Row 1 of the file is row 1 of the image, alpha forced to 1.
+        assert_eq!(img.texel(3, 1), [3.0, 1.0, 0.5, 1.0]);
+        assert_eq!(
+            loaded.notes,
+            vec![
+                "bad.exr: 2 NaN values set to 0",
+                "bad.exr: 2 infinite values set to 0",
+                "bad.exr: 3 negative values set to 0",
+                "bad.exr: 2 values above 65504 (the half-float maximum) clamped to 65504",
+            ]
+        );
+    }
+
+    #[test]
+    fn clean_exr_has_no_notes_and_luminance_exr_becomes_grey() {
+        use exr::prelude::*;
+        let dir = TempDir::new("grey-exr");
+
+        let rgb = dir.path("clean.exr");
+        write_rgb_file(&rgb, 2, 2, |x, y| (x as f32, y as f32, 0.25f32)).unwrap();
+        let loaded = load(&rgb).unwrap();
+        assert!(loaded.notes.is_empty(), "{:?}", loaded.notes);
+        assert_eq!(loaded.image.texel(1, 0), [1.0, 0.0, 0.25, 1.0]);
+
+        let y_only = dir.path("grey.exr");
+        let channels = SpecificChannels::build()
+            .with_channel("Y")
+            .with_pixel_fn(|p: Vec2<usize>| (p.x() as f32 + 10.0 * p.y() as f32,));
+        Image::from_channels((3, 2), channels)
+            .write()
+            .to_file(&y_only)
+            .unwrap();
+        let img = load(&y_only).unwrap().image;
+        assert_eq!((img.width, img.height), (3, 2));
+        assert_eq!(img.texel(2, 1), [12.0, 12.0, 12.0, 1.0]);
+    }
+
+    #[test]
+    fn dwab_exr_decodes() {
+        use exr::prelude::*;
+        let dir = TempDir::new("dwab");
+        let path = dir.path("dwab.exr");
+        let (w, h) = (64usize, 32usize);
+        let value = |x: usize, y: usize| 0.5 + (x as f32 / w as f32) + 2.0 * (y as f32 / h as f32);
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named("main"),
+            Encoding {
+                compression: Compression::DWAB(None),
+                blocks: Blocks::ScanLines,
+                line_order: LineOrder::Increasing,
+            },
+            SpecificChannels::rgb(move |p: Vec2<usize>| {
+                let v = f16::from_f32(value(p.x(), p.y()));
+                (v, v, v)
+            }),
+        );
+        Image::from_layer(layer).write().to_file(&path).unwrap();
+        let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+        assert!(matches!(meta.headers[0].compression, Compression::DWAB(_)));
+
+        let img = load(&path).unwrap().image;
+        assert_eq!((img.width, img.height), (64, 32));
+        // Lossy, but close to the smooth ramp.
+        for (x, y) in [(0u32, 0u32), (63, 0), (0, 31), (40, 20)] {
+            let got = img.texel(x, y)[1];
+            let want = value(x as usize, y as usize);
+            assert!(close(got, want, 0.05 * want), "({x},{y}): {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn png_is_srgb_decoded_and_grey_expands() {
+        let dir = TempDir::new("png");
+        let rgb = dir.path("rgb.png");
+        let img = image::RgbImage::from_raw(2, 1, vec![0, 128, 255, 10, 200, 1]).unwrap();
+        img.save_with_format(&rgb, image::ImageFormat::Png).unwrap();
+        let loaded = load(&rgb).unwrap();
+        assert!(loaded.notes.is_empty());
+        let t = loaded.image.texel(0, 0);
+        assert_eq!(t[0], 0.0);
+        // ((128/255 + 0.055) / 1.055)^2.4
+        assert!(close(t[1], 0.215_860_5, 1e-6), "{}", t[1]);
+        assert_eq!(t[2], 1.0);
+        assert_eq!(t[3], 1.0);
+        // 10/255 is below the linear-segment threshold 0.04045: c / 12.92.
+        let t = loaded.image.texel(1, 0);
+        assert!(close(t[0], 10.0 / 255.0 / 12.92, 1e-7));
+        assert!(close(t[1], srgb_to_linear(200.0 / 255.0), 1e-7));
+
+        let grey = dir.path("grey.PNG");
+        let g = image::GrayImage::from_raw(1, 2, vec![255, 64]).unwrap();
+        g.save_with_format(&grey, image::ImageFormat::Png).unwrap();
+        let img = load(&grey).unwrap().image;
+        assert_eq!((img.width, img.height), (1, 2));
+        assert_eq!(img.texel(0, 0), [1.0, 1.0, 1.0, 1.0]);
+        let l = srgb_to_linear(64.0 / 255.0);
+        assert_eq!(img.texel(0, 1), [l, l, l, 1.0]);
+
+        let rgba16 = dir.path("rgba16.png");
+        let im =
+            image::ImageBuffer::<image::Rgba<u16>, _>::from_raw(1, 1, vec![65535u16, 0, 32768, 0])
+                .unwrap();
+        im.save_with_format(&rgba16, image::ImageFormat::Png)
+            .unwrap();
+        let t = load(&rgba16).unwrap().image.texel(0, 0);
+        assert_eq!(t[0], 1.0);
+        assert_eq!(t[1], 0.0);
+        assert!(close(t[2], srgb_to_linear(32768.0 / 65535.0), 1e-6));
+        assert_eq!(t[3], 1.0, "alpha is dropped");
+    }
+
+    #[test]
+    fn srgb_eotf_is_exact_at_known_points() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert_eq!(srgb_to_linear(1.0), 1.0);
+        assert!(close(srgb_to_linear(0.04045), 0.04045 / 12.92, 1e-9));
+        assert!(close(srgb_to_linear(0.5), 0.214_041_14, 1e-7));
+        for i in 0..256 {
+            assert_eq!(SRGB8_TO_LINEAR[i], srgb_to_linear(i as f32 / 255.0));
+        }
+    }
+
+    #[test]
+    fn hdr_and_jpeg_load() {
+        let dir = TempDir::new("hdr-jpg");
+        let hdr = dir.path("sun.hdr");
+        let img =
+            image::Rgb32FImage::from_raw(2, 1, vec![100000.0, 1.0, 0.5, 0.0, 2.0, 4.0]).unwrap();
+        image::DynamicImage::ImageRgb32F(img)
+            .save_with_format(&hdr, image::ImageFormat::Hdr)
+            .unwrap();
+        let loaded = load(&hdr).unwrap();
+        assert_clean(&loaded.image);
+        assert_eq!(loaded.image.texel(0, 0)[0], F16_MAX);
+        assert!(close(loaded.image.texel(1, 0)[2], 4.0, 0.05));
+        assert_eq!(
+            loaded.notes,
+            vec!["sun.hdr: 1 value above 65504 (the half-float maximum) clamped to 65504"]
+        );
+
+        let jpg = dir.path("grey.jpeg");
+        let g = image::GrayImage::from_pixel(8, 8, image::Luma([128]));
+        g.save_with_format(&jpg, image::ImageFormat::Jpeg).unwrap();
+        let img = load(&jpg).unwrap().image;
+        assert_eq!((img.width, img.height), (8, 8));
+        let t = img.texel(4, 4);
+        assert!(close(t[0], 0.2159, 0.01), "{t:?}");
+        assert_eq!(t[0], t[1]);
+        assert_eq!(t[1], t[2]);
+    }
+
+    #[test]
+    fn known_directions() {
+        let uv = direction_to_uv(Vec3::Z);
+        assert!(close(uv.x, 0.5, 1e-6) && close(uv.y, 0.5, 1e-6), "{uv}");
+        let uv = direction_to_uv(Vec3::X);
+        assert!(close(uv.x, 0.75, 1e-6) && close(uv.y, 0.5, 1e-6), "{uv}");
+        let uv = direction_to_uv(-Vec3::X);
+        assert!(close(uv.x, 0.25, 1e-6), "{uv}");
+        assert_eq!(direction_to_uv(-Vec3::Y).y, 0.0);
+        assert!(close(direction_to_uv(Vec3::Y).y, 1.0, 1e-6));
+        // 45° above the horizon towards +z.
+        let uv = direction_to_uv(Vec3::new(0.0, 1.0, 1.0).normalize());
+        assert!(close(uv.y, 0.75, 1e-6), "{uv}");
+    }
+
+    #[test]
+    fn poles_give_finite_uv() {
+        for d in [
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::new(0.0, 1.000_001, 0.0),
+            Vec3::new(0.0, -1.000_001, 0.0),
+            Vec3::new(-0.0, 1.0, -0.0),
+            Vec3::ZERO,
+        ] {
+            let uv = direction_to_uv(d);
+            assert!(uv.is_finite(), "{d} -> {uv}");
+            assert_eq!(uv.x, 0.5, "{d}");
+            assert!((0.0..=1.0).contains(&uv.y));
+        }
+        assert_eq!(direction_to_uv(Vec3::new(0.0, 1.000_001, 0.0)).y, 1.0);
+        assert_eq!(direction_to_uv(Vec3::new(0.0, -1.000_001, 0.0)).y, 0.0);
+        // Nearly at the pole, still finite and v near 1.
+        let uv = direction_to_uv(Vec3::new(1e-20, 1.0, 1e-20));
+        assert!(uv.is_finite() && close(uv.y, 1.0, 1e-6));
+    }
+
+    #[test]
+    fn seam_is_at_minus_z_and_u_is_continuous_mod_1() {
+        let uv = direction_to_uv(-Vec3::Z);
+        assert!(uv.x == 0.0 || uv.x == 1.0, "{uv}");
+        let e = 1e-3f32;
+        let left = direction_to_uv(Vec3::new(e.sin(), 0.0, -e.cos()));
+        let right = direction_to_uv(Vec3::new(-e.sin(), 0.0, -e.cos()));
+        assert!(left.x > 0.99 && right.x < 0.01, "{left} {right}");
+        assert!(u_dist(left.x, right.x) < 2.0 * e / (2.0 * PI) + 1e-6);
+        assert!(u_dist(left.x, uv.x) < 1e-3 && u_dist(right.x, uv.x) < 1e-3);
+        // All the way round the horizon, and on a tilted circle: steps of
+        // 1/720 turn move u by 1/720 modulo 1, never by a jump.
+        for y in [0.0f32, 0.6, -0.9] {
+            let r = (1.0 - y * y).sqrt();
+            let dir = |i: i32| {
+                let a = i as f32 * 2.0 * PI / 720.0;
+                Vec3::new(r * a.sin(), y, r * a.cos())
+            };
+            for i in 0..720 {
+                let a = direction_to_uv(dir(i)).x;
+                let b = direction_to_uv(dir(i + 1)).x;
+                assert!(
+                    close(u_dist(a, b), 1.0 / 720.0, 1e-4),
+                    "step {i} at y={y}: {a} -> {b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn texel_uv_flips_v_so_the_sky_is_row_0() {
+        assert_eq!(uv_to_texel_uv(Vec2::new(0.3, 1.0)), Vec2::new(0.3, 0.0));
+        assert_eq!(uv_to_texel_uv(Vec2::new(0.3, 0.0)), Vec2::new(0.3, 1.0));
+        let img = EnvImage::constant(8, 4, [1.0; 3]);
+        assert_eq!(texel_for_direction(&img, Vec3::Y, 0.0).1, 0);
+        assert_eq!(texel_for_direction(&img, -Vec3::Y, 0.0).1, 3);
+        assert_eq!(texel_for_direction(&img, Vec3::Z, 0.0), (4, 2));
+        assert_eq!(texel_for_direction(&img, Vec3::X, 0.0).0, 6);
+    }
+
+    #[test]
+    fn rotation_turns_the_map_about_plus_y() {
+        let near = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+        // The texel seen towards +z at rotation 0 is seen towards +x at 90°.
+        assert!(near(rotate_y(Vec3::X, 90.0), Vec3::Z));
+        assert!(near(rotate_y(Vec3::Z, 90.0), -Vec3::X));
+        assert!(near(rotate_y(Vec3::Y, 37.0), Vec3::Y));
+        let d = Vec3::new(0.3, -0.4, 0.5).normalize();
+        assert!(near(rotate_y(d, 0.0), d));
+        assert!(near(rotate_y(d, 360.0), d));
+        assert!(close(rotate_y(d, 123.0).length(), 1.0, 1e-6));
+        assert!(near(rotate_y(rotate_y(d, 40.0), -40.0), d));
+        // Increasing rotation lowers u at a fixed view direction by
+        // degrees / 360 (modulo 1).
+        let u0 = direction_to_uv(rotate_y(Vec3::Z, 0.0)).x;
+        let u90 = direction_to_uv(rotate_y(Vec3::Z, 90.0)).x;
+        assert!(close(u_dist(u0 - 0.25, u90), 0.0, 1e-6), "{u0} {u90}");
+        let img = EnvImage::constant(8, 4, [1.0; 3]);
+        assert_eq!(texel_for_direction(&img, Vec3::X, 90.0).0, 4);
+    }
+
+    #[test]
+    fn constant_and_rgba16f() {
+        let img = constant(3, 2, [0.25, 1.5, 65504.0]);
+        assert_eq!(img, EnvImage::constant(3, 2, [0.25, 1.5, 65504.0]));
+        assert_eq!(img.pixels.len(), 6);
+        let h = img.to_rgba16f();
+        assert_eq!(h.len(), 3 * 2 * 4);
+        assert_eq!(h[0], f16::from_f32(0.25));
+        assert_eq!(h[1], f16::from_f32(1.5));
+        assert_eq!(h[2], f16::MAX);
+        assert_eq!(h[3], f16::ONE);
+        assert!(h.iter().all(|v| v.is_finite()));
+        assert_eq!(img.max_value(), 65504.0);
+    }
+
+    #[test]
+    fn missing_file_error_names_it() {
+        let err = load(Path::new("/nonexistent/dir/nowhere-sky.exr")).unwrap_err();
+        assert!(matches!(err, EnvMapError::Io { .. }), "{err:?}");
+        let msg = err.to_string();
+        assert!(msg.contains("nowhere-sky.exr"), "{msg}");
+        assert!(msg.contains("cannot read"), "{msg}");
+        assert_eq!(err.path(), Path::new("/nonexistent/dir/nowhere-sky.exr"));
+    }
+
+    #[test]
+    fn unsupported_extension_error_lists_formats() {
+        let dir = TempDir::new("ext");
+        let path = dir.path("sky.tga");
+        std::fs::write(&path, b"not an env map").unwrap();
+        let err = load(&path).unwrap_err();
+        assert!(matches!(err, EnvMapError::UnsupportedExtension { .. }));
+        let msg = err.to_string();
+        for needle in ["sky.tga", ".tga", ".exr", ".hdr", ".png", ".jpg", ".jpeg"] {
+            assert!(msg.contains(needle), "{needle} not in {msg}");
+        }
+        let err = load(Path::new("noext")).unwrap_err();
+        assert!(err.to_string().contains("noext"));
+        assert!(err.to_string().contains("(no extension)"));
+    }
+
+    #[test]
+    fn corrupt_files_error_names_them() {
+        let dir = TempDir::new("corrupt");
+        let png = dir.path("broken.png");
+        std::fs::write(&png, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
+        let err = load(&png).unwrap_err();
+        assert!(
+            matches!(err, EnvMapError::Decode { format: "PNG", .. }),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains("broken.png"), "{err}");
+
+        let exr = dir.path("garbage.exr");
+        std::fs::write(&exr, b"garbage").unwrap();
+        let err = load(&exr).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                EnvMapError::Decode {
+                    format: "OpenEXR",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains("garbage.exr"), "{err}");
+    }
+
+    #[test]
+    fn truncated_exr_error_names_the_file() {
+        let Some(sky) = shipped_map("sky.exr") else {
+            eprintln!("sky.exr not found; skipping");
+            return;
+        };
+        let bytes = std::fs::read(&sky).unwrap();
+        let dir = TempDir::new("truncated");
+        let path = dir.path("half-sky.exr");
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        let err = load(&path).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("half-sky.exr"), "{msg}");
+        assert!(matches!(err, EnvMapError::Decode { .. }), "{err:?}");
+    }
+
+    #[test]
+    fn error_messages_for_empty_and_dwa() {
+        let e = EnvMapError::Empty {
+            path: "maps/empty.png".into(),
+            width: 0,
+            height: 4,
+        };
+        assert_eq!(
+            e.to_string(),
+            "environment map maps/empty.png: the image is empty (0x4)"
+        );
+        let e = EnvMapError::ExrCompression {
+            path: "maps/dwa.exr".into(),
+            compression: "DWAB".into(),
+            message: "not supported: x".into(),
+        };
+        let msg = e.to_string();
+        assert!(
+            msg.contains("maps/dwa.exr") && msg.contains("DWAB"),
+            "{msg}"
+        );
+        assert!(msg.contains("ZIP or PIZ"), "{msg}");
+    }
+
+    #[test]
+    fn esplanade_is_finite_non_negative_with_its_sun() {
+        let Some(path) = shipped_map("esplanade.exr") else {
+            eprintln!("esplanade.exr not found; skipping");
+            return;
+        };
+        let loaded = load(&path).unwrap();
+        eprintln!("esplanade notes: {:?}", loaded.notes);
+        assert_clean(&loaded.image);
+        assert_eq!((loaded.image.width, loaded.image.height), (512, 256));
+        let max = loaded.image.max_value();
+        assert!(max > 10000.0, "max {max}");
+        assert!(
+            loaded.notes.iter().any(|n| n.contains("negative")),
+            "{:?}",
+            loaded.notes
+        );
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .all(|n| n.starts_with("esplanade.exr: "))
+        );
+        let h = loaded.image.to_rgba16f();
+        assert!(h.iter().all(|v| v.is_finite() && v.to_f32() >= 0.0));
+    }
+
+    #[test]
+    fn shipped_maps_load() {
+        for name in [
+            "sky.exr",
+            "esplanade.exr",
+            "studio.exr",
+            "sunset.exr",
+            "forest.exr",
+        ] {
+            let Some(path) = shipped_map(name) else {
+                eprintln!("{name} not found; skipping");
+                continue;
+            };
+            let loaded = load(&path).unwrap();
+            assert_clean(&loaded.image);
+            eprintln!(
+                "{name}: {}x{}, max {}, notes {:?}",
+                loaded.image.width,
+                loaded.image.height,
+                loaded.image.max_value(),
+                loaded.notes
+            );
+        }
+    }
+}

@@ -1,0 +1,63 @@
+//! Adapter and device creation, headless or for a window.
+
+use anyhow::{Context as _, Result};
+
+/// A device and what the stats panel and the benchmarks report about it.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// Whether GPU timestamp queries are enabled (not every adapter has them).
+    pub timestamps: bool,
+}
+
+impl GpuContext {
+    /// A device with no surface, for offscreen renders, the noise harness and
+    /// tests. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select the adapter.
+    pub fn headless() -> Result<Self> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
+        Self::from_instance(instance, None)
+    }
+
+    /// A device able to present to `surface`.
+    pub fn for_surface(instance: wgpu::Instance, surface: &wgpu::Surface<'_>) -> Result<Self> {
+        Self::from_instance(instance, Some(surface))
+    }
+
+    fn from_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self> {
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            ..Default::default()
+        }))
+        .context("no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers)")?;
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("marbre"),
+            required_features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .context("the adapter refused to create a device")?;
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            timestamps,
+        })
+    }
+
+    /// "name (backend)", as shown in the stats panel and benchmark tables.
+    pub fn describe(&self) -> String {
+        let info = self.adapter.get_info();
+        format!("{} ({:?})", info.name, info.backend)
+    }
+}

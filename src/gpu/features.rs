@@ -1,0 +1,162 @@
+//! Which shader features a scene needs: the key of shader specialisation.
+
+use crate::noise::{HashKind, NoiseKind};
+use crate::scene::{EnvSource, Pattern, Scene};
+use std::collections::BTreeSet;
+
+/// One piece of shader code that can be compiled out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Feature {
+    Ground,
+    PointLight,
+    EnvMap,
+    EnvConstant,
+    PatternChecker,
+    PatternFbm,
+    PatternTurbulence,
+    PatternMarble,
+    NoiseGradient,
+    NoisePerlin,
+    HashPcg,
+    HashSin,
+}
+
+impl Feature {
+    pub const ALL: [Feature; 12] = [
+        Feature::Ground,
+        Feature::PointLight,
+        Feature::EnvMap,
+        Feature::EnvConstant,
+        Feature::PatternChecker,
+        Feature::PatternFbm,
+        Feature::PatternTurbulence,
+        Feature::PatternMarble,
+        Feature::NoiseGradient,
+        Feature::NoisePerlin,
+        Feature::HashPcg,
+        Feature::HashSin,
+    ];
+
+    /// The name used by `#if` in the WGSL sources.
+    pub fn define(self) -> &'static str {
+        match self {
+            Feature::Ground => "GROUND",
+            Feature::PointLight => "POINT_LIGHT",
+            Feature::EnvMap => "ENV_MAP",
+            Feature::EnvConstant => "ENV_CONSTANT",
+            Feature::PatternChecker => "PATTERN_CHECKER",
+            Feature::PatternFbm => "PATTERN_FBM",
+            Feature::PatternTurbulence => "PATTERN_TURBULENCE",
+            Feature::PatternMarble => "PATTERN_MARBLE",
+            Feature::NoiseGradient => "NOISE_GRADIENT",
+            Feature::NoisePerlin => "NOISE_PERLIN",
+            Feature::HashPcg => "HASH_PCG",
+            Feature::HashSin => "HASH_SIN",
+        }
+    }
+}
+
+/// The set of features a shader is built with. Two scenes with equal sets
+/// share a pipeline; an edit that changes the set triggers a rebuild.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
+pub struct FeatureSet(pub BTreeSet<Feature>);
+
+impl FeatureSet {
+    /// Everything: the "uber shader" that renders any scene.
+    pub fn all() -> Self {
+        Self(Feature::ALL.into_iter().collect())
+    }
+
+    pub fn contains(&self, f: Feature) -> bool {
+        self.0.contains(&f)
+    }
+
+    pub fn defines(&self) -> BTreeSet<&'static str> {
+        self.0.iter().map(|f| f.define()).collect()
+    }
+
+    /// The features `scene` uses, and no others.
+    pub fn for_scene(scene: &Scene) -> Self {
+        let mut set = BTreeSet::new();
+        if scene.ground.is_some() {
+            set.insert(Feature::Ground);
+        }
+        if scene.point_light.is_some() {
+            set.insert(Feature::PointLight);
+        }
+        match scene.environment.source {
+            EnvSource::None => {}
+            EnvSource::Constant { .. } => {
+                set.insert(Feature::EnvConstant);
+            }
+            EnvSource::LatLong { .. } => {
+                set.insert(Feature::EnvMap);
+            }
+        }
+        for pattern in scene.materials().flat_map(|m| m.patterns()) {
+            set.extend(pattern_features(pattern));
+        }
+        Self(set)
+    }
+
+    /// For the noise harness: exactly what evaluating `kind`/`hash` needs.
+    pub fn for_noise(kind: NoiseKind, hash: HashKind) -> Self {
+        Self(noise_features(kind, hash).into_iter().collect())
+    }
+}
+
+fn noise_features(kind: NoiseKind, hash: HashKind) -> Vec<Feature> {
+    match (kind, hash) {
+        (NoiseKind::Perlin, _) => vec![Feature::NoisePerlin],
+        (NoiseKind::Gradient, HashKind::Pcg) => vec![Feature::NoiseGradient, Feature::HashPcg],
+        (NoiseKind::Gradient, HashKind::Sin) => vec![Feature::NoiseGradient, Feature::HashSin],
+    }
+}
+
+fn pattern_features(p: &Pattern) -> Vec<Feature> {
+    let mut out = match p {
+        Pattern::Constant => vec![],
+        Pattern::Checker { .. } => vec![Feature::PatternChecker],
+        Pattern::Fbm { .. } => vec![Feature::PatternFbm],
+        Pattern::Turbulence { .. } => vec![Feature::PatternTurbulence],
+        Pattern::Marble { .. } => vec![Feature::PatternMarble],
+    };
+    if let Some(n) = p.noise() {
+        out.extend(noise_features(n.kind, n.hash));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::noise::NoiseSettings;
+    use crate::scene::{ColorTexture, Sphere};
+
+    #[test]
+    fn an_empty_scene_needs_nothing() {
+        assert!(FeatureSet::for_scene(&Scene::default()).0.is_empty());
+    }
+
+    #[test]
+    fn a_perlin_marble_needs_marble_and_perlin_only() {
+        let mut scene = Scene::default();
+        let mut sphere = Sphere::default();
+        sphere.material.diffuse = ColorTexture {
+            pattern: Pattern::Marble {
+                noise: NoiseSettings {
+                    kind: NoiseKind::Perlin,
+                    ..Default::default()
+                },
+                stripe_frequency: 3.0,
+            },
+            ..Default::default()
+        };
+        scene.spheres.push(sphere);
+        let set = FeatureSet::for_scene(&scene);
+        assert_eq!(
+            set.0,
+            [Feature::PatternMarble, Feature::NoisePerlin].into_iter().collect()
+        );
+    }
+}

@@ -1,0 +1,17 @@
+//! Everything that talks to wgpu: device creation, shader assembly and
+//! specialisation, the progressive renderer, and the noise compute harness.
+
+pub mod context;
+pub mod features;
+pub mod noise_harness;
+pub mod pipelines;
+pub mod preprocess;
+pub mod readback;
+pub mod renderer;
+pub mod scene_gpu;
+pub mod shader_source;
+pub mod testing;
+
+pub use context::GpuContext;
+pub use features::{Feature, FeatureSet};
+pub use renderer::{Renderer, Viewport};

@@ -1,0 +1,126 @@
+//! Shader modules and pipelines, with validation errors caught instead of
+//! panicking, so a bad shader never takes the app down.
+
+use super::features::FeatureSet;
+use super::shader_source::{Program, assemble};
+use anyhow::{Result, anyhow};
+
+/// Assembles and validates a program with naga, then creates the module. A
+/// naga error names the file and line, which the wgpu panic would not.
+pub fn shader_module(
+    device: &wgpu::Device,
+    program: Program,
+    features: &FeatureSet,
+) -> Result<wgpu::ShaderModule> {
+    let source = assemble(program, features)?;
+    validate(&source).map_err(|e| anyhow!("{program:?} shader: {e}"))?;
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(&format!("{program:?}")),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(anyhow!("{program:?} shader rejected by the device: {e}"));
+    }
+    Ok(module)
+}
+
+/// Parses and validates WGSL with naga, as the device will.
+pub fn validate(source: &str) -> Result<(), String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| e.emit_to_string(source))?;
+    Ok(())
+}
+
+/// Runs `create` inside a validation error scope.
+pub fn checked<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T) -> Result<T> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = create();
+    match pollster::block_on(scope.pop()) {
+        Some(e) => Err(anyhow!("{what}: {e}")),
+        None => Ok(value),
+    }
+}
+
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    fragment_entry: &str,
+    format: wgpu::TextureFormat,
+) -> Result<wgpu::RenderPipeline> {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    checked(device, label, || {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fragment_entry),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    })
+}
+
+/// A bind group layout entry visible to the fragment and compute stages.
+pub fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+pub fn uniform() -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+pub fn storage(read_only: bool) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+pub fn float_texture(filterable: bool) -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable },
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
+}
+
+/// Perlin's permutation doubled to 512 entries, as the shader indexes it.
+pub fn permutation_table() -> Vec<u32> {
+    let p = crate::noise::perlin::PERMUTATION;
+    (0..512).map(|i| u32::from(p[i & 255])).collect()
+}

@@ -1,0 +1,505 @@
+//! The progressive renderer: trace pass into a running-mean accumulation
+//! target, display pass onto any colour target. It owns every GPU resource
+//! derived from the scene and rebuilds only what an edit invalidates.
+
+use super::context::GpuContext;
+use super::features::FeatureSet;
+use super::pipelines::{
+    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, storage,
+    uniform,
+};
+use super::readback::read_texture;
+use super::scene_gpu::{self, FrameUniform};
+use super::shader_source::Program;
+use crate::envmap::EnvImage;
+use crate::scene::{Scene, ToneMap};
+use anyhow::Result;
+use bytemuck::{Pod, Zeroable};
+use std::collections::HashMap;
+use wgpu::util::DeviceExt;
+
+pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct DisplayUniform {
+    exposure_scale: f32,
+    tone_map: u32,
+    encode_srgb: u32,
+    _pad: u32,
+    origin: [f32; 2],
+    scale: [f32; 2],
+}
+
+/// Where the image goes in a target: a rectangle in target pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Viewport {
+    pub x: f32,
+    pub y: f32,
+    pub width: f32,
+    pub height: f32,
+}
+
+struct Accumulation {
+    /// Ping-pong pair: each frame reads one and writes the other.
+    views: [wgpu::TextureView; 2],
+    textures: [wgpu::Texture; 2],
+    /// Index of the texture holding the latest mean.
+    latest: usize,
+}
+
+pub struct Renderer {
+    scene: Scene,
+    features: FeatureSet,
+    trace_layout: wgpu::BindGroupLayout,
+    trace_pipeline: wgpu::RenderPipeline,
+    display_layout: wgpu::BindGroupLayout,
+    display_pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    display_module: wgpu::ShaderModule,
+    frame_buffer: wgpu::Buffer,
+    display_buffer: wgpu::Buffer,
+    sphere_buffer: wgpu::Buffer,
+    material_buffer: wgpu::Buffer,
+    perm_buffer: wgpu::Buffer,
+    env_view: wgpu::TextureView,
+    env_sampler: wgpu::Sampler,
+    accumulation: Accumulation,
+    size: (u32, u32),
+    render_scale: f32,
+    accumulated: u32,
+    frame_index: u32,
+}
+
+impl Renderer {
+    pub fn new(ctx: &GpuContext, scene: &Scene, env: Option<&EnvImage>, size: (u32, u32)) -> Result<Self> {
+        let device = &ctx.device;
+        let features = FeatureSet::for_scene(scene);
+        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("trace"),
+            entries: &[
+                entry(0, uniform()),
+                entry(1, storage(true)),
+                entry(2, storage(true)),
+                entry(3, float_texture(true)),
+                entry(4, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+                entry(5, float_texture(false)),
+                entry(6, storage(true)),
+            ],
+        });
+        let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("display"),
+            entries: &[entry(0, uniform()), entry(1, float_texture(false))],
+        });
+        let trace_pipeline = Self::build_trace_pipeline(ctx, &trace_layout, &features)?;
+        let display_module = shader_module(device, Program::Display, &FeatureSet::default())?;
+        let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: usage | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let frame_buffer = buffer(
+            "frame",
+            bytemuck::bytes_of(&scene_gpu::frame_uniform(scene, size, 0, 0)),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let display_buffer = buffer(
+            "display",
+            bytemuck::bytes_of(&DisplayUniform::zeroed()),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let sphere_buffer = buffer(
+            "spheres",
+            bytemuck::cast_slice(&scene_gpu::spheres(scene)),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let material_buffer = buffer(
+            "materials",
+            bytemuck::cast_slice(&scene_gpu::materials(scene)),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let perm_buffer = buffer(
+            "permutation",
+            bytemuck::cast_slice(&permutation_table()),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let env_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            // Repeat in u: bilinear filtering wraps across the u = 0/1 seam.
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let env_view = upload_env(ctx, env);
+        let accumulation = create_accumulation(device, size);
+        Ok(Self {
+            scene: scene.clone(),
+            features,
+            trace_layout,
+            trace_pipeline,
+            display_layout,
+            display_pipelines: HashMap::new(),
+            display_module,
+            frame_buffer,
+            display_buffer,
+            sphere_buffer,
+            material_buffer,
+            perm_buffer,
+            env_view,
+            env_sampler,
+            accumulation,
+            size,
+            render_scale: 1.0,
+            accumulated: 0,
+            frame_index: 0,
+        })
+    }
+
+    fn build_trace_pipeline(
+        ctx: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        features: &FeatureSet,
+    ) -> Result<wgpu::RenderPipeline> {
+        let module = shader_module(&ctx.device, Program::Trace, features)?;
+        fullscreen_pipeline(&ctx.device, "trace", &module, layout, "fs_trace", ACCUMULATION_FORMAT)
+    }
+
+    pub fn features(&self) -> &FeatureSet {
+        &self.features
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Samples per pixel averaged so far.
+    pub fn accumulated_samples(&self) -> u32 {
+        self.accumulated
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The size actually traced: the target size times the render scale.
+    pub fn render_size(&self) -> (u32, u32) {
+        let s = |v: u32| ((v as f32 * self.render_scale).ceil() as u32).clamp(1, v.max(1));
+        (s(self.size.0), s(self.size.1))
+    }
+
+    /// Applies an edited scene. Parameter edits only rewrite buffers; an edit
+    /// that changes the feature set rebuilds the trace pipeline. If that
+    /// build fails, the previous pipeline and scene stay and the error is
+    /// returned for display.
+    pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        let features = FeatureSet::for_scene(scene);
+        if features != self.features {
+            self.trace_pipeline = Self::build_trace_pipeline(ctx, &self.trace_layout, &features)?;
+            self.features = features;
+        }
+        let spheres = scene_gpu::spheres(scene);
+        let materials = scene_gpu::materials(scene);
+        write_or_grow(ctx, &mut self.sphere_buffer, bytemuck::cast_slice(&spheres), "spheres");
+        write_or_grow(ctx, &mut self.material_buffer, bytemuck::cast_slice(&materials), "materials");
+        // Display-only edits (exposure, tone map) keep the samples.
+        let mut traced_before = self.scene.clone();
+        let mut traced_now = scene.clone();
+        traced_before.render.exposure = 0.0;
+        traced_now.render.exposure = 0.0;
+        traced_before.render.tone_map = ToneMap::default();
+        traced_now.render.tone_map = ToneMap::default();
+        if traced_before != traced_now {
+            self.reset_accumulation();
+        }
+        self.scene = scene.clone();
+        Ok(())
+    }
+
+    /// Replaces the environment image (None: a black 1×1 placeholder).
+    pub fn set_environment(&mut self, ctx: &GpuContext, env: Option<&EnvImage>) {
+        self.env_view = upload_env(ctx, env);
+        self.reset_accumulation();
+    }
+
+    pub fn resize(&mut self, ctx: &GpuContext, size: (u32, u32)) {
+        let size = (size.0.max(1), size.1.max(1));
+        if size != self.size {
+            self.size = size;
+            self.accumulation = create_accumulation(&ctx.device, size);
+            self.reset_accumulation();
+        }
+    }
+
+    /// Traces at a fraction of the resolution (while the camera moves).
+    pub fn set_render_scale(&mut self, scale: f32) {
+        let scale = scale.clamp(0.1, 1.0);
+        if scale != self.render_scale {
+            self.render_scale = scale;
+            self.reset_accumulation();
+        }
+    }
+
+    pub fn reset_accumulation(&mut self) {
+        self.accumulated = 0;
+    }
+
+    /// Records one trace pass: `samples_per_frame` more samples per pixel.
+    pub fn trace(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        if !self.scene.render.accumulate {
+            self.accumulated = 0;
+        }
+        let render_size = self.render_size();
+        let uniform: FrameUniform =
+            scene_gpu::frame_uniform(&self.scene, render_size, self.frame_index, self.accumulated);
+        ctx.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
+        let read = self.accumulation.latest;
+        let write = 1 - read;
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("trace"),
+            layout: &self.trace_layout,
+            entries: &[
+                bind(0, self.frame_buffer.as_entire_binding()),
+                bind(1, self.sphere_buffer.as_entire_binding()),
+                bind(2, self.material_buffer.as_entire_binding()),
+                bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
+                bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
+                bind(5, wgpu::BindingResource::TextureView(&self.accumulation.views[read])),
+                bind(6, self.perm_buffer.as_entire_binding()),
+            ],
+        });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("trace"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &self.accumulation.views[write],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_viewport(0.0, 0.0, render_size.0 as f32, render_size.1 as f32, 0.0, 1.0);
+            pass.set_pipeline(&self.trace_pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        self.accumulation.latest = write;
+        self.accumulated = self.accumulated.saturating_add(self.scene.render.samples_per_frame.max(1));
+        self.frame_index = self.frame_index.wrapping_add(1);
+    }
+
+    /// Records the display pass: exposure and tone mapping of the latest mean
+    /// into `viewport` of `target`. The rest of the target is left as is.
+    pub fn display(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        viewport: Viewport,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) -> Result<()> {
+        if !self.display_pipelines.contains_key(&format) {
+            let p = fullscreen_pipeline(
+                &ctx.device,
+                "display",
+                &self.display_module,
+                &self.display_layout,
+                "fs_display",
+                format,
+            )?;
+            self.display_pipelines.insert(format, p);
+        }
+        let render_size = self.render_size();
+        let uniform = DisplayUniform {
+            exposure_scale: self.scene.render.exposure.exp2(),
+            tone_map: match self.scene.render.tone_map {
+                ToneMap::Aces => 0,
+                ToneMap::Reinhard => 1,
+                ToneMap::Clamp => 2,
+            },
+            encode_srgb: u32::from(!format.is_srgb()),
+            _pad: 0,
+            origin: [viewport.x, viewport.y],
+            scale: [
+                render_size.0 as f32 / viewport.width.max(1.0),
+                render_size.1 as f32 / viewport.height.max(1.0),
+            ],
+        };
+        ctx.queue.write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("display"),
+            layout: &self.display_layout,
+            entries: &[
+                bind(0, self.display_buffer.as_entire_binding()),
+                bind(
+                    1,
+                    wgpu::BindingResource::TextureView(&self.accumulation.views[self.accumulation.latest]),
+                ),
+            ],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("display"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_viewport(viewport.x, viewport.y, viewport.width, viewport.height, 0.0, 1.0);
+        pass.set_pipeline(&self.display_pipelines[&format]);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+
+    /// The linear radiance of the traced region (the running mean), RGBA f32.
+    pub fn read_radiance(&self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+        let bytes = read_texture(
+            &ctx.device,
+            &ctx.queue,
+            &self.accumulation.textures[self.accumulation.latest],
+            16,
+        )?;
+        let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let (rw, rh) = self.render_size();
+        let mut out = Vec::with_capacity((rw * rh) as usize);
+        for y in 0..rh {
+            let start = (y * self.size.0) as usize;
+            out.extend_from_slice(&all[start..start + rw as usize]);
+        }
+        Ok((rw, rh, out))
+    }
+
+    /// The displayed (tone-mapped, sRGB) image at the trace resolution.
+    pub fn read_display(&mut self, ctx: &GpuContext) -> Result<image::RgbaImage> {
+        let (w, h) = self.render_size();
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let target = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("display readback"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = target.create_view(&Default::default());
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let viewport = Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: w as f32,
+            height: h as f32,
+        };
+        self.display(ctx, &mut encoder, &view, format, viewport, wgpu::LoadOp::Clear(wgpu::Color::BLACK))?;
+        ctx.queue.submit([encoder.finish()]);
+        let bytes = read_texture(&ctx.device, &ctx.queue, &target, 4)?;
+        image::RgbaImage::from_raw(w, h, bytes)
+            .ok_or_else(|| anyhow::anyhow!("readback returned the wrong number of bytes"))
+    }
+}
+
+fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource }
+}
+
+fn write_or_grow(ctx: &GpuContext, buffer: &mut wgpu::Buffer, bytes: &[u8], label: &str) {
+    if bytes.len() as u64 > buffer.size() {
+        *buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        });
+    } else {
+        ctx.queue.write_buffer(buffer, 0, bytes);
+    }
+}
+
+fn create_accumulation(device: &wgpu::Device, size: (u32, u32)) -> Accumulation {
+    let make = |i: usize| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("accumulation {i}")),
+            size: wgpu::Extent3d {
+                width: size.0.max(1),
+                height: size.1.max(1),
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: ACCUMULATION_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    };
+    let textures = [make(0), make(1)];
+    let views = [
+        textures[0].create_view(&Default::default()),
+        textures[1].create_view(&Default::default()),
+    ];
+    Accumulation {
+        views,
+        textures,
+        latest: 0,
+    }
+}
+
+/// Uploads an environment map as Rgba16Float (the sanitised values fit).
+fn upload_env(ctx: &GpuContext, env: Option<&EnvImage>) -> wgpu::TextureView {
+    let black = EnvImage {
+        width: 1,
+        height: 1,
+        pixels: vec![[0.0, 0.0, 0.0, 1.0]],
+    };
+    let image = env.unwrap_or(&black);
+    let texture = ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("environment"),
+            size: wgpu::Extent3d {
+                width: image.width,
+                height: image.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&image.to_rgba16f()),
+    );
+    texture.create_view(&Default::default())
+}

@@ -1,0 +1,89 @@
+//! Assembles a WGSL module from the files in `shaders/` for one program and
+//! one [`FeatureSet`].
+
+use super::features::{Feature, FeatureSet};
+use super::preprocess::{PreprocessError, preprocess};
+
+/// The WGSL sources, embedded at build time so the binary is self-contained.
+const SOURCES: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("hash.wgsl", include_str!("../../shaders/hash.wgsl")),
+    ("noise_gradient.wgsl", include_str!("../../shaders/noise_gradient.wgsl")),
+    ("noise_perlin.wgsl", include_str!("../../shaders/noise_perlin.wgsl")),
+    ("fractal.wgsl", include_str!("../../shaders/fractal.wgsl")),
+    ("env_mapping.wgsl", include_str!("../../shaders/env_mapping.wgsl")),
+    ("scene.wgsl", include_str!("../../shaders/scene.wgsl")),
+    ("textures.wgsl", include_str!("../../shaders/textures.wgsl")),
+    ("intersect.wgsl", include_str!("../../shaders/intersect.wgsl")),
+    ("random.wgsl", include_str!("../../shaders/random.wgsl")),
+    ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("env_lookup.wgsl", include_str!("../../shaders/env_lookup.wgsl")),
+    ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
+    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+    ("noise_harness.wgsl", include_str!("../../shaders/noise_harness.wgsl")),
+];
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Program {
+    /// The path tracer's fragment pass.
+    Trace,
+    /// Exposure and tone mapping to the screen or an image.
+    Display,
+    /// The compute pass that evaluates noise at given points.
+    NoiseHarness,
+}
+
+impl Program {
+    pub const ALL: [Program; 3] = [Program::Trace, Program::Display, Program::NoiseHarness];
+
+    /// The files this program is made of, in order, for a feature set.
+    fn files(self, features: &FeatureSet) -> Vec<&'static str> {
+        let noise = |out: &mut Vec<&'static str>| {
+            out.push("hash.wgsl");
+            if features.contains(Feature::NoiseGradient) {
+                out.push("noise_gradient.wgsl");
+            }
+            if features.contains(Feature::NoisePerlin) {
+                out.push("noise_perlin.wgsl");
+            }
+            out.push("fractal.wgsl");
+            out.push("env_mapping.wgsl");
+        };
+        let mut out = vec!["common.wgsl"];
+        match self {
+            Program::Trace => {
+                noise(&mut out);
+                out.extend([
+                    "scene.wgsl",
+                    "textures.wgsl",
+                    "intersect.wgsl",
+                    "random.wgsl",
+                    "bsdf.wgsl",
+                    "env_lookup.wgsl",
+                    "trace.wgsl",
+                ]);
+            }
+            Program::Display => out = vec!["tonemap.wgsl"],
+            Program::NoiseHarness => {
+                noise(&mut out);
+                out.push("noise_harness.wgsl");
+            }
+        }
+        out
+    }
+}
+
+/// The WGSL text of `program` specialised for `features`.
+pub fn assemble(program: Program, features: &FeatureSet) -> Result<String, PreprocessError> {
+    let defines = features.defines();
+    let mut module = String::new();
+    for name in program.files(features) {
+        let (_, text) = SOURCES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .expect("every listed file is embedded");
+        module.push_str(&format!("// ---- {name}\n"));
+        module.push_str(&preprocess(text, name, &defines)?);
+    }
+    Ok(module)
+}

@@ -1,0 +1,668 @@
+//! The side panel: egui controls that edit a [`Scene`] in place.
+//!
+//! The panel knows nothing about the GPU. It mutates the scene and reports the
+//! buttons pressed; the app compares the scene before and after the frame to
+//! decide what to rebuild (shader features, buffers, accumulation). For that
+//! comparison to be meaningful, no widget here may write to the scene unless
+//! the user touched it, which is why sliders do not clamp existing values and
+//! colours are written back only on a change.
+
+use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
+use crate::scene::{
+    EnvSource, Environment, Material, OrbitCamera, Pattern, PointLight, RenderSettings, Scene,
+    ToneMap,
+};
+use egui::emath::Numeric;
+use egui::{
+    CollapsingHeader, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping, TextEdit,
+    Ui,
+};
+use glam::Vec3;
+use std::ops::RangeInclusive;
+use std::path::PathBuf;
+
+/// How many of the latest messages the Preset section shows.
+const SHOWN_MESSAGES: usize = 5;
+/// How many messages are kept, so that a long session does not grow the list
+/// without bound.
+const KEPT_MESSAGES: usize = 100;
+
+/// The environment sources in the order of the source dropdown.
+const ENV_SOURCE_NAMES: [&str; 3] = ["none", "constant", "lat-long map"];
+
+/// A line of feedback for the user (a preset loaded, a file that failed).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Message {
+    pub text: String,
+    pub is_error: bool,
+}
+
+/// What the panel keeps between frames that is not part of the scene.
+#[derive(Debug, Clone)]
+pub struct PanelState {
+    /// The preset path being typed; Load and Save as use it.
+    pub preset_path: String,
+    /// The environment map path being typed; its Load button uses it.
+    pub env_path: String,
+    /// Feedback for the user, newest last.
+    pub messages: Vec<Message>,
+    /// The constant environment radiance last seen, so that switching the
+    /// source away from constant and back does not lose the colour.
+    last_radiance: Vec3,
+}
+
+impl PanelState {
+    pub fn new(preset_path: String, env_path: String) -> Self {
+        Self {
+            preset_path,
+            env_path,
+            messages: Vec::new(),
+            last_radiance: Vec3::ONE,
+        }
+    }
+
+    /// Adds an informational message.
+    pub fn info(&mut self, text: impl Into<String>) {
+        self.push(text.into(), false);
+    }
+
+    /// Adds an error message, shown in red.
+    pub fn error(&mut self, text: impl Into<String>) {
+        self.push(text.into(), true);
+    }
+
+    fn push(&mut self, text: String, is_error: bool) {
+        self.messages.push(Message { text, is_error });
+        let excess = self.messages.len().saturating_sub(KEPT_MESSAGES);
+        self.messages.drain(..excess);
+    }
+}
+
+/// Figures the app measures and the panel only displays.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Stats {
+    pub fps: f32,
+    pub ms_per_frame: f32,
+    /// Whether `ms_per_frame` comes from GPU timestamps rather than the CPU
+    /// clock around the frame.
+    pub ms_is_gpu: bool,
+    /// Samples per pixel accumulated in the current image.
+    pub samples: u32,
+    pub adapter: String,
+    pub backend: String,
+    /// The shader features the current scene compiled in.
+    pub features: Vec<String>,
+    pub resolution: (u32, u32),
+}
+
+/// A button press the app must act on: these need files, the GPU or the
+/// window, which the panel has no access to.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PanelAction {
+    LoadPreset(PathBuf),
+    /// Save to the preset file the scene came from.
+    SavePreset,
+    SavePresetAs(PathBuf),
+    LoadEnvironment(PathBuf),
+    Screenshot,
+    ResetCamera,
+}
+
+/// Draws the whole panel contents into `ui` and returns the buttons pressed.
+pub fn draw(
+    ui: &mut Ui,
+    scene: &mut Scene,
+    state: &mut PanelState,
+    stats: &Stats,
+) -> Vec<PanelAction> {
+    let mut actions = Vec::new();
+    ScrollArea::vertical()
+        .id_salt("panel scroll")
+        .show(ui, |ui| {
+            section(ui, "Preset", true, |ui| preset_ui(ui, state, &mut actions));
+            section(ui, "Materials", true, |ui| materials_ui(ui, scene));
+            section(ui, "Environment", true, |ui| {
+                environment_ui(ui, &mut scene.environment, state, &mut actions);
+            });
+            section(ui, "Point light", false, |ui| {
+                point_light_ui(ui, &mut scene.point_light);
+            });
+            section(ui, "Camera", false, |ui| {
+                camera_ui(ui, &mut scene.camera, &mut actions);
+            });
+            section(ui, "Render", true, |ui| {
+                render_ui(ui, &mut scene.render, &mut actions);
+            });
+            section(ui, "Stats", true, |ui| stats_ui(ui, stats));
+        });
+    actions
+}
+
+/// A top-level collapsible section, its open state keyed by its title.
+fn section(ui: &mut Ui, title: &str, default_open: bool, body: impl FnOnce(&mut Ui)) {
+    CollapsingHeader::new(title)
+        .id_salt(("section", title))
+        .default_open(default_open)
+        .show(ui, body);
+}
+
+/// A slider that clamps what the user enters but leaves a value already out
+/// of range (from a hand-written preset) alone: egui's default clamps and
+/// rounds the value every frame, which would edit the scene by itself.
+fn slider<'a, Num: Numeric>(
+    value: &'a mut Num,
+    range: RangeInclusive<Num>,
+    text: &str,
+) -> Slider<'a> {
+    Slider::new(value, range)
+        .clamping(SliderClamping::Edits)
+        .text(text)
+}
+
+/// Edits a linear RGB colour, writing it back only when the user changed it:
+/// egui goes through HSVA, whose round trip is not bit-exact, and a spurious
+/// change would restart the accumulation every frame.
+fn color_button(ui: &mut Ui, color: &mut Vec3) -> Response {
+    let mut rgb = color.to_array();
+    let response = ui.color_edit_button_rgb(&mut rgb);
+    if response.changed() {
+        *color = Vec3::from_array(rgb);
+    }
+    response
+}
+
+/// A colour button followed by its label, on one line.
+fn labelled_color(ui: &mut Ui, color: &mut Vec3, label: &str) -> Response {
+    ui.horizontal(|ui| {
+        let response = color_button(ui, color);
+        ui.label(label);
+        response
+    })
+    .inner
+}
+
+/// Three drag values for a point or direction, each with the same tooltip.
+fn vec3_ui(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, hint: &str) {
+    ui.horizontal(|ui| {
+        for (prefix, c) in [("x ", &mut v.x), ("y ", &mut v.y), ("z ", &mut v.z)] {
+            ui.add(DragValue::new(c).speed(speed).prefix(prefix))
+                .on_hover_text(hint);
+        }
+        ui.label(label);
+    });
+}
+
+fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>) {
+    ui.add(
+        TextEdit::singleline(&mut state.preset_path)
+            .hint_text("presets/scene.ron")
+            .desired_width(f32::INFINITY),
+    )
+    .on_hover_text("Preset file (RON) used by Load and Save as");
+    let path = || PathBuf::from(state.preset_path.trim());
+    ui.horizontal(|ui| {
+        if ui
+            .button("Load")
+            .on_hover_text("Replace the scene with the preset at the path above")
+            .clicked()
+        {
+            actions.push(PanelAction::LoadPreset(path()));
+        }
+        if ui
+            .button("Save")
+            .on_hover_text("Overwrite the preset file the scene was loaded from or last saved to")
+            .clicked()
+        {
+            actions.push(PanelAction::SavePreset);
+        }
+        if ui
+            .button("Save as")
+            .on_hover_text("Write the scene to the path above")
+            .clicked()
+        {
+            actions.push(PanelAction::SavePresetAs(path()));
+        }
+    });
+    let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
+    for message in &state.messages[first..] {
+        if message.is_error {
+            ui.colored_label(ui.visuals().error_fg_color, &message.text);
+        } else {
+            ui.label(&message.text);
+        }
+    }
+}
+
+/// One collapsible block per sphere, then the ground. Only the first is open
+/// at start, so a scene with many spheres still fits on screen.
+fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
+    let ground_first = scene.spheres.is_empty();
+    for (i, sphere) in scene.spheres.iter_mut().enumerate() {
+        // Keyed by index: names come from the preset and need not be unique.
+        ui.push_id(("sphere", i), |ui| {
+            CollapsingHeader::new(format!("sphere “{}”", sphere.name))
+                .id_salt("object")
+                .default_open(i == 0)
+                .show(ui, |ui| material_ui(ui, &mut sphere.material));
+        });
+    }
+    if let Some(ground) = &mut scene.ground {
+        ui.push_id("ground", |ui| {
+            CollapsingHeader::new("ground")
+                .id_salt("object")
+                .default_open(ground_first)
+                .show(ui, |ui| material_ui(ui, &mut ground.material));
+        });
+    }
+}
+
+fn material_ui(ui: &mut Ui, m: &mut Material) {
+    texture_ui(
+        ui,
+        "diffuse",
+        "Lambert colour: the light scattered evenly in all directions",
+        &mut m.diffuse.pattern,
+        [&mut m.diffuse.a, &mut m.diffuse.b],
+        labelled_color,
+    );
+    texture_ui(
+        ui,
+        "specular",
+        "GGX reflectance at normal incidence (about 0.04 for plastics and stone)",
+        &mut m.specular.pattern,
+        [&mut m.specular.a, &mut m.specular.b],
+        labelled_color,
+    );
+    texture_ui(
+        ui,
+        "roughness",
+        "GGX roughness: 0 is polished, 1 is matte",
+        &mut m.roughness.pattern,
+        [&mut m.roughness.a, &mut m.roughness.b],
+        |ui, v, label| ui.add(slider(v, 0.0..=1.0, label)),
+    );
+    ui.add(slider(&mut m.mirror, 0.0..=1.0, "mirror"))
+        .on_hover_text("Fraction of the light reflected by a perfect mirror, on top of GGX");
+}
+
+/// A colour or scalar texture: its pattern, then its two values, edited by
+/// `value_ui` (a constant pattern only uses the first).
+fn texture_ui<T>(
+    ui: &mut Ui,
+    title: &str,
+    hint: &str,
+    pattern: &mut Pattern,
+    [a, b]: [&mut T; 2],
+    value_ui: impl Fn(&mut Ui, &mut T, &str) -> Response,
+) {
+    ui.push_id(title, |ui| {
+        let header = CollapsingHeader::new(title)
+            .id_salt("texture")
+            .default_open(true)
+            .show(ui, |ui| {
+                pattern_ui(ui, pattern);
+                if *pattern == Pattern::Constant {
+                    value_ui(ui, a, "value").on_hover_text("The value everywhere");
+                } else {
+                    value_ui(ui, a, "a (t = 0)").on_hover_text("The value where the pattern is 0");
+                    value_ui(ui, b, "b (t = 1)").on_hover_text("The value where the pattern is 1");
+                }
+            });
+        header.header_response.on_hover_text(hint);
+    });
+}
+
+/// The pattern dropdown and the chosen pattern's parameters.
+fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
+    let mut index = pattern.index();
+    ComboBox::new("pattern", "pattern")
+        .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])
+        .on_hover_text("What blends between the two values across the surface");
+    if index != pattern.index() {
+        // `with_index` carries the noise settings over, so tuning survives.
+        *pattern = pattern.with_index(index);
+    }
+    match pattern {
+        Pattern::Constant => {}
+        Pattern::Checker { size } => {
+            ui.add(slider(size, 0.01..=10.0, "cube size").logarithmic(true))
+                .on_hover_text("Side of the checkerboard's cubes, in scene units");
+        }
+        Pattern::Fbm { noise } | Pattern::Turbulence { noise } => noise_ui(ui, noise),
+        Pattern::Marble {
+            noise,
+            stripe_frequency,
+        } => {
+            noise_ui(ui, noise);
+            ui.add(slider(stripe_frequency, 0.0..=32.0, "stripe frequency"))
+                .on_hover_text(
+                    "t = 0.5 + 0.5·sin(x · stripe frequency + fBm): veins per 2π units along x",
+                );
+        }
+    }
+}
+
+/// The lattice noise, its hash and the fractal sum of a noise pattern.
+fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
+    ComboBox::new("noise kind", "noise")
+        .selected_text(noise.kind.label())
+        .show_ui(ui, |ui| {
+            for kind in NoiseKind::ALL {
+                ui.selectable_value(&mut noise.kind, kind, kind.label());
+            }
+        })
+        .response
+        .on_hover_text("The lattice noise the fractal sum is built from");
+    let hash_used = noise.kind != NoiseKind::Perlin;
+    ui.add_enabled_ui(hash_used, |ui| {
+        ComboBox::new("hash", "hash")
+            .selected_text(noise.hash.label())
+            .show_ui(ui, |ui| {
+                for hash in HashKind::ALL {
+                    ui.selectable_value(&mut noise.hash, hash, hash.label());
+                }
+            })
+            .response
+            .on_hover_text(
+                "How gradient noise picks a corner's gradient: pcg3d agrees bit for bit \
+                 on every GPU, fract(sin) is the lab's and drifts far from the origin",
+            )
+            .on_disabled_hover_text("Unused: Perlin noise hashes with its permutation table");
+    });
+    let f = &mut noise.fractal;
+    ui.add(slider(
+        &mut f.octaves,
+        0.0..=FractalParams::MAX_OCTAVES,
+        "octaves",
+    ))
+    .on_hover_text("Number of noise layers; a fractional part fades the last one in");
+    ui.add(slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true))
+        .on_hover_text("Frequency of the first octave, in cycles per scene unit");
+    ui.add(slider(&mut f.amplitude, 0.0..=2.0, "amplitude").clamping(SliderClamping::Never))
+        .on_hover_text("Amplitude of the first octave (type any value in the number)");
+    ui.add(slider(&mut f.persistence, 0.0..=1.5, "persistence"))
+        .on_hover_text("Amplitude ratio between successive octaves (0.5: each half as strong)");
+    ui.add(slider(&mut f.lacunarity, 1.0..=4.0, "lacunarity"))
+        .on_hover_text("Frequency ratio between successive octaves (2: each twice as fine)");
+}
+
+fn environment_ui(
+    ui: &mut Ui,
+    env: &mut Environment,
+    state: &mut PanelState,
+    actions: &mut Vec<PanelAction>,
+) {
+    env_source_ui(ui, &mut env.source, state);
+    match &mut env.source {
+        EnvSource::None => {}
+        EnvSource::Constant { radiance } => {
+            labelled_color(ui, radiance, "colour").on_hover_text(
+                "Radiance arriving from every direction, times the intensity below \
+                 (white at intensity 1 is the white-furnace test)",
+            );
+        }
+        EnvSource::LatLong { path } => {
+            ui.label(format!("current: {}", path.display()))
+                .on_hover_text("The map the scene uses; relative to the preset file");
+            ui.horizontal(|ui| {
+                ui.add(TextEdit::singleline(&mut state.env_path).hint_text("map.exr"))
+                    .on_hover_text("Latitude-longitude image: .exr, .hdr, .png or .jpg");
+                if ui
+                    .add_enabled(!state.env_path.trim().is_empty(), egui::Button::new("Load"))
+                    .on_hover_text("Load the map at this path")
+                    .clicked()
+                {
+                    actions.push(PanelAction::LoadEnvironment(PathBuf::from(
+                        state.env_path.trim(),
+                    )));
+                }
+            });
+            ui.weak("or drop a file on the window");
+        }
+    }
+    ui.add(slider(&mut env.rotation_degrees, -180.0..=180.0, "rotation").suffix("°"))
+        .on_hover_text("Turns the environment about the vertical axis");
+    ui.add(slider(&mut env.intensity, 0.01..=100.0, "intensity").logarithmic(true))
+        .on_hover_text("Multiplies the environment's radiance");
+    ui.checkbox(&mut env.background_visible, "background visible")
+        .on_hover_text("Show the environment behind the scene; it lights the scene either way");
+}
+
+/// The source dropdown. Switching to constant restores the last colour;
+/// switching to a map takes the path typed below, which the app then loads.
+fn env_source_ui(ui: &mut Ui, source: &mut EnvSource, state: &mut PanelState) {
+    let current = match source {
+        EnvSource::None => 0,
+        EnvSource::Constant { radiance } => {
+            state.last_radiance = *radiance;
+            1
+        }
+        EnvSource::LatLong { .. } => 2,
+    };
+    let mut index = current;
+    ComboBox::new("env source", "source")
+        .show_index(ui, &mut index, ENV_SOURCE_NAMES.len(), |i| {
+            ENV_SOURCE_NAMES[i]
+        })
+        .on_hover_text("What rays that leave the scene see");
+    if index != current {
+        *source = match index {
+            1 => EnvSource::Constant {
+                radiance: state.last_radiance,
+            },
+            2 => EnvSource::LatLong {
+                path: PathBuf::from(state.env_path.trim()),
+            },
+            _ => EnvSource::None,
+        };
+    }
+}
+
+fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {
+    let mut enabled = light.is_some();
+    if ui
+        .checkbox(&mut enabled, "enabled")
+        .on_hover_text("An isotropic point light, besides the environment")
+        .changed()
+    {
+        *light = enabled.then(PointLight::default);
+    }
+    if let Some(l) = light {
+        vec3_ui(
+            ui,
+            "position",
+            &mut l.position,
+            0.05,
+            "Where the light is, in scene units",
+        );
+        labelled_color(ui, &mut l.color, "colour").on_hover_text("The light's colour");
+        ui.add(
+            slider(&mut l.intensity, 0.0..=10_000.0, "intensity")
+                .logarithmic(true)
+                .smallest_positive(0.1),
+        )
+        .on_hover_text("Radiant intensity in watts per steradian (times the colour)");
+    }
+}
+
+fn camera_ui(ui: &mut Ui, camera: &mut OrbitCamera, actions: &mut Vec<PanelAction>) {
+    vec3_ui(
+        ui,
+        "target",
+        &mut camera.target,
+        0.05,
+        "The point the camera orbits and looks at",
+    );
+    ui.add(
+        slider(
+            &mut camera.distance,
+            OrbitCamera::MIN_DISTANCE..=1000.0,
+            "distance",
+        )
+        .logarithmic(true),
+    )
+    .on_hover_text("Distance from the target");
+    ui.add(slider(&mut camera.yaw_degrees, 0.0..=360.0, "yaw").suffix("°"))
+        .on_hover_text("Rotation about the vertical axis");
+    ui.add(slider(&mut camera.pitch_degrees, -89.0..=89.0, "pitch").suffix("°"))
+        .on_hover_text("Elevation above the horizontal");
+    ui.add(slider(&mut camera.fov_degrees, 10.0..=120.0, "field of view").suffix("°"))
+        .on_hover_text("Vertical field of view");
+    if ui
+        .button("Reset")
+        .on_hover_text("Back to the preset's camera")
+        .clicked()
+    {
+        actions.push(PanelAction::ResetCamera);
+    }
+    ui.weak("left drag: orbit · right/middle drag: pan · wheel: zoom");
+}
+
+fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
+    ui.add(slider(
+        &mut render.samples_per_frame,
+        1..=RenderSettings::MAX_SAMPLES_PER_FRAME,
+        "samples per frame",
+    ))
+    .on_hover_text("Jittered samples per pixel each frame: smoother, slower frames");
+    ui.checkbox(&mut render.accumulate, "accumulate")
+        .on_hover_text("Average frames while nothing changes; off shows each frame alone");
+    ui.add(slider(&mut render.exposure, -10.0..=10.0, "exposure").suffix(" stops"))
+        .on_hover_text("Scales the radiance by 2^exposure before tone mapping");
+    ComboBox::new("tone map", "tone map")
+        .selected_text(render.tone_map.label())
+        .show_ui(ui, |ui| {
+            for t in ToneMap::ALL {
+                ui.selectable_value(&mut render.tone_map, t, t.label());
+            }
+        })
+        .response
+        .on_hover_text("How radiance is mapped to displayable [0, 1]");
+    ui.add(slider(
+        &mut render.interactive_scale,
+        0.1..=1.0,
+        "resolution while dragging",
+    ))
+    .on_hover_text("Resolution scale while the camera moves, to keep the view responsive");
+    ui.add(slider(
+        &mut render.max_bounces,
+        1..=RenderSettings::MAX_BOUNCES,
+        "max bounces",
+    ))
+    .on_hover_text("1 is direct light only; each more adds one reflection");
+    if ui
+        .button("Screenshot (F12)")
+        .on_hover_text("Save the current image as a PNG")
+        .clicked()
+    {
+        actions.push(PanelAction::Screenshot);
+    }
+}
+
+fn stats_ui(ui: &mut Ui, stats: &Stats) {
+    ui.label(format!("{:.1} fps", stats.fps));
+    let clock = if stats.ms_is_gpu { "GPU" } else { "CPU" };
+    ui.label(format!("{:.2} ms/frame ({clock})", stats.ms_per_frame))
+        .on_hover_text("GPU: timestamp queries around the passes; CPU: wall time per frame");
+    ui.label(format!("{} samples accumulated", stats.samples));
+    let (w, h) = stats.resolution;
+    ui.label(format!("{w} × {h}"));
+    ui.label(format!("{} ({})", stats.adapter, stats.backend));
+    let features = if stats.features.is_empty() {
+        "none".to_owned()
+    } else {
+        stats.features.join(", ")
+    };
+    ui.label(format!("shader features: {features}"))
+        .on_hover_text("What the current scene compiled into the shader");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{ColorTexture, Ground, Sphere};
+
+    fn marble_scene() -> Scene {
+        let mut sphere = Sphere::default();
+        sphere.material.diffuse = ColorTexture {
+            pattern: Pattern::Marble {
+                noise: NoiseSettings::default(),
+                stripe_frequency: 4.0,
+            },
+            a: Vec3::new(0.9, 0.88, 0.85),
+            b: Vec3::new(0.2, 0.25, 0.3),
+        };
+        Scene {
+            spheres: vec![sphere],
+            ground: Some(Ground::default()),
+            ..Scene::default()
+        }
+    }
+
+    /// Runs one headless egui frame around `f`.
+    fn frame(mut f: impl FnMut(&mut Ui)) {
+        let ctx = egui::Context::default();
+        ctx.run_ui(egui::RawInput::default(), |ui| {
+            egui::CentralPanel::default().show(ui, &mut f);
+        })
+        .drop_without_applying_deltas();
+    }
+
+    #[test]
+    fn drawing_without_input_changes_nothing() {
+        let mut scene = marble_scene();
+        let before = scene.clone();
+        let mut state = PanelState::new("presets/a.ron".into(), String::new());
+        state.error("something failed");
+        let mut actions = Vec::new();
+        frame(|ui| actions = draw(ui, &mut scene, &mut state, &Stats::default()));
+        assert_eq!(scene, before);
+        assert!(actions.is_empty(), "{actions:?}");
+    }
+
+    /// `draw` leaves some sections closed; their bodies must not edit the
+    /// scene either, whatever the source, pattern or light.
+    #[test]
+    fn closed_sections_change_nothing_either() {
+        let mut scene = marble_scene();
+        scene.point_light = Some(PointLight::default());
+        scene.ground.as_mut().unwrap().material.roughness.pattern = Pattern::Checker { size: 0.5 };
+        let mut state = PanelState::new(String::new(), "sky.exr".into());
+        for source in [
+            EnvSource::Constant {
+                radiance: Vec3::new(0.3, 0.7, 2.0),
+            },
+            EnvSource::LatLong {
+                path: "sky.exr".into(),
+            },
+        ] {
+            scene.environment.source = source;
+            let before = scene.clone();
+            let mut actions = Vec::new();
+            frame(|ui| {
+                for s in &mut scene.spheres {
+                    material_ui(ui, &mut s.material);
+                }
+                material_ui(ui, &mut scene.ground.as_mut().unwrap().material);
+                environment_ui(ui, &mut scene.environment, &mut state, &mut actions);
+                point_light_ui(ui, &mut scene.point_light);
+                camera_ui(ui, &mut scene.camera, &mut actions);
+            });
+            assert_eq!(scene, before);
+            assert!(actions.is_empty(), "{actions:?}");
+        }
+    }
+
+    #[test]
+    fn messages_are_capped() {
+        let mut state = PanelState::new(String::new(), String::new());
+        for i in 0..KEPT_MESSAGES + 7 {
+            state.info(format!("{i}"));
+        }
+        assert_eq!(state.messages.len(), KEPT_MESSAGES);
+        assert_eq!(
+            state.messages.last().unwrap().text,
+            format!("{}", KEPT_MESSAGES + 6)
+        );
+    }
+}
