@@ -53,7 +53,9 @@ impl Viewer {
             .formats
             .iter()
             .copied()
-            .find(wgpu::TextureFormat::is_srgb)
+            // egui blends in gamma space, so it wants a non-sRGB target; the
+            // display pass then encodes sRGB itself.
+            .find(|f| !f.is_srgb())
             .unwrap_or(caps.formats[0]);
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -285,10 +287,25 @@ impl Viewer {
         self.ms_per_frame = 0.9 * self.ms_per_frame + 0.1 * dt * 1000.0;
         self.fps = 1000.0 / self.ms_per_frame.max(1e-3);
 
-        let before = self.scene.clone();
-        let (output, image_rect, dragging) = self.run_ui();
-        self.egui_state.handle_platform_output(&self.window, output.platform_output.clone());
-        if self.scene != before
+        let (mut output, image_rect, dragging) = self.run_ui();
+        self.egui_state.handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
+        // Texture uploads are applied now, whatever happens to this frame;
+        // frees wait until the frame that may still use them is submitted.
+        for (id, deltas) in output.textures_delta.set.drain() {
+            for delta in &deltas {
+                self.egui_renderer.update_texture(&self.ctx.device, &self.ctx.queue, id, delta);
+            }
+        }
+        let to_free: Vec<egui::TextureId> = output.textures_delta.free.drain().collect();
+        let result = self.draw_frame(output, image_rect, dragging);
+        for id in &to_free {
+            self.egui_renderer.free_texture(id);
+        }
+        result
+    }
+
+    fn draw_frame(&mut self, output: egui::FullOutput, image_rect: egui::Rect, dragging: bool) -> Result<bool> {
+        if self.scene != *self.renderer.scene()
             && let Err(e) = self.renderer.set_scene(&self.ctx, &self.scene)
         {
             // Keep what is on screen; show why the edit was refused.
@@ -327,11 +344,6 @@ impl Viewer {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         self.renderer.trace(&self.ctx, &mut encoder, None);
         let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                self.egui_renderer.update_texture(&self.ctx.device, &self.ctx.queue, *id, delta);
-            }
-        }
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: ppp,
@@ -375,9 +387,6 @@ impl Viewer {
             .queue
             .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
         self.ctx.queue.present(frame);
-        for id in &output.textures_delta.free {
-            self.egui_renderer.free_texture(id);
-        }
         self.frames += 1;
         if self.screenshot_requested {
             self.screenshot_requested = false;

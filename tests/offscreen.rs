@@ -1,0 +1,141 @@
+//! Offscreen renders with closed-form answers.
+
+use glam::Vec3;
+use marbre::commands::session::accumulate;
+use marbre::gpu::testing::gpu_or_skip;
+use marbre::gpu::{GpuContext, Renderer};
+use marbre::scene::{
+    ColorTexture, EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, ScalarTexture, Sphere,
+};
+
+fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
+    let mut r = Renderer::new(ctx, scene, None, size).unwrap();
+    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+    let (w, h, pixels) = r.read_radiance(ctx).unwrap();
+    assert_eq!((w, h), size);
+    for p in &pixels {
+        assert!(p.iter().all(|c| c.is_finite()), "non-finite pixel {p:?}");
+    }
+    pixels
+}
+
+fn lambert(albedo: f32) -> Material {
+    Material {
+        diffuse: ColorTexture::constant(Vec3::splat(albedo)),
+        specular: ColorTexture::constant(Vec3::ZERO),
+        roughness: ScalarTexture::constant(1.0),
+        mirror: 0.0,
+    }
+}
+
+/// A diffuse sphere of albedo ρ under a constant white environment of
+/// radiance 1 reflects exactly ρ: every cosine-sampled bounce escapes to the
+/// environment (a convex object never sees itself), so the estimator has
+/// zero variance and the tolerance can be tight.
+#[test]
+fn diffuse_sphere_in_a_white_environment_reads_its_albedo() {
+    let Some(ctx) = gpu_or_skip("diffuse_sphere_in_a_white_environment_reads_its_albedo") else {
+        return;
+    };
+    for (albedo, bounces) in [(0.6, 1), (0.6, 4), (1.0, 2)] {
+        let mut scene = Scene::default();
+        scene.spheres.push(Sphere {
+            name: "ball".into(),
+            center: Vec3::ZERO,
+            radius: 1.0,
+            material: lambert(albedo),
+        });
+        scene.environment.source = EnvSource::Constant {
+            radiance: Vec3::ONE,
+        };
+        scene.camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 4.0,
+            yaw_degrees: 30.0,
+            pitch_degrees: 10.0,
+            fov_degrees: 40.0,
+        };
+        scene.render.max_bounces = bounces;
+        let (w, h) = (64, 64);
+        let pixels = render(&ctx, &scene, (w, h), 8);
+        // The sphere subtends asin(1/4) = 14.5° of the 20° half-field: the
+        // central 30×30 pixels are all on it; the corners are all background.
+        for y in 17..47 {
+            for x in 17..47 {
+                let p = pixels[(y * w + x) as usize];
+                for c in &p[..3] {
+                    assert!((c - albedo).abs() < 2e-3, "albedo {albedo}, bounces {bounces}: {p:?} at {x},{y}");
+                }
+            }
+        }
+        let corner = pixels[0];
+        assert!((corner[0] - 1.0).abs() < 1e-4, "background {corner:?}");
+    }
+}
+
+/// A Lambert ground lit by a point light of intensity I at height h, seen
+/// straight down: the point below the light reflects L = ρ/π · I / h². No
+/// environment, so nothing else contributes.
+#[test]
+fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
+    let Some(ctx) = gpu_or_skip("point_light_on_a_diffuse_plane_matches_the_closed_form") else {
+        return;
+    };
+    let (albedo, intensity, height) = (0.5_f32, 20.0_f32, 2.0_f32);
+    let mut scene = Scene::default();
+    scene.ground = Some(Ground {
+        height: 0.0,
+        material: lambert(albedo),
+    });
+    scene.point_light = Some(PointLight {
+        position: Vec3::new(0.0, height, 0.0),
+        color: Vec3::ONE,
+        intensity,
+    });
+    scene.camera = OrbitCamera {
+        target: Vec3::ZERO,
+        distance: 5.0,
+        yaw_degrees: 0.0,
+        pitch_degrees: 89.0,
+        fov_degrees: 10.0,
+    };
+    let (w, h) = (33, 33);
+    let pixels = render(&ctx, &scene, (w, h), 16);
+    let expected = albedo / std::f32::consts::PI * intensity / (height * height);
+    let centre = pixels[(16 * w + 16) as usize];
+    // The pixel footprint is ~0.03 units wide; across it the irradiance falls
+    // by cos⁴, under 0.1% here.
+    for c in &centre[..3] {
+        assert!((c - expected).abs() < 2e-3 * expected, "centre {centre:?}, expected {expected}");
+    }
+    // Farther from the light it is darker: the inverse-square law is there.
+    let edge = pixels[(16 * w) as usize];
+    assert!(edge[0] < centre[0], "edge {edge:?} vs centre {centre:?}");
+}
+
+/// Turning accumulation off shows each frame alone; turning it on averages:
+/// with a noisy scene the accumulated image has a lower pixel variance.
+#[test]
+fn accumulation_reduces_noise() {
+    let Some(ctx) = gpu_or_skip("accumulation_reduces_noise") else {
+        return;
+    };
+    let mut scene = Scene::default();
+    scene.ground = Some(Ground {
+        height: 0.0,
+        material: lambert(0.8),
+    });
+    scene.spheres.push(Sphere::default());
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    let variance = |pixels: &[[f32; 4]]| {
+        // Variance of horizontal neighbour differences: noise, not image.
+        let d: Vec<f32> = pixels.windows(2).map(|p| p[1][0] - p[0][0]).collect();
+        let m = d.iter().sum::<f32>() / d.len() as f32;
+        d.iter().map(|x| (x - m) * (x - m)).sum::<f32>() / d.len() as f32
+    };
+    let one = render(&ctx, &scene, (48, 32), 1);
+    let many = render(&ctx, &scene, (48, 32), 32);
+    assert!(variance(&many) < 0.25 * variance(&one), "{} vs {}", variance(&many), variance(&one));
+}
