@@ -3,7 +3,7 @@
 use super::{ViewerOptions, camera_input, screenshots};
 use crate::commands::session::{load_scene, preset_or_default};
 use crate::envmap;
-use crate::gpu::{GpuContext, Renderer, Viewport, readback::read_texture};
+use crate::gpu::{GpuContext, Renderer, Viewport, pass_timer::PassTimer, readback::read_texture};
 use crate::panel::{self, PanelAction, PanelState, Stats};
 use crate::preset::{self, Preset};
 use crate::scene::{EnvSource, OrbitCamera, Scene};
@@ -24,6 +24,8 @@ pub struct Viewer {
     config: wgpu::SurfaceConfiguration,
     ctx: GpuContext,
     renderer: Renderer,
+    /// GPU time of the trace pass, where the adapter has timestamp queries.
+    timer: Option<PassTimer>,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
@@ -89,7 +91,9 @@ impl Viewer {
         for note in &loaded.notes {
             panel.info(note.clone());
         }
+        let timer = PassTimer::new(&ctx);
         Ok(Self {
+            timer,
             window,
             surface,
             config,
@@ -242,11 +246,12 @@ impl Viewer {
     }
 
     fn stats(&self) -> Stats {
+        let gpu_ms = self.timer.as_ref().and_then(PassTimer::last_ms);
         let info = self.ctx.adapter.get_info();
         Stats {
             fps: self.fps,
-            ms_per_frame: self.ms_per_frame,
-            ms_is_gpu: false,
+            ms_per_frame: gpu_ms.unwrap_or(self.ms_per_frame),
+            ms_is_gpu: gpu_ms.is_some(),
             samples: self.renderer.accumulated_samples(),
             adapter: info.name,
             backend: format!("{:?}", info.backend),
@@ -342,7 +347,11 @@ impl Viewer {
             None
         };
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        self.renderer.trace(&self.ctx, &mut encoder, None);
+        let writes = self.timer.as_mut().and_then(PassTimer::begin_frame);
+        self.renderer.trace(&self.ctx, &mut encoder, writes);
+        if let Some(t) = &self.timer {
+            t.resolve(&mut encoder);
+        }
         let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
@@ -386,6 +395,9 @@ impl Viewer {
         self.ctx
             .queue
             .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
+        if let Some(t) = &mut self.timer {
+            t.after_submit();
+        }
         self.ctx.queue.present(frame);
         self.frames += 1;
         if self.screenshot_requested {

@@ -4,6 +4,7 @@
 pub mod context;
 pub mod features;
 pub mod noise_harness;
+pub mod pass_timer;
 pub mod pipelines;
 pub mod preprocess;
 pub mod readback;
