@@ -151,8 +151,22 @@ pub fn save(preset: &Preset, path: &Path) -> Result<(), PresetError> {
     })
 }
 
+/// An absolute path with `.` and `..` resolved lexically, so relative paths
+/// written into presets stay short (`canonicalize` would need the file).
 fn absolute(p: &Path) -> PathBuf {
-    std::path::absolute(p).unwrap_or_else(|_| p.to_owned())
+    use std::path::Component;
+    let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -188,6 +202,16 @@ mod tests {
         let loaded = parse("(scene: (spheres: [(radius: 2.0)]))", Path::new("old.ron")).unwrap();
         assert_eq!(loaded.preset.scene.spheres[0].radius, 2.0);
         assert_eq!(loaded.preset.scene.spheres[0].name, "sphere");
+    }
+
+    #[test]
+    fn saved_env_paths_are_short_and_relative() {
+        let mut p = Preset::default();
+        p.scene.environment.source = EnvSource::LatLong {
+            path: PathBuf::from("/data/presets/../envmaps/sky.exr"),
+        };
+        let text = to_text(&p, Path::new("/data/other/x.ron")).unwrap();
+        assert!(text.contains("\"../envmaps/sky.exr\""), "{text}");
     }
 
     #[test]
