@@ -14,7 +14,12 @@ pub enum ImageFormat {
 
 impl ImageFormat {
     pub fn from_path(path: &Path) -> Result<Self> {
-        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
             Some("png") => Ok(Self::Png),
             Some("exr") => Ok(Self::Exr),
             _ => bail!("{}: the output must end in .png or .exr", path.display()),
@@ -24,7 +29,10 @@ impl ImageFormat {
 
 pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
     let mut bytes = Vec::new();
-    image.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)?;
+    image.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )?;
     write_atomic(path, &bytes)?;
     Ok(())
 }

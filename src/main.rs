@@ -8,7 +8,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "marbre", version, about = "Interactive ray tracer for procedural textures")]
+#[command(
+    name = "marbre",
+    version,
+    about = "Interactive ray tracer for procedural textures"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,

@@ -183,7 +183,8 @@ mod tests {
 
     #[test]
     fn a_bad_field_names_its_line_column_and_path() {
-        let text = "(\n  format_version: 1,\n  scene: (\n    camera: (distance: \"far\"),\n  ),\n)\n";
+        let text =
+            "(\n  format_version: 1,\n  scene: (\n    camera: (distance: \"far\"),\n  ),\n)\n";
         let err = parse(text, Path::new("bad.ron")).unwrap_err().to_string();
         assert!(err.starts_with("bad.ron:4:"), "{err}");
         assert!(err.contains("scene.camera.distance"), "{err}");
@@ -194,7 +195,10 @@ mod tests {
         let text = to_text(&Preset::default(), Path::new("x.ron")).unwrap();
         let cut = &text[..text.len() / 2];
         let err = parse(cut, Path::new("cut.ron")).unwrap_err();
-        assert!(matches!(err, PresetError::Syntax { line, .. } if line > 1), "{err}");
+        assert!(
+            matches!(err, PresetError::Syntax { line, .. } if line > 1),
+            "{err}"
+        );
     }
 
     #[test]

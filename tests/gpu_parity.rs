@@ -79,13 +79,18 @@ fn integer_hash_and_perlin_noise_match_the_cpu() {
             let gpu = evaluate_scalar(&ctx, &s, what, &pts).unwrap();
             assert_eq!(gpu.len(), N);
             let (err, at) = max_error(&gpu, &s, what, &pts);
-            assert!(err < 1e-4, "{kind:?}/{hash:?} {what:?}: error {err} at {at}");
+            assert!(
+                err < 1e-4,
+                "{kind:?}/{hash:?} {what:?}: error {err} at {at}"
+            );
         }
     }
 }
 
 /// GPU Perlin noise equals Perlin's f64 reference to 1e-4 for |p| ≤ 100.
 #[test]
+// Perlin's published point is x = 3.14, not π.
+#[allow(clippy::approx_constant)]
 fn gpu_perlin_matches_the_f64_reference() {
     let Some(ctx) = gpu_or_skip("gpu_perlin_matches_the_f64_reference") else {
         return;
@@ -96,10 +101,16 @@ fn gpu_perlin_matches_the_f64_reference() {
     let gpu = evaluate_scalar(&ctx, &s, Evaluate::Noise, &pts).unwrap();
     for (g, p) in gpu.iter().zip(&pts) {
         let r = noise::improved_noise(p.x as f64, p.y as f64, p.z as f64);
-        assert!((*g as f64 - r).abs() < 1e-4, "{p}: gpu {g} vs reference {r}");
+        assert!(
+            (*g as f64 - r).abs() < 1e-4,
+            "{p}: gpu {g} vs reference {r}"
+        );
     }
     let last = *gpu.last().unwrap() as f64;
-    assert!((last - 0.136_919_958_784).abs() < 1e-4, "noise(3.14, 42, 7) = {last}");
+    assert!(
+        (last - 0.136_919_958_784).abs() < 1e-4,
+        "noise(3.14, 42, 7) = {last}"
+    );
 }
 
 /// The lab's sin hash agrees only where `sin` is accurate. Its argument
@@ -139,7 +150,10 @@ fn env_mapping_matches_the_cpu() {
     let Some(ctx) = gpu_or_skip("env_mapping_matches_the_cpu") else {
         return;
     };
-    let mut dirs: Vec<Vec3> = points(N, 1.0).into_iter().map(|p| p.normalize_or(Vec3::Y)).collect();
+    let mut dirs: Vec<Vec3> = points(N, 1.0)
+        .into_iter()
+        .map(|p| p.normalize_or(Vec3::Y))
+        .collect();
     dirs.extend([
         Vec3::Y,
         Vec3::NEG_Y,
@@ -159,10 +173,19 @@ fn env_mapping_matches_the_cpu() {
         let du = du.min(1.0 - du);
         // WGSL's acos/atan2 are approximations (lavapipe measured 2.4e-5):
         // 1e-4 is a fortieth of a texel on a 256-row map.
-        assert!(du < 1e-4 && (g.y - c.y).abs() < 1e-4, "{d}: gpu {g} vs cpu {c}");
+        assert!(
+            du < 1e-4 && (g.y - c.y).abs() < 1e-4,
+            "{d}: gpu {g} vs cpu {c}"
+        );
     }
     let angle = 1.1_f32;
-    let rotated = evaluate(&ctx, &NoiseSettings::default(), Evaluate::RotateY { angle }, &dirs).unwrap();
+    let rotated = evaluate(
+        &ctx,
+        &NoiseSettings::default(),
+        Evaluate::RotateY { angle },
+        &dirs,
+    )
+    .unwrap();
     for (g, d) in rotated.iter().zip(&dirs) {
         let c = envmap::rotate_y(*d, angle.to_degrees());
         assert!((Vec3::new(g[0], g[1], g[2]) - c).length() < 1e-5, "{d}");

@@ -5,7 +5,8 @@ use marbre::commands::session::accumulate;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{
-    ColorTexture, EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, ScalarTexture, Sphere,
+    ColorTexture, EnvSource, Ground, Material, OrbitCamera, PointLight, ScalarTexture, Scene,
+    Sphere,
 };
 
 fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
@@ -64,7 +65,10 @@ fn diffuse_sphere_in_a_white_environment_reads_its_albedo() {
             for x in 17..47 {
                 let p = pixels[(y * w + x) as usize];
                 for c in &p[..3] {
-                    assert!((c - albedo).abs() < 2e-3, "albedo {albedo}, bounces {bounces}: {p:?} at {x},{y}");
+                    assert!(
+                        (c - albedo).abs() < 2e-3,
+                        "albedo {albedo}, bounces {bounces}: {p:?} at {x},{y}"
+                    );
                 }
             }
         }
@@ -82,11 +86,13 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
         return;
     };
     let (albedo, intensity, height) = (0.5_f32, 20.0_f32, 2.0_f32);
-    let mut scene = Scene::default();
-    scene.ground = Some(Ground {
-        height: 0.0,
-        material: lambert(albedo),
-    });
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: lambert(albedo),
+        }),
+        ..Scene::default()
+    };
     scene.point_light = Some(PointLight {
         position: Vec3::new(0.0, height, 0.0),
         color: Vec3::ONE,
@@ -106,7 +112,10 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
     // The pixel footprint is ~0.03 units wide; across it the irradiance falls
     // by cos⁴, under 0.1% here.
     for c in &centre[..3] {
-        assert!((c - expected).abs() < 2e-3 * expected, "centre {centre:?}, expected {expected}");
+        assert!(
+            (c - expected).abs() < 2e-3 * expected,
+            "centre {centre:?}, expected {expected}"
+        );
     }
     // Farther from the light it is darker: the inverse-square law is there.
     let edge = pixels[(16 * w) as usize];
@@ -120,11 +129,13 @@ fn accumulation_reduces_noise() {
     let Some(ctx) = gpu_or_skip("accumulation_reduces_noise") else {
         return;
     };
-    let mut scene = Scene::default();
-    scene.ground = Some(Ground {
-        height: 0.0,
-        material: lambert(0.8),
-    });
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: lambert(0.8),
+        }),
+        ..Scene::default()
+    };
     scene.spheres.push(Sphere::default());
     scene.environment.source = EnvSource::Constant {
         radiance: Vec3::ONE,
@@ -137,5 +148,10 @@ fn accumulation_reduces_noise() {
     };
     let one = render(&ctx, &scene, (48, 32), 1);
     let many = render(&ctx, &scene, (48, 32), 32);
-    assert!(variance(&many) < 0.25 * variance(&one), "{} vs {}", variance(&many), variance(&one));
+    assert!(
+        variance(&many) < 0.25 * variance(&one),
+        "{} vs {}",
+        variance(&many),
+        variance(&one)
+    );
 }

@@ -11,7 +11,10 @@ pub fn apply(ui: &egui::Ui, response: &egui::Response, camera: &mut OrbitCamera)
     let delta = response.drag_delta();
     let height = response.rect.height().max(1.0);
     if response.dragged_by(egui::PointerButton::Primary) {
-        camera.orbit(-delta.x * ORBIT_DEGREES_PER_POINT, delta.y * ORBIT_DEGREES_PER_POINT);
+        camera.orbit(
+            -delta.x * ORBIT_DEGREES_PER_POINT,
+            delta.y * ORBIT_DEGREES_PER_POINT,
+        );
     } else if response.dragged_by(egui::PointerButton::Secondary)
         || response.dragged_by(egui::PointerButton::Middle)
     {

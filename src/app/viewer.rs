@@ -45,9 +45,14 @@ impl Viewer {
     pub fn new(window: Arc<Window>, options: ViewerOptions) -> Result<Self> {
         let preset_path = preset_or_default(options.preset.as_deref());
         let loaded = load_scene(&preset_path, options.env.as_deref())?;
-        let description = preset::load(&preset_path).map(|l| l.preset.description).unwrap_or_default();
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
-        let surface = instance.create_surface(window.clone()).context("creating the window surface")?;
+        let description = preset::load(&preset_path)
+            .map(|l| l.preset.description)
+            .unwrap_or_default();
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
+        let surface = instance
+            .create_surface(window.clone())
+            .context("creating the window surface")?;
         let ctx = GpuContext::for_surface(instance, &surface)?;
         let size = window.inner_size();
         let caps = surface.get_capabilities(&ctx.adapter);
@@ -71,7 +76,12 @@ impl Viewer {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&ctx.device, &config);
-        let renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), (config.width, config.height))?;
+        let renderer = Renderer::new(
+            &ctx,
+            &loaded.scene,
+            loaded.env.as_ref(),
+            (config.width, config.height),
+        )?;
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
             egui_ctx.clone(),
@@ -120,7 +130,10 @@ impl Viewer {
 
     /// Handles one window event; `Ok(false)` asks the loop to exit.
     pub fn handle_event(&mut self, event: &WindowEvent) -> Result<bool> {
-        let consumed = self.egui_state.on_window_event(&self.window, event).consumed;
+        let consumed = self
+            .egui_state
+            .on_window_event(&self.window, event)
+            .consumed;
         match event {
             WindowEvent::CloseRequested => return Ok(false),
             WindowEvent::Resized(size) => {
@@ -148,7 +161,9 @@ impl Viewer {
     }
 
     fn load_dropped(&mut self, path: &Path) {
-        let is_preset = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+        let is_preset = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
         if is_preset {
             self.load_preset(path);
         } else {
@@ -163,7 +178,9 @@ impl Viewer {
                     self.panel.error(format!("{}: {e:#}", path.display()));
                     return;
                 }
-                self.description = preset::load(path).map(|l| l.preset.description).unwrap_or_default();
+                self.description = preset::load(path)
+                    .map(|l| l.preset.description)
+                    .unwrap_or_default();
                 self.panel.preset_path = path.display().to_string();
                 if let EnvSource::LatLong { path } = &self.scene.environment.source {
                     self.panel.env_path = path.display().to_string();
@@ -182,7 +199,9 @@ impl Viewer {
         match envmap::load(path) {
             Ok(l) => {
                 let mut scene = self.scene.clone();
-                scene.environment.source = EnvSource::LatLong { path: path.to_owned() };
+                scene.environment.source = EnvSource::LatLong {
+                    path: path.to_owned(),
+                };
                 if let Err(e) = self.apply_scene(scene, Some(&l.image)) {
                     self.panel.error(format!("{}: {e:#}", path.display()));
                     return;
@@ -221,10 +240,15 @@ impl Viewer {
     }
 
     fn take_screenshot(&mut self) {
-        match screenshots::save(&self.ctx, &mut self.renderer, Path::new(screenshots::FOLDER)) {
-            Ok([png, exr]) => self
-                .panel
-                .info(format!("saved {} and {}", png.display(), exr.display())),
+        match screenshots::save(
+            &self.ctx,
+            &mut self.renderer,
+            Path::new(screenshots::FOLDER),
+        ) {
+            Ok([png, exr]) => {
+                self.panel
+                    .info(format!("saved {} and {}", png.display(), exr.display()))
+            }
             Err(e) => self.panel.error(format!("screenshot failed: {e:#}")),
         }
     }
@@ -255,7 +279,13 @@ impl Viewer {
             samples: self.renderer.accumulated_samples(),
             adapter: info.name,
             backend: format!("{:?}", info.backend),
-            features: self.renderer.features().0.iter().map(|f| format!("{f:?}")).collect(),
+            features: self
+                .renderer
+                .features()
+                .0
+                .iter()
+                .map(|f| format!("{f:?}"))
+                .collect(),
             resolution: self.renderer.render_size(),
         }
     }
@@ -293,12 +323,14 @@ impl Viewer {
         self.fps = 1000.0 / self.ms_per_frame.max(1e-3);
 
         let (mut output, image_rect, dragging) = self.run_ui();
-        self.egui_state.handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
+        self.egui_state
+            .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
         // Texture uploads are applied now, whatever happens to this frame;
         // frees wait until the frame that may still use them is submitted.
         for (id, deltas) in output.textures_delta.set.drain() {
             for delta in &deltas {
-                self.egui_renderer.update_texture(&self.ctx.device, &self.ctx.queue, id, delta);
+                self.egui_renderer
+                    .update_texture(&self.ctx.device, &self.ctx.queue, id, delta);
             }
         }
         let to_free: Vec<egui::TextureId> = output.textures_delta.free.drain().collect();
@@ -309,7 +341,12 @@ impl Viewer {
         result
     }
 
-    fn draw_frame(&mut self, output: egui::FullOutput, image_rect: egui::Rect, dragging: bool) -> Result<bool> {
+    fn draw_frame(
+        &mut self,
+        output: egui::FullOutput,
+        image_rect: egui::Rect,
+        dragging: bool,
+    ) -> Result<bool> {
         if self.scene != *self.renderer.scene()
             && let Err(e) = self.renderer.set_scene(&self.ctx, &self.scene)
         {
@@ -327,12 +364,17 @@ impl Viewer {
             width: (image_rect.width() * ppp).round().max(1.0),
             height: (image_rect.height() * ppp).round().max(1.0),
         };
-        self.renderer.resize(&self.ctx, (viewport.width as u32, viewport.height as u32));
         self.renderer
-            .set_render_scale(if dragging { self.scene.render.interactive_scale } else { 1.0 });
+            .resize(&self.ctx, (viewport.width as u32, viewport.height as u32));
+        self.renderer.set_render_scale(if dragging {
+            self.scene.render.interactive_scale
+        } else {
+            1.0
+        });
 
         let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.ctx.device, &self.config);
                 return Ok(true);
@@ -340,7 +382,10 @@ impl Viewer {
             _ => return Ok(true),
         };
         let target = frame.texture.create_view(&Default::default());
-        let is_last = self.options.exit_after_frames.is_some_and(|n| self.frames + 1 >= n);
+        let is_last = self
+            .options
+            .exit_after_frames
+            .is_some_and(|n| self.frames + 1 >= n);
         let capture = if is_last && self.options.window_screenshot.is_some() {
             Some(self.capture_texture())
         } else {
@@ -370,11 +415,18 @@ impl Viewer {
             b: 0.02,
             a: 1.0,
         });
-        let views: Vec<&wgpu::TextureView> =
-            std::iter::once(&target).chain(capture.as_ref().map(|(_, v)| v)).collect();
+        let views: Vec<&wgpu::TextureView> = std::iter::once(&target)
+            .chain(capture.as_ref().map(|(_, v)| v))
+            .collect();
         for view in views {
-            self.renderer
-                .display(&self.ctx, &mut encoder, view, self.config.format, viewport, background)?;
+            self.renderer.display(
+                &self.ctx,
+                &mut encoder,
+                view,
+                self.config.format,
+                viewport,
+                background,
+            )?;
             let mut pass = encoder
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("egui"),
@@ -404,7 +456,8 @@ impl Viewer {
             self.screenshot_requested = false;
             self.take_screenshot();
         }
-        if let (Some((texture, _)), Some(path)) = (capture, self.options.window_screenshot.clone()) {
+        if let (Some((texture, _)), Some(path)) = (capture, self.options.window_screenshot.clone())
+        {
             self.save_window_capture(&texture, &path)?;
         }
         Ok(!is_last)

@@ -49,8 +49,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .collect();
     presets.sort();
     println!("adapter: {}", ctx.describe());
-    println!("frames per measurement: {}, 1 sample per pixel per frame", args.frames);
-    let header: Vec<String> = args.sizes.iter().map(|(w, h)| format!("{w}x{h} ms (fps)")).collect();
+    println!(
+        "frames per measurement: {}, 1 sample per pixel per frame",
+        args.frames
+    );
+    let header: Vec<String> = args
+        .sizes
+        .iter()
+        .map(|(w, h)| format!("{w}x{h} ms (fps)"))
+        .collect();
     println!("| preset | features | {} |", header.join(" | "));
     println!("|---|---|{}", "---|".repeat(args.sizes.len()));
     for path in presets {

@@ -96,7 +96,11 @@ pub fn parse_points(input: impl BufRead) -> Result<Vec<Vec3>> {
             .collect::<Result<_, _>>()
             .with_context(|| format!("line {}: `{t}` is not x,y,z", i + 1))?;
         let [x, y, z] = values[..] else {
-            bail!("line {}: expected 3 numbers x,y,z, found {}", i + 1, values.len());
+            bail!(
+                "line {}: expected 3 numbers x,y,z, found {}",
+                i + 1,
+                values.len()
+            );
         };
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
             bail!("line {}: coordinates must be finite", i + 1);

@@ -53,11 +53,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), args.size)?;
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})")
-            .expect("a valid template"),
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})",
+        )
+        .expect("a valid template"),
     );
     bar.set_message(ctx.describe());
-    accumulate(&ctx, &mut renderer, args.spp, |n| bar.set_position(u64::from(n)))?;
+    accumulate(&ctx, &mut renderer, args.spp, |n| {
+        bar.set_position(u64::from(n))
+    })?;
     bar.finish();
     match format {
         image_io::ImageFormat::Png => {

@@ -16,7 +16,8 @@ impl GpuContext {
     /// A device with no surface, for offscreen renders, the noise harness and
     /// tests. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select the adapter.
     pub fn headless() -> Result<Self> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
         Self::from_instance(instance, None)
     }
 
@@ -25,14 +26,19 @@ impl GpuContext {
         Self::from_instance(instance, Some(surface))
     }
 
-    fn from_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self> {
+    fn from_instance(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
             compatible_surface: surface,
             ..Default::default()
         }))
-        .context("no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers)")?;
+        .context(
+            "no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers)",
+        )?;
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features = if timestamps {
             wgpu::Features::TIMESTAMP_QUERY

@@ -156,7 +156,9 @@ mod tests {
         let set = FeatureSet::for_scene(&scene);
         assert_eq!(
             set.0,
-            [Feature::PatternMarble, Feature::NoisePerlin].into_iter().collect()
+            [Feature::PatternMarble, Feature::NoisePerlin]
+                .into_iter()
+                .collect()
         );
     }
 }

@@ -20,11 +20,15 @@ pub enum Evaluate {
     Noise,
     Fbm,
     Turbulence,
-    Marble { stripe_frequency: f32 },
+    Marble {
+        stripe_frequency: f32,
+    },
     /// The lat-long mapping of a direction.
     EnvUv,
     /// The environment rotation applied to a direction, in radians.
-    RotateY { angle: f32 },
+    RotateY {
+        angle: f32,
+    },
 }
 
 impl Evaluate {
@@ -119,8 +123,16 @@ pub fn evaluate(
         })
     };
     let inputs: Vec<[f32; 4]> = points.iter().map(|p| [p.x, p.y, p.z, 0.0]).collect();
-    let uniform_buffer = init("harness", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-    let input_buffer = init("points", bytemuck::cast_slice(&inputs), wgpu::BufferUsages::STORAGE);
+    let uniform_buffer = init(
+        "harness",
+        bytemuck::bytes_of(&params),
+        wgpu::BufferUsages::UNIFORM,
+    );
+    let input_buffer = init(
+        "points",
+        bytemuck::cast_slice(&inputs),
+        wgpu::BufferUsages::STORAGE,
+    );
     let perm_buffer = init(
         "permutation",
         bytemuck::cast_slice(&permutation_table()),
@@ -175,14 +187,24 @@ pub fn evaluate(
 }
 
 /// Scalar results (the x component).
-pub fn evaluate_scalar(ctx: &GpuContext, noise: &NoiseSettings, what: Evaluate, points: &[Vec3]) -> Result<Vec<f32>> {
-    Ok(evaluate(ctx, noise, what, points)?.iter().map(|r| r[0]).collect())
+pub fn evaluate_scalar(
+    ctx: &GpuContext,
+    noise: &NoiseSettings,
+    what: Evaluate,
+    points: &[Vec3],
+) -> Result<Vec<f32>> {
+    Ok(evaluate(ctx, noise, what, points)?
+        .iter()
+        .map(|r| r[0])
+        .collect())
 }
 
 /// The GPU's lat-long uv for each direction.
 pub fn env_uv(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<Vec2>> {
-    Ok(evaluate(ctx, &NoiseSettings::default(), Evaluate::EnvUv, directions)?
-        .iter()
-        .map(|r| Vec2::new(r[0], r[1]))
-        .collect())
+    Ok(
+        evaluate(ctx, &NoiseSettings::default(), Evaluate::EnvUv, directions)?
+            .iter()
+            .map(|r| Vec2::new(r[0], r[1]))
+            .collect(),
+    )
 }

@@ -3,8 +3,8 @@
 //! start while a readback is pending are simply not timed.
 
 use super::context::GpuContext;
-use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 const IDLE: u8 = 0;
 const IN_FLIGHT: u8 = 1;
@@ -65,11 +65,12 @@ impl PassTimer {
             self.state.store(IDLE, Ordering::Release);
         }
         self.timing_this_frame = self.state.load(Ordering::Acquire) == IDLE;
-        self.timing_this_frame.then_some(wgpu::RenderPassTimestampWrites {
-            query_set: &self.queries,
-            beginning_of_pass_write_index: Some(0),
-            end_of_pass_write_index: Some(1),
-        })
+        self.timing_this_frame
+            .then_some(wgpu::RenderPassTimestampWrites {
+                query_set: &self.queries,
+                beginning_of_pass_write_index: Some(0),
+                end_of_pass_write_index: Some(1),
+            })
     }
 
     /// Records the resolve and copy; call after the timed pass.

@@ -12,7 +12,8 @@ pub fn read_texture(
 ) -> Result<Vec<u8>> {
     let (w, h) = (texture.width(), texture.height());
     let row = w * bytes_per_texel;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: u64::from(padded) * u64::from(h),
@@ -52,7 +53,8 @@ pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| anyhow!("waiting for the GPU failed: {e}"))?;
-    rx.recv()?.map_err(|e| anyhow!("mapping a readback buffer failed: {e}"))?;
+    rx.recv()?
+        .map_err(|e| anyhow!("mapping a readback buffer failed: {e}"))?;
     let bytes = buffer
         .get_mapped_range(..)
         .map_err(|e| anyhow!("reading a mapped buffer failed: {e}"))?

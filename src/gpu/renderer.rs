@@ -5,8 +5,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::pipelines::{
-    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, storage,
-    uniform,
+    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, storage, uniform,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
@@ -71,7 +70,12 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    pub fn new(ctx: &GpuContext, scene: &Scene, env: Option<&EnvImage>, size: (u32, u32)) -> Result<Self> {
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &Scene,
+        env: Option<&EnvImage>,
+        size: (u32, u32),
+    ) -> Result<Self> {
         let device = &ctx.device;
         let features = FeatureSet::for_scene(scene);
         let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -81,7 +85,10 @@ impl Renderer {
                 entry(1, storage(true)),
                 entry(2, storage(true)),
                 entry(3, float_texture(true)),
-                entry(4, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+                entry(
+                    4,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
                 entry(5, float_texture(false)),
                 entry(6, storage(true)),
             ],
@@ -164,7 +171,14 @@ impl Renderer {
         features: &FeatureSet,
     ) -> Result<wgpu::RenderPipeline> {
         let module = shader_module(&ctx.device, Program::Trace, features)?;
-        fullscreen_pipeline(&ctx.device, "trace", &module, layout, "fs_trace", ACCUMULATION_FORMAT)
+        fullscreen_pipeline(
+            &ctx.device,
+            "trace",
+            &module,
+            layout,
+            "fs_trace",
+            ACCUMULATION_FORMAT,
+        )
     }
 
     pub fn features(&self) -> &FeatureSet {
@@ -202,8 +216,18 @@ impl Renderer {
         }
         let spheres = scene_gpu::spheres(scene);
         let materials = scene_gpu::materials(scene);
-        write_or_grow(ctx, &mut self.sphere_buffer, bytemuck::cast_slice(&spheres), "spheres");
-        write_or_grow(ctx, &mut self.material_buffer, bytemuck::cast_slice(&materials), "materials");
+        write_or_grow(
+            ctx,
+            &mut self.sphere_buffer,
+            bytemuck::cast_slice(&spheres),
+            "spheres",
+        );
+        write_or_grow(
+            ctx,
+            &mut self.material_buffer,
+            bytemuck::cast_slice(&materials),
+            "materials",
+        );
         // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
         let mut traced_now = scene.clone();
@@ -259,7 +283,8 @@ impl Renderer {
         let render_size = self.render_size();
         let uniform: FrameUniform =
             scene_gpu::frame_uniform(&self.scene, render_size, self.frame_index, self.accumulated);
-        ctx.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
+        ctx.queue
+            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
         let read = self.accumulation.latest;
         let write = 1 - read;
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -271,7 +296,10 @@ impl Renderer {
                 bind(2, self.material_buffer.as_entire_binding()),
                 bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
                 bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
-                bind(5, wgpu::BindingResource::TextureView(&self.accumulation.views[read])),
+                bind(
+                    5,
+                    wgpu::BindingResource::TextureView(&self.accumulation.views[read]),
+                ),
                 bind(6, self.perm_buffer.as_entire_binding()),
             ],
         });
@@ -292,13 +320,22 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_viewport(0.0, 0.0, render_size.0 as f32, render_size.1 as f32, 0.0, 1.0);
+            pass.set_viewport(
+                0.0,
+                0.0,
+                render_size.0 as f32,
+                render_size.1 as f32,
+                0.0,
+                1.0,
+            );
             pass.set_pipeline(&self.trace_pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
         self.accumulation.latest = write;
-        self.accumulated = self.accumulated.saturating_add(self.scene.render.samples_per_frame.max(1));
+        self.accumulated = self
+            .accumulated
+            .saturating_add(self.scene.render.samples_per_frame.max(1));
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
@@ -340,7 +377,8 @@ impl Renderer {
                 render_size.1 as f32 / viewport.height.max(1.0),
             ],
         };
-        ctx.queue.write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
+        ctx.queue
+            .write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display"),
             layout: &self.display_layout,
@@ -348,7 +386,9 @@ impl Renderer {
                 bind(0, self.display_buffer.as_entire_binding()),
                 bind(
                     1,
-                    wgpu::BindingResource::TextureView(&self.accumulation.views[self.accumulation.latest]),
+                    wgpu::BindingResource::TextureView(
+                        &self.accumulation.views[self.accumulation.latest],
+                    ),
                 ),
             ],
         });
@@ -368,7 +408,14 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_viewport(viewport.x, viewport.y, viewport.width, viewport.height, 0.0, 1.0);
+        pass.set_viewport(
+            viewport.x,
+            viewport.y,
+            viewport.width,
+            viewport.height,
+            0.0,
+            1.0,
+        );
         pass.set_pipeline(&self.display_pipelines[&format]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
@@ -419,7 +466,14 @@ impl Renderer {
             width: w as f32,
             height: h as f32,
         };
-        self.display(ctx, &mut encoder, &view, format, viewport, wgpu::LoadOp::Clear(wgpu::Color::BLACK))?;
+        self.display(
+            ctx,
+            &mut encoder,
+            &view,
+            format,
+            viewport,
+            wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        )?;
         ctx.queue.submit([encoder.finish()]);
         let bytes = read_texture(&ctx.device, &ctx.queue, &target, 4)?;
         image::RgbaImage::from_raw(w, h, bytes)
@@ -433,11 +487,13 @@ fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEnt
 
 fn write_or_grow(ctx: &GpuContext, buffer: &mut wgpu::Buffer, bytes: &[u8], label: &str) {
     if bytes.len() as u64 > buffer.size() {
-        *buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        });
+        *buffer = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            });
     } else {
         ctx.queue.write_buffer(buffer, 0, bytes);
     }

@@ -8,19 +8,37 @@ use super::preprocess::{PreprocessError, preprocess};
 const SOURCES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
     ("hash.wgsl", include_str!("../../shaders/hash.wgsl")),
-    ("noise_gradient.wgsl", include_str!("../../shaders/noise_gradient.wgsl")),
-    ("noise_perlin.wgsl", include_str!("../../shaders/noise_perlin.wgsl")),
+    (
+        "noise_gradient.wgsl",
+        include_str!("../../shaders/noise_gradient.wgsl"),
+    ),
+    (
+        "noise_perlin.wgsl",
+        include_str!("../../shaders/noise_perlin.wgsl"),
+    ),
     ("fractal.wgsl", include_str!("../../shaders/fractal.wgsl")),
-    ("env_mapping.wgsl", include_str!("../../shaders/env_mapping.wgsl")),
+    (
+        "env_mapping.wgsl",
+        include_str!("../../shaders/env_mapping.wgsl"),
+    ),
     ("scene.wgsl", include_str!("../../shaders/scene.wgsl")),
     ("textures.wgsl", include_str!("../../shaders/textures.wgsl")),
-    ("intersect.wgsl", include_str!("../../shaders/intersect.wgsl")),
+    (
+        "intersect.wgsl",
+        include_str!("../../shaders/intersect.wgsl"),
+    ),
     ("random.wgsl", include_str!("../../shaders/random.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
-    ("env_lookup.wgsl", include_str!("../../shaders/env_lookup.wgsl")),
+    (
+        "env_lookup.wgsl",
+        include_str!("../../shaders/env_lookup.wgsl"),
+    ),
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
-    ("noise_harness.wgsl", include_str!("../../shaders/noise_harness.wgsl")),
+    (
+        "noise_harness.wgsl",
+        include_str!("../../shaders/noise_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

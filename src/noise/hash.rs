@@ -104,6 +104,9 @@ mod tests {
         }
         // Mean of a uniform on [-1, 1] is 0, with standard error 0.577/sqrt(n).
         let mean = sum / n;
-        assert!(mean.abs().max_element() < 4.0 * 0.577 / f32::sqrt(n), "{mean}");
+        assert!(
+            mean.abs().max_element() < 4.0 * 0.577 / f32::sqrt(n),
+            "{mean}"
+        );
     }
 }

@@ -91,7 +91,10 @@ impl OrbitCamera {
             self.distance = d.distance;
         }
         if !(self.fov_degrees.is_finite() && (1.0..=170.0).contains(&self.fov_degrees)) {
-            notes.push(format!("camera: field of view {} clamped", self.fov_degrees));
+            notes.push(format!(
+                "camera: field of view {} clamped",
+                self.fov_degrees
+            ));
             self.fov_degrees = self.fov_degrees.clamp(1.0, 170.0);
             if !self.fov_degrees.is_finite() {
                 self.fov_degrees = d.fov_degrees;

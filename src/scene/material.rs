@@ -56,18 +56,18 @@ impl Pattern {
 
     pub fn noise(&self) -> Option<&NoiseSettings> {
         match self {
-            Pattern::Fbm { noise } | Pattern::Turbulence { noise } | Pattern::Marble { noise, .. } => {
-                Some(noise)
-            }
+            Pattern::Fbm { noise }
+            | Pattern::Turbulence { noise }
+            | Pattern::Marble { noise, .. } => Some(noise),
             Pattern::Constant | Pattern::Checker { .. } => None,
         }
     }
 
     pub fn noise_mut(&mut self) -> Option<&mut NoiseSettings> {
         match self {
-            Pattern::Fbm { noise } | Pattern::Turbulence { noise } | Pattern::Marble { noise, .. } => {
-                Some(noise)
-            }
+            Pattern::Fbm { noise }
+            | Pattern::Turbulence { noise }
+            | Pattern::Marble { noise, .. } => Some(noise),
             Pattern::Constant | Pattern::Checker { .. } => None,
         }
     }
@@ -96,13 +96,23 @@ impl Pattern {
 fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) {
     let d = FractalParams::default();
     let mut clamp = |name: &str, v: &mut f32, lo: f32, hi: f32, fallback: f32| {
-        let c = if v.is_finite() { v.clamp(lo, hi) } else { fallback };
+        let c = if v.is_finite() {
+            v.clamp(lo, hi)
+        } else {
+            fallback
+        };
         if c != *v {
             notes.push(format!("{what}: {name} {v} clamped to {c}"));
             *v = c;
         }
     };
-    clamp("octaves", &mut f.octaves, 0.0, FractalParams::MAX_OCTAVES, d.octaves);
+    clamp(
+        "octaves",
+        &mut f.octaves,
+        0.0,
+        FractalParams::MAX_OCTAVES,
+        d.octaves,
+    );
     clamp("frequency", &mut f.frequency, 0.0, 1e6, d.frequency);
     clamp("amplitude", &mut f.amplitude, -100.0, 100.0, d.amplitude);
     clamp("persistence", &mut f.persistence, 0.0, 1.5, d.persistence);
@@ -194,23 +204,41 @@ impl Material {
     }
 
     pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
-        self.diffuse.pattern.sanitize(&format!("{what} diffuse"), notes);
-        self.specular.pattern.sanitize(&format!("{what} specular"), notes);
-        self.roughness.pattern.sanitize(&format!("{what} roughness"), notes);
+        self.diffuse
+            .pattern
+            .sanitize(&format!("{what} diffuse"), notes);
+        self.specular
+            .pattern
+            .sanitize(&format!("{what} specular"), notes);
+        self.roughness
+            .pattern
+            .sanitize(&format!("{what} roughness"), notes);
         for (name, c) in [
             ("diffuse", &mut self.diffuse),
             ("specular", &mut self.specular),
         ] {
             for v in [&mut c.a, &mut c.b] {
-                let s = if v.is_finite() { v.clamp(Vec3::ZERO, Vec3::ONE) } else { Vec3::ZERO };
+                let s = if v.is_finite() {
+                    v.clamp(Vec3::ZERO, Vec3::ONE)
+                } else {
+                    Vec3::ZERO
+                };
                 if s != *v {
                     notes.push(format!("{what} {name}: colour {v} clamped to [0, 1]"));
                     *v = s;
                 }
             }
         }
-        for v in [&mut self.roughness.a, &mut self.roughness.b, &mut self.mirror] {
-            let s = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+        for v in [
+            &mut self.roughness.a,
+            &mut self.roughness.b,
+            &mut self.mirror,
+        ] {
+            let s = if v.is_finite() {
+                v.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             if s != *v {
                 notes.push(format!("{what}: {v} clamped to [0, 1]"));
                 *v = s;

@@ -107,7 +107,8 @@ impl Scene {
                 notes.push(format!("sphere `{}`: non-finite centre set to 0", s.name));
                 s.center = Vec3::ZERO;
             }
-            s.material.sanitize(&format!("sphere `{}`", s.name), &mut notes);
+            s.material
+                .sanitize(&format!("sphere `{}`", s.name), &mut notes);
         }
         if let Some(g) = &mut self.ground {
             if !g.height.is_finite() {

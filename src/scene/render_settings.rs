@@ -51,20 +51,33 @@ impl RenderSettings {
         let d = Self::default();
         let spp = self.samples_per_frame.clamp(1, Self::MAX_SAMPLES_PER_FRAME);
         if spp != self.samples_per_frame {
-            notes.push(format!("render: samples per frame {} clamped to {spp}", self.samples_per_frame));
+            notes.push(format!(
+                "render: samples per frame {} clamped to {spp}",
+                self.samples_per_frame
+            ));
             self.samples_per_frame = spp;
         }
         let b = self.max_bounces.clamp(1, Self::MAX_BOUNCES);
         if b != self.max_bounces {
-            notes.push(format!("render: max bounces {} clamped to {b}", self.max_bounces));
+            notes.push(format!(
+                "render: max bounces {} clamped to {b}",
+                self.max_bounces
+            ));
             self.max_bounces = b;
         }
         if !self.exposure.is_finite() || self.exposure.abs() > 20.0 {
             notes.push(format!("render: exposure {} clamped", self.exposure));
-            self.exposure = if self.exposure.is_finite() { self.exposure.clamp(-20.0, 20.0) } else { d.exposure };
+            self.exposure = if self.exposure.is_finite() {
+                self.exposure.clamp(-20.0, 20.0)
+            } else {
+                d.exposure
+            };
         }
         if !(self.interactive_scale.is_finite() && (0.1..=1.0).contains(&self.interactive_scale)) {
-            notes.push(format!("render: interactive scale {} reset", self.interactive_scale));
+            notes.push(format!(
+                "render: interactive scale {} reset",
+                self.interactive_scale
+            ));
             self.interactive_scale = d.interactive_scale;
         }
     }
