@@ -7,15 +7,17 @@
 
 fn environment(d: vec3f) -> vec3f {
 #if ENV_MAP
-    let uv = env_uv(rotate_y(d, frame.env_rotation));
-    // The image's first row is the top (v = 1 in the lab's convention).
-    let texel = textureSampleLevel(env_texture, env_sampler, vec2f(uv.x, 1.0 - uv.y), 0.0).rgb;
-    return texel * frame.env_intensity;
-#else
+    if frame.env_kind == 2u {
+        let uv = env_uv(rotate_y(d, frame.env_rotation));
+        // The image's first row is the top (v = 1 in the lab's convention).
+        let texel = textureSampleLevel(env_texture, env_sampler, vec2f(uv.x, 1.0 - uv.y), 0.0).rgb;
+        return texel * frame.env_intensity;
+    }
+#endif
 #if ENV_CONSTANT
-    return frame.env_constant * frame.env_intensity;
-#else
+    if frame.env_kind == 1u {
+        return frame.env_constant * frame.env_intensity;
+    }
+#endif
     return vec3f(0.0);
-#endif
-#endif
 }

@@ -63,7 +63,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
         hit.material = index;
     }
 #if GROUND
-    if d.y != 0.0 {
+    if frame.has_ground != 0u && d.y != 0.0 {
         let t = (frame.ground_height - o.y) / d.y;
         if t > 0.0 && t < hit.t {
             hit.t = t;
@@ -88,7 +88,7 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
         }
     }
 #if GROUND
-    if d.y != 0.0 {
+    if frame.has_ground != 0u && d.y != 0.0 {
         let t = (frame.ground_height - o.y) / d.y;
         if t > 0.0 && t < t_max {
             return true;

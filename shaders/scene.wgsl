@@ -21,7 +21,10 @@ struct Frame {
     samples_per_frame: u32,
     max_bounces: u32,
     render_size: vec2f,
-    _pad: vec2f,
+    // Runtime switches, so an uber shader (every feature compiled in) still
+    // renders exactly the scene: 0 none, 1 constant, 2 map.
+    env_kind: u32,
+    has_ground: u32,
 }
 
 struct Texture {

@@ -10,7 +10,18 @@ use marbre::scene::{
 };
 
 fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
+    render_with(ctx, scene, size, spp, None)
+}
+
+fn render_with(
+    ctx: &GpuContext,
+    scene: &Scene,
+    size: (u32, u32),
+    spp: u32,
+    features: Option<marbre::gpu::FeatureSet>,
+) -> Vec<[f32; 4]> {
     let mut r = Renderer::new(ctx, scene, None, size).unwrap();
+    r.set_feature_override(ctx, features).unwrap();
     accumulate(ctx, &mut r, spp, |_| {}).unwrap();
     let (w, h, pixels) = r.read_radiance(ctx).unwrap();
     assert_eq!((w, h), size);
@@ -38,7 +49,15 @@ fn diffuse_sphere_in_a_white_environment_reads_its_albedo() {
     let Some(ctx) = gpu_or_skip("diffuse_sphere_in_a_white_environment_reads_its_albedo") else {
         return;
     };
-    for (albedo, bounces) in [(0.6, 1), (0.6, 4), (1.0, 2)] {
+    // The uber shader compiles the ground, the light and the env map in: its
+    // runtime switches must keep them out of this scene.
+    let uber = Some(marbre::gpu::FeatureSet::all());
+    for (albedo, bounces, features) in [
+        (0.6, 1, None),
+        (0.6, 4, None),
+        (1.0, 2, None),
+        (0.6, 3, uber),
+    ] {
         let mut scene = Scene::default();
         scene.spheres.push(Sphere {
             name: "ball".into(),
@@ -58,7 +77,7 @@ fn diffuse_sphere_in_a_white_environment_reads_its_albedo() {
         };
         scene.render.max_bounces = bounces;
         let (w, h) = (64, 64);
-        let pixels = render(&ctx, &scene, (w, h), 8);
+        let pixels = render_with(&ctx, &scene, (w, h), 8, features.clone());
         // The sphere subtends asin(1/4) = 14.5° of the 20° half-field: the
         // central 30×30 pixels are all on it; the corners are all background.
         for y in 17..47 {
@@ -154,4 +173,35 @@ fn accumulation_reduces_noise() {
         variance(&many),
         variance(&one)
     );
+}
+
+/// The uber shader (every feature compiled in) and the specialised one
+/// render the same image: specialisation removes code, never behaviour.
+#[test]
+fn uber_and_specialised_shaders_agree() {
+    let Some(ctx) = gpu_or_skip("uber_and_specialised_shaders_agree") else {
+        return;
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let loaded =
+        marbre::commands::session::load_scene(&root.join("presets/default.ron"), None).unwrap();
+    let size = (48, 27);
+    let mut specialised = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
+    let mut uber = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
+    uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
+        .unwrap();
+    assert!(uber.features().0.len() > specialised.features().0.len());
+    for r in [&mut specialised, &mut uber] {
+        accumulate(&ctx, r, 4, |_| {}).unwrap();
+    }
+    let (_, _, a) = specialised.read_radiance(&ctx).unwrap();
+    let (_, _, b) = uber.read_radiance(&ctx).unwrap();
+    for (p, q) in a.iter().zip(&b) {
+        for c in 0..3 {
+            assert!(
+                (p[c] - q[c]).abs() <= 1e-3 * (1.0 + p[c].abs()),
+                "specialised {p:?} vs uber {q:?}"
+            );
+        }
+    }
 }

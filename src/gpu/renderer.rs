@@ -50,6 +50,9 @@ struct Accumulation {
 pub struct Renderer {
     scene: Scene,
     features: FeatureSet,
+    /// When set, the shader is built with these features whatever the scene
+    /// uses: `FeatureSet::all()` is the uber shader the benchmarks compare.
+    feature_override: Option<FeatureSet>,
     trace_layout: wgpu::BindGroupLayout,
     trace_pipeline: wgpu::RenderPipeline,
     display_layout: wgpu::BindGroupLayout,
@@ -145,6 +148,7 @@ impl Renderer {
         Ok(Self {
             scene: scene.clone(),
             features,
+            feature_override: None,
             trace_layout,
             trace_pipeline,
             display_layout,
@@ -209,7 +213,10 @@ impl Renderer {
     /// build fails, the previous pipeline and scene stay and the error is
     /// returned for display.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
-        let features = FeatureSet::for_scene(scene);
+        let features = self
+            .feature_override
+            .clone()
+            .unwrap_or_else(|| FeatureSet::for_scene(scene));
         if features != self.features {
             self.trace_pipeline = Self::build_trace_pipeline(ctx, &self.trace_layout, &features)?;
             self.features = features;
@@ -240,6 +247,18 @@ impl Renderer {
         }
         self.scene = scene.clone();
         Ok(())
+    }
+
+    /// Builds the shader with `features` instead of the scene's own set
+    /// (`None` goes back to specialising per scene).
+    pub fn set_feature_override(
+        &mut self,
+        ctx: &GpuContext,
+        features: Option<FeatureSet>,
+    ) -> Result<()> {
+        self.feature_override = features;
+        let scene = self.scene.clone();
+        self.set_scene(ctx, &scene)
     }
 
     /// Replaces the environment image (None: a black 1×1 placeholder).

@@ -26,7 +26,8 @@ pub struct FrameUniform {
     pub samples_per_frame: u32,
     pub max_bounces: u32,
     pub render_size: [f32; 2],
-    pub _pad: [f32; 2],
+    pub env_kind: u32,
+    pub has_ground: u32,
 }
 
 #[repr(C)]
@@ -156,7 +157,13 @@ pub fn frame_uniform(
 ) -> FrameUniform {
     let cam = scene.camera.frame();
     let (w, h) = (render_size.0.max(1) as f32, render_size.1.max(1) as f32);
-    let light = scene.point_light.clone().unwrap_or_default();
+    // No light: zero power, so an uber shader that compiles the light in adds nothing.
+    let (light_pos, light_power) = scene
+        .point_light
+        .as_ref()
+        .map_or(([0.0; 3], [0.0; 3]), |l| {
+            (l.position.to_array(), (l.color * l.intensity).to_array())
+        });
     let env = &scene.environment;
     let env_constant = match env.source {
         EnvSource::Constant { radiance } => radiance.to_array(),
@@ -171,9 +178,9 @@ pub fn frame_uniform(
         frame_index,
         cam_forward: cam.forward.to_array(),
         accumulated,
-        light_pos: light.position.to_array(),
+        light_pos,
         env_intensity: env.intensity,
-        light_power: (light.color * light.intensity).to_array(),
+        light_power,
         env_rotation: env.rotation_degrees.to_radians(),
         env_constant,
         background_visible: u32::from(env.background_visible),
@@ -182,7 +189,12 @@ pub fn frame_uniform(
         samples_per_frame: scene.render.samples_per_frame.max(1),
         max_bounces: scene.render.max_bounces.max(1),
         render_size: [w, h],
-        _pad: [0.0; 2],
+        env_kind: match env.source {
+            EnvSource::None => 0,
+            EnvSource::Constant { .. } => 1,
+            EnvSource::LatLong { .. } => 2,
+        },
+        has_ground: u32::from(scene.ground.is_some()),
     }
 }
 
