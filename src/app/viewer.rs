@@ -32,6 +32,8 @@ pub struct Viewer {
     scene: Scene,
     /// The preset's description, kept so that saving does not lose it.
     description: String,
+    /// The camera the preset was loaded with, for the panel's Reset.
+    preset_camera: OrbitCamera,
     panel: PanelState,
     options: ViewerOptions,
     frames: u64,
@@ -102,6 +104,7 @@ impl Viewer {
             panel.info(note.clone());
         }
         let timer = PassTimer::new(&ctx);
+        let preset_camera = loaded.scene.camera;
         Ok(Self {
             timer,
             window,
@@ -114,6 +117,7 @@ impl Viewer {
             egui_renderer,
             scene: loaded.scene,
             description,
+            preset_camera,
             panel,
             options,
             frames: 0,
@@ -178,6 +182,7 @@ impl Viewer {
                     self.panel.error(format!("{}: {e:#}", path.display()));
                     return;
                 }
+                self.preset_camera = self.scene.camera;
                 self.description = preset::load(path)
                     .map(|l| l.preset.description)
                     .unwrap_or_default();
@@ -264,7 +269,7 @@ impl Viewer {
                 PanelAction::SavePresetAs(p) => self.save_preset(&p),
                 PanelAction::LoadEnvironment(p) => self.load_environment(&p),
                 PanelAction::Screenshot => self.screenshot_requested = true,
-                PanelAction::ResetCamera => self.scene.camera = OrbitCamera::default(),
+                PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
             }
         }
     }
@@ -347,6 +352,14 @@ impl Viewer {
         image_rect: egui::Rect,
         dragging: bool,
     ) -> Result<bool> {
+        // A lat-long path chosen in the panel needs its image loaded first.
+        if let EnvSource::LatLong { path } = &self.scene.environment.source
+            && self.scene.environment.source != self.renderer.scene().environment.source
+        {
+            let path = path.clone();
+            self.scene.environment.source = self.renderer.scene().environment.source.clone();
+            self.load_environment(&path);
+        }
         if self.scene != *self.renderer.scene()
             && let Err(e) = self.renderer.set_scene(&self.ctx, &self.scene)
         {
