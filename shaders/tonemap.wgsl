@@ -14,12 +14,6 @@ struct Display {
 @group(0) @binding(0) var<uniform> display: Display;
 @group(0) @binding(1) var radiance: texture_2d<f32>;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
-    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 // Narkowicz's fit of the ACES filmic curve.
 fn aces(x: vec3f) -> vec3f {
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3f(0.0), vec3f(1.0));

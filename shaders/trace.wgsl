@@ -4,12 +4,6 @@
 
 @group(0) @binding(5) var previous: texture_2d<f32>;
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
-    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 fn camera_ray(pixel: vec2f) -> vec3f {
     let ndc = vec2f(pixel.x / frame.render_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.render_size.y * 2.0);
     let x = ndc.x * frame.tan_half_fov * frame.aspect;

@@ -7,6 +7,10 @@ use super::preprocess::{PreprocessError, preprocess};
 /// The WGSL sources, embedded at build time so the binary is self-contained.
 const SOURCES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    (
+        "fullscreen.wgsl",
+        include_str!("../../shaders/fullscreen.wgsl"),
+    ),
     ("hash.wgsl", include_str!("../../shaders/hash.wgsl")),
     (
         "noise_gradient.wgsl",
@@ -78,10 +82,11 @@ impl Program {
                     "random.wgsl",
                     "bsdf.wgsl",
                     "env_lookup.wgsl",
+                    "fullscreen.wgsl",
                     "trace.wgsl",
                 ]);
             }
-            Program::Display => out = vec!["tonemap.wgsl"],
+            Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
             Program::NoiseHarness => {
                 noise(&mut out);
                 out.push("noise_harness.wgsl");

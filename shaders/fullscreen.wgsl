@@ -1,0 +1,8 @@
+// One triangle that covers the viewport: the vertex stage of every pass
+// that shades each pixel once (trace, display).
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+}
