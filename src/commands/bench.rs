@@ -53,13 +53,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "frames per measurement: {}, 1 sample per pixel per frame",
         args.frames
     );
+    println!(
+        "specialised: the shader holds only what the preset uses; uber: every feature compiled in"
+    );
     let header: Vec<String> = args
         .sizes
         .iter()
-        .map(|(w, h)| format!("{w}x{h} ms (fps)"))
+        .map(|(w, h)| format!("{w}x{h} ms (fps) | {w}x{h} uber ms | uber / specialised"))
         .collect();
     println!("| preset | features | {} |", header.join(" | "));
-    println!("|---|---|{}", "---|".repeat(args.sizes.len()));
+    println!("|---|---|{}", "---|".repeat(3 * args.sizes.len()));
     for path in presets {
         let mut loaded = load_scene(&path, None)?;
         loaded.scene.render.samples_per_frame = 1;
