@@ -297,16 +297,16 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvImage, EnvMapError> {
         .all_attributes()
         .from_buffered(Cursor::new(bytes));
 
-    let layer_size = |size: Vec2<usize>| (size.width() as u32, size.height() as u32);
+    let to_image = |size: Vec2<usize>, pixels: Vec<[f32; 4]>| EnvImage {
+        width: size.width() as u32,
+        height: size.height() as u32,
+        pixels,
+    };
     match rgba {
-        Ok(img) => {
-            let (width, height) = layer_size(img.layer_data.size);
-            Ok(EnvImage {
-                width,
-                height,
-                pixels: img.layer_data.channel_data.pixels.1,
-            })
-        }
+        Ok(img) => Ok(to_image(
+            img.layer_data.size,
+            img.layer_data.channel_data.pixels.1,
+        )),
         Err(rgba_err) => {
             // A luminance-only file has no R, G, B: read its Y channel.
             let grey = read()
@@ -329,14 +329,10 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvImage, EnvMapError> {
                 .all_attributes()
                 .from_buffered(Cursor::new(bytes));
             match grey {
-                Ok(img) => {
-                    let (width, height) = layer_size(img.layer_data.size);
-                    Ok(EnvImage {
-                        width,
-                        height,
-                        pixels: img.layer_data.channel_data.pixels.1,
-                    })
-                }
+                Ok(img) => Ok(to_image(
+                    img.layer_data.size,
+                    img.layer_data.channel_data.pixels.1,
+                )),
                 Err(_) => Err(exr_error(path, bytes, rgba_err)),
             }
         }
