@@ -104,11 +104,12 @@ impl SanitizeCounts {
 #[derive(Debug, Error)]
 pub enum EnvMapError {
     /// The file is missing or unreadable.
-    #[error("environment map {}: cannot read the file: {source}", .path.display())]
+    #[error("environment map {}: cannot read the file: {cause}", .path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        /// Not a `#[source]`: the message already says it, and a chain
+        /// would print it twice.
+        cause: std::io::Error,
     },
     /// The extension is not one [`load`] understands.
     #[error(
@@ -246,9 +247,9 @@ pub fn load(path: &Path) -> Result<EnvLoad, EnvMapError> {
             extension,
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| EnvMapError::Io {
+    let bytes = std::fs::read(path).map_err(|cause| EnvMapError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     let mut image = match extension.as_str() {
         "exr" => decode_exr(path, &bytes)?,

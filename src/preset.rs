@@ -29,10 +29,12 @@ impl Default for Preset {
 
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
-    #[error("{path}: cannot read: {source}")]
+    #[error("{path}: cannot read: {cause}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        /// Not a `#[source]`: the message already says it, and a chain
+        /// would print it twice.
+        cause: std::io::Error,
     },
     #[error("{path}: not UTF-8 text (byte {offset}); a preset is a RON text file")]
     NotText { path: PathBuf, offset: usize },
@@ -49,10 +51,12 @@ pub enum PresetError {
         "{path}: format version {found} is newer than this build understands ({FORMAT_VERSION}); update marbre"
     )]
     FutureVersion { path: PathBuf, found: u32 },
-    #[error("{path}: cannot save: {source}")]
+    #[error("{path}: cannot save: {cause}")]
     Write {
         path: PathBuf,
-        source: std::io::Error,
+        /// Not a `#[source]`: the message already says it, and a chain
+        /// would print it twice.
+        cause: std::io::Error,
     },
     #[error("cannot serialise the scene: {0}")]
     Serialise(#[from] ron::Error),
@@ -114,9 +118,9 @@ fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> Pre
 
 /// Reads and parses a preset file.
 pub fn load(path: &Path) -> Result<Loaded, PresetError> {
-    let bytes = std::fs::read(path).map_err(|source| PresetError::Read {
+    let bytes = std::fs::read(path).map_err(|cause| PresetError::Read {
         path: path.to_owned(),
-        source,
+        cause,
     })?;
     let text = String::from_utf8(bytes).map_err(|e| PresetError::NotText {
         path: path.to_owned(),
@@ -145,9 +149,9 @@ pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
 /// Saves atomically: a crash mid-save never destroys the previous file.
 pub fn save(preset: &Preset, path: &Path) -> Result<(), PresetError> {
     let text = to_text(preset, path)?;
-    write_atomic(path, text.as_bytes()).map_err(|source| PresetError::Write {
+    write_atomic(path, text.as_bytes()).map_err(|cause| PresetError::Write {
         path: path.to_owned(),
-        source,
+        cause,
     })
 }
 
