@@ -10,13 +10,18 @@ struct SurfacePoint {
 }
 
 fn surface_at(hit: Hit) -> SurfacePoint {
-    let m = materials[hit.material];
+    let p = hit.texture_point;
+#if NOISE
+    let signals = material_signals(hit.material, p);
+#else
+    let signals = vec3f(0.0);
+#endif
     var s: SurfacePoint;
-    s.diffuse = eval_color(m.diffuse, hit.texture_point);
-    s.specular = eval_color(m.specular, hit.texture_point);
-    let r = clamp(eval_scalar(m.roughness, hit.texture_point), 0.0, 1.0);
+    s.diffuse = eval_color(materials[hit.material].diffuse, p, signals);
+    s.specular = eval_color(materials[hit.material].specular, p, signals);
+    let r = clamp(eval_scalar(materials[hit.material].roughness, p, signals), 0.0, 1.0);
     s.alpha = max(r * r, 1e-3);
-    s.mirror = m.mirror;
+    s.mirror = materials[hit.material].mirror;
     return s;
 }
 
@@ -31,18 +36,6 @@ fn smith_g1(n_v: f32, a: f32) -> f32 {
     return 2.0 * n_v / (n_v + sqrt(a2 + (1.0 - a2) * n_v * n_v));
 }
 
-// f(wo, wi)·cos θi for the non-mirror part.
-fn eval_bsdf_cos(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> vec3f {
-    let n_i = dot(n, wi);
-    let n_o = dot(n, wo);
-    if n_i <= 0.0 || n_o <= 0.0 {
-        return vec3f(0.0);
-    }
-    let h = normalize(wi + wo);
-    let spec = s.specular * ggx_d(max(dot(n, h), 0.0), s.alpha) * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
-    return s.diffuse * INV_PI * n_i + spec;
-}
-
 fn specular_probability(s: SurfacePoint) -> f32 {
     let d = luminance(s.diffuse);
     let g = luminance(s.specular);
@@ -52,16 +45,26 @@ fn specular_probability(s: SurfacePoint) -> f32 {
     return g / (d + g);
 }
 
-fn pdf_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> f32 {
+struct BsdfEval {
+    f_cos: vec3f,    // f(wo, wi)·cos θi for the non-mirror part
+    pdf: f32,        // the sampling pdf of wi (solid angle), lobe mixture
+}
+
+// The value and the sampling pdf together: they share the half vector and
+// D(h), and code is paid for whether used or not on SIMD (see trace.wgsl).
+fn eval_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> BsdfEval {
     let n_i = dot(n, wi);
-    if n_i <= 0.0 {
-        return 0.0;
+    let n_o = dot(n, wo);
+    if n_i <= 0.0 || n_o <= 0.0 {
+        return BsdfEval(vec3f(0.0), 0.0);
     }
     let h = normalize(wi + wo);
     let n_h = max(dot(n, h), 0.0);
-    let p_spec = ggx_d(n_h, s.alpha) * n_h / (4.0 * max(dot(wo, h), 1e-8));
+    let d = ggx_d(n_h, s.alpha);
+    let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
     let ps = specular_probability(s);
-    return (1.0 - ps) * n_i * INV_PI + ps * p_spec;
+    let pdf = (1.0 - ps) * n_i * INV_PI + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
+    return BsdfEval(s.diffuse * INV_PI * n_i + spec, pdf);
 }
 
 // An orthonormal basis around n (Duff et al. 2017), free of singularities.
@@ -80,39 +83,24 @@ struct BsdfSample {
     valid: bool,
 }
 
+// One code path for both lobes, chosen by selects: the lobes differ only in
+// how cos θ is drawn and whether the direction is a half vector.
 fn sample_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f) -> BsdfSample {
-    var out: BsdfSample;
-    out.valid = false;
-    if rand() < s.mirror {
-        out.wi = reflect(-wo, n);
-        out.weight = vec3f(1.0);
-        out.valid = true;
-        return out;
-    }
-    let frame_n = basis(n);
+    let mirror = rand() < s.mirror;
     let u1 = rand();
     let u2 = rand();
-    var wi: vec3f;
-    if rand() < specular_probability(s) {
-        // GGX half-vector sampling, pdf D(h) cos θh.
-        let a2 = s.alpha * s.alpha;
-        let cos_h = sqrt((1.0 - u1) / (1.0 + (a2 - 1.0) * u1));
-        let sin_h = sqrt(max(0.0, 1.0 - cos_h * cos_h));
-        let phi = TWO_PI * u2;
-        let h = frame_n * vec3f(sin_h * cos(phi), sin_h * sin(phi), cos_h);
-        wi = reflect(-wo, h);
-    } else {
-        // Cosine-weighted hemisphere.
-        let r = sqrt(u1);
-        let phi = TWO_PI * u2;
-        wi = frame_n * vec3f(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u1)));
-    }
-    let pdf = pdf_bsdf(s, n, wo, wi);
-    if pdf <= 0.0 {
-        return out;
-    }
-    out.wi = wi;
-    out.weight = eval_bsdf_cos(s, n, wo, wi) / pdf;
-    out.valid = true;
+    let specular = rand() < specular_probability(s);
+    // GGX half vectors have pdf D(h) cos θh; the diffuse lobe is cosine-weighted.
+    let a2 = s.alpha * s.alpha;
+    let cos_t = select(sqrt(max(0.0, 1.0 - u1)), sqrt((1.0 - u1) / (1.0 + (a2 - 1.0) * u1)), specular);
+    let sin_t = sqrt(max(0.0, 1.0 - cos_t * cos_t));
+    let phi = TWO_PI * u2;
+    let local = basis(n) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t);
+    let wi = select(local, reflect(-wo, local), specular);
+    let e = eval_bsdf(s, n, wo, wi);
+    var out: BsdfSample;
+    out.wi = select(wi, reflect(-wo, n), mirror);
+    out.weight = select(e.f_cos / e.pdf, vec3f(1.0), mirror);
+    out.valid = mirror || e.pdf > 0.0;
     return out;
 }

@@ -8,7 +8,8 @@ struct NoiseParams {
     amplitude: f32,
     persistence: f32,
     lacunarity: f32,
-    _pad: f32,
+    // Non-zero: sum |noise| (turbulence) instead of noise (fBm).
+    absolute: u32,
 }
 
 const MAX_OCTAVES: f32 = 16.0;
@@ -26,33 +27,74 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 #endif
 }
 
-fn fractal_sum(p: vec3f, n: NoiseParams, absolute: bool) -> f32 {
+// One octave loop per noise kind, each calling only its own noise. A loop
+// shared by both kinds would hold both noises, and SIMD lanes run both
+// whenever either is needed (lavapipe runs every branch): the renderer calls
+// each kind's loop only for the signals of that kind.
+
+#if NOISE_GRADIENT
+fn fractal_sum_gradient(p: vec3f, n: NoiseParams) -> f32 {
     let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
-    let whole = u32(ceil(octaves));
     var frequency = n.frequency;
     var amplitude = n.amplitude;
     var sum = 0.0;
-    for (var i = 0u; i < whole; i++) {
-        let weight = min(octaves - f32(i), 1.0);
-        var v = lattice_noise(p * frequency, n.kind, n.hash);
-        if absolute {
-            v = abs(v);
-        }
-        sum += weight * amplitude * v;
+    for (var i = 0u; i < u32(ceil(octaves)); i++) {
+        let v = gradient_noise(p * frequency, n.hash);
+        sum += min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
         frequency *= n.lacunarity;
         amplitude *= n.persistence;
     }
     return sum;
 }
+#endif
+
+#if NOISE_PERLIN
+fn fractal_sum_perlin(p: vec3f, n: NoiseParams) -> f32 {
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    var frequency = n.frequency;
+    var amplitude = n.amplitude;
+    var sum = 0.0;
+    for (var i = 0u; i < u32(ceil(octaves)); i++) {
+        let v = perlin_noise(p * frequency);
+        sum += min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
+        frequency *= n.lacunarity;
+        amplitude *= n.persistence;
+    }
+    return sum;
+}
+#endif
+
+// The fractal sum of either kind, for callers that hold one signal.
+fn fractal_sum(p: vec3f, n: NoiseParams) -> f32 {
+#if NOISE_PERLIN
+    if n.kind == 1u {
+        return fractal_sum_perlin(p, n);
+    }
+#endif
+#if NOISE_GRADIENT
+    return fractal_sum_gradient(p, n);
+#else
+    return 0.0;
+#endif
+}
 
 fn fbm(p: vec3f, n: NoiseParams) -> f32 {
-    return fractal_sum(p, n, false);
+    var signed = n;
+    signed.absolute = 0u;
+    return fractal_sum(p, signed);
 }
 
 fn turbulence(p: vec3f, n: NoiseParams) -> f32 {
-    return fractal_sum(p, n, true);
+    var absolute = n;
+    absolute.absolute = 1u;
+    return fractal_sum(p, absolute);
+}
+
+// The stripes of marble, given the fBm value at the point.
+fn marble_stripes(x: f32, fbm_value: f32, stripe_frequency: f32) -> f32 {
+    return sin(x * stripe_frequency + fbm_value);
 }
 
 fn marble(p: vec3f, n: NoiseParams, stripe_frequency: f32) -> f32 {
-    return sin(p.x * stripe_frequency + fbm(p, n));
+    return marble_stripes(p.x, fbm(p, n), stripe_frequency);
 }

@@ -1,11 +1,37 @@
 // Procedural textures: each pattern gives a blend factor t in [0, 1] between
 // the texture's two values. Patterns the scene does not use are compiled out.
+//
+// The fractal sums, the expensive part, are evaluated once per hit as the
+// material's noise signals (deduplicated on the CPU), outside any pattern
+// branch. SIMD hardware runs every branch some lane takes under a mask
+// (lavapipe runs every branch, taken or not), so a sum written inside each
+// pattern's case would be paid for by every pattern in the scene.
 
-fn texture_noise(t: Texture) -> NoiseParams {
-    return NoiseParams(t.noise_kind, t.hash, t.octaves, t.frequency, t.amplitude, t.persistence, t.lacunarity, 0.0);
+#if NOISE
+// The material's signals, ordered by kind on the CPU: gradient noise ones
+// first, then Perlin ones from `first_perlin` on. Each kind's loop holds only
+// its own noise, so a hit pays for Perlin octaves only where some lane reads
+// a Perlin signal.
+fn material_signals(material: u32, p: vec3f) -> vec3f {
+    var values = vec3f(0.0);
+    let count = min(materials[material].signal_count, MAX_SIGNALS);
+    let first_perlin = min(materials[material].first_perlin, count);
+#if NOISE_GRADIENT
+    for (var k = 0u; k < first_perlin; k++) {
+        values[k] = fractal_sum_gradient(p, materials[material].signals[k]);
+    }
+#endif
+#if NOISE_PERLIN
+    for (var k = first_perlin; k < count; k++) {
+        values[k] = fractal_sum_perlin(p, materials[material].signals[k]);
+    }
+#endif
+    return values;
 }
+#endif
 
-fn pattern_t(t: Texture, p: vec3f) -> f32 {
+fn pattern_t(t: Texture, p: vec3f, signals: vec3f) -> f32 {
+    let n = signals[min(t.signal, MAX_SIGNALS - 1u)];
     switch t.kind {
 #if PATTERN_CHECKER
         case 1u: {
@@ -15,17 +41,17 @@ fn pattern_t(t: Texture, p: vec3f) -> f32 {
 #endif
 #if PATTERN_FBM
         case 2u: {
-            return clamp(0.5 + 0.5 * fbm(p, texture_noise(t)), 0.0, 1.0);
+            return clamp(0.5 + 0.5 * n, 0.0, 1.0);
         }
 #endif
 #if PATTERN_TURBULENCE
         case 3u: {
-            return clamp(turbulence(p, texture_noise(t)), 0.0, 1.0);
+            return clamp(n, 0.0, 1.0);
         }
 #endif
 #if PATTERN_MARBLE
         case 4u: {
-            return 0.5 + 0.5 * marble(p, texture_noise(t), t.param);
+            return 0.5 + 0.5 * marble_stripes(p.x, n, t.param);
         }
 #endif
         default: {
@@ -34,10 +60,10 @@ fn pattern_t(t: Texture, p: vec3f) -> f32 {
     }
 }
 
-fn eval_color(t: Texture, p: vec3f) -> vec3f {
-    return mix(t.a.xyz, t.b.xyz, pattern_t(t, p));
+fn eval_color(t: Texture, p: vec3f, signals: vec3f) -> vec3f {
+    return mix(t.a.xyz, t.b.xyz, pattern_t(t, p, signals));
 }
 
-fn eval_scalar(t: Texture, p: vec3f) -> f32 {
-    return mix(t.a.x, t.b.x, pattern_t(t, p));
+fn eval_scalar(t: Texture, p: vec3f, signals: vec3f) -> f32 {
+    return mix(t.a.x, t.b.x, pattern_t(t, p, signals));
 }

@@ -16,7 +16,7 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let to_light = frame.light_pos - hit.p;
     let dist2 = dot(to_light, to_light);
     let wi = to_light * inverseSqrt(dist2);
-    let f_cos = eval_bsdf_cos(s, hit.n, wo, wi);
+    let f_cos = eval_bsdf(s, hit.n, wo, wi).f_cos;
     if all(f_cos == vec3f(0.0)) {
         return vec3f(0.0);
     }
@@ -29,20 +29,22 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
 }
 #endif
 
+// SIMD lanes run every piece of code some lane needs, and lavapipe runs
+// every branch and at least one pass of every loop. So each expensive site
+// appears once: one intersection before the loop and one at the end of each
+// bounce, the shading once per bounce, the environment once after the loop.
+// A loop that shaded and then tested for its last bounce would pay for one
+// shading more than it uses.
 fn trace_path(pixel: vec2f) -> vec3f {
-    var o = frame.cam_pos;
     var d = camera_ray(pixel);
+    var hit = intersect_scene(frame.cam_pos, d);
     var throughput = vec3f(1.0);
     var radiance = vec3f(0.0);
-    for (var depth = 0u; depth <= frame.max_bounces; depth++) {
-        let hit = intersect_scene(o, d);
+    // Whether the path is still going: it ends by escaping or by absorption.
+    var alive = true;
+    var bounces = 0u;
+    for (; bounces < frame.max_bounces; bounces++) {
         if hit.t >= NO_HIT {
-            if depth > 0u || frame.background_visible != 0u {
-                radiance += throughput * environment(d);
-            }
-            break;
-        }
-        if depth == frame.max_bounces {
             break;
         }
         let s = surface_at(hit);
@@ -52,11 +54,19 @@ fn trace_path(pixel: vec2f) -> vec3f {
 #endif
         let bs = sample_bsdf(s, hit.n, wo);
         if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
+            alive = false;
             break;
         }
         throughput *= bs.weight;
-        o = offset_ray(hit.p, hit.n);
         d = bs.wi;
+        hit = intersect_scene(offset_ray(hit.p, hit.n), d);
+    }
+    // A path that escaped sees the environment; the camera sees it only if
+    // the background is visible. One that ran out of bounces on a surface
+    // gets nothing more.
+    let escaped = alive && hit.t >= NO_HIT;
+    if escaped && (bounces > 0u || frame.background_visible != 0u) {
+        radiance += throughput * environment(d);
     }
     return radiance;
 }

@@ -20,7 +20,9 @@ pub struct BenchArgs {
     pub sizes: Vec<(u32, u32)>,
 }
 
-/// Wall-clock time per frame, each frame waited for: trace plus GPU sync.
+/// Median wall-clock time per frame, each frame waited for: trace plus GPU
+/// sync. The median, not the mean: on a shared CPU (lavapipe) a few frames
+/// stall for reasons unrelated to the shader.
 fn time_frames(ctx: &GpuContext, renderer: &mut Renderer, frames: u32) -> Result<f64> {
     let frame = |renderer: &mut Renderer| -> Result<()> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -33,11 +35,14 @@ fn time_frames(ctx: &GpuContext, renderer: &mut Renderer, frames: u32) -> Result
     for _ in 0..3 {
         frame(renderer)?;
     }
-    let start = Instant::now();
-    for _ in 0..frames {
+    let mut times = Vec::with_capacity(frames as usize);
+    for _ in 0..frames.max(1) {
+        let start = Instant::now();
         frame(renderer)?;
+        times.push(start.elapsed().as_secs_f64() * 1000.0);
     }
-    Ok(start.elapsed().as_secs_f64() * 1000.0 / f64::from(frames.max(1)))
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {

@@ -71,8 +71,14 @@ impl FeatureSet {
         self.0.contains(&f)
     }
 
+    /// The `#if` names: one per feature, plus `NOISE` when any noise kind
+    /// is in (the code shared by every fractal sum).
     pub fn defines(&self) -> BTreeSet<&'static str> {
-        self.0.iter().map(|f| f.define()).collect()
+        let mut names: BTreeSet<_> = self.0.iter().map(|f| f.define()).collect();
+        if self.contains(Feature::NoiseGradient) || self.contains(Feature::NoisePerlin) {
+            names.insert("NOISE");
+        }
+        names
     }
 
     /// The features `scene` uses, and no others.

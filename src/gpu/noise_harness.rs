@@ -6,7 +6,7 @@ use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::pipelines::{checked, entry, permutation_table, shader_module, storage, uniform};
 use super::readback::read_buffer;
-use super::scene_gpu::{hash_id, noise_kind_id};
+use super::scene_gpu::NoiseParamsGpu;
 use super::shader_source::Program;
 use crate::noise::NoiseSettings;
 use anyhow::Result;
@@ -47,14 +47,7 @@ impl Evaluate {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct HarnessUniform {
-    kind: u32,
-    hash: u32,
-    octaves: f32,
-    frequency: f32,
-    amplitude: f32,
-    persistence: f32,
-    lacunarity: f32,
-    _pad0: f32,
+    noise: NoiseParamsGpu,
     mode: u32,
     count: u32,
     param: f32,
@@ -81,7 +74,7 @@ pub fn evaluate(
             entry(0, uniform()),
             entry(1, storage(true)),
             entry(2, storage(false)),
-            entry(6, storage(true)),
+            entry(6, uniform()),
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -100,16 +93,8 @@ pub fn evaluate(
         })
     })?;
     let (mode, param) = what.mode_and_param();
-    let f = &noise.fractal;
     let params = HarnessUniform {
-        kind: noise_kind_id(noise.kind),
-        hash: hash_id(noise.hash),
-        octaves: f.octaves,
-        frequency: f.frequency,
-        amplitude: f.amplitude,
-        persistence: f.persistence,
-        lacunarity: f.lacunarity,
-        _pad0: 0.0,
+        noise: NoiseParamsGpu::new(noise, false),
         mode,
         count: points.len() as u32,
         param,
@@ -136,7 +121,7 @@ pub fn evaluate(
     let perm_buffer = init(
         "permutation",
         bytemuck::cast_slice(&permutation_table()),
-        wgpu::BufferUsages::STORAGE,
+        wgpu::BufferUsages::UNIFORM,
     );
     let size = (inputs.len() * 16) as u64;
     let output_buffer = device.create_buffer(&wgpu::BufferDescriptor {

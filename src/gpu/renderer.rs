@@ -5,7 +5,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::pipelines::{
-    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, storage, uniform,
+    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, uniform,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
@@ -85,15 +85,15 @@ impl Renderer {
             label: Some("trace"),
             entries: &[
                 entry(0, uniform()),
-                entry(1, storage(true)),
-                entry(2, storage(true)),
+                entry(1, uniform()),
+                entry(2, uniform()),
                 entry(3, float_texture(true)),
                 entry(
                     4,
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
                 entry(5, float_texture(false)),
-                entry(6, storage(true)),
+                entry(6, uniform()),
             ],
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -122,17 +122,17 @@ impl Renderer {
         let sphere_buffer = buffer(
             "spheres",
             bytemuck::cast_slice(&scene_gpu::spheres(scene)),
-            wgpu::BufferUsages::STORAGE,
+            wgpu::BufferUsages::UNIFORM,
         );
         let material_buffer = buffer(
             "materials",
             bytemuck::cast_slice(&scene_gpu::materials(scene)),
-            wgpu::BufferUsages::STORAGE,
+            wgpu::BufferUsages::UNIFORM,
         );
         let perm_buffer = buffer(
             "permutation",
             bytemuck::cast_slice(&permutation_table()),
-            wgpu::BufferUsages::STORAGE,
+            wgpu::BufferUsages::UNIFORM,
         );
         let env_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
@@ -221,20 +221,13 @@ impl Renderer {
             self.trace_pipeline = Self::build_trace_pipeline(ctx, &self.trace_layout, &features)?;
             self.features = features;
         }
+        // Fixed-size arrays: the buffers never grow.
         let spheres = scene_gpu::spheres(scene);
         let materials = scene_gpu::materials(scene);
-        write_or_grow(
-            ctx,
-            &mut self.sphere_buffer,
-            bytemuck::cast_slice(&spheres),
-            "spheres",
-        );
-        write_or_grow(
-            ctx,
-            &mut self.material_buffer,
-            bytemuck::cast_slice(&materials),
-            "materials",
-        );
+        ctx.queue
+            .write_buffer(&self.sphere_buffer, 0, bytemuck::cast_slice(&spheres));
+        ctx.queue
+            .write_buffer(&self.material_buffer, 0, bytemuck::cast_slice(&materials));
         // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
         let mut traced_now = scene.clone();
@@ -502,20 +495,6 @@ impl Renderer {
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource }
-}
-
-fn write_or_grow(ctx: &GpuContext, buffer: &mut wgpu::Buffer, bytes: &[u8], label: &str) {
-    if bytes.len() as u64 > buffer.size() {
-        *buffer = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytes,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            });
-    } else {
-        ctx.queue.write_buffer(buffer, 0, bytes);
-    }
 }
 
 fn create_accumulation(device: &wgpu::Device, size: (u32, u32)) -> Accumulation {

@@ -1,7 +1,7 @@
 //! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
 
-use crate::noise::{HashKind, NoiseKind};
-use crate::scene::{ColorTexture, EnvSource, Material, Pattern, ScalarTexture, Scene};
+use crate::noise::{HashKind, NoiseKind, NoiseSettings};
+use crate::scene::{EnvSource, MAX_SPHERES, Material, Pattern, Scene};
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
@@ -30,31 +30,64 @@ pub struct FrameUniform {
     pub has_ground: u32,
 }
 
+/// `NoiseParams` of `shaders/fractal.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct TextureGpu {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
+pub struct NoiseParamsGpu {
     pub kind: u32,
-    pub noise_kind: u32,
     pub hash: u32,
     pub octaves: f32,
     pub frequency: f32,
     pub amplitude: f32,
     pub persistence: f32,
     pub lacunarity: f32,
-    pub param: f32,
-    pub _pad: [f32; 3],
-    pub a: [f32; 4],
-    pub b: [f32; 4],
+    /// Non-zero sums |noise| (turbulence) rather than noise (fBm).
+    pub absolute: u32,
+}
+
+impl NoiseParamsGpu {
+    pub fn new(n: &NoiseSettings, absolute: bool) -> Self {
+        let f = &n.fractal;
+        Self {
+            kind: noise_kind_id(n.kind),
+            hash: hash_id(n.hash),
+            octaves: f.octaves,
+            frequency: f.frequency,
+            amplitude: f.amplitude,
+            persistence: f.persistence,
+            lacunarity: f.lacunarity,
+            absolute: u32::from(absolute),
+        }
+    }
 }
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct TextureGpu {
+    pub kind: u32,
+    pub signal: u32,
+    pub param: f32,
+    pub _pad: f32,
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+}
+
+/// Noise signals a material may read; `MAX_SIGNALS` in `shaders/scene.wgsl`.
+/// Three textures read at most three distinct sums.
+pub const MAX_SIGNALS: usize = 3;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct MaterialGpu {
+    pub signals: [NoiseParamsGpu; MAX_SIGNALS],
     pub diffuse: TextureGpu,
     pub specular: TextureGpu,
     pub roughness: TextureGpu,
+    pub signal_count: u32,
+    /// Signals before this index are gradient noise, from it on Perlin.
+    pub first_perlin: u32,
     pub mirror: f32,
-    pub _pad: [f32; 3],
+    pub _pad: f32,
 }
 
 #[repr(C)]
@@ -78,61 +111,78 @@ pub fn hash_id(h: HashKind) -> u32 {
     }
 }
 
-fn texture(pattern: &Pattern, a: [f32; 3], b: [f32; 3]) -> TextureGpu {
-    let mut t = TextureGpu {
+/// The fractal sum a pattern reads, if any. Marble reads a plain fBm.
+fn signal_of(pattern: &Pattern) -> Option<NoiseParamsGpu> {
+    let absolute = matches!(pattern, Pattern::Turbulence { .. });
+    pattern.noise().map(|n| NoiseParamsGpu::new(n, absolute))
+}
+
+fn texture(pattern: &Pattern, a: [f32; 3], b: [f32; 3], signal: u32) -> TextureGpu {
+    TextureGpu {
         kind: pattern.index() as u32,
+        signal,
+        param: match *pattern {
+            Pattern::Checker { size } => size,
+            Pattern::Marble {
+                stripe_frequency, ..
+            } => stripe_frequency,
+            _ => 0.0,
+        },
+        _pad: 0.0,
         a: [a[0], a[1], a[2], 0.0],
         b: [b[0], b[1], b[2], 0.0],
+    }
+}
+
+/// A material's textures with their noise signals deduplicated (two
+/// textures reading the same fractal sum, like rust's diffuse and specular
+/// colours, share one evaluation per hit) and ordered by noise kind, gradient
+/// first, as `material_signals` in `shaders/textures.wgsl` expects.
+pub fn material(m: &Material) -> MaterialGpu {
+    let patterns = m.patterns();
+    let mut signals: Vec<NoiseParamsGpu> = Vec::with_capacity(MAX_SIGNALS);
+    for signal in patterns.iter().filter_map(|p| signal_of(p)) {
+        if !signals.contains(&signal) {
+            signals.push(signal);
+        }
+    }
+    signals.sort_by_key(|s| s.kind);
+    let slot = |pattern: &Pattern| -> u32 {
+        signal_of(pattern)
+            .and_then(|signal| signals.iter().position(|s| *s == signal))
+            .map_or(0, |i| i as u32)
+    };
+    let mut out = MaterialGpu {
+        signal_count: signals.len() as u32,
+        first_perlin: signals
+            .iter()
+            .position(|s| s.kind == noise_kind_id(NoiseKind::Perlin))
+            .unwrap_or(signals.len()) as u32,
+        mirror: m.mirror,
         ..Default::default()
     };
-    if let Some(n) = pattern.noise() {
-        t.noise_kind = noise_kind_id(n.kind);
-        t.hash = hash_id(n.hash);
-        t.octaves = n.fractal.octaves;
-        t.frequency = n.fractal.frequency;
-        t.amplitude = n.fractal.amplitude;
-        t.persistence = n.fractal.persistence;
-        t.lacunarity = n.fractal.lacunarity;
-    }
-    t.param = match *pattern {
-        Pattern::Checker { size } => size,
-        Pattern::Marble {
-            stripe_frequency, ..
-        } => stripe_frequency,
-        _ => 0.0,
-    };
-    t
-}
-
-fn color(c: &ColorTexture) -> TextureGpu {
-    texture(&c.pattern, c.a.to_array(), c.b.to_array())
-}
-
-fn scalar(s: &ScalarTexture) -> TextureGpu {
-    texture(&s.pattern, [s.a; 3], [s.b; 3])
-}
-
-pub fn material(m: &Material) -> MaterialGpu {
-    MaterialGpu {
-        diffuse: color(&m.diffuse),
-        specular: color(&m.specular),
-        roughness: scalar(&m.roughness),
-        mirror: m.mirror,
-        _pad: [0.0; 3],
-    }
-}
-
-/// Materials in the order the shader indexes them; never empty, because a
-/// storage binding may not be.
-pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
-    let mut out: Vec<_> = scene.materials().map(material).collect();
-    if out.is_empty() {
-        out.push(MaterialGpu::default());
-    }
+    out.signals[..signals.len()].copy_from_slice(&signals);
+    let (d, sp, r) = (&m.diffuse, &m.specular, &m.roughness);
+    out.diffuse = texture(&d.pattern, d.a.to_array(), d.b.to_array(), slot(&d.pattern));
+    out.specular = texture(
+        &sp.pattern,
+        sp.a.to_array(),
+        sp.b.to_array(),
+        slot(&sp.pattern),
+    );
+    out.roughness = texture(&r.pattern, [r.a; 3], [r.b; 3], slot(&r.pattern));
     out
 }
 
-/// Spheres, padded to one element when there are none.
+/// Materials in the order the shader indexes them, padded to the uniform
+/// array's length.
+pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
+    let mut out: Vec<_> = scene.materials().map(material).collect();
+    out.resize(MAX_SPHERES + 1, MaterialGpu::default());
+    out
+}
+
+/// Spheres, padded to the uniform array's length.
 pub fn spheres(scene: &Scene) -> Vec<SphereGpu> {
     let mut out: Vec<_> = scene
         .spheres
@@ -141,10 +191,9 @@ pub fn spheres(scene: &Scene) -> Vec<SphereGpu> {
             center: s.center.to_array(),
             radius: s.radius,
         })
+        .take(MAX_SPHERES)
         .collect();
-    if out.is_empty() {
-        out.push(SphereGpu::default());
-    }
+    out.resize(MAX_SPHERES, SphereGpu::default());
     out
 }
 
@@ -185,7 +234,7 @@ pub fn frame_uniform(
         env_constant,
         background_visible: u32::from(env.background_visible),
         ground_height: scene.ground.as_ref().map_or(0.0, |g| g.height),
-        sphere_count: scene.spheres.len() as u32,
+        sphere_count: scene.spheres.len().min(MAX_SPHERES) as u32,
         samples_per_frame: scene.render.samples_per_frame.max(1),
         max_bounces: scene.render.max_bounces.max(1),
         render_size: [w, h],
@@ -206,8 +255,112 @@ mod tests {
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
         assert_eq!(std::mem::size_of::<FrameUniform>(), 144);
-        assert_eq!(std::mem::size_of::<TextureGpu>(), 80);
+        assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 32);
+        assert_eq!(std::mem::size_of::<TextureGpu>(), 48);
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 256);
         assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
+    }
+
+    /// The element count of a uniform array global in the trace shader.
+    fn wgsl_array_len(name: &str) -> u32 {
+        let source = crate::gpu::shader_source::assemble(
+            crate::gpu::shader_source::Program::Trace,
+            &crate::gpu::features::FeatureSet::all(),
+        )
+        .unwrap();
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let (_, global) = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.name.as_deref() == Some(name))
+            .unwrap();
+        match module.types[global.ty].inner {
+            naga::TypeInner::Array {
+                size: naga::ArraySize::Constant(n),
+                ..
+            } => n.get(),
+            ref other => panic!("{name} is {other:?}"),
+        }
+    }
+
+    #[test]
+    fn uniform_arrays_hold_what_the_cpu_uploads() {
+        let scene = Scene::default();
+        assert_eq!(wgsl_array_len("spheres") as usize, spheres(&scene).len());
+        assert_eq!(
+            wgsl_array_len("materials") as usize,
+            materials(&scene).len()
+        );
+        assert_eq!(spheres(&scene).len(), MAX_SPHERES);
+    }
+
+    fn fbm_texture(noise: NoiseSettings) -> crate::scene::ColorTexture {
+        crate::scene::ColorTexture {
+            pattern: Pattern::Fbm { noise },
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn textures_reading_the_same_sum_share_one_signal() {
+        let noise = NoiseSettings::default();
+        let mut m = Material {
+            diffuse: fbm_texture(noise),
+            specular: fbm_texture(noise),
+            ..Default::default()
+        };
+        m.roughness.pattern = Pattern::Turbulence { noise };
+        let gpu = material(&m);
+        // fBm once for both colours; turbulence, |noise|, is another sum.
+        assert_eq!(gpu.signal_count, 2);
+        assert_eq!((gpu.diffuse.signal, gpu.specular.signal), (0, 0));
+        assert_eq!(gpu.roughness.signal, 1);
+        assert_eq!(gpu.signals[0].absolute, 0);
+        assert_eq!(gpu.signals[1].absolute, 1);
+    }
+
+    #[test]
+    fn perlin_signals_come_after_gradient_ones() {
+        let perlin = NoiseSettings {
+            kind: NoiseKind::Perlin,
+            ..Default::default()
+        };
+        let m = Material {
+            diffuse: fbm_texture(perlin),
+            specular: fbm_texture(NoiseSettings::default()),
+            ..Default::default()
+        };
+        let gpu = material(&m);
+        assert_eq!((gpu.signal_count, gpu.first_perlin), (2, 1));
+        assert_eq!(gpu.signals[gpu.diffuse.signal as usize].kind, 1);
+        assert_eq!(gpu.signals[gpu.specular.signal as usize].kind, 0);
+    }
+
+    #[test]
+    fn three_different_sums_take_three_signals() {
+        let at = |frequency| NoiseSettings {
+            fractal: crate::noise::FractalParams {
+                frequency,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let mut m = Material {
+            diffuse: fbm_texture(at(1.0)),
+            specular: fbm_texture(at(2.0)),
+            ..Default::default()
+        };
+        m.roughness.pattern = Pattern::Fbm { noise: at(3.0) };
+        let gpu = material(&m);
+        assert_eq!(gpu.signal_count, MAX_SIGNALS as u32);
+        assert_eq!(
+            [
+                gpu.diffuse.signal,
+                gpu.specular.signal,
+                gpu.roughness.signal
+            ],
+            [0, 1, 2]
+        );
+        assert_eq!(gpu.signals[2].frequency, 3.0);
     }
 }

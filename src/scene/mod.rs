@@ -74,6 +74,12 @@ impl Default for PointLight {
     }
 }
 
+/// The most spheres a scene holds: the renderer keeps spheres and their
+/// materials (one more, the ground's) in fixed-size uniform arrays
+/// (`shaders/scene.wgsl`), whose divergent reads cost far less than
+/// storage-buffer reads on lavapipe.
+pub const MAX_SPHERES: usize = 63;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default)]
 pub struct Scene {
@@ -98,6 +104,13 @@ impl Scene {
     /// into range; each clamp is reported so a preset author can see it.
     pub fn sanitize(&mut self) -> Vec<String> {
         let mut notes = Vec::new();
+        if self.spheres.len() > MAX_SPHERES {
+            notes.push(format!(
+                "{} spheres: only the first {MAX_SPHERES} are kept (the renderer's limit)",
+                self.spheres.len()
+            ));
+            self.spheres.truncate(MAX_SPHERES);
+        }
         for s in &mut self.spheres {
             if !(s.radius.is_finite() && s.radius > 0.0) {
                 notes.push(format!("sphere `{}`: radius {} set to 1", s.name, s.radius));
@@ -120,5 +133,36 @@ impl Scene {
         self.render.sanitize(&mut notes);
         self.camera.sanitize(&mut notes);
         notes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spheres_beyond_the_renderer_limit_are_dropped_with_a_note() {
+        let mut scene = Scene {
+            spheres: vec![Sphere::default(); MAX_SPHERES + 2],
+            ..Default::default()
+        };
+        let notes = scene.sanitize();
+        assert_eq!(scene.spheres.len(), MAX_SPHERES);
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains(&format!("{}", MAX_SPHERES + 2))),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn a_scene_at_the_limit_keeps_every_sphere() {
+        let mut scene = Scene {
+            spheres: vec![Sphere::default(); MAX_SPHERES],
+            ..Default::default()
+        };
+        assert!(scene.sanitize().is_empty());
+        assert_eq!(scene.spheres.len(), MAX_SPHERES);
     }
 }
