@@ -27,6 +27,12 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 #endif
 }
 
+// Octave i's share of the sum, in one place for both kinds' loops: the last,
+// fractional octave fades in, and turbulence sums |noise|.
+fn octave_term(v: f32, n: NoiseParams, octaves: f32, i: u32, amplitude: f32) -> f32 {
+    return min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
+}
+
 // One octave loop per noise kind, each calling only its own noise. A loop
 // shared by both kinds would hold both noises, and SIMD lanes run both
 // whenever either is needed (lavapipe runs every branch): the renderer calls
@@ -40,7 +46,7 @@ fn fractal_sum_gradient(p: vec3f, n: NoiseParams) -> f32 {
     var sum = 0.0;
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
         let v = gradient_noise(p * frequency, n.hash);
-        sum += min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
+        sum += octave_term(v, n, octaves, i, amplitude);
         frequency *= n.lacunarity;
         amplitude *= n.persistence;
     }
@@ -56,7 +62,7 @@ fn fractal_sum_perlin(p: vec3f, n: NoiseParams) -> f32 {
     var sum = 0.0;
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
         let v = perlin_noise(p * frequency);
-        sum += min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
+        sum += octave_term(v, n, octaves, i, amplitude);
         frequency *= n.lacunarity;
         amplitude *= n.persistence;
     }
