@@ -141,6 +141,58 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
     assert!(edge[0] < centre[0], "edge {edge:?} vs centre {centre:?}");
 }
 
+/// An integrating sphere: a point light of intensity I at the centre of a
+/// closed Lambert sphere of radius R and albedo ρ gives every wall point the
+/// same direct irradiance I/R², so every path of N bounces carries exactly
+/// (ρ/π)(I/R²)·Σ_{k<N} ρ^k, one next-event term per bounce, with no variance.
+/// It pins the bounce count: one shading too many or too few changes it.
+#[test]
+fn integrating_sphere_counts_one_light_sample_per_bounce() {
+    let Some(ctx) = gpu_or_skip("integrating_sphere_counts_one_light_sample_per_bounce") else {
+        return;
+    };
+    let (albedo, intensity, radius) = (0.5_f32, 30.0_f32, 5.0_f32);
+    for (bounces, features) in [
+        (1, None),
+        (2, None),
+        (4, None),
+        (3, Some(marbre::gpu::FeatureSet::all())),
+    ] {
+        let mut scene = Scene::default();
+        scene.spheres.push(Sphere {
+            name: "integrating sphere".into(),
+            center: Vec3::ZERO,
+            radius,
+            material: lambert(albedo),
+        });
+        scene.point_light = Some(PointLight {
+            position: Vec3::ZERO,
+            color: Vec3::ONE,
+            intensity,
+        });
+        scene.environment.source = EnvSource::None;
+        scene.camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 0.5,
+            yaw_degrees: 20.0,
+            pitch_degrees: 10.0,
+            fov_degrees: 60.0,
+        };
+        scene.render.max_bounces = bounces;
+        let pixels = render_with(&ctx, &scene, (16, 16), 2, features);
+        let series: f32 = (0..bounces).map(|k| albedo.powi(k as i32)).sum();
+        let expected = albedo / std::f32::consts::PI * intensity / (radius * radius) * series;
+        for p in &pixels {
+            for c in &p[..3] {
+                assert!(
+                    (c - expected).abs() < 1e-3 * expected,
+                    "{bounces} bounces: {p:?}, expected {expected}"
+                );
+            }
+        }
+    }
+}
+
 /// Turning accumulation off shows each frame alone; turning it on averages:
 /// with a noisy scene the accumulated image has a lower pixel variance.
 #[test]
