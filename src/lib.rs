@@ -10,3 +10,4 @@ pub mod noise;
 pub mod panel;
 pub mod preset;
 pub mod scene;
+pub mod texture;

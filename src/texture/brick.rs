@@ -1,0 +1,148 @@
+//! Bricks and tiles: cells separated by mortar. Bricks run in rows shifted
+//! by a fraction of a brick; a tile fills its (unit) cell and rises from the
+//! mortar along a bevel, which tilts the shading normal.
+
+use super::checker::{Cell, odd};
+use glam::Vec2;
+
+/// Bricks of `size` (u, v) with mortar joints `mortar` wide (in uv units),
+/// odd rows shifted by `row_offset` of a brick. `select` is 1 on a brick and
+/// 0 in the mortar; `local` is the point in its brick's [0, 1)² space.
+pub fn brick(uv: Vec2, size: Vec2, mortar: f32, row_offset: f32) -> Cell {
+    let row = (uv.y / size.y).floor();
+    let x = uv.x / size.x + row_offset * odd(row);
+    let local = Vec2::new(x - x.floor(), uv.y / size.y - row);
+    // Half a joint on each side of every brick, in uv units.
+    let from_edge = local.min(Vec2::ONE - local) * size;
+    let on_brick = from_edge.x >= 0.5 * mortar && from_edge.y >= 0.5 * mortar;
+    Cell {
+        select: if on_brick { 1.0 } else { 0.0 },
+        local,
+    }
+}
+
+/// The fraction of a wall that is mortar, for [`brick`]'s parameters.
+pub fn brick_mortar_fraction(size: Vec2, mortar: f32) -> f32 {
+    let brick = (size - Vec2::splat(mortar)).max(Vec2::ZERO);
+    1.0 - brick.x * brick.y / (size.x * size.y)
+}
+
+/// A tile filling the unit cell `uv` ∈ [0, 1)² (lay it with a checker to
+/// repeat it): mortar within `mortar_half_width` of the cell's edge, then a
+/// bevel `bevel_width` wide over which the tile rises by `bevel_height`, then
+/// the flat top.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TileSample {
+    /// 1 on the tile (bevel included), 0 in the mortar.
+    pub select: f32,
+    /// The gradient of the tile's height over uv: zero on the top and in
+    /// the mortar, pointing inwards on the bevel. Bump mapping turns it into
+    /// a tilted normal.
+    pub height_gradient: Vec2,
+}
+
+pub fn tile(uv: Vec2, mortar_half_width: f32, bevel_width: f32, bevel_height: f32) -> TileSample {
+    let local = uv - uv.floor();
+    // Distance to the nearest edge along each axis, and which way is inward.
+    let inward = Vec2::new(
+        if local.x < 0.5 { 1.0 } else { -1.0 },
+        if local.y < 0.5 { 1.0 } else { -1.0 },
+    );
+    let from_edge = local.min(Vec2::ONE - local);
+    let nearest = from_edge.x.min(from_edge.y);
+    if nearest < mortar_half_width {
+        return TileSample {
+            select: 0.0,
+            height_gradient: Vec2::ZERO,
+        };
+    }
+    let on_bevel = nearest < mortar_half_width + bevel_width && bevel_width > 0.0;
+    let height_gradient = if on_bevel {
+        // The height rises along the axis of the nearest edge only.
+        let slope = bevel_height / bevel_width;
+        if from_edge.x <= from_edge.y {
+            Vec2::new(slope * inward.x, 0.0)
+        } else {
+            Vec2::new(0.0, slope * inward.y)
+        }
+    } else {
+        Vec2::ZERO
+    };
+    TileSample {
+        select: 1.0,
+        height_gradient,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize) -> impl Iterator<Item = Vec2> {
+        (0..n * n).map(move |k| {
+            Vec2::new(
+                ((k % n) as f32 + 0.5) / n as f32,
+                ((k / n) as f32 + 0.5) / n as f32,
+            )
+        })
+    }
+
+    #[test]
+    fn brick_mortar_covers_its_share_of_the_wall() {
+        let n = 800;
+        for (size, mortar, offset) in [
+            (Vec2::new(0.25, 0.1), 0.02, 0.5),
+            (Vec2::new(0.1, 0.1), 0.01, 0.0),
+            (Vec2::new(0.5, 0.2), 0.05, 0.25),
+        ] {
+            // A whole number of bricks in each direction: the unit square.
+            let mortar_samples = grid(n)
+                .filter(|&uv| brick(uv, size, mortar, offset).select == 0.0)
+                .count();
+            let fraction = mortar_samples as f32 / (n * n) as f32;
+            let expected = brick_mortar_fraction(size, mortar);
+            assert!(
+                (fraction - expected).abs() < 5e-3,
+                "{size} {mortar}: {fraction} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn odd_rows_are_offset() {
+        let size = Vec2::new(1.0, 1.0);
+        let even = brick(Vec2::new(0.3, 0.5), size, 0.1, 0.5);
+        let odd_row = brick(Vec2::new(0.3, 1.5), size, 0.1, 0.5);
+        assert!((even.local.x - 0.3).abs() < 1e-6);
+        assert!((odd_row.local.x - 0.8).abs() < 1e-6);
+    }
+
+    #[test]
+    fn tile_mortar_bevel_and_top() {
+        let (m, b, h) = (0.02, 0.05, 0.4);
+        let n = 1000;
+        let mortar = grid(n)
+            .filter(|&uv| tile(uv, m, b, h).select == 0.0)
+            .count();
+        let fraction = mortar as f32 / (n * n) as f32;
+        let expected = 1.0 - (1.0 - 2.0 * m) * (1.0 - 2.0 * m);
+        assert!(
+            (fraction - expected).abs() < 3e-3,
+            "{fraction} vs {expected}"
+        );
+        // On the top the surface is flat; on the bevel it rises inwards.
+        assert_eq!(tile(Vec2::splat(0.5), m, b, h).height_gradient, Vec2::ZERO);
+        assert_eq!(
+            tile(Vec2::new(0.04, 0.5), m, b, h).height_gradient,
+            Vec2::new(h / b, 0.0)
+        );
+        assert_eq!(
+            tile(Vec2::new(0.5, 0.97), m, b, h).height_gradient,
+            Vec2::new(0.0, -h / b)
+        );
+        assert_eq!(
+            tile(Vec2::new(0.01, 0.5), m, b, h).height_gradient,
+            Vec2::ZERO
+        );
+    }
+}

@@ -1,0 +1,26 @@
+//! The texture library: the patterns of the course material as pure
+//! functions of a point (uv in 2D, p in 3D) and their parameters.
+//!
+//! This is the CPU reference. `shaders/texture_patterns.wgsl` mirrors every
+//! function here operation for operation; the GPU parity tests run it in a
+//! compute harness (`gpu::texture_harness`) and compare. Composition (which
+//! child texture a cell shows, what a blend weight mixes) is the texture
+//! tree's business: a pattern only says where a point falls.
+
+pub mod brick;
+pub mod bump;
+pub mod checker;
+pub mod cutout;
+pub mod marble;
+pub mod ramp;
+pub mod waves;
+pub mod wood;
+
+pub use brick::{TileSample, brick, brick_mortar_fraction, tile};
+pub use bump::bumped_normal;
+pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
+pub use cutout::{cutout, cutout_area};
+pub use marble::marble_veins;
+pub use ramp::{RampStop, ramp};
+pub use waves::waves_gradient;
+pub use wood::{default_axis, wood};
