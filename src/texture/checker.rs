@@ -74,7 +74,7 @@ mod tests {
     #[test]
     fn neighbouring_cells_alternate_in_2d_and_3d() {
         let size = Vec2::new(0.5, 2.0);
-        for (i, j) in [(0, 0), (3, -2), (-5, 7)] {
+        for (i, j) in [(0_i32, 0_i32), (3, -2), (-5, 7)] {
             let centre = Vec2::new((i as f32 + 0.5) * size.x, (j as f32 + 0.5) * size.y);
             let here = checker_2d(centre, size, 0.0).select;
             assert_eq!(here, (i + j).rem_euclid(2) as f32);
