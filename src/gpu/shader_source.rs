@@ -43,6 +43,14 @@ const SOURCES: &[(&str, &str)] = &[
         "noise_harness.wgsl",
         include_str!("../../shaders/noise_harness.wgsl"),
     ),
+    (
+        "texture_patterns.wgsl",
+        include_str!("../../shaders/texture_patterns.wgsl"),
+    ),
+    (
+        "texture_harness.wgsl",
+        include_str!("../../shaders/texture_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,10 +61,17 @@ pub enum Program {
     Display,
     /// The compute pass that evaluates noise at given points.
     NoiseHarness,
+    /// The compute pass that evaluates the texture library's patterns.
+    TextureHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 3] = [Program::Trace, Program::Display, Program::NoiseHarness];
+    pub const ALL: [Program; 4] = [
+        Program::Trace,
+        Program::Display,
+        Program::NoiseHarness,
+        Program::TextureHarness,
+    ];
 
     /// The files this program is made of, in order, for a feature set.
     fn files(self, features: &FeatureSet) -> Vec<&'static str> {
@@ -90,6 +105,10 @@ impl Program {
             Program::NoiseHarness => {
                 noise(&mut out);
                 out.push("noise_harness.wgsl");
+            }
+            Program::TextureHarness => {
+                noise(&mut out);
+                out.extend(["texture_patterns.wgsl", "texture_harness.wgsl"]);
             }
         }
         out

@@ -35,7 +35,7 @@ pub fn checker_3d(p: Vec3, size: Vec3) -> f32 {
 }
 
 /// 1 for an odd integer, 0 for an even one (any sign).
-pub(crate) fn odd(n: f32) -> f32 {
+pub fn odd(n: f32) -> f32 {
     n - 2.0 * (n * 0.5).floor()
 }
 

@@ -1,0 +1,71 @@
+// Compute harness for the texture library: evaluates one pattern of
+// texture_patterns.wgsl at a list of points, for the GPU parity tests.
+// 2D patterns read uv from the point's x and y.
+
+struct TextureHarness {
+    noise: NoiseParams,
+    mode: u32,
+    count: u32,
+    sides: u32,      // cutout sides, or ramp stop count
+    _pad: u32,
+    a: vec4f,
+    b: vec4f,
+    c: vec4f,
+    stops: array<vec4f, 8>,
+}
+
+@group(0) @binding(0) var<uniform> harness: TextureHarness;
+@group(0) @binding(1) var<storage, read> points: array<vec4f>;
+@group(0) @binding(2) var<storage, read_write> results: array<vec4f>;
+
+@compute @workgroup_size(64)
+fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
+    let i = id.x;
+    if i >= harness.count {
+        return;
+    }
+    let p = points[i].xyz;
+    let a = harness.a;
+    let b = harness.b;
+    let c = harness.c;
+    var r = vec4f(0.0);
+    switch harness.mode {
+        case 0u: {
+            let cell = checker_2d(p.xy, a.xy, a.z);
+            r = vec4f(cell.select, cell.local, 0.0);
+        }
+        case 1u: {
+            r.x = checker_3d(p, a.xyz);
+        }
+        case 2u: {
+            r.x = filtered_checker_2d(p.xy, a.xy, a.z, b.xy);
+        }
+        case 3u: {
+            let cell = brick(p.xy, a.xy, a.z, a.w);
+            r = vec4f(cell.select, cell.local, 0.0);
+        }
+        case 4u: {
+            let t = tile(p.xy, a.x, a.y, a.z);
+            r = vec4f(t.select, t.height_gradient, 0.0);
+        }
+        case 5u: {
+            r.x = cutout(p.xy, harness.sides, a.x);
+        }
+        case 6u: {
+            r.x = wood(p, a.xyz, a.w, b.x, harness.noise);
+        }
+        case 7u: {
+            r.x = marble_veins(p, a.xyz, a.w, b.x, harness.noise);
+        }
+        case 8u: {
+            r = vec4f(waves_gradient(p.xy, a.x, a.y, b.xy), 0.0, 0.0);
+        }
+        case 9u: {
+            r = vec4f(bumped_normal(p, a.xyz, b.xyz, c.x, c.y), 0.0);
+        }
+        default: {
+            r = vec4f(ramp(harness.stops, harness.sides, p.x), 0.0);
+        }
+    }
+    results[i] = r;
+}
