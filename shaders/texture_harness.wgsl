@@ -1,5 +1,6 @@
 // Compute harness for the texture library: evaluates one pattern of
-// texture_patterns.wgsl at a list of points, for the GPU parity tests.
+// texture_patterns.wgsl or one mapping of texture_mapping.wgsl at a list
+// of points, for the GPU parity tests.
 // 2D patterns read uv from the point's x and y.
 
 struct TextureHarness {
@@ -63,8 +64,25 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         case 9u: {
             r = vec4f(bumped_normal(p, a.xyz, b.xyz, c.x, c.y), 0.0);
         }
-        default: {
+        case 10u: {
             r = vec4f(ramp(harness.stops, harness.sides, p.x), 0.0);
+        }
+        case 11u: {
+            r = vec4f(sphere_uv(p), 0.0, 0.0);
+        }
+        case 12u: {
+            r = vec4f(cylinder_uv(p, a.x), 0.0, 0.0);
+        }
+        case 13u: {
+            r = vec4f(plane_uv(p, a.xyz, b.xyz, c.xyz), 0.0, 0.0);
+        }
+        case 14u: {
+            let s = harness.stops;
+            r = vec4f(triangle_uv(p, s[0].xyz, s[1].xyz, s[2].xyz, s[3].xy, s[4].xy, s[5].xy), 0.0, 0.0);
+        }
+        default: {
+            let linear = mat3x3f(a.xyz, b.xyz, c.xyz);
+            r = vec4f(to_texture_space(p, linear, vec3f(a.w, b.w, c.w)), 0.0);
         }
     }
     results[i] = r;

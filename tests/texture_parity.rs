@@ -1,6 +1,6 @@
 //! The texture library's WGSL (`shaders/texture_patterns.wgsl`), run on the
 //! GPU through the compute harness, against the CPU reference in
-//! `marbre::texture`, at 10,000 points per pattern.
+//! `marbre::texture`, at 10,000 points per pattern and per mapping.
 //!
 //! Patterns that switch at an edge (a cell, the mortar, a ring) may differ
 //! where the GPU's rounding puts a point on the other side of it: such a
@@ -384,5 +384,117 @@ fn waves_bump_and_ramp_match_the_cpu() {
         1e-5,
         |p| texture::ramp(&stops, p.x).extend(0.0).to_array(),
         |p| p.x.abs() < 1e-5,
+    );
+}
+
+#[test]
+fn mappings_match_the_cpu() {
+    let Some(ctx) = gpu_or_skip("mappings_match_the_cpu") else {
+        return;
+    };
+    let pts = points(2.0);
+    // Where u wraps (towards -z) the two sides differ by 1: only a point
+    // within a hair of the seam may.
+    let near_seam = |p: Vec3| p.z < 0.0 && p.x.abs() < 1e-4 * p.z.abs().max(1e-3);
+    let gpu = evaluate(&ctx, &PatternQuery::SphereUv, &pts).unwrap();
+    assert_parity(
+        "sphere uv",
+        &gpu,
+        &pts,
+        1e-4,
+        |p| texture::sphere_uv(p).extend(0.0).extend(0.0).to_array(),
+        near_seam,
+    );
+    // The poles and the centre stay finite on the GPU too.
+    let poles = [Vec3::Y, Vec3::NEG_Y, Vec3::ZERO, Vec3::new(0.0, 3.0, 0.0)];
+    for (g, p) in evaluate(&ctx, &PatternQuery::SphereUv, &poles)
+        .unwrap()
+        .iter()
+        .zip(poles)
+    {
+        assert!(g.iter().all(|c| c.is_finite()), "{p}: {g:?}");
+        assert!((g[0] - 0.5).abs() < 1e-6, "{p}: {g:?}");
+    }
+
+    let height = 1.7;
+    let gpu = evaluate(&ctx, &PatternQuery::CylinderUv { height }, &pts).unwrap();
+    assert_parity(
+        "cylinder uv",
+        &gpu,
+        &pts,
+        1e-4,
+        |p| {
+            texture::cylinder_uv(p, height)
+                .extend(0.0)
+                .extend(0.0)
+                .to_array()
+        },
+        near_seam,
+    );
+
+    let (origin, u_axis, v_axis) = (
+        Vec3::new(0.5, -1.0, 2.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 1.0),
+    );
+    let query = PatternQuery::PlaneUv {
+        origin,
+        u_axis,
+        v_axis,
+    };
+    let gpu = evaluate(&ctx, &query, &pts).unwrap();
+    assert_parity(
+        "plane uv",
+        &gpu,
+        &pts,
+        1e-4,
+        |p| {
+            texture::plane_uv(p, origin, u_axis, v_axis)
+                .extend(0.0)
+                .extend(0.0)
+                .to_array()
+        },
+        |_| false,
+    );
+
+    let vertices = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(2.0, 0.0, 0.5),
+        Vec3::new(0.3, 1.5, -0.4),
+    ];
+    let uvs = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(1.0, 0.2),
+        Vec2::new(0.4, 1.0),
+    ];
+    let gpu = evaluate(&ctx, &PatternQuery::TriangleUv { vertices, uvs }, &pts).unwrap();
+    assert_parity(
+        "triangle uv",
+        &gpu,
+        &pts,
+        1e-4,
+        |p| {
+            texture::triangle_uv(p, vertices, uvs)
+                .extend(0.0)
+                .extend(0.0)
+                .to_array()
+        },
+        |_| false,
+    );
+
+    let transform = texture::TextureTransform {
+        translate: Vec3::new(0.3, -2.0, 1.0),
+        rotate_degrees: Vec3::new(10.0, 35.0, -70.0),
+        scale: Vec3::new(0.5, 2.0, 1.5),
+    };
+    let to_texture = transform.to_texture();
+    let gpu = evaluate(&ctx, &PatternQuery::Transform { to_texture }, &pts).unwrap();
+    assert_parity(
+        "3D transform",
+        &gpu,
+        &pts,
+        1e-5,
+        |p| to_texture.transform_point3(p).extend(0.0).to_array(),
+        |_| false,
     );
 }

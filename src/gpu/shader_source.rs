@@ -48,6 +48,10 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/texture_patterns.wgsl"),
     ),
     (
+        "texture_mapping.wgsl",
+        include_str!("../../shaders/texture_mapping.wgsl"),
+    ),
+    (
         "texture_harness.wgsl",
         include_str!("../../shaders/texture_harness.wgsl"),
     ),
@@ -108,7 +112,11 @@ impl Program {
             }
             Program::TextureHarness => {
                 noise(&mut out);
-                out.extend(["texture_patterns.wgsl", "texture_harness.wgsl"]);
+                out.extend([
+                    "texture_patterns.wgsl",
+                    "texture_mapping.wgsl",
+                    "texture_harness.wgsl",
+                ]);
             }
         }
         out

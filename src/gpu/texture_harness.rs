@@ -11,7 +11,7 @@ use crate::noise::NoiseSettings;
 use crate::texture::RampStop;
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
 /// One pattern with its parameters. 2D patterns read uv from the points'
 /// x and y; `Bump` reads the unbumped normal from the point.
@@ -74,6 +74,27 @@ pub enum PatternQuery {
     /// Result: the colour at t = the point's x.
     Ramp {
         stops: Vec<RampStop>,
+    },
+    /// Result: (u, v) of the point as an offset from a sphere's centre.
+    SphereUv,
+    /// Result: (u, v) of the point as an offset from a cylinder's base.
+    CylinderUv {
+        height: f32,
+    },
+    /// Result: (u, v) in the frame origin + u·u_axis + v·v_axis.
+    PlaneUv {
+        origin: Vec3,
+        u_axis: Vec3,
+        v_axis: Vec3,
+    },
+    /// Result: the triangle's interpolated (u, v).
+    TriangleUv {
+        vertices: [Vec3; 3],
+        uvs: [Vec2; 3],
+    },
+    /// Result: the 3D texture point.
+    Transform {
+        to_texture: Affine3A,
     },
 }
 
@@ -192,6 +213,37 @@ impl PatternQuery {
                 for (slot, s) in u.stops.iter_mut().zip(stops) {
                     *slot = v3(s.color, s.position);
                 }
+            }
+            PatternQuery::SphereUv => u.mode = 11,
+            PatternQuery::CylinderUv { height } => {
+                u.mode = 12;
+                u.a[0] = *height;
+            }
+            PatternQuery::PlaneUv {
+                origin,
+                u_axis,
+                v_axis,
+            } => {
+                u.mode = 13;
+                u.a = v3(*origin, 0.0);
+                u.b = v3(*u_axis, 0.0);
+                u.c = v3(*v_axis, 0.0);
+            }
+            PatternQuery::TriangleUv { vertices, uvs } => {
+                u.mode = 14;
+                for (slot, v) in u.stops.iter_mut().zip(vertices) {
+                    *slot = v3(*v, 0.0);
+                }
+                for (slot, t) in u.stops[3..].iter_mut().zip(uvs) {
+                    *slot = v2(*t, 0.0, 0.0);
+                }
+            }
+            PatternQuery::Transform { to_texture } => {
+                u.mode = 15;
+                let (m, t) = (to_texture.matrix3, to_texture.translation);
+                u.a = v3(m.x_axis.into(), t.x);
+                u.b = v3(m.y_axis.into(), t.y);
+                u.c = v3(m.z_axis.into(), t.z);
             }
         }
         Ok(u)

@@ -1,5 +1,6 @@
 //! The texture library: the patterns of the course material as pure
-//! functions of a point (uv in 2D, p in 3D) and their parameters.
+//! functions of a point (uv in 2D, p in 3D) and their parameters, and the
+//! mappings that give a surface point those coordinates.
 //!
 //! This is the CPU reference. `shaders/texture_patterns.wgsl` mirrors every
 //! function here operation for operation; the GPU parity tests run it in a
@@ -11,6 +12,7 @@ pub mod brick;
 pub mod bump;
 pub mod checker;
 pub mod cutout;
+pub mod mapping;
 pub mod marble;
 pub mod ramp;
 pub mod waves;
@@ -20,6 +22,7 @@ pub use brick::{TileSample, brick, brick_mortar_fraction, tile};
 pub use bump::bumped_normal;
 pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
 pub use cutout::{cutout, cutout_area};
+pub use mapping::{TextureTransform, cylinder_uv, plane_uv, polygon_frame, sphere_uv, triangle_uv};
 pub use marble::marble_veins;
 pub use ramp::{RampStop, ramp};
 pub use waves::waves_gradient;
