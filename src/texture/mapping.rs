@@ -38,7 +38,8 @@ pub fn plane_uv(p: Vec3, origin: Vec3, u_axis: Vec3, v_axis: Vec3) -> Vec2 {
     let d = p - origin;
     let (uu, uv, vv) = (u_axis.dot(u_axis), u_axis.dot(v_axis), v_axis.dot(v_axis));
     let det = uu * vv - uv * uv;
-    if !(det > 1e-12 * uu * vv) {
+    // Also catches NaN axes, for which every comparison is false.
+    if det.is_nan() || det <= 1e-12 * uu * vv {
         return Vec2::ZERO;
     }
     let (du, dv) = (u_axis.dot(d), v_axis.dot(d));
