@@ -14,12 +14,13 @@ fn surface_at(hit: Hit) -> SurfacePoint {
 #if NOISE
     let signals = material_signals(hit.material, p);
 #else
-    let signals = vec3f(0.0);
+    let signals = vec4f(0.0);
 #endif
+    let textures = surface_textures(hit.material, p, hit.uv, signals);
     var s: SurfacePoint;
-    s.diffuse = eval_color(materials[hit.material].diffuse, p, signals);
-    s.specular = eval_color(materials[hit.material].specular, p, signals);
-    let r = clamp(eval_scalar(materials[hit.material].roughness, p, signals), 0.0, 1.0);
+    s.diffuse = textures.diffuse;
+    s.specular = textures.specular;
+    let r = clamp(textures.roughness, 0.0, 1.0);
     s.alpha = max(r * r, 1e-3);
     s.mirror = materials[hit.material].mirror;
     return s;

@@ -6,6 +6,9 @@ struct Hit {
     p: vec3f,
     n: vec3f,            // geometric normal, facing the ray's origin side
     texture_point: vec3f,
+    // The primitive's 2D texture coordinates: lat-long on a sphere, world
+    // (x, z) on the ground. Only computed where a 2D pattern reads them.
+    uv: vec2f,
     material: u32,
 }
 
@@ -60,6 +63,9 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
         hit.p = s.center + dir * s.radius;
         hit.n = dir;
         hit.texture_point = hit.p - s.center;
+#if TEXTURE_UV
+        hit.uv = sphere_uv(dir);
+#endif
         hit.material = index;
     }
 #if GROUND
@@ -70,6 +76,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.p = vec3f(o.x + t * d.x, frame.ground_height, o.z + t * d.z);
             hit.n = vec3f(0.0, 1.0, 0.0);
             hit.texture_point = vec3f(hit.p.x, 0.0, hit.p.z);
+            hit.uv = vec2f(hit.p.x, hit.p.z);
             hit.material = frame.sphere_count;
         }
     }

@@ -27,26 +27,12 @@ struct Frame {
     has_ground: u32,
 }
 
-struct Texture {
-    kind: u32,        // 0 constant, 1 checker, 2 fBm, 3 turbulence, 4 marble
-    // Which of the material's noise signals a noise pattern reads.
-    signal: u32,
-    // Checker: cell size. Marble: stripe frequency.
-    param: f32,
-    _pad: f32,
-    a: vec4f,
-    b: vec4f,
-}
-
-const MAX_SIGNALS: u32 = 3u;
+const MAX_SIGNALS: u32 = 4u;
 
 struct Material {
     // The distinct fractal sums the material's textures read, each evaluated
     // once per hit (see textures.wgsl).
-    signals: array<NoiseParams, 3>,
-    diffuse: Texture,
-    specular: Texture,
-    roughness: Texture,
+    signals: array<NoiseParams, 4>,
     signal_count: u32,
     // Signals before this index are gradient noise, from it on Perlin noise.
     first_perlin: u32,
@@ -67,3 +53,6 @@ const MAX_SPHERES: u32 = 63u;
 @group(0) @binding(1) var<uniform> spheres: array<Sphere, 63>;
 // The spheres' materials, then the ground's.
 @group(0) @binding(2) var<uniform> materials: array<Material, 64>;
+// The numbers of the scene's texture trees, read at constant indices by the
+// generated texture functions (Rust: gpu::texture_codegen).
+@group(0) @binding(7) var<uniform> texture_params: array<vec4f, 1024>;

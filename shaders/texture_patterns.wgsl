@@ -1,6 +1,7 @@
 // The texture library's patterns; twin of src/texture/ (the CPU reference).
 // Each is a pure function of a point and its parameters: where the point
-// falls (which child, which cell-local point) or how the surface tilts.
+// falls (which child, which cell-local point). Each pattern is compiled in
+// only when the scene uses it (its PATTERN_* feature).
 
 // Where a 2D point falls in a board of cells: `select` 0 for the first
 // child, 1 for the second, and the point in the cell's own [0, 1)² space.
@@ -14,18 +15,23 @@ fn odd(n: f32) -> f32 {
     return n - 2.0 * floor(n * 0.5);
 }
 
+#if PATTERN_CHECKER_2D
 fn checker_2d(uv: vec2f, size: vec2f, phase: f32) -> Cell {
     let row = floor(uv.y / size.y);
     let x = uv.x / size.x + phase * odd(row);
     let column = floor(x);
     return Cell(odd(column + row), vec2f(x - column, uv.y / size.y - row));
 }
+#endif
 
+#if PATTERN_CHECKER
 fn checker_3d(p: vec3f, size: vec3f) -> f32 {
     let c = floor(p / size);
     return odd(c.x + c.y + c.z);
 }
+#endif
 
+#if PATTERN_CHECKER_2D
 // How much of [0, x] lies in odd unit cells.
 fn odd_measure(x: f32) -> f32 {
     let half = floor(x * 0.5);
@@ -47,7 +53,9 @@ fn filtered_checker_2d(uv: vec2f, size: vec2f, phase: f32, half_width: vec2f) ->
     let sy = odd_fraction(uv.y / size.y, half_width.y / size.y);
     return sx + sy - 2.0 * sx * sy;
 }
+#endif
 
+#if PATTERN_BRICK
 fn brick(uv: vec2f, size: vec2f, mortar: f32, row_offset: f32) -> Cell {
     let row = floor(uv.y / size.y);
     let x = uv.x / size.x + row_offset * odd(row);
@@ -56,7 +64,9 @@ fn brick(uv: vec2f, size: vec2f, mortar: f32, row_offset: f32) -> Cell {
     let on_brick = from_edge.x >= 0.5 * mortar && from_edge.y >= 0.5 * mortar;
     return Cell(select(0.0, 1.0, on_brick), local);
 }
+#endif
 
+#if PATTERN_TILE
 struct TileSample {
     select: f32,
     height_gradient: vec2f,
@@ -74,7 +84,9 @@ fn tile(uv: vec2f, mortar_half_width: f32, bevel_width: f32, bevel_height: f32) 
     let gradient = select(vec2f(0.0, slope * inward.y), vec2f(slope * inward.x, 0.0), along_u);
     return TileSample(select(0.0, 1.0, on_tile), select(vec2f(0.0), gradient, on_bevel));
 }
+#endif
 
+#if PATTERN_CUTOUT
 fn cutout(uv: vec2f, sides: u32, radius: f32) -> f32 {
     let q = uv - floor(uv) - 0.5;
     let r = length(q);
@@ -87,51 +99,25 @@ fn cutout(uv: vec2f, sides: u32, radius: f32) -> f32 {
     let apothem = radius * cos(PI / f32(sides));
     return select(0.0, 1.0, r * cos(folded) <= apothem);
 }
+#endif
+
+#if PATTERN_WOOD
+// The report's ring axis: tilted 15° from z towards x (texture::default_axis).
+const WOOD_AXIS = vec3f(0.25881904, 0.0, 0.9659258);
 
 fn wood(p: vec3f, axis: vec3f, ring_width: f32, turbulence_amount: f32, n: NoiseParams) -> f32 {
-    let radius = length(p - dot(p, axis) * axis);
-    let perturbed = radius + turbulence_amount * turbulence(p, n);
-    return odd(floor(perturbed / ring_width));
+    return wood_rings(p, axis, ring_width, turbulence_amount * turbulence(p, n));
 }
 
+// wood() given its radius perturbation, shared as a signal by the renderer.
+fn wood_rings(p: vec3f, axis: vec3f, ring_width: f32, perturbation: f32) -> f32 {
+    let radius = length(p - dot(p, axis) * axis);
+    return odd(floor((radius + perturbation) / ring_width));
+}
+#endif
+
+#if PATTERN_VEINS
 fn marble_veins(p: vec3f, axis: vec3f, frequency: f32, turbulence_amount: f32, n: NoiseParams) -> f32 {
     return max(sin(frequency * dot(axis, p) + turbulence_amount * turbulence(p, n)), 0.0);
 }
-
-fn waves_gradient(uv: vec2f, frequency: f32, amplitude: f32, direction: vec2f) -> vec2f {
-    let phase = TWO_PI * frequency * dot(direction, uv);
-    return amplitude * TWO_PI * frequency * cos(phase) * direction;
-}
-
-fn bump_along(dp: vec3f, dh: f32) -> vec3f {
-    let len2 = dot(dp, dp);
-    return select(vec3f(0.0), dp * (dh / len2), len2 > 0.0);
-}
-
-// Blinn's bump: the normal tilted by the height gradient over uv; a zero or
-// non-finite result (tested on the bits) falls back to the normal.
-fn bumped_normal(n: vec3f, dp_du: vec3f, dp_dv: vec3f, dh_du: f32, dh_dv: f32) -> vec3f {
-    let tilted = n - bump_along(dp_du, dh_du) - bump_along(dp_dv, dh_dv);
-    let len = length(tilted);
-    let usable = len > 0.0 && !is_non_finite(len);
-    return select(n, tilted / len, usable);
-}
-
-// A colour ramp of `count` stops (position in w, colour in xyz), sorted.
-const MAX_RAMP_STOPS: u32 = 8u;
-
-fn ramp(stops: array<vec4f, 8>, count: u32, t: f32) -> vec3f {
-    let n = min(count, MAX_RAMP_STOPS);
-    if n == 0u {
-        return vec3f(0.0);
-    }
-    var color = stops[0].xyz;
-    for (var i = 1u; i < n; i++) {
-        let a = stops[i - 1u];
-        let b = stops[i];
-        let span = b.w - a.w;
-        let w = select(1.0, (t - a.w) / span, span > 0.0);
-        color = select(color, mix(a.xyz, b.xyz, clamp(w, 0.0, 1.0)), t > a.w);
-    }
-    return color;
-}
+#endif

@@ -9,8 +9,8 @@
 
 use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::{
-    EnvSource, Environment, Material, OrbitCamera, Pattern, PointLight, RenderSettings, Scene,
-    ToneMap,
+    Child, EnvSource, Environment, Material, OrbitCamera, Pattern, PointLight, RenderSettings,
+    Scene, Texture, ToneMap,
 };
 use egui::emath::Numeric;
 use egui::{
@@ -261,54 +261,113 @@ fn material_ui(ui: &mut Ui, m: &mut Material) {
         ui,
         "diffuse",
         "Lambert colour: the light scattered evenly in all directions",
-        &mut m.diffuse.pattern,
-        [&mut m.diffuse.a, &mut m.diffuse.b],
-        labelled_color,
+        &mut m.diffuse,
+        ValueKind::Color,
+        1,
     );
     texture_ui(
         ui,
         "specular",
         "GGX reflectance at normal incidence (about 0.04 for plastics and stone)",
-        &mut m.specular.pattern,
-        [&mut m.specular.a, &mut m.specular.b],
-        labelled_color,
+        &mut m.specular,
+        ValueKind::Color,
+        1,
     );
     texture_ui(
         ui,
         "roughness",
         "GGX roughness: 0 is polished, 1 is matte",
-        &mut m.roughness.pattern,
-        [&mut m.roughness.a, &mut m.roughness.b],
-        |ui, v, label| ui.add(slider(v, 0.0..=1.0, label)),
+        &mut m.roughness,
+        ValueKind::Scalar,
+        1,
     );
     ui.add(slider(&mut m.mirror, 0.0..=1.0, "mirror"))
         .on_hover_text("Fraction of the light reflected by a perfect mirror, on top of GGX");
 }
 
-/// A colour or scalar texture: its pattern, then its two values, edited by
-/// `value_ui` (a constant pattern only uses the first).
-fn texture_ui<T>(
+/// What a property's values are: colours, or scalars (the first channel).
+#[derive(Clone, Copy, PartialEq)]
+enum ValueKind {
+    Color,
+    Scalar,
+}
+
+/// A texture: its pattern, then its two children (a constant pattern only
+/// uses the first). `depth` is 1 for a property's own texture.
+fn texture_ui(
     ui: &mut Ui,
     title: &str,
     hint: &str,
-    pattern: &mut Pattern,
-    [a, b]: [&mut T; 2],
-    value_ui: impl Fn(&mut Ui, &mut T, &str) -> Response,
+    texture: &mut Texture,
+    kind: ValueKind,
+    depth: usize,
 ) {
     ui.push_id(title, |ui| {
         let header = CollapsingHeader::new(title)
             .id_salt("texture")
-            .default_open(true)
+            .default_open(depth == 1)
             .show(ui, |ui| {
-                pattern_ui(ui, pattern);
-                if *pattern == Pattern::Constant {
-                    value_ui(ui, a, "value").on_hover_text("The value everywhere");
+                pattern_ui(ui, &mut texture.pattern);
+                if texture.pattern == Pattern::Constant {
+                    child_ui(ui, "value", &mut texture.a, kind, depth);
                 } else {
-                    value_ui(ui, a, "a (t = 0)").on_hover_text("The value where the pattern is 0");
-                    value_ui(ui, b, "b (t = 1)").on_hover_text("The value where the pattern is 1");
+                    child_ui(ui, "a (t = 0)", &mut texture.a, kind, depth);
+                    child_ui(ui, "b (t = 1)", &mut texture.b, kind, depth);
                 }
             });
         header.header_response.on_hover_text(hint);
+    });
+}
+
+/// One side of a blend: its value, or (ticked "texture") a nested texture
+/// edited in place. Unticking keeps the nested texture's colour at the
+/// origin as the value.
+fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth: usize) {
+    ui.push_id(label, |ui| {
+        ui.horizontal(|ui| {
+            let mut nested = matches!(child, Child::Texture(_));
+            let can_nest = depth < Texture::MAX_DEPTH;
+            if (can_nest || nested)
+                && ui
+                    .checkbox(&mut nested, "texture")
+                    .on_hover_text(
+                        "Nest a whole texture here (a checker of marbles, bricks of noise)",
+                    )
+                    .changed()
+            {
+                *child = if nested {
+                    Child::Texture(Box::new(Texture::blend(
+                        Pattern::Checker2d {
+                            size: glam::Vec2::splat(0.5),
+                            phase: 0.0,
+                        },
+                        child.clone(),
+                        child.clone(),
+                    )))
+                } else {
+                    let c = child.eval(Vec3::ZERO, glam::Vec2::ZERO);
+                    match kind {
+                        ValueKind::Color => Child::Color(c),
+                        ValueKind::Scalar => Child::Scalar(c.x),
+                    }
+                };
+            }
+            match child {
+                Child::Color(c) if kind == ValueKind::Color => {
+                    labelled_color(ui, c, label);
+                }
+                Child::Color(c) => {
+                    ui.add(slider(&mut c.x, 0.0..=1.0, label));
+                }
+                Child::Scalar(v) => {
+                    ui.add(slider(v, 0.0..=1.0, label));
+                }
+                Child::Texture(_) => {}
+            }
+        });
+        if let Child::Texture(t) = child {
+            texture_ui(ui, label, "A nested texture", t, kind, depth + 1);
+        }
     });
 }
 
@@ -338,6 +397,57 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
                 .on_hover_text(
                     "t = 0.5 + 0.5·sin(x · stripe frequency + fBm): veins per 2π units along x",
                 );
+        }
+        Pattern::Checker2d { size, phase } => {
+            ui.add(slider(&mut size.x, 0.01..=4.0, "cell width (u)").logarithmic(true))
+                .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
+            ui.add(slider(&mut size.y, 0.01..=4.0, "cell height (v)").logarithmic(true));
+            ui.add(slider(phase, 0.0..=1.0, "row phase"))
+                .on_hover_text("Shift of every other row, in cells: 0.5 lays them like bricks");
+        }
+        Pattern::Brick {
+            size,
+            mortar,
+            row_offset,
+        } => {
+            ui.add(slider(&mut size.x, 0.01..=4.0, "brick width (u)").logarithmic(true));
+            ui.add(slider(&mut size.y, 0.01..=4.0, "brick height (v)").logarithmic(true));
+            ui.add(slider(mortar, 0.0..=0.2, "mortar width"))
+                .on_hover_text(
+                    "Width of the joints, in (u, v) units; a is the mortar, b the bricks",
+                );
+            ui.add(slider(row_offset, 0.0..=1.0, "row offset"));
+        }
+        Pattern::Tile { mortar_half_width } => {
+            ui.add(slider(mortar_half_width, 0.0..=0.5, "mortar half-width"))
+                .on_hover_text("One tile per unit (u, v) square: lay it in a checker cell");
+        }
+        Pattern::Cutout { sides, radius } => {
+            ui.add(Slider::new(sides, 0..=12).text("sides"))
+                .on_hover_text("A regular polygon; below 3, a disc. a is outside, b inside");
+            ui.add(slider(radius, 0.0..=0.71, "radius"));
+        }
+        Pattern::Wood {
+            noise,
+            ring_width,
+            turbulence_amount,
+        } => {
+            ui.add(slider(ring_width, 0.01..=1.0, "ring width").logarithmic(true));
+            ui.add(slider(turbulence_amount, 0.0..=2.0, "turbulence"))
+                .on_hover_text("How far turbulence moves the rings; a dark, b pale");
+            noise_ui(ui, noise);
+        }
+        Pattern::Veins {
+            noise,
+            frequency,
+            turbulence_amount,
+        } => {
+            ui.add(slider(frequency, 0.0..=32.0, "frequency"))
+                .on_hover_text(
+                    "t = max(0, sin(frequency · x + turbulence · T(p))): a dominant, b veins",
+                );
+            ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"));
+            noise_ui(ui, noise);
         }
     }
 }
@@ -580,18 +690,18 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{ColorTexture, Ground, Sphere};
+    use crate::scene::{Ground, Sphere};
 
     fn marble_scene() -> Scene {
         let mut sphere = Sphere::default();
-        sphere.material.diffuse = ColorTexture {
-            pattern: Pattern::Marble {
+        sphere.material.diffuse = Texture::blend(
+            Pattern::Marble {
                 noise: NoiseSettings::default(),
                 stripe_frequency: 4.0,
             },
-            a: Vec3::new(0.9, 0.88, 0.85),
-            b: Vec3::new(0.2, 0.25, 0.3),
-        };
+            Vec3::new(0.9, 0.88, 0.85),
+            Vec3::new(0.2, 0.25, 0.3),
+        );
         Scene {
             spheres: vec![sphere],
             ground: Some(Ground::default()),

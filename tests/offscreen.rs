@@ -4,10 +4,7 @@ use glam::Vec3;
 use marbre::commands::session::accumulate;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{
-    ColorTexture, EnvSource, Ground, Material, OrbitCamera, PointLight, ScalarTexture, Scene,
-    Sphere,
-};
+use marbre::scene::{EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, Sphere, Texture};
 
 fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
     render_with(ctx, scene, size, spp, None)
@@ -33,9 +30,9 @@ fn render_with(
 
 fn lambert(albedo: f32) -> Material {
     Material {
-        diffuse: ColorTexture::constant(Vec3::splat(albedo)),
-        specular: ColorTexture::constant(Vec3::ZERO),
-        roughness: ScalarTexture::constant(1.0),
+        diffuse: Texture::color(Vec3::splat(albedo)),
+        specular: Texture::color(Vec3::ZERO),
+        roughness: Texture::scalar(1.0),
         mirror: 0.0,
     }
 }

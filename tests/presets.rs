@@ -8,10 +8,11 @@ use marbre::commands::session::{accumulate, load_scene};
 use marbre::gpu::pipelines::validate;
 use marbre::gpu::shader_source::{Program, assemble};
 use marbre::gpu::testing::gpu_or_skip;
+use marbre::gpu::texture_codegen::generate;
 use marbre::gpu::{Feature, FeatureSet, Renderer};
 use marbre::noise::{HashKind, NoiseKind, NoiseSettings};
 use marbre::preset::{self, Preset, PresetError};
-use marbre::scene::{ColorTexture, EnvSource, Ground, Pattern, Scene, Sphere};
+use marbre::scene::{EnvSource, Ground, Pattern, Scene, Sphere, Texture};
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
 
@@ -224,10 +225,12 @@ fn to_text_writes_the_environment_path_relative_to_the_preset() {
 // ---------------------------------------------------------------------------
 // Shader specialisation
 
-/// Every program assembles and validates with naga for `features`.
-fn assert_validates(features: &FeatureSet, what: &str) {
+/// Every program assembles and validates with naga for `features`, the
+/// trace program with the texture code generated from `scene`.
+fn assert_validates(features: &FeatureSet, scene: &Scene, what: &str) {
+    let textures = generate(scene).unwrap();
     for program in [Program::Trace, Program::Display] {
-        let source = assemble(program, features)
+        let source = assemble(program, features, &textures.wgsl)
             .unwrap_or_else(|e| panic!("{what}: {program:?} does not assemble: {e}"));
         if let Err(e) = validate(&source) {
             panic!(
@@ -243,30 +246,44 @@ fn every_shipped_preset_specialisation_validates() {
     for path in shipped_presets() {
         let p = load(&path);
         let features = FeatureSet::for_scene(&p.scene);
-        assert_validates(&features, &path.display().to_string());
+        assert_validates(&features, &p.scene, &path.display().to_string());
     }
 }
 
 #[test]
 fn the_uber_shader_validates() {
-    assert_validates(&FeatureSet::all(), "the uber shader");
+    assert_validates(&FeatureSet::all(), &Scene::default(), "the uber shader");
+    for path in shipped_presets() {
+        let p = load(&path);
+        assert_validates(&FeatureSet::all(), &p.scene, &path.display().to_string());
+    }
 }
 
 #[test]
 fn the_empty_feature_set_validates() {
-    assert_validates(&FeatureSet::default(), "the empty feature set");
+    assert_validates(
+        &FeatureSet::default(),
+        &Scene::default(),
+        "the empty feature set",
+    );
 }
 
 #[test]
 fn every_single_feature_set_validates() {
     for f in Feature::ALL {
         let set = FeatureSet([f].into_iter().collect());
-        assert_validates(&set, &format!("{{{f:?}}}"));
+        assert_validates(&set, &Scene::default(), &format!("{{{f:?}}}"));
     }
 }
 
 fn trace_source(scene: &Scene) -> String {
-    assemble(Program::Trace, &FeatureSet::for_scene(scene)).unwrap()
+    let textures = generate(scene).unwrap();
+    assemble(
+        Program::Trace,
+        &FeatureSet::for_scene(scene),
+        &textures.wgsl,
+    )
+    .unwrap()
 }
 
 fn noise(kind: NoiseKind) -> NoiseSettings {
@@ -280,7 +297,7 @@ fn noise(kind: NoiseKind) -> NoiseSettings {
 /// A marble sphere on a ground plane, its noise of the given kind.
 fn marble_scene(kind: NoiseKind) -> Scene {
     let mut sphere = Sphere::default();
-    sphere.material.diffuse = ColorTexture {
+    sphere.material.diffuse = Texture {
         pattern: Pattern::Marble {
             noise: noise(kind),
             stripe_frequency: 4.0,
@@ -296,7 +313,12 @@ fn marble_scene(kind: NoiseKind) -> Scene {
 
 #[test]
 fn specialisation_removes_code() {
-    let uber = assemble(Program::Trace, &FeatureSet::all()).unwrap();
+    let uber = assemble(
+        Program::Trace,
+        &FeatureSet::all(),
+        &generate(&Scene::default()).unwrap().wgsl,
+    )
+    .unwrap();
     assert!(
         uber.contains("fn perlin_noise"),
         "the uber shader has Perlin noise"

@@ -26,7 +26,7 @@ pub fn run(
         return Ok(Vec::new());
     }
     let device = &ctx.device;
-    let module = shader_module(device, program, features)?;
+    let module = shader_module(device, program, features, "")?;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("compute harness"),
         entries: &[

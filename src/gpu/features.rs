@@ -15,6 +15,12 @@ pub enum Feature {
     PatternFbm,
     PatternTurbulence,
     PatternMarble,
+    PatternChecker2d,
+    PatternBrick,
+    PatternTile,
+    PatternCutout,
+    PatternWood,
+    PatternVeins,
     NoiseGradient,
     NoisePerlin,
     HashPcg,
@@ -22,7 +28,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 12] = [
+    pub const ALL: [Feature; 18] = [
         Feature::Ground,
         Feature::PointLight,
         Feature::EnvMap,
@@ -31,6 +37,12 @@ impl Feature {
         Feature::PatternFbm,
         Feature::PatternTurbulence,
         Feature::PatternMarble,
+        Feature::PatternChecker2d,
+        Feature::PatternBrick,
+        Feature::PatternTile,
+        Feature::PatternCutout,
+        Feature::PatternWood,
+        Feature::PatternVeins,
         Feature::NoiseGradient,
         Feature::NoisePerlin,
         Feature::HashPcg,
@@ -48,6 +60,12 @@ impl Feature {
             Feature::PatternFbm => "PATTERN_FBM",
             Feature::PatternTurbulence => "PATTERN_TURBULENCE",
             Feature::PatternMarble => "PATTERN_MARBLE",
+            Feature::PatternChecker2d => "PATTERN_CHECKER_2D",
+            Feature::PatternBrick => "PATTERN_BRICK",
+            Feature::PatternTile => "PATTERN_TILE",
+            Feature::PatternCutout => "PATTERN_CUTOUT",
+            Feature::PatternWood => "PATTERN_WOOD",
+            Feature::PatternVeins => "PATTERN_VEINS",
             Feature::NoiseGradient => "NOISE_GRADIENT",
             Feature::NoisePerlin => "NOISE_PERLIN",
             Feature::HashPcg => "HASH_PCG",
@@ -72,11 +90,21 @@ impl FeatureSet {
     }
 
     /// The `#if` names: one per feature, plus `NOISE` when any noise kind
-    /// is in (the code shared by every fractal sum).
+    /// is in (the code shared by every fractal sum) and `TEXTURE_UV` when a
+    /// pattern reads the surface's (u, v).
     pub fn defines(&self) -> BTreeSet<&'static str> {
         let mut names: BTreeSet<_> = self.0.iter().map(|f| f.define()).collect();
         if self.contains(Feature::NoiseGradient) || self.contains(Feature::NoisePerlin) {
             names.insert("NOISE");
+        }
+        let uv_patterns = [
+            Feature::PatternChecker2d,
+            Feature::PatternBrick,
+            Feature::PatternTile,
+            Feature::PatternCutout,
+        ];
+        if uv_patterns.iter().any(|&f| self.contains(f)) {
+            names.insert("TEXTURE_UV");
         }
         names
     }
@@ -109,6 +137,22 @@ impl FeatureSet {
     pub fn for_noise(kind: NoiseKind, hash: HashKind) -> Self {
         Self(noise_features(kind, hash).into_iter().collect())
     }
+
+    /// For the texture harness: every pattern, and the noise `kind`/`hash`
+    /// their turbulence uses.
+    pub fn for_texture_library(kind: NoiseKind, hash: HashKind) -> Self {
+        let mut set = Self::for_noise(kind, hash);
+        set.0.extend([
+            Feature::PatternChecker,
+            Feature::PatternChecker2d,
+            Feature::PatternBrick,
+            Feature::PatternTile,
+            Feature::PatternCutout,
+            Feature::PatternWood,
+            Feature::PatternVeins,
+        ]);
+        set
+    }
 }
 
 fn noise_features(kind: NoiseKind, hash: HashKind) -> Vec<Feature> {
@@ -126,6 +170,12 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
         Pattern::Fbm { .. } => vec![Feature::PatternFbm],
         Pattern::Turbulence { .. } => vec![Feature::PatternTurbulence],
         Pattern::Marble { .. } => vec![Feature::PatternMarble],
+        Pattern::Checker2d { .. } => vec![Feature::PatternChecker2d],
+        Pattern::Brick { .. } => vec![Feature::PatternBrick],
+        Pattern::Tile { .. } => vec![Feature::PatternTile],
+        Pattern::Cutout { .. } => vec![Feature::PatternCutout],
+        Pattern::Wood { .. } => vec![Feature::PatternWood],
+        Pattern::Veins { .. } => vec![Feature::PatternVeins],
     };
     if let Some(n) = p.noise() {
         out.extend(noise_features(n.kind, n.hash));
@@ -137,7 +187,7 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
 mod tests {
     use super::*;
     use crate::noise::NoiseSettings;
-    use crate::scene::{ColorTexture, Sphere};
+    use crate::scene::{Sphere, Texture};
 
     #[test]
     fn an_empty_scene_needs_nothing() {
@@ -148,7 +198,7 @@ mod tests {
     fn a_perlin_marble_needs_marble_and_perlin_only() {
         let mut scene = Scene::default();
         let mut sphere = Sphere::default();
-        sphere.material.diffuse = ColorTexture {
+        sphere.material.diffuse = Texture {
             pattern: Pattern::Marble {
                 noise: NoiseSettings {
                     kind: NoiseKind::Perlin,

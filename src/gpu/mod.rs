@@ -13,6 +13,7 @@ pub mod renderer;
 pub mod scene_gpu;
 pub mod shader_source;
 pub mod testing;
+pub mod texture_codegen;
 pub mod texture_harness;
 
 pub use context::GpuContext;

@@ -11,8 +11,9 @@ pub fn shader_module(
     device: &wgpu::Device,
     program: Program,
     features: &FeatureSet,
+    generated_textures: &str,
 ) -> Result<wgpu::ShaderModule> {
-    let source = assemble(program, features)?;
+    let source = assemble(program, features, generated_textures)?;
     validate(&source).map_err(|e| anyhow!("{program:?} shader: {e}"))?;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

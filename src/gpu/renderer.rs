@@ -10,6 +10,7 @@ use super::pipelines::{
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
 use super::shader_source::Program;
+use super::texture_codegen;
 use crate::envmap::EnvImage;
 use crate::scene::{Scene, ToneMap};
 use anyhow::Result;
@@ -63,6 +64,10 @@ pub struct Renderer {
     sphere_buffer: wgpu::Buffer,
     material_buffer: wgpu::Buffer,
     perm_buffer: wgpu::Buffer,
+    texture_param_buffer: wgpu::Buffer,
+    /// The generated texture code the trace pipeline was built with: a
+    /// scene whose code differs needs a new pipeline.
+    texture_code: String,
     env_view: wgpu::TextureView,
     env_sampler: wgpu::Sampler,
     accumulation: Accumulation,
@@ -94,14 +99,17 @@ impl Renderer {
                 ),
                 entry(5, float_texture(false)),
                 entry(6, uniform()),
+                entry(7, uniform()),
             ],
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
             entries: &[entry(0, uniform()), entry(1, float_texture(false))],
         });
-        let trace_pipeline = Self::build_trace_pipeline(ctx, &trace_layout, &features)?;
-        let display_module = shader_module(device, Program::Display, &FeatureSet::default())?;
+        let textures = texture_codegen::generate(scene)?;
+        let trace_pipeline =
+            Self::build_trace_pipeline(ctx, &trace_layout, &features, &textures.wgsl)?;
+        let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -134,6 +142,11 @@ impl Renderer {
             bytemuck::cast_slice(&permutation_table()),
             wgpu::BufferUsages::UNIFORM,
         );
+        let texture_param_buffer = buffer(
+            "texture parameters",
+            bytemuck::cast_slice(&textures.params),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let env_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
             // Repeat in u: bilinear filtering wraps across the u = 0/1 seam.
@@ -159,6 +172,8 @@ impl Renderer {
             sphere_buffer,
             material_buffer,
             perm_buffer,
+            texture_param_buffer,
+            texture_code: textures.wgsl,
             env_view,
             env_sampler,
             accumulation,
@@ -173,8 +188,9 @@ impl Renderer {
         ctx: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         features: &FeatureSet,
+        texture_code: &str,
     ) -> Result<wgpu::RenderPipeline> {
-        let module = shader_module(&ctx.device, Program::Trace, features)?;
+        let module = shader_module(&ctx.device, Program::Trace, features, texture_code)?;
         fullscreen_pipeline(
             &ctx.device,
             "trace",
@@ -209,18 +225,26 @@ impl Renderer {
     }
 
     /// Applies an edited scene. Parameter edits only rewrite buffers; an edit
-    /// that changes the feature set rebuilds the trace pipeline. If that
-    /// build fails, the previous pipeline and scene stay and the error is
-    /// returned for display.
+    /// that changes the feature set or the texture trees' structure rebuilds
+    /// the trace pipeline. If that build fails, the previous pipeline and
+    /// scene stay and the error is returned for display.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
         let features = self
             .feature_override
             .clone()
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
-        if features != self.features {
-            self.trace_pipeline = Self::build_trace_pipeline(ctx, &self.trace_layout, &features)?;
+        let textures = texture_codegen::generate(scene)?;
+        if features != self.features || textures.wgsl != self.texture_code {
+            self.trace_pipeline =
+                Self::build_trace_pipeline(ctx, &self.trace_layout, &features, &textures.wgsl)?;
             self.features = features;
+            self.texture_code = textures.wgsl;
         }
+        ctx.queue.write_buffer(
+            &self.texture_param_buffer,
+            0,
+            bytemuck::cast_slice(&textures.params),
+        );
         // Fixed-size arrays: the buffers never grow.
         let spheres = scene_gpu::spheres(scene);
         let materials = scene_gpu::materials(scene);
@@ -313,6 +337,7 @@ impl Renderer {
                     wgpu::BindingResource::TextureView(&self.accumulation.views[read]),
                 ),
                 bind(6, self.perm_buffer.as_entire_binding()),
+                bind(7, self.texture_param_buffer.as_entire_binding()),
             ],
         });
         {

@@ -1,7 +1,9 @@
 //! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
 
+use super::texture_codegen;
 use crate::noise::{HashKind, NoiseKind, NoiseSettings};
-use crate::scene::{EnvSource, MAX_SPHERES, Material, Pattern, Scene};
+use crate::scene::material::MAX_SIGNALS;
+use crate::scene::{EnvSource, MAX_SPHERES, Material, Scene};
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
@@ -63,26 +65,8 @@ impl NoiseParamsGpu {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct TextureGpu {
-    pub kind: u32,
-    pub signal: u32,
-    pub param: f32,
-    pub _pad: f32,
-    pub a: [f32; 4],
-    pub b: [f32; 4],
-}
-
-/// Noise signals a material may read; `MAX_SIGNALS` in `shaders/scene.wgsl`.
-/// Three textures read at most three distinct sums.
-pub const MAX_SIGNALS: usize = 3;
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct MaterialGpu {
     pub signals: [NoiseParamsGpu; MAX_SIGNALS],
-    pub diffuse: TextureGpu,
-    pub specular: TextureGpu,
-    pub roughness: TextureGpu,
     pub signal_count: u32,
     /// Signals before this index are gradient noise, from it on Perlin.
     pub first_perlin: u32,
@@ -111,47 +95,15 @@ pub fn hash_id(h: HashKind) -> u32 {
     }
 }
 
-/// The fractal sum a pattern reads, if any. Marble reads a plain fBm.
-fn signal_of(pattern: &Pattern) -> Option<NoiseParamsGpu> {
-    let absolute = matches!(pattern, Pattern::Turbulence { .. });
-    pattern.noise().map(|n| NoiseParamsGpu::new(n, absolute))
-}
-
-fn texture(pattern: &Pattern, a: [f32; 3], b: [f32; 3], signal: u32) -> TextureGpu {
-    TextureGpu {
-        kind: pattern.index() as u32,
-        signal,
-        param: match *pattern {
-            Pattern::Checker { size } => size,
-            Pattern::Marble {
-                stripe_frequency, ..
-            } => stripe_frequency,
-            _ => 0.0,
-        },
-        _pad: 0.0,
-        a: [a[0], a[1], a[2], 0.0],
-        b: [b[0], b[1], b[2], 0.0],
-    }
-}
-
-/// A material's textures with their noise signals deduplicated (two
-/// textures reading the same fractal sum, like rust's diffuse and specular
-/// colours, share one evaluation per hit) and ordered by noise kind, gradient
-/// first, as `material_signals` in `shaders/textures.wgsl` expects.
+/// A material's noise signals (its textures' distinct fractal sums,
+/// deduplicated so that rust's diffuse and specular colours share one
+/// evaluation per hit, gradient noise first) and its mirror fraction. The
+/// textures themselves are generated code (`texture_codegen`).
 pub fn material(m: &Material) -> MaterialGpu {
-    let patterns = m.patterns();
-    let mut signals: Vec<NoiseParamsGpu> = Vec::with_capacity(MAX_SIGNALS);
-    for signal in patterns.iter().filter_map(|p| signal_of(p)) {
-        if !signals.contains(&signal) {
-            signals.push(signal);
-        }
-    }
-    signals.sort_by_key(|s| s.kind);
-    let slot = |pattern: &Pattern| -> u32 {
-        signal_of(pattern)
-            .and_then(|signal| signals.iter().position(|s| *s == signal))
-            .map_or(0, |i| i as u32)
-    };
+    let signals: Vec<NoiseParamsGpu> = texture_codegen::material_signals(m)
+        .iter()
+        .map(|(noise, absolute)| NoiseParamsGpu::new(noise, *absolute))
+        .collect();
     let mut out = MaterialGpu {
         signal_count: signals.len() as u32,
         first_perlin: signals
@@ -162,15 +114,6 @@ pub fn material(m: &Material) -> MaterialGpu {
         ..Default::default()
     };
     out.signals[..signals.len()].copy_from_slice(&signals);
-    let (d, sp, r) = (&m.diffuse, &m.specular, &m.roughness);
-    out.diffuse = texture(&d.pattern, d.a.to_array(), d.b.to_array(), slot(&d.pattern));
-    out.specular = texture(
-        &sp.pattern,
-        sp.a.to_array(),
-        sp.b.to_array(),
-        slot(&sp.pattern),
-    );
-    out.roughness = texture(&r.pattern, [r.a; 3], [r.b; 3], slot(&r.pattern));
     out
 }
 
@@ -250,22 +193,25 @@ pub fn frame_uniform(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::{Pattern, Texture};
+    use glam::Vec3;
 
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
         assert_eq!(std::mem::size_of::<FrameUniform>(), 144);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 32);
-        assert_eq!(std::mem::size_of::<TextureGpu>(), 48);
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 256);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 144);
         assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
     }
 
     /// The element count of a uniform array global in the trace shader.
     fn wgsl_array_len(name: &str) -> u32 {
+        let generated = texture_codegen::generate(&Scene::default()).unwrap();
         let source = crate::gpu::shader_source::assemble(
             crate::gpu::shader_source::Program::Trace,
             &crate::gpu::features::FeatureSet::all(),
+            &generated.wgsl,
         )
         .unwrap();
         let module = naga::front::wgsl::parse_str(&source).unwrap();
@@ -292,13 +238,14 @@ mod tests {
             materials(&scene).len()
         );
         assert_eq!(spheres(&scene).len(), MAX_SPHERES);
+        assert_eq!(
+            wgsl_array_len("texture_params") as usize,
+            texture_codegen::generate(&scene).unwrap().params.len()
+        );
     }
 
-    fn fbm_texture(noise: NoiseSettings) -> crate::scene::ColorTexture {
-        crate::scene::ColorTexture {
-            pattern: Pattern::Fbm { noise },
-            ..Default::default()
-        }
+    fn fbm_texture(noise: NoiseSettings) -> Texture {
+        Texture::blend(Pattern::Fbm { noise }, Vec3::ZERO, Vec3::ONE)
     }
 
     #[test]
@@ -313,8 +260,6 @@ mod tests {
         let gpu = material(&m);
         // fBm once for both colours; turbulence, |noise|, is another sum.
         assert_eq!(gpu.signal_count, 2);
-        assert_eq!((gpu.diffuse.signal, gpu.specular.signal), (0, 0));
-        assert_eq!(gpu.roughness.signal, 1);
         assert_eq!(gpu.signals[0].absolute, 0);
         assert_eq!(gpu.signals[1].absolute, 1);
     }
@@ -332,12 +277,14 @@ mod tests {
         };
         let gpu = material(&m);
         assert_eq!((gpu.signal_count, gpu.first_perlin), (2, 1));
-        assert_eq!(gpu.signals[gpu.diffuse.signal as usize].kind, 1);
-        assert_eq!(gpu.signals[gpu.specular.signal as usize].kind, 0);
+        assert_eq!(gpu.signals[0].kind, 0);
+        assert_eq!(gpu.signals[1].kind, 1);
     }
 
+    /// Nested textures add their sums; past the limit, `Scene::sanitize`
+    /// turns the extra patterns constant.
     #[test]
-    fn three_different_sums_take_three_signals() {
+    fn nested_sums_count_up_to_the_limit() {
         let at = |frequency| NoiseSettings {
             fractal: crate::noise::FractalParams {
                 frequency,
@@ -345,22 +292,23 @@ mod tests {
             },
             ..Default::default()
         };
+        let nested = Texture::blend(
+            Pattern::Fbm { noise: at(1.0) },
+            fbm_texture(at(2.0)),
+            fbm_texture(at(3.0)),
+        );
         let mut m = Material {
-            diffuse: fbm_texture(at(1.0)),
-            specular: fbm_texture(at(2.0)),
+            diffuse: nested,
+            specular: fbm_texture(at(4.0)),
+            roughness: fbm_texture(at(5.0)),
             ..Default::default()
         };
-        m.roughness.pattern = Pattern::Fbm { noise: at(3.0) };
+        let mut notes = Vec::new();
+        m.sanitize("test", &mut notes);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert_eq!(m.roughness.pattern, Pattern::Constant);
         let gpu = material(&m);
         assert_eq!(gpu.signal_count, MAX_SIGNALS as u32);
-        assert_eq!(
-            [
-                gpu.diffuse.signal,
-                gpu.specular.signal,
-                gpu.roughness.signal
-            ],
-            [0, 1, 2]
-        );
-        assert_eq!(gpu.signals[2].frequency, 3.0);
+        assert_eq!(gpu.signals[3].frequency, 4.0);
     }
 }

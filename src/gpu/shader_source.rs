@@ -48,6 +48,10 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/texture_patterns.wgsl"),
     ),
     (
+        "texture_shading.wgsl",
+        include_str!("../../shaders/texture_shading.wgsl"),
+    ),
+    (
         "texture_mapping.wgsl",
         include_str!("../../shaders/texture_mapping.wgsl"),
     ),
@@ -96,6 +100,8 @@ impl Program {
                 noise(&mut out);
                 out.extend([
                     "scene.wgsl",
+                    "texture_patterns.wgsl",
+                    "texture_mapping.wgsl",
                     "textures.wgsl",
                     "intersect.wgsl",
                     "random.wgsl",
@@ -114,6 +120,7 @@ impl Program {
                 noise(&mut out);
                 out.extend([
                     "texture_patterns.wgsl",
+                    "texture_shading.wgsl",
                     "texture_mapping.wgsl",
                     "texture_harness.wgsl",
                 ]);
@@ -123,8 +130,14 @@ impl Program {
     }
 }
 
-/// The WGSL text of `program` specialised for `features`.
-pub fn assemble(program: Program, features: &FeatureSet) -> Result<String, PreprocessError> {
+/// The WGSL text of `program` specialised for `features`. The trace program
+/// also takes the scene's generated texture code
+/// ([`super::texture_codegen::generate`]); the others ignore it.
+pub fn assemble(
+    program: Program,
+    features: &FeatureSet,
+    generated_textures: &str,
+) -> Result<String, PreprocessError> {
     let defines = features.defines();
     let mut module = String::new();
     for name in program.files(features) {
@@ -134,6 +147,10 @@ pub fn assemble(program: Program, features: &FeatureSet) -> Result<String, Prepr
             .expect("every listed file is embedded");
         module.push_str(&format!("// ---- {name}\n"));
         module.push_str(&preprocess(text, name, &defines)?);
+    }
+    if program == Program::Trace {
+        module.push_str("// ---- generated textures\n");
+        module.push_str(generated_textures);
     }
     Ok(module)
 }

@@ -267,7 +267,7 @@ pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Resu
     compute_harness::run(
         ctx,
         Program::TextureHarness,
-        &FeatureSet::for_noise(noise.kind, noise.hash),
+        &FeatureSet::for_texture_library(noise.kind, noise.hash),
         bytemuck::bytes_of(&uniform),
         points,
     )

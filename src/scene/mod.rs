@@ -12,7 +12,7 @@ pub mod render_settings;
 
 pub use camera::OrbitCamera;
 pub use environment::{EnvSource, Environment};
-pub use material::{ColorTexture, Material, Pattern, ScalarTexture};
+pub use material::{Child, Material, Pattern, Texture};
 pub use render_settings::{RenderSettings, ToneMap};
 
 use glam::Vec3;

@@ -23,9 +23,19 @@ pub fn wood(
     turbulence_amount: f32,
     noise: &NoiseSettings,
 ) -> f32 {
+    rings(
+        p,
+        axis,
+        ring_width,
+        turbulence_amount * turbulence(p, noise),
+    )
+}
+
+/// [`wood`] given its radius perturbation: the renderer evaluates the
+/// turbulence once per hit and shares it.
+pub fn rings(p: Vec3, axis: Vec3, ring_width: f32, perturbation: f32) -> f32 {
     let radius = (p - p.dot(axis) * axis).length();
-    let perturbed = radius + turbulence_amount * turbulence(p, noise);
-    odd((perturbed / ring_width).floor())
+    odd(((radius + perturbation) / ring_width).floor())
 }
 
 #[cfg(test)]

@@ -1,0 +1,211 @@
+//! Generates the WGSL that evaluates a scene's texture trees.
+//!
+//! Each material's three property textures become straight-line WGSL
+//! functions whose structure (pattern kinds, nesting) is fixed in the code
+//! and whose numbers (colours, cell sizes, frequencies) are read at constant
+//! indices from the `texture_params` uniform. So a parameter edit rewrites a
+//! buffer and the next frame shows it; only a structural edit (a new
+//! pattern, a nested texture) changes the code and rebuilds the pipeline.
+//! Constant indices matter on lavapipe: a uniform read at an index that
+//! differs between lanes costs eight scalar loads, one at a constant index a
+//! single broadcast.
+//!
+//! The fractal sums the patterns read are the material's noise signals,
+//! evaluated once per hit by `material_signals` (textures.wgsl); the
+//! generated code reads them from `signals`.
+
+use crate::scene::material::MAX_SIGNALS;
+use crate::scene::{Child, Material, Pattern, Scene, Texture};
+use anyhow::{Result, ensure};
+use std::fmt::Write;
+
+/// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
+/// shaders/scene.wgsl): 16 KiB.
+pub const MAX_TEXTURE_PARAMS: usize = 1024;
+
+/// The generated code and the parameters it reads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneratedTextures {
+    /// WGSL defining `surface_textures`; identical for two scenes whose
+    /// textures differ only in their numbers.
+    pub wgsl: String,
+    /// The `texture_params` values, padded to [`MAX_TEXTURE_PARAMS`].
+    pub params: Vec<[f32; 4]>,
+}
+
+/// The code and parameters for every material of `scene`, in GPU order.
+pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
+    let mut generator = Generator::default();
+    let mut dispatch = String::new();
+    for (index, material) in scene.materials().enumerate() {
+        let signals = material_signals(material);
+        let names = ["diffuse", "specular", "roughness"].map(|p| format!("texture_{index}_{p}"));
+        for (name, texture) in names.iter().zip(material.textures()) {
+            generator.function(name, texture, &signals);
+        }
+        let [d, s, r] = &names;
+        writeln!(
+            dispatch,
+            "        case {index}u: {{\n            out = SurfaceTextures({d}(p, uv, signals), {s}(p, uv, signals), {r}(p, uv, signals).x);\n        }}"
+        )?;
+    }
+    ensure!(
+        generator.params.len() <= MAX_TEXTURE_PARAMS,
+        "the scene's textures need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
+        generator.params.len()
+    );
+    let mut wgsl =
+        String::from("// Generated from the scene's texture trees (gpu::texture_codegen).\n\n");
+    wgsl.push_str(&generator.code);
+    write!(
+        wgsl,
+        "fn surface_textures(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0);\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+    )?;
+    let mut params = generator.params;
+    params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
+    Ok(GeneratedTextures { wgsl, params })
+}
+
+/// A material's distinct fractal sums, gradient noise first (the order
+/// `material_signals` in textures.wgsl expects), at most [`MAX_SIGNALS`]
+/// (`Scene::sanitize` keeps materials within it).
+pub fn material_signals(material: &Material) -> Vec<(crate::noise::NoiseSettings, bool)> {
+    let mut signals = Vec::new();
+    for signal in material.patterns().iter().filter_map(|p| p.signal()) {
+        if !signals.contains(&signal) {
+            signals.push(signal);
+        }
+    }
+    signals.truncate(MAX_SIGNALS);
+    signals.sort_by_key(|(noise, _)| noise.kind as u8);
+    signals
+}
+
+#[derive(Default)]
+struct Generator {
+    code: String,
+    params: Vec<[f32; 4]>,
+    /// Numbers the local variables of the function being generated.
+    next: usize,
+}
+
+impl Generator {
+    fn function(
+        &mut self,
+        name: &str,
+        texture: &Texture,
+        signals: &[(crate::noise::NoiseSettings, bool)],
+    ) {
+        self.next = 0;
+        let mut body = String::new();
+        let value = self.texture(texture, "p", "uv", signals, &mut body);
+        let _ = write!(
+            self.code,
+            "fn {name}(p: vec3f, uv: vec2f, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
+        );
+    }
+
+    /// Reserves a parameter slot and returns the WGSL that reads it.
+    fn param(&mut self, value: [f32; 4]) -> String {
+        self.params.push(value);
+        format!("texture_params[{}]", self.params.len() - 1)
+    }
+
+    fn child(
+        &mut self,
+        child: &Child,
+        p: &str,
+        uv: &str,
+        signals: &[(crate::noise::NoiseSettings, bool)],
+        body: &mut String,
+    ) -> String {
+        match child {
+            Child::Scalar(v) => format!("{}.xyz", self.param([*v, *v, *v, 0.0])),
+            Child::Color(c) => format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0])),
+            Child::Texture(t) => self.texture(t, p, uv, signals, body),
+        }
+    }
+
+    /// Appends the statements evaluating `texture` at (p, uv) to `body` and
+    /// returns the expression holding its colour.
+    fn texture(
+        &mut self,
+        texture: &Texture,
+        p: &str,
+        uv: &str,
+        signals: &[(crate::noise::NoiseSettings, bool)],
+        body: &mut String,
+    ) -> String {
+        let k = self.next;
+        self.next += 1;
+        if texture.pattern == Pattern::Constant {
+            return self.child(&texture.a, p, uv, signals, body);
+        }
+        let signal = texture
+            .pattern
+            .signal()
+            .and_then(|s| signals.iter().position(|x| *x == s))
+            .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
+        let mut child_uv = uv.to_string();
+        let t = match texture.pattern {
+            Pattern::Constant => unreachable!("handled above"),
+            Pattern::Checker { size } => {
+                let q = self.param([size, size, size, 0.0]);
+                format!("checker_3d({p}, {q}.xyz)")
+            }
+            Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
+            Pattern::Turbulence { .. } => format!("clamp({signal}, 0.0, 1.0)"),
+            Pattern::Marble {
+                stripe_frequency, ..
+            } => {
+                let q = self.param([stripe_frequency, 0.0, 0.0, 0.0]);
+                format!("0.5 + 0.5 * marble_stripes({p}.x, {signal}, {q}.x)")
+            }
+            Pattern::Checker2d { size, phase } => {
+                let q = self.param([size.x, size.y, phase, 0.0]);
+                let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
+                child_uv = format!("cell{k}.local");
+                format!("cell{k}.select")
+            }
+            Pattern::Brick {
+                size,
+                mortar,
+                row_offset,
+            } => {
+                let q = self.param([size.x, size.y, mortar, row_offset]);
+                let _ = writeln!(body, "    let cell{k} = brick({uv}, {q}.xy, {q}.z, {q}.w);");
+                child_uv = format!("cell{k}.local");
+                format!("cell{k}.select")
+            }
+            Pattern::Tile { mortar_half_width } => {
+                let q = self.param([mortar_half_width, 0.0, 0.0, 0.0]);
+                format!("tile({uv}, {q}.x, 0.0, 0.0).select")
+            }
+            Pattern::Cutout { sides, radius } => {
+                let q = self.param([radius, sides as f32, 0.0, 0.0]);
+                format!("cutout({uv}, u32({q}.y), {q}.x)")
+            }
+            Pattern::Wood {
+                ring_width,
+                turbulence_amount,
+                ..
+            } => {
+                let q = self.param([ring_width, turbulence_amount, 0.0, 0.0]);
+                format!("wood_rings({p}, WOOD_AXIS, {q}.x, {q}.y * {signal})")
+            }
+            Pattern::Veins {
+                frequency,
+                turbulence_amount,
+                ..
+            } => {
+                let q = self.param([frequency, turbulence_amount, 0.0, 0.0]);
+                format!("max(sin({q}.x * {p}.x + {q}.y * {signal}), 0.0)")
+            }
+        };
+        let _ = writeln!(body, "    let t{k} = {t};");
+        let a = self.child(&texture.a, p, &child_uv, signals, body);
+        let b = self.child(&texture.b, p, &child_uv, signals, body);
+        let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
+        format!("v{k}")
+    }
+}
