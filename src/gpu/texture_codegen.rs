@@ -209,3 +209,100 @@ impl Generator {
         format!("v{k}")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Ground, Sphere};
+    use glam::{Vec2, Vec3};
+
+    fn nested() -> Texture {
+        let inner = Texture::blend(
+            Pattern::Checker2d {
+                size: Vec2::splat(1.0 / 3.0),
+                phase: 0.0,
+            },
+            Vec3::new(0.8, 0.0, 0.0),
+            Vec3::new(0.4, 0.8, 0.0),
+        );
+        Texture::blend(
+            Pattern::Checker2d {
+                size: Vec2::splat(0.25),
+                phase: 0.0,
+            },
+            inner,
+            Vec3::new(0.0, 0.0, 0.8),
+        )
+    }
+
+    fn scene_with(texture: Texture) -> Scene {
+        let mut ground = Ground::default();
+        ground.material.diffuse = texture;
+        Scene {
+            spheres: vec![Sphere::default()],
+            ground: Some(ground),
+            ..Scene::default()
+        }
+    }
+
+    /// Numbers live in the parameter buffer: editing them keeps the code,
+    /// so the pipeline is not rebuilt; a structural edit changes it.
+    #[test]
+    fn parameter_edits_keep_the_code_and_structural_edits_change_it() {
+        let base = generate(&scene_with(nested())).unwrap();
+        let mut edited = nested();
+        edited.pattern = Pattern::Checker2d {
+            size: Vec2::splat(0.1),
+            phase: 0.5,
+        };
+        edited.b = Child::Color(Vec3::ONE);
+        let numbers = generate(&scene_with(edited.clone())).unwrap();
+        assert_eq!(numbers.wgsl, base.wgsl);
+        assert_ne!(numbers.params, base.params);
+        assert!(numbers.params.contains(&[0.1, 0.1, 0.5, 0.0]));
+
+        edited.pattern = Pattern::Cutout {
+            sides: 5,
+            radius: 0.3,
+        };
+        let structure = generate(&scene_with(edited)).unwrap();
+        assert_ne!(structure.wgsl, base.wgsl);
+        assert!(structure.wgsl.contains("cutout("));
+    }
+
+    /// Nested cell patterns hand their children the cell's local (u, v).
+    #[test]
+    fn nested_cells_read_the_parent_cell_coordinates() {
+        let code = generate(&scene_with(nested())).unwrap().wgsl;
+        assert!(code.contains("checker_2d(uv,"), "{code}");
+        assert!(
+            code.contains("checker_2d(cell1.local,") || code.contains("checker_2d(cell0.local,"),
+            "{code}"
+        );
+    }
+
+    /// The CPU reference of the same tree: a 4×4 board whose even cells
+    /// hold 3×3 boards.
+    #[test]
+    fn cpu_reference_of_a_nested_checker() {
+        let t = nested();
+        let red = Vec3::new(0.8, 0.0, 0.0);
+        let green = Vec3::new(0.4, 0.8, 0.0);
+        let blue = Vec3::new(0.0, 0.0, 0.8);
+        // Outer cell (0, 0) is even: the inner board, whose cell (0, 0) is red
+        // and (1, 0) green.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.01, 0.01)), red);
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.12, 0.01)), green);
+        // Outer cell (1, 0) is odd: blue.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), blue);
+    }
+
+    #[test]
+    fn every_material_has_a_case() {
+        let scene = scene_with(nested());
+        let code = generate(&scene).unwrap().wgsl;
+        for i in 0..scene.materials().count() {
+            assert!(code.contains(&format!("case {i}u:")), "{code}");
+        }
+    }
+}
