@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 /// The format this build writes. Older files load through `#[serde(default)]`
 /// on every struct; newer ones are refused rather than half-understood.
-pub const FORMAT_VERSION: u32 = 1;
+/// Version 2 lets a texture's `a` and `b` be textures themselves; a version
+/// 1 file (values only) reads unchanged.
+pub const FORMAT_VERSION: u32 = 2;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]

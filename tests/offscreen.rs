@@ -343,25 +343,27 @@ fn uber_and_specialised_shaders_agree() {
         return;
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let loaded =
-        marbre::commands::session::load_scene(&root.join("presets/default.ron"), None).unwrap();
-    let size = (48, 27);
-    let mut specialised = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
-    let mut uber = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
-    uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
-        .unwrap();
-    assert!(uber.features().0.len() > specialised.features().0.len());
-    for r in [&mut specialised, &mut uber] {
-        accumulate(&ctx, r, 4, |_| {}).unwrap();
-    }
-    let (_, _, a) = specialised.read_radiance(&ctx).unwrap();
-    let (_, _, b) = uber.read_radiance(&ctx).unwrap();
-    for (p, q) in a.iter().zip(&b) {
-        for c in 0..3 {
-            assert!(
-                (p[c] - q[c]).abs() <= 1e-3 * (1.0 + p[c].abs()),
-                "specialised {p:?} vs uber {q:?}"
-            );
+    for preset in ["presets/default.ron", "presets/tiles.ron"] {
+        let loaded = marbre::commands::session::load_scene(&root.join(preset), None).unwrap();
+        let size = (48, 27);
+        let mut specialised =
+            Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
+        let mut uber = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
+        uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
+            .unwrap();
+        assert!(uber.features().0.len() > specialised.features().0.len());
+        for r in [&mut specialised, &mut uber] {
+            accumulate(&ctx, r, 4, |_| {}).unwrap();
+        }
+        let (_, _, a) = specialised.read_radiance(&ctx).unwrap();
+        let (_, _, b) = uber.read_radiance(&ctx).unwrap();
+        for (p, q) in a.iter().zip(&b) {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - q[c]).abs() <= 1e-3 * (1.0 + p[c].abs()),
+                    "{preset}: specialised {p:?} vs uber {q:?}"
+                );
+            }
         }
     }
 }

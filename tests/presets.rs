@@ -355,6 +355,31 @@ fn specialisation_removes_code() {
     assert!(!trace_source(&rust.scene).contains("perlin_noise"));
 }
 
+/// Each texture pattern's WGSL is in the trace shader only when the scene
+/// uses that pattern.
+#[test]
+fn unused_patterns_leave_no_code() {
+    let plain = load(&root().join("presets/rust.ron"));
+    let plain_src = trace_source(&plain.scene);
+    let bricks = load(&root().join("presets/brick_wood.ron"));
+    let bricks_src = trace_source(&bricks.scene);
+    for function in [
+        "fn brick(",
+        "fn wood_rings(",
+        "fn checker_2d(",
+        "fn cutout(",
+    ] {
+        assert!(!plain_src.contains(function), "rust has {function}");
+    }
+    for function in ["fn brick(", "fn wood_rings("] {
+        assert!(bricks_src.contains(function), "brick_wood lacks {function}");
+    }
+    assert!(!bricks_src.contains("fn cutout("));
+    // Only a pattern that reads (u, v) makes the hit compute it.
+    assert!(!plain_src.contains("sphere_uv(dir)"));
+    assert!(bricks_src.contains("sphere_uv(dir)"));
+}
+
 // ---------------------------------------------------------------------------
 // Broken files
 
