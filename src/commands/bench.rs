@@ -45,6 +45,18 @@ fn time_frames(ctx: &GpuContext, renderer: &mut Renderer, frames: u32) -> Result
     Ok(times[times.len() / 2])
 }
 
+/// Wall-clock time to build the preset's trace pipeline and draw its first
+/// small frame: drivers like lavapipe compile the shader at the first draw.
+fn time_build(ctx: &GpuContext, loaded: &super::session::LoadedScene) -> Result<f64> {
+    let start = Instant::now();
+    let mut renderer = Renderer::new(ctx, &loaded.scene, loaded.env.as_ref(), (64, 36))?;
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    renderer.trace(ctx, &mut encoder, None);
+    ctx.queue.submit([encoder.finish()]);
+    ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+    Ok(start.elapsed().as_secs_f64() * 1000.0)
+}
+
 pub fn run(args: &BenchArgs) -> Result<()> {
     let ctx = GpuContext::headless()?;
     let mut presets: Vec<PathBuf> = std::fs::read_dir(&args.presets)
@@ -61,18 +73,22 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     println!(
         "specialised: the shader holds only what the preset uses; uber: every feature compiled in"
     );
+    println!(
+        "build: a new trace pipeline (what a structural edit costs), from WGSL to the first frame; cold only with an empty Mesa shader cache (MESA_SHADER_CACHE_DIR=$(mktemp -d))"
+    );
     let header: Vec<String> = args
         .sizes
         .iter()
         .map(|(w, h)| format!("{w}x{h} ms (fps) | {w}x{h} uber ms | uber / specialised"))
         .collect();
-    println!("| preset | features | {} |", header.join(" | "));
-    println!("|---|---|{}", "---|".repeat(3 * args.sizes.len()));
+    println!("| preset | features | build ms | {} |", header.join(" | "));
+    println!("|---|---|---|{}", "---|".repeat(3 * args.sizes.len()));
     for path in presets {
         let mut loaded = load_scene(&path, None)?;
         loaded.scene.render.samples_per_frame = 1;
         let mut cells = Vec::new();
         let mut features = 0;
+        let build = time_build(&ctx, &loaded)?;
         for &size in &args.sizes {
             let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size)?;
             features = renderer.features().0.len();
@@ -86,7 +102,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             ));
         }
         let name = path.file_stem().unwrap_or_default().to_string_lossy();
-        println!("| {name} | {features} | {} |", cells.join(" | "));
+        println!(
+            "| {name} | {features} | {build:.0} | {} |",
+            cells.join(" | ")
+        );
     }
     Ok(())
 }
