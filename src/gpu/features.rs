@@ -49,6 +49,19 @@ impl Feature {
         Feature::HashSin,
     ];
 
+    /// Whether the feature's pattern is one of texture_patterns.wgsl's.
+    fn reads_library(self) -> bool {
+        matches!(
+            self,
+            Feature::PatternChecker2d
+                | Feature::PatternBrick
+                | Feature::PatternTile
+                | Feature::PatternCutout
+                | Feature::PatternWood
+                | Feature::PatternVeins
+        )
+    }
+
     /// The name used by `#if` in the WGSL sources.
     pub fn define(self) -> &'static str {
         match self {
@@ -138,19 +151,13 @@ impl FeatureSet {
         Self(noise_features(kind, hash).into_iter().collect())
     }
 
-    /// For the texture harness: every pattern, and the noise `kind`/`hash`
-    /// their turbulence uses.
+    /// For the texture harness: every pattern of the texture library, and
+    /// the noise `kind`/`hash` their turbulence uses.
     pub fn for_texture_library(kind: NoiseKind, hash: HashKind) -> Self {
         let mut set = Self::for_noise(kind, hash);
-        set.0.extend([
-            Feature::PatternChecker,
-            Feature::PatternChecker2d,
-            Feature::PatternBrick,
-            Feature::PatternTile,
-            Feature::PatternCutout,
-            Feature::PatternWood,
-            Feature::PatternVeins,
-        ]);
+        set.0.insert(Feature::PatternChecker);
+        set.0
+            .extend(Feature::ALL.into_iter().filter(|f| f.reads_library()));
         set
     }
 }

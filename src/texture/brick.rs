@@ -77,15 +77,7 @@ pub fn tile(uv: Vec2, mortar_half_width: f32, bevel_width: f32, bevel_height: f3
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn grid(n: usize) -> impl Iterator<Item = Vec2> {
-        (0..n * n).map(move |k| {
-            Vec2::new(
-                ((k % n) as f32 + 0.5) / n as f32,
-                ((k / n) as f32 + 0.5) / n as f32,
-            )
-        })
-    }
+    use crate::texture::covered_fraction;
 
     #[test]
     fn brick_mortar_covers_its_share_of_the_wall() {
@@ -96,10 +88,9 @@ mod tests {
             (Vec2::new(0.5, 0.2), 0.05, 0.25),
         ] {
             // A whole number of bricks in each direction: the unit square.
-            let mortar_samples = grid(n)
-                .filter(|&uv| brick(uv, size, mortar, offset).select == 0.0)
-                .count();
-            let fraction = mortar_samples as f32 / (n * n) as f32;
+            let fraction = covered_fraction(n, Vec2::ZERO, |uv| {
+                brick(uv, size, mortar, offset).select == 0.0
+            });
             let expected = brick_mortar_fraction(size, mortar);
             assert!(
                 (fraction - expected).abs() < 5e-3,
@@ -121,10 +112,7 @@ mod tests {
     fn tile_mortar_bevel_and_top() {
         let (m, b, h) = (0.02, 0.05, 0.4);
         let n = 1000;
-        let mortar = grid(n)
-            .filter(|&uv| tile(uv, m, b, h).select == 0.0)
-            .count();
-        let fraction = mortar as f32 / (n * n) as f32;
+        let fraction = covered_fraction(n, Vec2::ZERO, |uv| tile(uv, m, b, h).select == 0.0);
         let expected = 1.0 - (1.0 - 2.0 * m) * (1.0 - 2.0 * m);
         assert!(
             (fraction - expected).abs() < 3e-3,

@@ -38,6 +38,7 @@ pub fn cutout_area(sides: u32, radius: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::texture::covered_fraction;
 
     /// The covered fraction of a cell, by a fine grid of samples, is the
     /// polygon's area.
@@ -45,17 +46,9 @@ mod tests {
     fn covered_fraction_is_the_polygon_area() {
         let n = 600;
         for (sides, radius) in [(0, 0.4), (3, 0.45), (4, 0.3), (6, 0.5), (7, 0.2)] {
-            let mut inside = 0;
-            for i in 0..n {
-                for j in 0..n {
-                    let uv = Vec2::new(
-                        3.0 + (i as f32 + 0.5) / n as f32,
-                        -2.0 + (j as f32 + 0.5) / n as f32,
-                    );
-                    inside += cutout(uv, sides, radius) as u32;
-                }
-            }
-            let fraction = inside as f32 / (n * n) as f32;
+            let fraction = covered_fraction(n, Vec2::new(3.0, -2.0), |uv| {
+                cutout(uv, sides, radius) == 1.0
+            });
             let area = cutout_area(sides, radius);
             assert!(
                 (fraction - area).abs() < 2e-3,

@@ -27,3 +27,20 @@ pub use marble::marble_veins;
 pub use ramp::{RampStop, ramp};
 pub use waves::waves_gradient;
 pub use wood::{default_axis, wood};
+
+/// The fraction of an n×n grid of cell centres over the unit square moved
+/// to `origin` where `inside` holds: the area a pattern covers, for tests.
+#[cfg(test)]
+pub(crate) fn covered_fraction(
+    n: usize,
+    origin: glam::Vec2,
+    inside: impl Fn(glam::Vec2) -> bool,
+) -> f32 {
+    let covered = (0..n * n)
+        .filter(|k| {
+            let cell = glam::Vec2::new((k % n) as f32 + 0.5, (k / n) as f32 + 0.5);
+            inside(origin + cell / n as f32)
+        })
+        .count();
+    covered as f32 / (n * n) as f32
+}
