@@ -92,6 +92,8 @@ pub struct Stats {
     pub backend: String,
     /// The shader features the current scene compiled in.
     pub features: Vec<String>,
+    /// Size of the trace shader's WGSL: what specialisation keeps it to.
+    pub shader_bytes: usize,
     pub resolution: (u32, u32),
 }
 
@@ -685,6 +687,11 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
     };
     ui.label(format!("shader features: {features}"))
         .on_hover_text("What the current scene compiled into the shader");
+    ui.label(format!(
+        "trace shader: {:.1} KiB of WGSL",
+        stats.shader_bytes as f32 / 1024.0
+    ))
+    .on_hover_text("The assembled trace module: the files its features need, plus the code generated from the texture trees");
 }
 
 #[cfg(test)]

@@ -291,6 +291,7 @@ impl Viewer {
                 .iter()
                 .map(|f| format!("{f:?}"))
                 .collect(),
+            shader_bytes: self.renderer.trace_shader_bytes(),
             resolution: self.renderer.render_size(),
         }
     }

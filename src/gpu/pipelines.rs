@@ -14,6 +14,15 @@ pub fn shader_module(
     generated_textures: &str,
 ) -> Result<wgpu::ShaderModule> {
     let source = assemble(program, features, generated_textures)?;
+    compile_wgsl(device, program, source)
+}
+
+/// Validates assembled WGSL with naga, then creates the module.
+pub fn compile_wgsl(
+    device: &wgpu::Device,
+    program: Program,
+    source: String,
+) -> Result<wgpu::ShaderModule> {
     validate(&source).map_err(|e| anyhow!("{program:?} shader: {e}"))?;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -5,11 +5,12 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::pipelines::{
-    entry, float_texture, fullscreen_pipeline, permutation_table, shader_module, uniform,
+    compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
+    uniform,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
-use super::shader_source::Program;
+use super::shader_source::{Program, assemble};
 use super::texture_codegen;
 use crate::envmap::EnvImage;
 use crate::scene::{Scene, ToneMap};
@@ -68,6 +69,8 @@ pub struct Renderer {
     /// The generated texture code the trace pipeline was built with: a
     /// scene whose code differs needs a new pipeline.
     texture_code: String,
+    /// Size of the trace module's WGSL, for the Stats panel.
+    trace_shader_bytes: usize,
     env_view: wgpu::TextureView,
     env_sampler: wgpu::Sampler,
     accumulation: Accumulation,
@@ -107,7 +110,7 @@ impl Renderer {
             entries: &[entry(0, uniform()), entry(1, float_texture(false))],
         });
         let textures = texture_codegen::generate(scene)?;
-        let trace_pipeline =
+        let (trace_pipeline, trace_shader_bytes) =
             Self::build_trace_pipeline(ctx, &trace_layout, &features, &textures.wgsl)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -174,6 +177,7 @@ impl Renderer {
             perm_buffer,
             texture_param_buffer,
             texture_code: textures.wgsl,
+            trace_shader_bytes,
             env_view,
             env_sampler,
             accumulation,
@@ -184,21 +188,30 @@ impl Renderer {
         })
     }
 
+    /// The trace pipeline, and the size of its WGSL.
     fn build_trace_pipeline(
         ctx: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         features: &FeatureSet,
         texture_code: &str,
-    ) -> Result<wgpu::RenderPipeline> {
-        let module = shader_module(&ctx.device, Program::Trace, features, texture_code)?;
-        fullscreen_pipeline(
+    ) -> Result<(wgpu::RenderPipeline, usize)> {
+        let source = assemble(Program::Trace, features, texture_code)?;
+        let bytes = source.len();
+        let module = compile_wgsl(&ctx.device, Program::Trace, source)?;
+        let pipeline = fullscreen_pipeline(
             &ctx.device,
             "trace",
             &module,
             layout,
             "fs_trace",
             ACCUMULATION_FORMAT,
-        )
+        )?;
+        Ok((pipeline, bytes))
+    }
+
+    /// Size of the trace shader's assembled WGSL.
+    pub fn trace_shader_bytes(&self) -> usize {
+        self.trace_shader_bytes
     }
 
     pub fn features(&self) -> &FeatureSet {
@@ -235,7 +248,7 @@ impl Renderer {
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
         let textures = texture_codegen::generate(scene)?;
         if features != self.features || textures.wgsl != self.texture_code {
-            self.trace_pipeline =
+            (self.trace_pipeline, self.trace_shader_bytes) =
                 Self::build_trace_pipeline(ctx, &self.trace_layout, &features, &textures.wgsl)?;
             self.features = features;
             self.texture_code = textures.wgsl;
