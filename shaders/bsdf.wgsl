@@ -3,6 +3,8 @@
 // estimator stays unbiased whichever lobe dominates.
 
 struct SurfacePoint {
+    // The shading normal: the geometric one, tilted by the bump texture.
+    n: vec3f,
     diffuse: vec3f,
     specular: vec3f,
     alpha: f32,      // GGX α = roughness², kept above 1e-3 so D stays finite
@@ -23,6 +25,11 @@ fn surface_at(hit: Hit) -> SurfacePoint {
     let r = clamp(textures.roughness, 0.0, 1.0);
     s.alpha = max(r * r, 1e-3);
     s.mirror = materials[hit.material].mirror;
+#if BUMP
+    s.n = bumped_shading_normal(hit, signals);
+#else
+    s.n = hit.n;
+#endif
     return s;
 }
 

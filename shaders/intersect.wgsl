@@ -9,6 +9,11 @@ struct Hit {
     // The primitive's 2D texture coordinates: lat-long on a sphere, world
     // (x, z) on the ground. Only computed where a 2D pattern reads them.
     uv: vec2f,
+#if BUMP
+    // ∂p/∂u and ∂p/∂v: how the surface moves with its (u, v), for bumps.
+    dp_du: vec3f,
+    dp_dv: vec3f,
+#endif
     material: u32,
 }
 
@@ -66,6 +71,15 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #if TEXTURE_UV
         hit.uv = sphere_uv(dir);
 #endif
+#if BUMP
+        // Lat-long about +y: u turns around the axis (2π r per unit), v
+        // climbs from pole to pole (π r per unit). Zero at the poles, where
+        // bumped_normal keeps the plain normal.
+        let ring = length(dir.xz);
+        hit.dp_du = TWO_PI * s.radius * vec3f(dir.z, 0.0, -dir.x);
+        let climb = vec3f(-dir.y * dir.x / ring, ring, -dir.y * dir.z / ring);
+        hit.dp_dv = select(vec3f(0.0), PI * s.radius * climb, ring > 0.0);
+#endif
         hit.material = index;
     }
 #if GROUND
@@ -77,6 +91,10 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.n = vec3f(0.0, 1.0, 0.0);
             hit.texture_point = vec3f(hit.p.x, 0.0, hit.p.z);
             hit.uv = vec2f(hit.p.x, hit.p.z);
+#if BUMP
+            hit.dp_du = vec3f(1.0, 0.0, 0.0);
+            hit.dp_dv = vec3f(0.0, 0.0, 1.0);
+#endif
             hit.material = frame.sphere_count;
         }
     }

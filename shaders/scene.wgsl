@@ -37,7 +37,8 @@ struct Material {
     // Signals before this index are gradient noise, from it on Perlin noise.
     first_perlin: u32,
     mirror: f32,
-    _pad: f32,
+    // Scene units of height for a bump value of 1.
+    bump_height: f32,
 }
 
 struct Sphere {

@@ -47,7 +47,7 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         }
         case 4u: {
             let t = tile(p.xy, a.x, a.y, a.z);
-            r = vec4f(t.select, t.height_gradient, 0.0);
+            r = vec4f(t.select, t.height_gradient, tile_height(p.xy, a.x, a.y));
         }
         case 5u: {
             r.x = cutout(p.xy, harness.sides, a.x);
@@ -59,7 +59,7 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
             r.x = marble_veins(p, a.xyz, a.w, b.x, harness.noise);
         }
         case 8u: {
-            r = vec4f(waves_gradient(p.xy, a.x, a.y, b.xy), 0.0, 0.0);
+            r = vec4f(waves_gradient(p.xy, a.x, a.y, b.xy), waves(p.xy, a.x, b.xy), 0.0);
         }
         case 9u: {
             r = vec4f(bumped_normal(p, a.xyz, b.xyz, c.x, c.y), 0.0);

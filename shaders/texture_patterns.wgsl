@@ -84,6 +84,15 @@ fn tile(uv: vec2f, mortar_half_width: f32, bevel_width: f32, bevel_height: f32) 
     let gradient = select(vec2f(0.0, slope * inward.y), vec2f(slope * inward.x, 0.0), along_u);
     return TileSample(select(0.0, 1.0, on_tile), select(vec2f(0.0), gradient, on_bevel));
 }
+
+// The tile's height profile: 0 in the mortar, rising over the bevel to 1.
+fn tile_height(uv: vec2f, mortar_half_width: f32, bevel_width: f32) -> f32 {
+    let local = uv - floor(uv);
+    let from_edge = min(local, 1.0 - local);
+    let rise = min(from_edge.x, from_edge.y) - mortar_half_width;
+    let ramp = select(1.0, rise / bevel_width, rise < bevel_width);
+    return select(ramp, 0.0, rise < 0.0);
+}
 #endif
 
 #if PATTERN_CUTOUT
@@ -113,6 +122,12 @@ fn wood(p: vec3f, axis: vec3f, ring_width: f32, turbulence_amount: f32, n: Noise
 fn wood_rings(p: vec3f, axis: vec3f, ring_width: f32, perturbation: f32) -> f32 {
     let radius = length(p - dot(p, axis) * axis);
     return odd(floor((radius + perturbation) / ring_width));
+}
+#endif
+
+#if PATTERN_WAVES
+fn waves(uv: vec2f, frequency: f32, direction: vec2f) -> f32 {
+    return 0.5 + 0.5 * sin(TWO_PI * frequency * dot(direction, uv));
 }
 #endif
 

@@ -16,7 +16,7 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let to_light = frame.light_pos - hit.p;
     let dist2 = dot(to_light, to_light);
     let wi = to_light * inverseSqrt(dist2);
-    let f_cos = eval_bsdf(s, hit.n, wo, wi).f_cos;
+    let f_cos = eval_bsdf(s, s.n, wo, wi).f_cos;
     if all(f_cos == vec3f(0.0)) {
         return vec3f(0.0);
     }
@@ -51,7 +51,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
 #if POINT_LIGHT
             radiance += throughput * point_light(hit, s, wo);
 #endif
-            let bs = sample_bsdf(s, hit.n, wo);
+            let bs = sample_bsdf(s, s.n, wo);
             if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
                 alive = false;
                 break;

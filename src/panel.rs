@@ -285,6 +285,16 @@ fn material_ui(ui: &mut Ui, m: &mut Material) {
     );
     ui.add(slider(&mut m.mirror, 0.0..=1.0, "mirror"))
         .on_hover_text("Fraction of the light reflected by a perfect mirror, on top of GGX");
+    texture_ui(
+        ui,
+        "bump",
+        "A height field that tilts the shading normal (tiles with a bevel, waves)",
+        &mut m.bump,
+        ValueKind::Scalar,
+        1,
+    );
+    ui.add(slider(&mut m.bump_height, -0.5..=0.5, "bump height"))
+        .on_hover_text("Height in scene units of a bump value of 1; 0 turns the bump off");
 }
 
 /// What a property's values are: colours, or scalars (the first channel).
@@ -420,9 +430,30 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
                 );
             ui.add(slider(row_offset, 0.0..=1.0, "row offset"));
         }
-        Pattern::Tile { mortar_half_width } => {
+        Pattern::Tile {
+            mortar_half_width,
+            bevel,
+        } => {
             ui.add(slider(mortar_half_width, 0.0..=0.5, "mortar half-width"))
                 .on_hover_text("One tile per unit (u, v) square: lay it in a checker cell");
+            ui.add(slider(bevel, 0.0..=0.5, "bevel")).on_hover_text(
+                "Width over which the tile rises from the mortar: bump it to raise the tiles",
+            );
+        }
+        Pattern::Waves {
+            frequency,
+            direction,
+        } => {
+            ui.add(slider(frequency, 0.0..=64.0, "frequency"))
+                .on_hover_text("Crests per unit of (u, v) along the direction");
+            let mut angle = direction.y.atan2(direction.x).to_degrees();
+            if ui
+                .add(slider(&mut angle, -180.0..=180.0, "direction (°)"))
+                .changed()
+            {
+                let a = angle.to_radians();
+                *direction = glam::Vec2::new(a.cos(), a.sin());
+            }
         }
         Pattern::Cutout { sides, radius } => {
             ui.add(Slider::new(sides, 0..=12).text("sides"))

@@ -34,6 +34,7 @@ fn lambert(albedo: f32) -> Material {
         specular: Texture::color(Vec3::ZERO),
         roughness: Texture::scalar(1.0),
         mirror: 0.0,
+        ..Material::default()
     }
 }
 
@@ -299,6 +300,70 @@ fn generated_texture_code_renders_the_cpu_reference() {
         checked > (w * h) as usize / 3,
         "only {checked} pixels lie inside one cell"
     );
+}
+
+/// Bump mapping, in closed form: a Lambert ground rippled by waves along x,
+/// h(x) = H·(0.5 + 0.5·sin 2πx), lit by a point light. At x = 0 the slope is
+/// s = H·π, so the shading normal is (−s, 1, 0)/√(1 + s²) and the ground
+/// reflects ρ/π · I/d² · max(0, n·l). A light to the −x side (which the
+/// rising slope faces) pins the tilt's sign as well as its size.
+#[test]
+fn waves_bump_tilts_the_shading_normal_as_the_closed_form() {
+    let Some(ctx) = gpu_or_skip("waves_bump_tilts_the_shading_normal_as_the_closed_form") else {
+        return;
+    };
+    use marbre::scene::Pattern;
+    let (albedo, intensity, bump_height) = (0.5_f32, 20.0_f32, 0.1_f32);
+    let slope = bump_height * std::f32::consts::PI;
+    let normal = Vec3::new(-slope, 1.0, 0.0).normalize();
+    for light in [Vec3::new(0.0, 2.0, 0.0), Vec3::new(-1.0, 2.0, 0.0)] {
+        let mut material = lambert(albedo);
+        material.bump = Texture::blend(
+            Pattern::Waves {
+                frequency: 1.0,
+                direction: glam::Vec2::X,
+            },
+            0.0,
+            1.0,
+        );
+        material.bump_height = bump_height;
+        let mut scene = Scene {
+            ground: Some(Ground {
+                height: 0.0,
+                material,
+            }),
+            ..Scene::default()
+        };
+        scene.point_light = Some(PointLight {
+            position: light,
+            color: Vec3::ONE,
+            intensity,
+        });
+        scene.camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 5.0,
+            yaw_degrees: 0.0,
+            pitch_degrees: 89.0,
+            fov_degrees: 4.0,
+        };
+        let (w, h) = (33, 33);
+        let pixels = render(&ctx, &scene, (w, h), 16);
+        let to_light = light.normalize();
+        let expected = albedo / std::f32::consts::PI * intensity / light.length_squared()
+            * normal.dot(to_light);
+        let flat = albedo / std::f32::consts::PI * intensity / light.length_squared() * to_light.y;
+        assert!(
+            (expected - flat).abs() > 0.03 * flat,
+            "the test would not see the bump"
+        );
+        let centre = pixels[(16 * w + 16) as usize];
+        for c in &centre[..3] {
+            assert!(
+                (c - expected).abs() < 5e-3 * expected,
+                "light at {light}: centre {centre:?}, expected {expected} (flat: {flat})"
+            );
+        }
+    }
 }
 
 /// Turning accumulation off shows each frame alone; turning it on averages:

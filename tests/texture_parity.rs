@@ -189,7 +189,8 @@ fn masonry_and_cutouts_match_the_cpu() {
         1e-5,
         |p| {
             let t = texture::tile(p.truncate(), m, w, h);
-            [t.select, t.height_gradient.x, t.height_gradient.y, 0.0]
+            let height = texture::tile_height(p.truncate(), m, w);
+            [t.select, t.height_gradient.x, t.height_gradient.y, height]
         },
         |p| {
             let l = p.truncate() - p.truncate().floor();
@@ -304,7 +305,8 @@ fn waves_bump_and_ramp_match_the_cpu() {
         1e-3 * amplitude * frequency * std::f32::consts::TAU,
         |p| {
             let g = texture::waves_gradient(p.truncate(), frequency, amplitude, direction);
-            [g.x, g.y, 0.0, 0.0]
+            let height = texture::waves(p.truncate(), frequency, direction);
+            [g.x, g.y, height, 0.0]
         },
         |_| false,
     );

@@ -1,7 +1,7 @@
 //! Which shader features a scene needs: the key of shader specialisation.
 
 use crate::noise::{HashKind, NoiseKind};
-use crate::scene::{EnvSource, Pattern, Scene};
+use crate::scene::{EnvSource, Material, Pattern, Scene};
 use std::collections::BTreeSet;
 
 /// One piece of shader code that can be compiled out.
@@ -21,6 +21,8 @@ pub enum Feature {
     PatternCutout,
     PatternWood,
     PatternVeins,
+    PatternWaves,
+    Bump,
     NoiseGradient,
     NoisePerlin,
     HashPcg,
@@ -28,7 +30,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 18] = [
+    pub const ALL: [Feature; 20] = [
         Feature::Ground,
         Feature::PointLight,
         Feature::EnvMap,
@@ -43,6 +45,8 @@ impl Feature {
         Feature::PatternCutout,
         Feature::PatternWood,
         Feature::PatternVeins,
+        Feature::PatternWaves,
+        Feature::Bump,
         Feature::NoiseGradient,
         Feature::NoisePerlin,
         Feature::HashPcg,
@@ -59,6 +63,7 @@ impl Feature {
                 | Feature::PatternCutout
                 | Feature::PatternWood
                 | Feature::PatternVeins
+                | Feature::PatternWaves
         )
     }
 
@@ -79,6 +84,8 @@ impl Feature {
             Feature::PatternCutout => "PATTERN_CUTOUT",
             Feature::PatternWood => "PATTERN_WOOD",
             Feature::PatternVeins => "PATTERN_VEINS",
+            Feature::PatternWaves => "PATTERN_WAVES",
+            Feature::Bump => "BUMP",
             Feature::NoiseGradient => "NOISE_GRADIENT",
             Feature::NoisePerlin => "NOISE_PERLIN",
             Feature::HashPcg => "HASH_PCG",
@@ -115,6 +122,8 @@ impl FeatureSet {
             Feature::PatternBrick,
             Feature::PatternTile,
             Feature::PatternCutout,
+            Feature::PatternWaves,
+            Feature::Bump,
         ];
         if uv_patterns.iter().any(|&f| self.contains(f)) {
             names.insert("TEXTURE_UV");
@@ -142,6 +151,9 @@ impl FeatureSet {
         }
         for pattern in scene.materials().flat_map(|m| m.patterns()) {
             set.extend(pattern_features(pattern));
+        }
+        if scene.materials().any(Material::has_bump) {
+            set.insert(Feature::Bump);
         }
         Self(set)
     }
@@ -183,6 +195,7 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
         Pattern::Cutout { .. } => vec![Feature::PatternCutout],
         Pattern::Wood { .. } => vec![Feature::PatternWood],
         Pattern::Veins { .. } => vec![Feature::PatternVeins],
+        Pattern::Waves { .. } => vec![Feature::PatternWaves],
     };
     if let Some(n) = p.noise() {
         out.extend(noise_features(n.kind, n.hash));

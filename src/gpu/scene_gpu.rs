@@ -71,7 +71,7 @@ pub struct MaterialGpu {
     /// Signals before this index are gradient noise, from it on Perlin.
     pub first_perlin: u32,
     pub mirror: f32,
-    pub _pad: f32,
+    pub bump_height: f32,
 }
 
 #[repr(C)]
@@ -111,6 +111,7 @@ pub fn material(m: &Material) -> MaterialGpu {
             .position(|s| s.kind == noise_kind_id(NoiseKind::Perlin))
             .unwrap_or(signals.len()) as u32,
         mirror: m.mirror,
+        bump_height: m.bump_height,
         ..Default::default()
     };
     out.signals[..signals.len()].copy_from_slice(&signals);

@@ -47,6 +47,7 @@ const SOURCES: &[(&str, &str)] = &[
         "texture_patterns.wgsl",
         include_str!("../../shaders/texture_patterns.wgsl"),
     ),
+    ("bump.wgsl", include_str!("../../shaders/bump.wgsl")),
     (
         "texture_shading.wgsl",
         include_str!("../../shaders/texture_shading.wgsl"),
@@ -110,6 +111,9 @@ impl Program {
                     "fullscreen.wgsl",
                     "trace.wgsl",
                 ]);
+                if features.contains(Feature::Bump) {
+                    out.extend(["texture_shading.wgsl", "bump.wgsl"]);
+                }
             }
             Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
             Program::NoiseHarness => {

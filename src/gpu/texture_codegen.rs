@@ -33,10 +33,12 @@ pub struct GeneratedTextures {
     pub params: Vec<[f32; 4]>,
 }
 
-/// The code and parameters for every material of `scene`, in GPU order.
+/// The code and parameters for every material of `scene`, in GPU order:
+/// `surface_textures`, and `surface_height` for the bump textures.
 pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     let mut generator = Generator::default();
     let mut dispatch = String::new();
+    let mut heights = String::new();
     for (index, material) in scene.materials().enumerate() {
         let signals = material_signals(material);
         let names = ["diffuse", "specular", "roughness"].map(|p| format!("texture_{index}_{p}"));
@@ -48,6 +50,14 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
             dispatch,
             "        case {index}u: {{\n            out = SurfaceTextures({d}(p, uv, signals), {s}(p, uv, signals), {r}(p, uv, signals).x);\n        }}"
         )?;
+        if material.has_bump() {
+            let name = format!("texture_{index}_bump");
+            generator.function(&name, &material.bump, &signals);
+            writeln!(
+                heights,
+                "        case {index}u: {{\n            return {name}(p, uv, signals).x;\n        }}"
+            )?;
+        }
     }
     ensure!(
         generator.params.len() <= MAX_TEXTURE_PARAMS,
@@ -60,6 +70,12 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     write!(
         wgsl,
         "fn surface_textures(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0);\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+    )?;
+    // Always defined, so that a shader with the bump feature forced on (the
+    // uber shader) builds for any scene.
+    write!(
+        wgsl,
+        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
     )?;
     let mut params = generator.params;
     params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
@@ -177,9 +193,19 @@ impl Generator {
                 child_uv = format!("cell{k}.local");
                 format!("cell{k}.select")
             }
-            Pattern::Tile { mortar_half_width } => {
-                let q = self.param([mortar_half_width, 0.0, 0.0, 0.0]);
-                format!("tile({uv}, {q}.x, 0.0, 0.0).select")
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => {
+                let q = self.param([mortar_half_width, bevel, 0.0, 0.0]);
+                format!("tile_height({uv}, {q}.x, {q}.y)")
+            }
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => {
+                let q = self.param([frequency, direction.x, direction.y, 0.0]);
+                format!("waves({uv}, {q}.x, {q}.yz)")
             }
             Pattern::Cutout { sides, radius } => {
                 let q = self.param([radius, sides as f32, 0.0, 0.0]);

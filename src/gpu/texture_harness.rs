@@ -36,7 +36,8 @@ pub enum PatternQuery {
         mortar: f32,
         row_offset: f32,
     },
-    /// Result: (select, ∂h/∂u, ∂h/∂v).
+    /// Result: (select, ∂h/∂u, ∂h/∂v, the height profile for a bevel one
+    /// unit high).
     Tile {
         mortar_half_width: f32,
         bevel_width: f32,
@@ -58,7 +59,7 @@ pub enum PatternQuery {
         turbulence_amount: f32,
         noise: NoiseSettings,
     },
-    /// Result: (∂h/∂u, ∂h/∂v).
+    /// Result: (∂h/∂u, ∂h/∂v, the unit waves' height).
     WavesGradient {
         frequency: f32,
         amplitude: f32,

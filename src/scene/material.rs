@@ -48,8 +48,17 @@ pub enum Pattern {
         row_offset: f32,
     },
     /// One tile per unit (u, v) square (lay it in a checker): `a` the mortar
-    /// `mortar_half_width` wide along the edges, `b` the tile.
-    Tile { mortar_half_width: f32 },
+    /// `mortar_half_width` wide along the edges, `b` the tile, which rises
+    /// from the mortar over a `bevel` wide edge (0: a step). As a bump
+    /// texture it raises the tiles.
+    Tile {
+        mortar_half_width: f32,
+        #[serde(default)]
+        bevel: f32,
+    },
+    /// Parallel waves across (u, v): `t = 0.5 + 0.5 · sin(2π · frequency ·
+    /// direction·uv)`. As a bump texture it ripples the surface.
+    Waves { frequency: f32, direction: Vec2 },
     /// A regular polygon of `sides` sides (a disc below 3) of circumradius
     /// `radius`, centred in every unit (u, v) square: `a` outside, `b` inside.
     Cutout { sides: u32, radius: f32 },
@@ -71,7 +80,7 @@ pub enum Pattern {
 }
 
 impl Pattern {
-    pub const NAMES: [&'static str; 11] = [
+    pub const NAMES: [&'static str; 12] = [
         "constant",
         "checker 3D",
         "fBm",
@@ -83,6 +92,7 @@ impl Pattern {
         "cutout",
         "wood",
         "veins",
+        "waves",
     ];
 
     /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
@@ -99,6 +109,7 @@ impl Pattern {
             Pattern::Cutout { .. } => 8,
             Pattern::Wood { .. } => 9,
             Pattern::Veins { .. } => 10,
+            Pattern::Waves { .. } => 11,
         }
     }
 
@@ -125,6 +136,7 @@ impl Pattern {
             },
             7 => Pattern::Tile {
                 mortar_half_width: 0.02,
+                bevel: 0.02,
             },
             8 => Pattern::Cutout {
                 sides: 0,
@@ -139,6 +151,10 @@ impl Pattern {
                 noise,
                 frequency: 10.0,
                 turbulence_amount: 5.0,
+            },
+            11 => Pattern::Waves {
+                frequency: 4.0,
+                direction: Vec2::X,
             },
             _ => Pattern::Constant,
         }
@@ -200,9 +216,14 @@ impl Pattern {
                 let cell = texture::brick(uv, size, mortar, row_offset);
                 (cell.select, cell.local)
             }
-            Pattern::Tile { mortar_half_width } => {
-                (texture::tile(uv, mortar_half_width, 0.0, 0.0).select, uv)
-            }
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => (texture::tile_height(uv, mortar_half_width, bevel), uv),
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => (texture::waves(uv, frequency, direction), uv),
             Pattern::Cutout { sides, radius } => (texture::cutout(uv, sides, radius), uv),
             Pattern::Wood {
                 ring_width,
@@ -273,7 +294,27 @@ impl Pattern {
                 finite("mortar", mortar);
                 finite("row offset", row_offset);
             }
-            Pattern::Tile { mortar_half_width } => finite("mortar", mortar_half_width),
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => {
+                finite("mortar", mortar_half_width);
+                finite("bevel", bevel);
+                *bevel = bevel.max(0.0);
+            }
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => {
+                finite("frequency", frequency);
+                let d = direction.normalize_or(Vec2::X);
+                if d != *direction {
+                    notes.push(format!(
+                        "{what}: wave direction {direction} made unit length"
+                    ));
+                    *direction = d;
+                }
+            }
             Pattern::Cutout { radius, .. } => finite("radius", radius),
             Pattern::Wood {
                 turbulence_amount, ..
@@ -579,6 +620,11 @@ pub struct Material {
     pub roughness: Texture,
     /// Fraction of light reflected by a perfect mirror, 0 to 1.
     pub mirror: f32,
+    /// A height field over the surface (its first channel) that tilts the
+    /// shading normal: bump mapping. Constant: no bump.
+    pub bump: Texture,
+    /// The height, in scene units, of a bump value of 1.
+    pub bump_height: f32,
 }
 
 impl Default for Material {
@@ -588,19 +634,28 @@ impl Default for Material {
             specular: Texture::color(Vec3::splat(0.04)),
             roughness: Texture::scalar(0.4),
             mirror: 0.0,
+            bump: Texture::scalar(0.0),
+            bump_height: 0.0,
         }
     }
 }
 
 impl Material {
-    /// The material's three property textures, in shader order.
+    /// The material's colour and roughness textures, in shader order.
     pub fn textures(&self) -> [&Texture; 3] {
         [&self.diffuse, &self.specular, &self.roughness]
     }
 
-    /// Every pattern of every property texture, nested ones included.
+    /// Whether the bump texture varies: only then is bump code compiled in.
+    pub fn has_bump(&self) -> bool {
+        self.bump.pattern != Pattern::Constant
+    }
+
+    /// Every pattern of every texture, bump and nested ones included.
     pub fn patterns(&self) -> Vec<&Pattern> {
-        self.textures().iter().flat_map(|t| t.patterns()).collect()
+        let mut out: Vec<&Pattern> = self.textures().iter().flat_map(|t| t.patterns()).collect();
+        out.extend(self.bump.patterns());
+        out
     }
 
     pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
@@ -609,9 +664,19 @@ impl Material {
             .sanitize(&format!("{what} specular"), notes, 1);
         self.roughness
             .sanitize(&format!("{what} roughness"), notes, 1);
+        self.bump.sanitize(&format!("{what} bump"), notes, 1);
         let mut signals = Vec::new();
-        for texture in [&mut self.diffuse, &mut self.specular, &mut self.roughness] {
+        for texture in [
+            &mut self.diffuse,
+            &mut self.specular,
+            &mut self.roughness,
+            &mut self.bump,
+        ] {
             texture.limit_signals(&mut signals, what, notes);
+        }
+        if !self.bump_height.is_finite() {
+            notes.push(format!("{what}: non-finite bump height set to 0"));
+            self.bump_height = 0.0;
         }
         let s = if self.mirror.is_finite() {
             self.mirror.clamp(0.0, 1.0)

@@ -74,6 +74,23 @@ pub fn tile(uv: Vec2, mortar_half_width: f32, bevel_width: f32, bevel_height: f3
     }
 }
 
+/// The height of [`tile`]'s profile: 0 in the mortar, rising linearly over
+/// the bevel to 1 on the top (a step when `bevel_width` is 0). As a bump
+/// texture it raises the tiles; as a colour blend it fades the tile in over
+/// its bevel.
+pub fn tile_height(uv: Vec2, mortar_half_width: f32, bevel_width: f32) -> f32 {
+    let local = uv - uv.floor();
+    let from_edge = local.min(Vec2::ONE - local);
+    let rise = from_edge.x.min(from_edge.y) - mortar_half_width;
+    if rise < 0.0 {
+        0.0
+    } else if rise >= bevel_width {
+        1.0
+    } else {
+        rise / bevel_width
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,6 +123,33 @@ mod tests {
         let odd_row = brick(Vec2::new(0.3, 1.5), size, 0.1, 0.5);
         assert!((even.local.x - 0.3).abs() < 1e-6);
         assert!((odd_row.local.x - 0.8).abs() < 1e-6);
+    }
+
+    /// The height profile's slope on the bevel is the tile's height gradient
+    /// for a bevel one unit high.
+    #[test]
+    fn tile_height_rises_over_the_bevel_with_the_tile_slope() {
+        let (m, b) = (0.02, 0.05);
+        assert_eq!(tile_height(Vec2::new(0.01, 0.5), m, b), 0.0);
+        assert_eq!(tile_height(Vec2::splat(0.5), m, b), 1.0);
+        let e = 1e-3;
+        for uv in [
+            Vec2::new(0.04, 0.5),
+            Vec2::new(0.5, 0.95),
+            Vec2::new(0.96, 0.3),
+        ] {
+            let numeric = Vec2::new(
+                tile_height(uv + Vec2::X * e, m, b) - tile_height(uv - Vec2::X * e, m, b),
+                tile_height(uv + Vec2::Y * e, m, b) - tile_height(uv - Vec2::Y * e, m, b),
+            ) / (2.0 * e);
+            let analytic = tile(uv, m, b, 1.0).height_gradient;
+            assert!(
+                (numeric - analytic).length() < 1e-2,
+                "{uv}: {numeric} vs {analytic}"
+            );
+        }
+        // No bevel: a step.
+        assert_eq!(tile_height(Vec2::new(0.021, 0.5), m, 0.0), 1.0);
     }
 
     #[test]

@@ -18,14 +18,14 @@ pub mod ramp;
 pub mod waves;
 pub mod wood;
 
-pub use brick::{TileSample, brick, brick_mortar_fraction, tile};
+pub use brick::{TileSample, brick, brick_mortar_fraction, tile, tile_height};
 pub use bump::bumped_normal;
 pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
 pub use cutout::{cutout, cutout_area};
 pub use mapping::{TextureTransform, cylinder_uv, plane_uv, polygon_frame, sphere_uv, triangle_uv};
 pub use marble::marble_veins;
 pub use ramp::{RampStop, ramp};
-pub use waves::waves_gradient;
+pub use waves::{waves, waves_gradient};
 pub use wood::{default_axis, wood};
 
 /// The fraction of an n×n grid of cell centres over the unit square moved

@@ -4,6 +4,12 @@
 use glam::Vec2;
 use std::f32::consts::TAU;
 
+/// The height of the waves in [0, 1]: `0.5 + 0.5 · sin(2π · frequency ·
+/// direction·uv)`. As a bump texture it ripples the surface.
+pub fn waves(uv: Vec2, frequency: f32, direction: Vec2) -> f32 {
+    0.5 + 0.5 * (TAU * frequency * direction.dot(uv)).sin()
+}
+
 /// The gradient over uv of the height `amplitude · sin(2π · frequency ·
 /// direction·uv)`, `direction` of unit length: the crests run across it.
 pub fn waves_gradient(uv: Vec2, frequency: f32, amplitude: f32, direction: Vec2) -> Vec2 {
@@ -14,6 +20,20 @@ pub fn waves_gradient(uv: Vec2, frequency: f32, amplitude: f32, direction: Vec2)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `waves` is the height whose gradient `waves_gradient` gives, for an
+    /// amplitude of one half.
+    #[test]
+    fn waves_and_their_gradient_agree() {
+        let (f, d) = (2.0, Vec2::new(0.8, 0.6));
+        let e = 1e-3;
+        let uv = Vec2::new(0.3, -0.1);
+        let numeric = Vec2::new(
+            waves(uv + Vec2::X * e, f, d) - waves(uv - Vec2::X * e, f, d),
+            waves(uv + Vec2::Y * e, f, d) - waves(uv - Vec2::Y * e, f, d),
+        ) / (2.0 * e);
+        assert!((numeric - waves_gradient(uv, f, 0.5, d)).length() < 1e-2);
+    }
 
     /// The gradient matches central differences of the height.
     #[test]
