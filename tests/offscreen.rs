@@ -28,6 +28,16 @@ fn render_with(
     pixels
 }
 
+/// Every colour channel of `pixel` within `relative` of `expected`.
+fn assert_channels_near(pixel: [f32; 4], expected: f32, relative: f32, what: &str) {
+    for c in &pixel[..3] {
+        assert!(
+            (c - expected).abs() < relative * expected,
+            "{what}: {pixel:?}, expected {expected}"
+        );
+    }
+}
+
 fn lambert(albedo: f32) -> Material {
     Material {
         diffuse: Texture::color(Vec3::splat(albedo)),
@@ -128,12 +138,7 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
     let centre = pixels[(16 * w + 16) as usize];
     // The pixel footprint is ~0.03 units wide; across it the irradiance falls
     // by cos⁴, under 0.1% here.
-    for c in &centre[..3] {
-        assert!(
-            (c - expected).abs() < 2e-3 * expected,
-            "centre {centre:?}, expected {expected}"
-        );
-    }
+    assert_channels_near(centre, expected, 2e-3, "centre");
     // Farther from the light it is darker: the inverse-square law is there.
     let edge = pixels[(16 * w) as usize];
     assert!(edge[0] < centre[0], "edge {edge:?} vs centre {centre:?}");
@@ -181,22 +186,18 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
         let series: f32 = (0..bounces).map(|k| albedo.powi(k as i32)).sum();
         let expected = albedo / std::f32::consts::PI * intensity / (radius * radius) * series;
         for p in &pixels {
-            for c in &p[..3] {
-                assert!(
-                    (c - expected).abs() < 1e-3 * expected,
-                    "{bounces} bounces: {p:?}, expected {expected}"
-                );
-            }
+            assert_channels_near(*p, expected, 1e-3, &format!("{bounces} bounces"));
         }
     }
 }
 
 /// A Lambert ground under a constant white environment reflects exactly its
 /// albedo (every cosine-sampled bounce escapes upwards), so each pixel shows
-/// the diffuse texture where its ray meets the ground. With a nested tree
-/// (a 4×4 board whose even cells hold 3×3 boards of marble-veined and plain
-/// colours, and bricks), the generated WGSL must agree with the CPU
-/// reference `Texture::eval` wherever a pixel's footprint lies in one cell.
+/// the diffuse texture where its ray meets the ground. With a nested tree (a
+/// board whose even cells hold phased 3×3 boards of red and of bricks, and
+/// whose odd cells hold a pentagon cutout), the generated WGSL must agree
+/// with the CPU reference `Texture::eval` wherever a pixel's footprint lies
+/// in one cell.
 #[test]
 fn generated_texture_code_renders_the_cpu_reference() {
     let Some(ctx) = gpu_or_skip("generated_texture_code_renders_the_cpu_reference") else {
@@ -357,12 +358,12 @@ fn waves_bump_tilts_the_shading_normal_as_the_closed_form() {
             "the test would not see the bump"
         );
         let centre = pixels[(16 * w + 16) as usize];
-        for c in &centre[..3] {
-            assert!(
-                (c - expected).abs() < 5e-3 * expected,
-                "light at {light}: centre {centre:?}, expected {expected} (flat: {flat})"
-            );
-        }
+        assert_channels_near(
+            centre,
+            expected,
+            5e-3,
+            &format!("light at {light}, flat {flat}"),
+        );
     }
 }
 
