@@ -12,6 +12,7 @@ use crate::scene::{
     Child, EnvSource, Environment, Material, OrbitCamera, Pattern, PointLight, RenderSettings,
     Scene, Texture, ToneMap,
 };
+use crate::texture::{MAX_RAMP_STOPS, RampStop};
 use egui::emath::Numeric;
 use egui::{
     CollapsingHeader, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping, TextEdit,
@@ -320,6 +321,10 @@ fn texture_ui(
             .default_open(depth == 1)
             .show(ui, |ui| {
                 pattern_ui(ui, &mut texture.pattern);
+                ramp_ui(ui, texture);
+                if !texture.ramp.is_empty() {
+                    return;
+                }
                 if texture.pattern == Pattern::Constant {
                     child_ui(ui, "value", &mut texture.a, kind, depth);
                 } else {
@@ -329,6 +334,66 @@ fn texture_ui(
             });
         header.header_response.on_hover_text(hint);
     });
+}
+
+/// The colour ramp: ticked, the pattern's blend factor picks a colour from
+/// the stops instead of blending `a` and `b` (which seed the first two).
+fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
+    let mut on = !texture.ramp.is_empty();
+    if ui
+        .checkbox(&mut on, "colour ramp")
+        .on_hover_text("Map the pattern's t through colour stops (like Blender's ColorRamp)")
+        .changed()
+    {
+        texture.ramp = if on {
+            let at = |c: &Child| c.eval(Vec3::ZERO, glam::Vec2::ZERO);
+            vec![
+                RampStop {
+                    position: 0.0,
+                    color: at(&texture.a),
+                },
+                RampStop {
+                    position: 1.0,
+                    color: at(&texture.b),
+                },
+            ]
+        } else {
+            Vec::new()
+        };
+    }
+    let mut remove = None;
+    for (i, stop) in texture.ramp.iter_mut().enumerate() {
+        ui.push_id(("stop", i), |ui| {
+            ui.horizontal(|ui| {
+                color_button(ui, &mut stop.color);
+                ui.add(slider(&mut stop.position, 0.0..=1.0, "at"));
+                if ui
+                    .small_button("✕")
+                    .on_hover_text("Remove this stop")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+            });
+        });
+    }
+    if let Some(i) = remove.filter(|_| texture.ramp.len() > 1) {
+        texture.ramp.remove(i);
+    }
+    if !texture.ramp.is_empty()
+        && texture.ramp.len() < MAX_RAMP_STOPS
+        && ui.small_button("add stop").clicked()
+    {
+        let last = texture.ramp[texture.ramp.len() - 1];
+        texture.ramp.push(RampStop {
+            position: (last.position + 0.1).min(1.0),
+            ..last
+        });
+    }
+    // The shader interpolates neighbours: keep the stops in order.
+    texture
+        .ramp
+        .sort_by(|x, y| x.position.total_cmp(&y.position));
 }
 
 /// One side of a blend: its value, or (ticked "texture") a nested texture

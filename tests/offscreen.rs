@@ -303,6 +303,96 @@ fn generated_texture_code_renders_the_cpu_reference() {
     );
 }
 
+/// A colour ramp in the generated code: slow waves across the ground
+/// (t from 0 to 1 over two units) mapped through five stops, rendered as in
+/// the test above, against `Texture::eval` at each pixel's centre: away
+/// from the stops the colour changes by at most 0.04 across a pixel, nearly
+/// linearly, so 16 jittered samples average to the centre's value.
+#[test]
+fn generated_ramp_renders_the_cpu_reference() {
+    let Some(ctx) = gpu_or_skip("generated_ramp_renders_the_cpu_reference") else {
+        return;
+    };
+    use glam::Vec2;
+    use marbre::scene::Pattern;
+    use marbre::texture::RampStop;
+    let stop = |position, r, g, b| RampStop {
+        position,
+        color: Vec3::new(r, g, b),
+    };
+    let mut ramp = Texture::blend(
+        Pattern::Waves {
+            frequency: 0.25,
+            direction: Vec2::X,
+        },
+        0.0,
+        1.0,
+    );
+    ramp.ramp = vec![
+        stop(0.05, 0.8, 0.2, 0.2),
+        stop(0.3, 0.8, 0.6, 0.2),
+        stop(0.3, 0.2, 0.6, 0.2),
+        stop(0.7, 0.2, 0.3, 0.7),
+        stop(0.95, 0.7, 0.7, 0.7),
+    ];
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: Material {
+                diffuse: ramp.clone(),
+                ..lambert(0.5)
+            },
+        }),
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    scene.camera = OrbitCamera {
+        target: Vec3::new(0.5, 0.0, 0.0),
+        distance: 4.0,
+        yaw_degrees: 0.0,
+        pitch_degrees: 89.0,
+        fov_degrees: 20.0,
+    };
+    let (w, h) = (64, 32);
+    let pixels = render(&ctx, &scene, (w, h), 16);
+    let frame = scene.camera.frame();
+    let mut checked = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+            );
+            let d = (frame.forward
+                + ndc.x * frame.tan_half_fov * (w as f32 / h as f32) * frame.right
+                + ndc.y * frame.tan_half_fov * frame.up)
+                .normalize();
+            let p = frame.position - frame.position.y / d.y * d;
+            let expected = ramp.eval(p, Vec2::new(p.x, p.z));
+            // Where the ramp bends or jumps (at its stops) a pixel's mean
+            // is not its centre's value.
+            let t = marbre::texture::waves(Vec2::new(p.x, p.z), 0.25, Vec2::X);
+            if ramp.ramp.iter().any(|s| (t - s.position).abs() < 0.03) {
+                continue;
+            }
+            let got = pixels[(y * w + x) as usize];
+            for c in 0..3 {
+                assert!(
+                    (got[c] - expected[c]).abs() < 0.015,
+                    "pixel {x},{y} (t = {t}): rendered {got:?}, the CPU ramp gives {expected}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        checked > (w * h) as usize / 2,
+        "only {checked} pixels checked"
+    );
+}
+
 /// Bump mapping, in closed form: a Lambert ground rippled by waves along x,
 /// h(x) = H·(0.5 + 0.5·sin 2πx), lit by a point light. At x = 0 the slope is
 /// s = H·π, so the shading normal is (−s, 1, 0)/√(1 + s²) and the ground

@@ -142,6 +142,25 @@ impl Generator {
         }
     }
 
+    /// The ramp of texture `k` at its blend factor `t{k}`, unrolled stop by
+    /// stop (twin of `texture::ramp`): before the first stop its colour, then
+    /// each pair of neighbours takes over past its first position.
+    fn ramp(&mut self, stops: &[crate::texture::RampStop], k: usize, body: &mut String) -> String {
+        let slots: Vec<String> = stops
+            .iter()
+            .map(|s| self.param([s.color.x, s.color.y, s.color.z, s.position]))
+            .collect();
+        let _ = writeln!(body, "    var ramp{k} = {}.xyz;", slots[0]);
+        for pair in slots.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let _ = writeln!(
+                body,
+                "    ramp{k} = select(ramp{k}, mix({a}.xyz, {b}.xyz, clamp(select(1.0, (t{k} - {a}.w) / ({b}.w - {a}.w), {b}.w > {a}.w), 0.0, 1.0)), t{k} > {a}.w);"
+            );
+        }
+        format!("ramp{k}")
+    }
+
     /// Appends the statements evaluating `texture` at (p, uv) to `body` and
     /// returns the expression holding its colour.
     fn texture(
@@ -154,7 +173,7 @@ impl Generator {
     ) -> String {
         let k = self.next;
         self.next += 1;
-        if texture.pattern == Pattern::Constant {
+        if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
             return self.child(&texture.a, p, uv, signals, body);
         }
         let signal = texture
@@ -164,7 +183,7 @@ impl Generator {
             .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
         let mut child_uv = uv.to_string();
         let t = match texture.pattern {
-            Pattern::Constant => unreachable!("handled above"),
+            Pattern::Constant => "0.0".to_string(),
             Pattern::Checker { size } => {
                 let q = self.param([size, size, size, 0.0]);
                 format!("checker_3d({p}, {q}.xyz)")
@@ -229,6 +248,9 @@ impl Generator {
             }
         };
         let _ = writeln!(body, "    let t{k} = {t};");
+        if !texture.ramp.is_empty() {
+            return self.ramp(&texture.ramp, k, body);
+        }
         let a = self.child(&texture.a, p, &child_uv, signals, body);
         let b = self.child(&texture.b, p, &child_uv, signals, body);
         let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
@@ -321,6 +343,31 @@ mod tests {
         assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.12, 0.01)), green);
         // Outer cell (1, 0) is odd: blue.
         assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), blue);
+    }
+
+    /// With a ramp, the pattern's t picks a stop colour: the children are
+    /// neither generated nor evaluated, and each stop is one parameter.
+    #[test]
+    fn a_ramp_replaces_the_blend_of_the_children() {
+        use crate::texture::RampStop;
+        let mut t = nested();
+        t.ramp = vec![
+            RampStop {
+                position: 0.0,
+                color: Vec3::X,
+            },
+            RampStop {
+                position: 1.0,
+                color: Vec3::Y,
+            },
+        ];
+        let generated = generate(&scene_with(t.clone())).unwrap();
+        assert!(generated.wgsl.contains("var ramp0"), "{}", generated.wgsl);
+        assert!(!generated.wgsl.contains("cell1"), "children were generated");
+        assert!(generated.params.contains(&[0.0, 1.0, 0.0, 1.0]));
+        // Outer cell (1, 0) is odd: t = 1, the last stop.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), Vec3::Y);
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.1, 0.1)), Vec3::X);
     }
 
     #[test]

@@ -8,7 +8,7 @@ use super::features::FeatureSet;
 use super::scene_gpu::NoiseParamsGpu;
 use super::shader_source::Program;
 use crate::noise::NoiseSettings;
-use crate::texture::RampStop;
+use crate::texture::{MAX_RAMP_STOPS, RampStop};
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
 use glam::{Affine3A, Vec2, Vec3};
@@ -98,9 +98,6 @@ pub enum PatternQuery {
         to_texture: Affine3A,
     },
 }
-
-/// The most stops a ramp holds on the GPU (`MAX_RAMP_STOPS` in WGSL).
-pub const MAX_RAMP_STOPS: usize = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]

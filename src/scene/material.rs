@@ -450,13 +450,17 @@ impl Child {
     }
 }
 
-/// A property across a surface: `mix(a, b, t)` with `t` from the pattern.
+/// A property across a surface: `mix(a, b, t)` with `t` from the pattern,
+/// or, when `ramp` has stops, the ramp's colour at `t` (Blender's
+/// ColorRamp after a pattern: a noise mapped through chosen colours).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Texture {
     pub pattern: Pattern,
     pub a: Child,
     pub b: Child,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ramp: Vec<texture::RampStop>,
 }
 
 impl Texture {
@@ -466,6 +470,8 @@ impl Texture {
             pattern: Pattern::Constant,
             a: Child::Color(c),
             b: Child::Color(c),
+
+            ramp: Vec::new(),
         }
     }
 
@@ -475,6 +481,8 @@ impl Texture {
             pattern: Pattern::Constant,
             a: Child::Scalar(v),
             b: Child::Scalar(v),
+
+            ramp: Vec::new(),
         }
     }
 
@@ -484,6 +492,8 @@ impl Texture {
             pattern,
             a: a.into(),
             b: b.into(),
+
+            ramp: Vec::new(),
         }
     }
 
@@ -499,11 +509,23 @@ impl Texture {
             }
         });
         let (t, child_uv) = self.pattern.blend(p, uv, signal);
+        if !self.ramp.is_empty() {
+            return texture::ramp(&self.ramp, t);
+        }
         let a = self.a.eval(p, child_uv);
         if self.pattern == Pattern::Constant {
             return a;
         }
         a.lerp(self.b.eval(p, child_uv), t)
+    }
+
+    /// Whether any texture in the tree maps its blend factor through a ramp.
+    pub fn has_ramp(&self) -> bool {
+        !self.ramp.is_empty()
+            || [&self.a, &self.b]
+                .iter()
+                .filter_map(|c| c.texture())
+                .any(Texture::has_ramp)
     }
 
     /// Every pattern in the tree, this one first.
@@ -533,6 +555,7 @@ impl Texture {
     /// their `a` value).
     fn sanitize(&mut self, what: &str, notes: &mut Vec<String>, depth: usize) {
         self.pattern.sanitize(what, notes);
+        self.sanitize_ramp(what, notes);
         for (name, child) in [("a", &mut self.a), ("b", &mut self.b)] {
             let path = format!("{what}.{name}");
             match child {
@@ -567,6 +590,32 @@ impl Texture {
                 }
                 Child::Texture(t) => t.sanitize(&path, notes, depth + 1),
             }
+        }
+    }
+
+    /// Ramp stops: at most [`texture::MAX_RAMP_STOPS`], finite, colours in
+    /// [0, 1], sorted by position (the shader interpolates neighbours).
+    fn sanitize_ramp(&mut self, what: &str, notes: &mut Vec<String>) {
+        if self.ramp.len() > texture::MAX_RAMP_STOPS {
+            notes.push(format!(
+                "{what}: a ramp holds at most {} stops; the rest are dropped",
+                texture::MAX_RAMP_STOPS
+            ));
+            self.ramp.truncate(texture::MAX_RAMP_STOPS);
+        }
+        for stop in &mut self.ramp {
+            if !stop.position.is_finite() || !stop.color.is_finite() {
+                notes.push(format!("{what}: a non-finite ramp stop set to 0"));
+                *stop = texture::RampStop {
+                    position: 0.0,
+                    color: Vec3::ZERO,
+                };
+            }
+            stop.color = stop.color.clamp(Vec3::ZERO, Vec3::ONE);
+        }
+        if !self.ramp.is_sorted_by(|x, y| x.position <= y.position) {
+            notes.push(format!("{what}: ramp stops sorted by position"));
+            self.ramp.sort_by(|x, y| x.position.total_cmp(&y.position));
         }
     }
 

@@ -156,6 +156,33 @@ mod tests {
         );
     }
 
+    /// Ramps come out of `sanitize` in order, finite, within the limit.
+    #[test]
+    fn ramp_stops_are_sorted_and_bounded() {
+        use crate::texture::{MAX_RAMP_STOPS, RampStop};
+        let mut scene = Scene {
+            spheres: vec![Sphere::default()],
+            ..Default::default()
+        };
+        let stops = &mut scene.spheres[0].material.diffuse.ramp;
+        for k in 0..MAX_RAMP_STOPS + 3 {
+            stops.push(RampStop {
+                position: 1.0 - k as f32 * 0.1,
+                color: Vec3::splat(2.0),
+            });
+        }
+        stops[1].position = f32::NAN;
+        let notes = scene.sanitize();
+        let ramp = &scene.spheres[0].material.diffuse.ramp;
+        assert_eq!(ramp.len(), MAX_RAMP_STOPS);
+        assert!(ramp.is_sorted_by(|a, b| a.position <= b.position));
+        assert!(
+            ramp.iter()
+                .all(|s| s.position.is_finite() && s.color.max_element() <= 1.0)
+        );
+        assert!(notes.len() >= 3, "{notes:?}");
+    }
+
     #[test]
     fn a_scene_at_the_limit_keeps_every_sphere() {
         let mut scene = Scene {

@@ -24,7 +24,7 @@ pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
 pub use cutout::{cutout, cutout_area};
 pub use mapping::{TextureTransform, cylinder_uv, plane_uv, polygon_frame, sphere_uv, triangle_uv};
 pub use marble::marble_veins;
-pub use ramp::{RampStop, ramp};
+pub use ramp::{MAX_RAMP_STOPS, RampStop, ramp};
 pub use waves::{waves, waves_gradient};
 pub use wood::{default_axis, wood};
 

@@ -4,6 +4,9 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+/// The most stops a ramp holds (the shader's code is unrolled per stop).
+pub const MAX_RAMP_STOPS: usize = 8;
+
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RampStop {
     pub position: f32,
