@@ -191,6 +191,25 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
     }
 }
 
+/// A Lambert ground with `diffuse` under a constant white environment of
+/// radiance 1: each point reflects exactly its diffuse colour.
+fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: Material {
+                diffuse,
+                ..lambert(0.5)
+            },
+        }),
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    scene
+}
+
 /// A Lambert ground under a constant white environment reflects exactly its
 /// albedo (every cosine-sampled bounce escapes upwards), so each pixel shows
 /// the diffuse texture where its ray meets the ground. With a nested tree (a
@@ -236,19 +255,7 @@ fn generated_texture_code_renders_the_cpu_reference() {
             Vec3::new(0.9, 0.8, 0.1),
         ),
     );
-    let mut scene = Scene {
-        ground: Some(Ground {
-            height: 0.0,
-            material: Material {
-                diffuse: tree.clone(),
-                ..lambert(0.5)
-            },
-        }),
-        ..Scene::default()
-    };
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::ONE,
-    };
+    let mut scene = textured_ground_in_white_light(tree.clone());
     scene.camera = OrbitCamera {
         target: Vec3::new(0.3, 0.0, -0.2),
         distance: 3.0,
@@ -335,19 +342,7 @@ fn generated_ramp_renders_the_cpu_reference() {
         stop(0.7, 0.2, 0.3, 0.7),
         stop(0.95, 0.7, 0.7, 0.7),
     ];
-    let mut scene = Scene {
-        ground: Some(Ground {
-            height: 0.0,
-            material: Material {
-                diffuse: ramp.clone(),
-                ..lambert(0.5)
-            },
-        }),
-        ..Scene::default()
-    };
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::ONE,
-    };
+    let mut scene = textured_ground_in_white_light(ramp.clone());
     scene.camera = OrbitCamera {
         target: Vec3::new(0.5, 0.0, 0.0),
         distance: 4.0,
