@@ -191,6 +191,19 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
     }
 }
 
+/// Where the camera ray through image point `at` (in pixels) meets the
+/// ground y = 0: the shader's `camera_ray`, on the CPU.
+fn ground_point(scene: &Scene, (w, h): (u32, u32), at: glam::Vec2) -> Vec3 {
+    let frame = scene.camera.frame();
+    let ndc = glam::Vec2::new(at.x / w as f32 * 2.0 - 1.0, 1.0 - at.y / h as f32 * 2.0);
+    let d = (frame.forward
+        + ndc.x * frame.tan_half_fov * (w as f32 / h as f32) * frame.right
+        + ndc.y * frame.tan_half_fov * frame.up)
+        .normalize();
+    let p = frame.position - frame.position.y / d.y * d;
+    Vec3::new(p.x, 0.0, p.z)
+}
+
 /// A Lambert ground with `diffuse` under a constant white environment of
 /// radiance 1: each point reflects exactly its diffuse colour.
 fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
@@ -266,17 +279,9 @@ fn generated_texture_code_renders_the_cpu_reference() {
     let (w, h) = (96, 64);
     let pixels = render(&ctx, &scene, (w, h), 4);
     // The shader's camera ray through a point of the image, on the CPU.
-    let frame = scene.camera.frame();
     let ground_uv = |x: f32, y: f32| {
-        let ndc = Vec2::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0);
-        let aspect = w as f32 / h as f32;
-        let d = (frame.forward
-            + ndc.x * frame.tan_half_fov * aspect * frame.right
-            + ndc.y * frame.tan_half_fov * frame.up)
-            .normalize();
-        let t = -frame.position.y / d.y;
-        let p = frame.position + t * d;
-        (Vec3::new(p.x, 0.0, p.z), Vec2::new(p.x, p.z))
+        let p = ground_point(&scene, (w, h), Vec2::new(x, y));
+        (p, Vec2::new(p.x, p.z))
     };
     let mut checked = 0;
     for y in 0..h {
@@ -352,19 +357,10 @@ fn generated_ramp_renders_the_cpu_reference() {
     };
     let (w, h) = (64, 32);
     let pixels = render(&ctx, &scene, (w, h), 16);
-    let frame = scene.camera.frame();
     let mut checked = 0;
     for y in 0..h {
         for x in 0..w {
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-                1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-            );
-            let d = (frame.forward
-                + ndc.x * frame.tan_half_fov * (w as f32 / h as f32) * frame.right
-                + ndc.y * frame.tan_half_fov * frame.up)
-                .normalize();
-            let p = frame.position - frame.position.y / d.y * d;
+            let p = ground_point(&scene, (w, h), Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let expected = ramp.eval(p, Vec2::new(p.x, p.z));
             // Where the ramp bends or jumps (at its stops) a pixel's mean
             // is not its centre's value.
@@ -386,6 +382,33 @@ fn generated_ramp_renders_the_cpu_reference() {
         checked > (w * h) as usize / 2,
         "only {checked} pixels checked"
     );
+}
+
+/// A colour edit reaches the image through the parameter buffer, and a
+/// camera edit (which skips regenerating the textures) keeps them.
+#[test]
+fn texture_edits_reach_the_image_without_a_new_renderer() {
+    let Some(ctx) = gpu_or_skip("texture_edits_reach_the_image_without_a_new_renderer") else {
+        return;
+    };
+    let mut scene = textured_ground_in_white_light(Texture::color(Vec3::new(0.2, 0.4, 0.6)));
+    scene.camera.pitch_degrees = 60.0;
+    let size = (8, 8);
+    let mut renderer = Renderer::new(&ctx, &scene, None, size).unwrap();
+    let centre = |r: &mut Renderer| {
+        accumulate(&ctx, r, 1, |_| {}).unwrap();
+        r.read_radiance(&ctx).unwrap().2[4 * 8 + 4]
+    };
+    let before = centre(&mut renderer);
+    for (c, want) in before[..3].iter().zip([0.2, 0.4, 0.6]) {
+        assert!((c - want).abs() < 1e-3, "before: {before:?}");
+    }
+    scene.ground.as_mut().unwrap().material.diffuse = Texture::color(Vec3::splat(0.7));
+    renderer.set_scene(&ctx, &scene).unwrap();
+    assert_channels_near(centre(&mut renderer), 0.7, 1e-3, "after a colour edit");
+    scene.camera.yaw_degrees += 30.0;
+    renderer.set_scene(&ctx, &scene).unwrap();
+    assert_channels_near(centre(&mut renderer), 0.7, 1e-3, "after a camera edit");
 }
 
 /// Bump mapping, in closed form: a Lambert ground rippled by waves along x,

@@ -246,18 +246,27 @@ impl Renderer {
             .feature_override
             .clone()
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
-        let textures = texture_codegen::generate(scene)?;
-        if features != self.features || textures.wgsl != self.texture_code {
+        // Camera and light edits (every frame of a drag) leave the textures
+        // alone: regenerate them only when a material changed.
+        let textures = if self.scene.materials().eq(scene.materials()) {
+            None
+        } else {
+            Some(texture_codegen::generate(scene)?)
+        };
+        let code = textures.as_ref().map_or(&self.texture_code, |t| &t.wgsl);
+        if features != self.features || *code != self.texture_code {
             (self.trace_pipeline, self.trace_shader_bytes) =
-                Self::build_trace_pipeline(ctx, &self.trace_layout, &features, &textures.wgsl)?;
+                Self::build_trace_pipeline(ctx, &self.trace_layout, &features, code)?;
             self.features = features;
+        }
+        if let Some(textures) = textures {
+            ctx.queue.write_buffer(
+                &self.texture_param_buffer,
+                0,
+                bytemuck::cast_slice(&textures.params),
+            );
             self.texture_code = textures.wgsl;
         }
-        ctx.queue.write_buffer(
-            &self.texture_param_buffer,
-            0,
-            bytemuck::cast_slice(&textures.params),
-        );
         // Fixed-size arrays: the buffers never grow.
         let spheres = scene_gpu::spheres(scene);
         let materials = scene_gpu::materials(scene);
