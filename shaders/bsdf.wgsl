@@ -9,6 +9,9 @@ struct SurfacePoint {
     specular: vec3f,
     alpha: f32,      // GGX α = roughness², kept above 1e-3 so D stays finite
     mirror: f32,
+    // The chance that a ray meets the surface rather than passing through.
+    opacity: f32,
+    emission: vec3f,
 }
 
 fn surface_at(hit: Hit) -> SurfacePoint {
@@ -20,11 +23,15 @@ fn surface_at(hit: Hit) -> SurfacePoint {
 #endif
     let textures = surface_textures(hit.material, p, hit.uv, signals);
     var s: SurfacePoint;
-    s.diffuse = textures.diffuse;
-    s.specular = textures.specular;
+    // Math steps can leave [0, 1]: reflectances stay within it, so no
+    // bounce ever adds energy.
+    s.diffuse = clamp(textures.diffuse, vec3f(0.0), vec3f(1.0));
+    s.specular = clamp(textures.specular, vec3f(0.0), vec3f(1.0));
     let r = clamp(textures.roughness, 0.0, 1.0);
     s.alpha = max(r * r, 1e-3);
-    s.mirror = materials[hit.material].mirror;
+    s.mirror = clamp(textures.mirror, 0.0, 1.0);
+    s.opacity = clamp(textures.opacity, 0.0, 1.0);
+    s.emission = max(textures.emission, vec3f(0.0));
 #if BUMP
     s.n = bumped_shading_normal(hit, signals);
 #else

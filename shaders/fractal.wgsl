@@ -8,8 +8,14 @@ struct NoiseParams {
     amplitude: f32,
     persistence: f32,
     lacunarity: f32,
-    // Non-zero: sum |noise| (turbulence) instead of noise (fBm).
-    absolute: u32,
+    // What each octave adds: 0 noise (fBm), 1 |noise| (turbulence),
+    // 2 (1 - |noise|)² (ridged).
+    shape: u32,
+    // Domain warp amount (0: none); compiled in with NOISE_WARP only.
+    distortion: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 const MAX_OCTAVES: f32 = 16.0;
@@ -28,9 +34,34 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 }
 
 // Octave i's share of the sum, in one place for both kinds' loops: the last,
-// fractional octave fades in, and turbulence sums |noise|.
+// fractional octave fades in, and the shape applies.
 fn octave_term(v: f32, n: NoiseParams, octaves: f32, i: u32, amplitude: f32) -> f32 {
-    return min(octaves - f32(i), 1.0) * amplitude * select(v, abs(v), n.absolute != 0u);
+    let ridge = (1.0 - abs(v)) * (1.0 - abs(v));
+    let shaped = select(select(v, abs(v), n.shape == 1u), ridge, n.shape == 2u);
+    return min(octaves - f32(i), 1.0) * amplitude * shaped;
+}
+
+#if NOISE_WARP
+// Offsets that decorrelate the warp's three components (src/noise/fractal.rs).
+const WARP_OFFSET_0 = vec3f(5.2, 1.3, 7.1);
+const WARP_OFFSET_1 = vec3f(1.7, 9.2, 3.4);
+const WARP_OFFSET_2 = vec3f(8.3, 2.8, 4.9);
+#endif
+
+// p moved by the signal's domain warp: three noises at the base frequency.
+// Without NOISE_WARP no signal of the scene warps, and p stays.
+fn warped(p: vec3f, n: NoiseParams) -> vec3f {
+#if NOISE_WARP
+    let q = p * n.frequency;
+    let w = vec3f(
+        lattice_noise(q + WARP_OFFSET_0, n.kind, n.hash),
+        lattice_noise(q + WARP_OFFSET_1, n.kind, n.hash),
+        lattice_noise(q + WARP_OFFSET_2, n.kind, n.hash),
+    );
+    return select(p + n.distortion * w, p, n.distortion == 0.0);
+#else
+    return p;
+#endif
 }
 
 // One octave loop per noise kind, each calling only its own noise. A loop
@@ -39,7 +70,8 @@ fn octave_term(v: f32, n: NoiseParams, octaves: f32, i: u32, amplitude: f32) -> 
 // each kind's loop only for the signals of that kind.
 
 #if NOISE_GRADIENT
-fn fractal_sum_gradient(p: vec3f, n: NoiseParams) -> f32 {
+fn fractal_sum_gradient(point: vec3f, n: NoiseParams) -> f32 {
+    let p = warped(point, n);
     let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
     var frequency = n.frequency;
     var amplitude = n.amplitude;
@@ -55,7 +87,8 @@ fn fractal_sum_gradient(p: vec3f, n: NoiseParams) -> f32 {
 #endif
 
 #if NOISE_PERLIN
-fn fractal_sum_perlin(p: vec3f, n: NoiseParams) -> f32 {
+fn fractal_sum_perlin(point: vec3f, n: NoiseParams) -> f32 {
+    let p = warped(point, n);
     let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
     var frequency = n.frequency;
     var amplitude = n.amplitude;
@@ -86,14 +119,20 @@ fn fractal_sum(p: vec3f, n: NoiseParams) -> f32 {
 
 fn fbm(p: vec3f, n: NoiseParams) -> f32 {
     var signed = n;
-    signed.absolute = 0u;
+    signed.shape = 0u;
     return fractal_sum(p, signed);
 }
 
 fn turbulence(p: vec3f, n: NoiseParams) -> f32 {
     var absolute = n;
-    absolute.absolute = 1u;
+    absolute.shape = 1u;
     return fractal_sum(p, absolute);
+}
+
+fn ridged(p: vec3f, n: NoiseParams) -> f32 {
+    var ridges = n;
+    ridges.shape = 2u;
+    return fractal_sum(p, ridges);
 }
 
 // The stripes of marble, given the fBm value at the point.

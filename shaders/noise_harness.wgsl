@@ -3,7 +3,7 @@
 
 struct Harness {
     noise: NoiseParams,
-    mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y
+    mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged
     count: u32,
     param: f32,           // marble stripe frequency, or rotation in radians
     _pad: f32,
@@ -37,6 +37,9 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         }
         case 4u: {
             r = vec4f(env_uv(p), 0.0, 0.0);
+        }
+        case 6u: {
+            r.x = ridged(p, n);
         }
         default: {
             r = vec4f(rotate_y(p, harness.param), 0.0);

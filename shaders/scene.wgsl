@@ -36,9 +36,9 @@ struct Material {
     signal_count: u32,
     // Signals before this index are gradient noise, from it on Perlin noise.
     first_perlin: u32,
-    mirror: f32,
     // Scene units of height for a bump value of 1.
     bump_height: f32,
+    _pad: f32,
 }
 
 struct Sphere {

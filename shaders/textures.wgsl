@@ -13,6 +13,9 @@ struct SurfaceTextures {
     diffuse: vec3f,
     specular: vec3f,
     roughness: f32,
+    mirror: f32,
+    opacity: f32,
+    emission: vec3f,
 }
 
 #if NOISE

@@ -21,12 +21,50 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
         return vec3f(0.0);
     }
     let origin = offset_ray(hit.p, hit.n);
-    let to_light_from_origin = frame.light_pos - origin;
-    if occluded(origin, wi, length(to_light_from_origin)) {
-        return vec3f(0.0);
-    }
-    return (1.0 - s.mirror) * f_cos * frame.light_power / dist2;
+#if OPACITY
+    let through = transmittance(origin, wi, frame.light_pos);
+#else
+    let through = select(1.0, 0.0, occluded(origin, wi, length(frame.light_pos - origin)));
+#endif
+    return through * (1.0 - s.mirror) * f_cos * frame.light_power / dist2;
 }
+#endif
+
+// The most surfaces a ray passes through (opacity < 1) before it counts as
+// stopped: a bound, so that a stack of holes always ends.
+const MAX_CROSSINGS: u32 = 16u;
+
+#if OPACITY
+// The fraction of light going from `o` along `d` that reaches `light`
+// through the surfaces in between: each lets `1 - opacity` through, like a
+// ray crossing it (no refraction, no tint).
+fn transmittance(o: vec3f, d: vec3f, light: vec3f) -> f32 {
+    var origin = o;
+    var through = 1.0;
+    var crossings = 0u;
+    loop {
+        let h = intersect_scene(origin, d);
+        if h.t >= length(light - origin) {
+            break;
+        }
+        through *= 1.0 - clamp(surface_opacity(h.material, h.texture_point, h.uv), 0.0, 1.0);
+        origin = offset_ray(h.p, -h.n);
+        crossings++;
+        continuing {
+            break if through <= 0.0 || crossings >= MAX_CROSSINGS;
+        }
+    }
+    return select(through, 0.0, crossings >= MAX_CROSSINGS);
+}
+#endif
+
+#if EMISSION
+// With emitters, the loop runs one pass past the last bounce, to add the
+// emission of the surface the last bounce reached (as the environment is
+// added when it escapes).
+const EMISSION_PASS: u32 = 1u;
+#else
+const EMISSION_PASS: u32 = 0u;
 #endif
 
 // SIMD lanes run every piece of code some lane needs, and lavapipe runs
@@ -44,31 +82,54 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // Whether the path is still going: it ends by escaping or by absorption.
     var alive = true;
     var bounces = 0u;
+    // Surfaces passed straight through (where opacity < 1).
+    var crossings = 0u;
     if hit.t < NO_HIT && frame.max_bounces > 0u {
         loop {
             let s = surface_at(hit);
             let wo = -d;
-#if POINT_LIGHT
-            radiance += throughput * point_light(hit, s, wo);
+#if OPACITY
+            // Draws only where the surface has holes, so an opaque scene
+            // keeps its random sequence whether or not this is compiled in.
+            let crossing = s.opacity < 1.0 && rand() >= s.opacity;
+#else
+            let crossing = false;
 #endif
-            let bs = sample_bsdf(s, s.n, wo);
-            if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
-                alive = false;
-                break;
+            var origin: vec3f;
+            if crossing {
+                origin = offset_ray(hit.p, -hit.n);
+                crossings++;
+            } else {
+#if EMISSION
+                radiance += throughput * s.emission;
+                if bounces >= frame.max_bounces {
+                    alive = false;
+                    break;
+                }
+#endif
+#if POINT_LIGHT
+                radiance += throughput * point_light(hit, s, wo);
+#endif
+                let bs = sample_bsdf(s, s.n, wo);
+                if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
+                    alive = false;
+                    break;
+                }
+                throughput *= bs.weight;
+                d = bs.wi;
+                origin = offset_ray(hit.p, hit.n);
+                bounces++;
             }
-            throughput *= bs.weight;
-            d = bs.wi;
-            hit = intersect_scene(offset_ray(hit.p, hit.n), d);
-            bounces++;
+            hit = intersect_scene(origin, d);
             continuing {
-                break if bounces >= frame.max_bounces || hit.t >= NO_HIT;
+                break if bounces >= frame.max_bounces + EMISSION_PASS || hit.t >= NO_HIT || crossings >= MAX_CROSSINGS;
             }
         }
     }
     // A path that escaped sees the environment; the camera sees it only if
     // the background is visible. One that ran out of bounces on a surface
     // gets nothing more.
-    let escaped = alive && hit.t >= NO_HIT;
+    let escaped = alive && hit.t >= NO_HIT && crossings < MAX_CROSSINGS;
     if escaped && (bounces > 0u || frame.background_visible != 0u) {
         radiance += throughput * environment(d);
     }

@@ -31,6 +31,7 @@ fn settings(kind: NoiseKind, hash: HashKind) -> NoiseSettings {
             amplitude: 0.9,
             persistence: 0.5,
             lacunarity: 2.0,
+            distortion: 0.0,
         },
     }
 }
@@ -40,6 +41,7 @@ fn cpu(s: &NoiseSettings, what: Evaluate, p: Vec3) -> f32 {
         Evaluate::Noise => noise::noise(p, s.kind, s.hash),
         Evaluate::Fbm => noise::fbm(p, s),
         Evaluate::Turbulence => noise::turbulence(p, s),
+        Evaluate::Ridged => noise::ridged(p, s),
         Evaluate::Marble { stripe_frequency } => noise::marble(p, s, stripe_frequency),
         _ => unreachable!("scalar modes only"),
     }
@@ -52,10 +54,11 @@ fn max_error(gpu: &[f32], s: &NoiseSettings, what: Evaluate, pts: &[Vec3]) -> (f
         .fold((0.0, Vec3::ZERO), |a, b| if b.0 > a.0 { b } else { a })
 }
 
-const MODES: [Evaluate; 4] = [
+const MODES: [Evaluate; 5] = [
     Evaluate::Noise,
     Evaluate::Fbm,
     Evaluate::Turbulence,
+    Evaluate::Ridged,
     Evaluate::Marble {
         stripe_frequency: 3.0,
     },
@@ -82,6 +85,43 @@ fn integer_hash_and_perlin_noise_match_the_cpu() {
             assert!(
                 err < 1e-4,
                 "{kind:?}/{hash:?} {what:?}: error {err} at {at}"
+            );
+        }
+    }
+}
+
+/// Domain-warped sums (distortion 0.8) agree too, for both noise kinds.
+/// The warp moves the point by noise, whose rounding (~1e-6) the sum's
+/// gradient (about 100 per unit at the finest of 5.5 octaves) amplifies,
+/// hence a looser bound, over |p| ≤ 10.
+#[test]
+fn domain_warped_sums_match_the_cpu() {
+    let Some(ctx) = gpu_or_skip("domain_warped_sums_match_the_cpu") else {
+        return;
+    };
+    let pts = points(N, 10.0);
+    for kind in NoiseKind::ALL {
+        let mut s = settings(kind, HashKind::Pcg);
+        s.fractal.distortion = 0.8;
+        for what in [Evaluate::Fbm, Evaluate::Ridged] {
+            let gpu = evaluate_scalar(&ctx, &s, what, &pts).unwrap();
+            let (err, at) = max_error(&gpu, &s, what, &pts);
+            assert!(err < 5e-4, "{kind:?} warped {what:?}: error {err} at {at}");
+            let unwarped = NoiseSettings {
+                fractal: FractalParams {
+                    distortion: 0.0,
+                    ..s.fractal
+                },
+                ..s
+            };
+            let moved = pts
+                .iter()
+                .zip(&gpu)
+                .filter(|&(&p, &g)| (g - cpu(&unwarped, what, p)).abs() > 1e-2)
+                .count();
+            assert!(
+                moved > N / 2,
+                "{kind:?} {what:?}: the warp changed only {moved} values"
             );
         }
     }

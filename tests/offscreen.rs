@@ -1,52 +1,13 @@
 //! Offscreen renders with closed-form answers.
 
+mod common;
+
+use common::*;
 use glam::Vec3;
 use marbre::commands::session::accumulate;
+use marbre::gpu::Renderer;
 use marbre::gpu::testing::gpu_or_skip;
-use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, Sphere, Texture};
-
-fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
-    render_with(ctx, scene, size, spp, None)
-}
-
-fn render_with(
-    ctx: &GpuContext,
-    scene: &Scene,
-    size: (u32, u32),
-    spp: u32,
-    features: Option<marbre::gpu::FeatureSet>,
-) -> Vec<[f32; 4]> {
-    let mut r = Renderer::new(ctx, scene, None, size).unwrap();
-    r.set_feature_override(ctx, features).unwrap();
-    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
-    let (w, h, pixels) = r.read_radiance(ctx).unwrap();
-    assert_eq!((w, h), size);
-    for p in &pixels {
-        assert!(p.iter().all(|c| c.is_finite()), "non-finite pixel {p:?}");
-    }
-    pixels
-}
-
-/// Every colour channel of `pixel` within `relative` of `expected`.
-fn assert_channels_near(pixel: [f32; 4], expected: f32, relative: f32, what: &str) {
-    for c in &pixel[..3] {
-        assert!(
-            (c - expected).abs() < relative * expected,
-            "{what}: {pixel:?}, expected {expected}"
-        );
-    }
-}
-
-fn lambert(albedo: f32) -> Material {
-    Material {
-        diffuse: Texture::color(Vec3::splat(albedo)),
-        specular: Texture::color(Vec3::ZERO),
-        roughness: Texture::scalar(1.0),
-        mirror: 0.0,
-        ..Material::default()
-    }
-}
+use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere, Texture};
 
 /// A diffuse sphere of albedo ρ under a constant white environment of
 /// radiance 1 reflects exactly ρ: every cosine-sampled bounce escapes to the
@@ -191,38 +152,6 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
     }
 }
 
-/// Where the camera ray through image point `at` (in pixels) meets the
-/// ground y = 0: the shader's `camera_ray`, on the CPU.
-fn ground_point(scene: &Scene, (w, h): (u32, u32), at: glam::Vec2) -> Vec3 {
-    let frame = scene.camera.frame();
-    let ndc = glam::Vec2::new(at.x / w as f32 * 2.0 - 1.0, 1.0 - at.y / h as f32 * 2.0);
-    let d = (frame.forward
-        + ndc.x * frame.tan_half_fov * (w as f32 / h as f32) * frame.right
-        + ndc.y * frame.tan_half_fov * frame.up)
-        .normalize();
-    let p = frame.position - frame.position.y / d.y * d;
-    Vec3::new(p.x, 0.0, p.z)
-}
-
-/// A Lambert ground with `diffuse` under a constant white environment of
-/// radiance 1: each point reflects exactly its diffuse colour.
-fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
-    let mut scene = Scene {
-        ground: Some(Ground {
-            height: 0.0,
-            material: Material {
-                diffuse,
-                ..lambert(0.5)
-            },
-        }),
-        ..Scene::default()
-    };
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::ONE,
-    };
-    scene
-}
-
 /// A Lambert ground under a constant white environment reflects exactly its
 /// albedo (every cosine-sampled bounce escapes upwards), so each pixel shows
 /// the diffuse texture where its ray meets the ground. With a nested tree (a
@@ -278,41 +207,7 @@ fn generated_texture_code_renders_the_cpu_reference() {
     };
     let (w, h) = (96, 64);
     let pixels = render(&ctx, &scene, (w, h), 4);
-    // The shader's camera ray through a point of the image, on the CPU.
-    let ground_uv = |x: f32, y: f32| {
-        let p = ground_point(&scene, (w, h), Vec2::new(x, y));
-        (p, Vec2::new(p.x, p.z))
-    };
-    let mut checked = 0;
-    for y in 0..h {
-        for x in 0..w {
-            // A 10×10 grid over the pixel: thin mortar lines must not slip
-            // between the samples.
-            let samples: Vec<Vec3> = (0..100)
-                .map(|k| {
-                    let (dx, dy) = ((k % 10) as f32 / 9.0, (k / 10) as f32 / 9.0);
-                    let (p, uv) = ground_uv(x as f32 + dx, y as f32 + dy);
-                    tree.eval(p, uv)
-                })
-                .collect();
-            if samples.iter().any(|c| (*c - samples[0]).length() > 1e-6) {
-                continue;
-            }
-            let got = pixels[(y * w + x) as usize];
-            let expected = samples[0];
-            for c in 0..3 {
-                assert!(
-                    (got[c] - expected[c]).abs() < 2e-3,
-                    "pixel {x},{y}: rendered {got:?}, the CPU tree gives {expected}"
-                );
-            }
-            checked += 1;
-        }
-    }
-    assert!(
-        checked > (w * h) as usize / 3,
-        "only {checked} pixels lie inside one cell"
-    );
+    assert_ground_matches(&scene, &pixels, (w, h), 1.0 / 3.0, |p, uv| tree.eval(p, uv));
 }
 
 /// A colour ramp in the generated code: slow waves across the ground

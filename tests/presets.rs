@@ -378,6 +378,10 @@ fn unused_patterns_leave_no_code() {
     // Only a pattern that reads (u, v) makes the hit compute it.
     assert!(!plain_src.contains("sphere_uv(dir)"));
     assert!(bricks_src.contains("sphere_uv(dir)"));
+    // Only a scene with holes traces shadow rays through surfaces.
+    let holes = load(&root().join("presets/cutouts.ron"));
+    assert!(trace_source(&holes.scene).contains("fn transmittance("));
+    assert!(!bricks_src.contains("fn transmittance("));
 }
 
 // ---------------------------------------------------------------------------

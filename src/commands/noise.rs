@@ -65,6 +65,7 @@ impl NoiseArgs {
                 amplitude: self.amplitude,
                 persistence: self.persistence,
                 lacunarity: self.lacunarity,
+                ..Default::default()
             },
         }
     }

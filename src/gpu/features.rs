@@ -1,6 +1,6 @@
 //! Which shader features a scene needs: the key of shader specialisation.
 
-use crate::noise::{HashKind, NoiseKind};
+use crate::noise::{HashKind, NoiseKind, NoiseSettings};
 use crate::scene::{EnvSource, Material, Pattern, Scene};
 use std::collections::BTreeSet;
 
@@ -22,7 +22,12 @@ pub enum Feature {
     PatternWood,
     PatternVeins,
     PatternWaves,
+    PatternRidged,
+    PatternMix,
     Bump,
+    Opacity,
+    Emission,
+    NoiseWarp,
     NoiseGradient,
     NoisePerlin,
     HashPcg,
@@ -30,7 +35,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 20] = [
+    pub const ALL: [Feature; 25] = [
         Feature::Ground,
         Feature::PointLight,
         Feature::EnvMap,
@@ -46,7 +51,12 @@ impl Feature {
         Feature::PatternWood,
         Feature::PatternVeins,
         Feature::PatternWaves,
+        Feature::PatternRidged,
+        Feature::PatternMix,
         Feature::Bump,
+        Feature::Opacity,
+        Feature::Emission,
+        Feature::NoiseWarp,
         Feature::NoiseGradient,
         Feature::NoisePerlin,
         Feature::HashPcg,
@@ -85,7 +95,12 @@ impl Feature {
             Feature::PatternWood => "PATTERN_WOOD",
             Feature::PatternVeins => "PATTERN_VEINS",
             Feature::PatternWaves => "PATTERN_WAVES",
+            Feature::PatternRidged => "PATTERN_RIDGED",
+            Feature::PatternMix => "PATTERN_MIX",
             Feature::Bump => "BUMP",
+            Feature::Opacity => "OPACITY",
+            Feature::Emission => "EMISSION",
+            Feature::NoiseWarp => "NOISE_WARP",
             Feature::NoiseGradient => "NOISE_GRADIENT",
             Feature::NoisePerlin => "NOISE_PERLIN",
             Feature::HashPcg => "HASH_PCG",
@@ -152,21 +167,27 @@ impl FeatureSet {
         for pattern in scene.materials().flat_map(|m| m.patterns()) {
             set.extend(pattern_features(pattern));
         }
-        if scene.materials().any(Material::has_bump) {
-            set.insert(Feature::Bump);
+        for (used, feature) in [
+            (Material::has_bump as fn(&Material) -> bool, Feature::Bump),
+            (Material::has_opacity, Feature::Opacity),
+            (Material::has_emission, Feature::Emission),
+        ] {
+            if scene.materials().any(used) {
+                set.insert(feature);
+            }
         }
         Self(set)
     }
 
-    /// For the noise harness: exactly what evaluating `kind`/`hash` needs.
-    pub fn for_noise(kind: NoiseKind, hash: HashKind) -> Self {
-        Self(noise_features(kind, hash).into_iter().collect())
+    /// For the noise harness: exactly what evaluating `noise` needs.
+    pub fn for_noise(noise: &NoiseSettings) -> Self {
+        Self(noise_features(noise).into_iter().collect())
     }
 
     /// For the texture harness: every pattern of the texture library, and
-    /// the noise `kind`/`hash` their turbulence uses.
-    pub fn for_texture_library(kind: NoiseKind, hash: HashKind) -> Self {
-        let mut set = Self::for_noise(kind, hash);
+    /// what the `noise` their turbulence uses needs.
+    pub fn for_texture_library(noise: &NoiseSettings) -> Self {
+        let mut set = Self::for_noise(noise);
         set.0.insert(Feature::PatternChecker);
         set.0
             .extend(Feature::ALL.into_iter().filter(|f| f.reads_library()));
@@ -174,12 +195,16 @@ impl FeatureSet {
     }
 }
 
-fn noise_features(kind: NoiseKind, hash: HashKind) -> Vec<Feature> {
-    match (kind, hash) {
+fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {
+    let mut out = match (noise.kind, noise.hash) {
         (NoiseKind::Perlin, _) => vec![Feature::NoisePerlin],
         (NoiseKind::Gradient, HashKind::Pcg) => vec![Feature::NoiseGradient, Feature::HashPcg],
         (NoiseKind::Gradient, HashKind::Sin) => vec![Feature::NoiseGradient, Feature::HashSin],
+    };
+    if noise.fractal.distortion != 0.0 {
+        out.push(Feature::NoiseWarp);
     }
+    out
 }
 
 fn pattern_features(p: &Pattern) -> Vec<Feature> {
@@ -196,9 +221,11 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
         Pattern::Wood { .. } => vec![Feature::PatternWood],
         Pattern::Veins { .. } => vec![Feature::PatternVeins],
         Pattern::Waves { .. } => vec![Feature::PatternWaves],
+        Pattern::Ridged { .. } => vec![Feature::PatternRidged],
+        Pattern::Mix => vec![Feature::PatternMix],
     };
     if let Some(n) = p.noise() {
-        out.extend(noise_features(n.kind, n.hash));
+        out.extend(noise_features(n));
     }
     out
 }
@@ -212,6 +239,38 @@ mod tests {
     #[test]
     fn an_empty_scene_needs_nothing() {
         assert!(FeatureSet::for_scene(&Scene::default()).0.is_empty());
+    }
+
+    #[test]
+    fn opacity_emission_and_warp_follow_the_materials() {
+        let mut scene = Scene::default();
+        scene.spheres.push(Sphere::default());
+        assert!(FeatureSet::for_scene(&scene).0.is_empty());
+        let m = &mut scene.spheres[0].material;
+        m.opacity = Texture::scalar(0.5);
+        m.emission = Texture::color(glam::Vec3::ONE);
+        m.roughness = Texture::blend(
+            Pattern::Ridged {
+                noise: NoiseSettings {
+                    fractal: crate::noise::FractalParams {
+                        distortion: 0.5,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                },
+            },
+            0.0,
+            1.0,
+        );
+        let set = FeatureSet::for_scene(&scene);
+        for f in [
+            Feature::Opacity,
+            Feature::Emission,
+            Feature::PatternRidged,
+            Feature::NoiseWarp,
+        ] {
+            assert!(set.contains(f), "{f:?} missing from {set:?}");
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::scene_gpu::NoiseParamsGpu;
 use super::shader_source::Program;
-use crate::noise::NoiseSettings;
+use crate::noise::{FractalShape, NoiseSettings};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
@@ -18,6 +18,7 @@ pub enum Evaluate {
     Noise,
     Fbm,
     Turbulence,
+    Ridged,
     Marble {
         stripe_frequency: f32,
     },
@@ -38,6 +39,7 @@ impl Evaluate {
             Evaluate::Marble { stripe_frequency } => (3, stripe_frequency),
             Evaluate::EnvUv => (4, 0.0),
             Evaluate::RotateY { angle } => (5, angle),
+            Evaluate::Ridged => (6, 0.0),
         }
     }
 }
@@ -62,7 +64,7 @@ pub fn evaluate(
 ) -> Result<Vec<[f32; 4]>> {
     let (mode, param) = what.mode_and_param();
     let params = HarnessUniform {
-        noise: NoiseParamsGpu::new(noise, false),
+        noise: NoiseParamsGpu::new(noise, FractalShape::Signed),
         mode,
         count: points.len() as u32,
         param,
@@ -71,7 +73,7 @@ pub fn evaluate(
     compute_harness::run(
         ctx,
         Program::NoiseHarness,
-        &FeatureSet::for_noise(noise.kind, noise.hash),
+        &FeatureSet::for_noise(noise),
         bytemuck::bytes_of(&params),
         points,
     )

@@ -1,7 +1,7 @@
 //! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
 
 use super::texture_codegen;
-use crate::noise::{HashKind, NoiseKind, NoiseSettings};
+use crate::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::material::MAX_SIGNALS;
 use crate::scene::{EnvSource, MAX_SPHERES, Material, Scene};
 use bytemuck::{Pod, Zeroable};
@@ -43,12 +43,14 @@ pub struct NoiseParamsGpu {
     pub amplitude: f32,
     pub persistence: f32,
     pub lacunarity: f32,
-    /// Non-zero sums |noise| (turbulence) rather than noise (fBm).
-    pub absolute: u32,
+    /// [`FractalShape::id`]: fBm, turbulence or ridged.
+    pub shape: u32,
+    pub distortion: f32,
+    pub _pad: [f32; 3],
 }
 
 impl NoiseParamsGpu {
-    pub fn new(n: &NoiseSettings, absolute: bool) -> Self {
+    pub fn new(n: &NoiseSettings, shape: FractalShape) -> Self {
         let f = &n.fractal;
         Self {
             kind: noise_kind_id(n.kind),
@@ -58,7 +60,9 @@ impl NoiseParamsGpu {
             amplitude: f.amplitude,
             persistence: f.persistence,
             lacunarity: f.lacunarity,
-            absolute: u32::from(absolute),
+            shape: shape.id(),
+            distortion: f.distortion,
+            _pad: [0.0; 3],
         }
     }
 }
@@ -70,8 +74,8 @@ pub struct MaterialGpu {
     pub signal_count: u32,
     /// Signals before this index are gradient noise, from it on Perlin.
     pub first_perlin: u32,
-    pub mirror: f32,
     pub bump_height: f32,
+    pub _pad: f32,
 }
 
 #[repr(C)]
@@ -97,12 +101,12 @@ pub fn hash_id(h: HashKind) -> u32 {
 
 /// A material's noise signals (its textures' distinct fractal sums,
 /// deduplicated so that rust's diffuse and specular colours share one
-/// evaluation per hit, gradient noise first) and its mirror fraction. The
+/// evaluation per hit, gradient noise first) and its bump height. The
 /// textures themselves are generated code (`texture_codegen`).
 pub fn material(m: &Material) -> MaterialGpu {
     let signals: Vec<NoiseParamsGpu> = texture_codegen::material_signals(m)
         .iter()
-        .map(|(noise, absolute)| NoiseParamsGpu::new(noise, *absolute))
+        .map(|signal| NoiseParamsGpu::new(&signal.noise, signal.shape))
         .collect();
     let mut out = MaterialGpu {
         signal_count: signals.len() as u32,
@@ -110,7 +114,6 @@ pub fn material(m: &Material) -> MaterialGpu {
             .iter()
             .position(|s| s.kind == noise_kind_id(NoiseKind::Perlin))
             .unwrap_or(signals.len()) as u32,
-        mirror: m.mirror,
         bump_height: m.bump_height,
         ..Default::default()
     };
@@ -201,8 +204,8 @@ mod tests {
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
         assert_eq!(std::mem::size_of::<FrameUniform>(), 144);
-        assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 32);
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 144);
+        assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 208);
         assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
     }
 
@@ -261,8 +264,8 @@ mod tests {
         let gpu = material(&m);
         // fBm once for both colours; turbulence, |noise|, is another sum.
         assert_eq!(gpu.signal_count, 2);
-        assert_eq!(gpu.signals[0].absolute, 0);
-        assert_eq!(gpu.signals[1].absolute, 1);
+        assert_eq!(gpu.signals[0].shape, FractalShape::Signed.id());
+        assert_eq!(gpu.signals[1].shape, FractalShape::Absolute.id());
     }
 
     #[test]

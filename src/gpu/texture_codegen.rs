@@ -15,7 +15,7 @@
 //! generated code reads them from `signals`.
 
 use crate::scene::material::MAX_SIGNALS;
-use crate::scene::{Child, Material, Pattern, Scene, Texture};
+use crate::scene::{Child, Material, MathOp, Pattern, Property, Scene, Signal, Texture};
 use anyhow::{Result, ensure};
 use std::fmt::Write;
 
@@ -38,21 +38,23 @@ pub struct GeneratedTextures {
 pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     let mut generator = Generator::default();
     let mut dispatch = String::new();
+    let mut opacities = String::new();
     let mut heights = String::new();
     for (index, material) in scene.materials().enumerate() {
-        let signals = material_signals(material);
-        let names = ["diffuse", "specular", "roughness"].map(|p| format!("texture_{index}_{p}"));
-        for (name, texture) in names.iter().zip(material.textures()) {
-            generator.function(name, texture, &signals);
-        }
-        let [d, s, r] = &names;
+        let cases = generator.material(index, material);
         writeln!(
             dispatch,
-            "        case {index}u: {{\n            out = SurfaceTextures({d}(p, uv, signals), {s}(p, uv, signals), {r}(p, uv, signals).x);\n        }}"
+            "        case {index}u: {{\n{}        }}",
+            cases.textures
+        )?;
+        writeln!(
+            opacities,
+            "        case {index}u: {{\n{}        }}",
+            cases.opacity
         )?;
         if material.has_bump() {
             let name = format!("texture_{index}_bump");
-            generator.function(&name, &material.bump, &signals);
+            generator.function(&name, &material.bump, &material_signals(material));
             writeln!(
                 heights,
                 "        case {index}u: {{\n            return {name}(p, uv, signals).x;\n        }}"
@@ -69,7 +71,29 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     wgsl.push_str(&generator.code);
     write!(
         wgsl,
-        "fn surface_textures(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0);\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+        "fn surface_textures(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+    )?;
+    // Shadow rays read opacity alone; they evaluate the noise signals only
+    // if some opacity texture reads one.
+    let opacity_reads_noise = scene.materials().any(|m| {
+        std::iter::once(&m.opacity)
+            .chain(
+                m.layers
+                    .iter()
+                    .flat_map(|l| [Some(&l.mask), l.opacity.as_ref()])
+                    .flatten(),
+            )
+            .flat_map(Texture::patterns)
+            .any(|p| p.signal().is_some())
+    });
+    let signals = if opacity_reads_noise {
+        "material_signals(material, p)"
+    } else {
+        "vec4f(0.0)"
+    };
+    write!(
+        wgsl,
+        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
     )?;
     // Always defined, so that a shader with the bump feature forced on (the
     // uber shader) builds for any scene.
@@ -85,7 +109,7 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
 /// A material's distinct fractal sums, gradient noise first (the order
 /// `material_signals` in textures.wgsl expects), at most [`MAX_SIGNALS`]
 /// (`Scene::sanitize` keeps materials within it).
-pub fn material_signals(material: &Material) -> Vec<(crate::noise::NoiseSettings, bool)> {
+pub fn material_signals(material: &Material) -> Vec<Signal> {
     let mut signals = Vec::new();
     for signal in material.patterns().iter().filter_map(|p| p.signal()) {
         if !signals.contains(&signal) {
@@ -93,8 +117,15 @@ pub fn material_signals(material: &Material) -> Vec<(crate::noise::NoiseSettings
         }
     }
     signals.truncate(MAX_SIGNALS);
-    signals.sort_by_key(|(noise, _)| noise.kind as u8);
+    signals.sort_by_key(|s| s.noise.kind as u8);
     signals
+}
+
+/// What [`Generator::material`] returns: a material's statements in the
+/// two dispatch functions.
+struct MaterialCases {
+    textures: String,
+    opacity: String,
 }
 
 #[derive(Default)]
@@ -106,12 +137,55 @@ struct Generator {
 }
 
 impl Generator {
-    fn function(
-        &mut self,
-        name: &str,
-        texture: &Texture,
-        signals: &[(crate::noise::NoiseSettings, bool)],
-    ) {
+    /// Generates the functions of material `index`'s textures and returns
+    /// the statements of its case in `surface_textures` (each property's
+    /// base texture, then each layer over it where its mask lies) and in
+    /// `surface_opacity` (the same for opacity alone).
+    fn material(&mut self, index: usize, material: &Material) -> MaterialCases {
+        let signals = material_signals(material);
+        let mut masks = Vec::new();
+        for (l, layer) in material.layers.iter().enumerate() {
+            let name = format!("texture_{index}_layer{l}_mask");
+            self.function(&name, &layer.mask, &signals);
+            masks.push(format!(
+                "            let mask{l} = clamp({name}(p, uv, signals).x, 0.0, 1.0);\n"
+            ));
+        }
+        let mut cases = MaterialCases {
+            textures: masks.concat(),
+            opacity: String::new(),
+        };
+        for property in Property::ALL {
+            let value = property.name();
+            let name = format!("texture_{index}_{value}");
+            self.function(&name, material.texture(property), &signals);
+            let mut statements = format!("            var {value} = {name}(p, uv, signals);\n");
+            let mut masks_read = String::new();
+            for (l, layer) in material.layers.iter().enumerate() {
+                if let Some(texture) = layer.texture(property) {
+                    let name = format!("texture_{index}_layer{l}_{value}");
+                    self.function(&name, texture, &signals);
+                    let _ = writeln!(
+                        statements,
+                        "            {value} = mix({value}, {name}(p, uv, signals), mask{l});"
+                    );
+                    masks_read.push_str(&masks[l]);
+                }
+            }
+            cases.textures.push_str(&statements);
+            if property == Property::Opacity {
+                cases.opacity = format!("{masks_read}{statements}            return opacity.x;\n");
+            }
+        }
+        let strength = self.param([material.emission_strength, 0.0, 0.0, 0.0]);
+        let _ = writeln!(
+            cases.textures,
+            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, emission * {strength}.x);"
+        );
+        cases
+    }
+
+    fn function(&mut self, name: &str, texture: &Texture, signals: &[Signal]) {
         self.next = 0;
         let mut body = String::new();
         let value = self.texture(texture, "p", "uv", signals, &mut body);
@@ -132,7 +206,7 @@ impl Generator {
         child: &Child,
         p: &str,
         uv: &str,
-        signals: &[(crate::noise::NoiseSettings, bool)],
+        signals: &[Signal],
         body: &mut String,
     ) -> String {
         match child {
@@ -168,11 +242,48 @@ impl Generator {
         texture: &Texture,
         p: &str,
         uv: &str,
-        signals: &[(crate::noise::NoiseSettings, bool)],
+        signals: &[Signal],
         body: &mut String,
     ) -> String {
         let k = self.next;
         self.next += 1;
+        let value = self.blended(texture, k, p, uv, signals, body);
+        if texture.ops.is_empty() {
+            return value;
+        }
+        let _ = writeln!(body, "    var r{k} = {value};");
+        for op in &texture.ops {
+            let r = format!("r{k}");
+            let expression = match op {
+                MathOp::Abs => format!("abs({r})"),
+                MathOp::Invert => format!("1.0 - {r}"),
+                MathOp::Scale(_) => format!("{r} * {}.x", self.param(op.params())),
+                MathOp::Bias(_) => format!("{r} + {}.x", self.param(op.params())),
+                MathOp::Clamp { .. } => {
+                    let q = self.param(op.params());
+                    format!("min(max({r}, vec3f({q}.x)), vec3f({q}.y))")
+                }
+                MathOp::Power(_) => {
+                    let q = self.param(op.params());
+                    format!("pow(max({r}, vec3f(0.0)), vec3f({q}.x))")
+                }
+            };
+            let _ = writeln!(body, "    {r} = {expression};");
+        }
+        format!("r{k}")
+    }
+
+    /// [`Generator::texture`] before the math steps: texture number `k`'s
+    /// blend of its children (or ramp).
+    fn blended(
+        &mut self,
+        texture: &Texture,
+        k: usize,
+        p: &str,
+        uv: &str,
+        signals: &[Signal],
+        body: &mut String,
+    ) -> String {
         if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
             return self.child(&texture.a, p, uv, signals, body);
         }
@@ -189,7 +300,16 @@ impl Generator {
                 format!("checker_3d({p}, {q}.xyz)")
             }
             Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
-            Pattern::Turbulence { .. } => format!("clamp({signal}, 0.0, 1.0)"),
+            Pattern::Turbulence { .. } | Pattern::Ridged { .. } => {
+                format!("clamp({signal}, 0.0, 1.0)")
+            }
+            Pattern::Mix => match &texture.factor {
+                Some(factor) => {
+                    let f = self.texture(factor, p, uv, signals, body);
+                    format!("clamp({f}.x, 0.0, 1.0)")
+                }
+                None => "0.0".to_string(),
+            },
             Pattern::Marble {
                 stripe_frequency, ..
             } => {
@@ -368,6 +488,39 @@ mod tests {
         // Outer cell (1, 0) is odd: t = 1, the last stop.
         assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), Vec3::Y);
         assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.1, 0.1)), Vec3::X);
+    }
+
+    /// Shadow rays evaluate the noise signals only when an opacity texture
+    /// reads one; layers' opacity bindings count.
+    #[test]
+    fn surface_opacity_reads_noise_only_when_opacity_does() {
+        let mut scene = scene_with(nested());
+        scene.spheres[0].material.diffuse = Texture::blend(
+            Pattern::Fbm {
+                noise: Default::default(),
+            },
+            0.0,
+            1.0,
+        );
+        let code = generate(&scene).unwrap().wgsl;
+        assert!(code.contains("fn surface_opacity"), "{code}");
+        assert!(!code.contains("let signals = material_signals"), "{code}");
+        scene.spheres[0].material.layers.push(crate::scene::Layer {
+            opacity: Some(Texture::blend(
+                Pattern::Turbulence {
+                    noise: Default::default(),
+                },
+                0.0,
+                1.0,
+            )),
+            ..Default::default()
+        });
+        let code = generate(&scene).unwrap().wgsl;
+        assert!(code.contains("let signals = material_signals"), "{code}");
+        assert!(
+            code.contains("opacity = mix(opacity, texture_0_layer0_opacity"),
+            "{code}"
+        );
     }
 
     #[test]

@@ -7,7 +7,7 @@ use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::scene_gpu::NoiseParamsGpu;
 use super::shader_source::Program;
-use crate::noise::NoiseSettings;
+use crate::noise::{FractalShape, NoiseSettings};
 use crate::texture::{MAX_RAMP_STOPS, RampStop};
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
@@ -165,7 +165,7 @@ impl PatternQuery {
                 noise,
             } => {
                 u.mode = 6;
-                u.noise = NoiseParamsGpu::new(noise, true);
+                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *ring_width);
                 u.b[0] = *turbulence_amount;
             }
@@ -176,7 +176,7 @@ impl PatternQuery {
                 noise,
             } => {
                 u.mode = 7;
-                u.noise = NoiseParamsGpu::new(noise, true);
+                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *frequency);
                 u.b[0] = *turbulence_amount;
             }
@@ -265,7 +265,7 @@ pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Resu
     compute_harness::run(
         ctx,
         Program::TextureHarness,
-        &FeatureSet::for_texture_library(noise.kind, noise.hash),
+        &FeatureSet::for_texture_library(&noise),
         bytemuck::bytes_of(&uniform),
         points,
     )

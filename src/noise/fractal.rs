@@ -17,6 +17,10 @@ pub struct FractalParams {
     pub amplitude: f32,
     pub persistence: f32,
     pub lacunarity: f32,
+    /// Domain warp (Blender's distortion): the sum is taken at `p` moved by
+    /// this much times a vector of three decorrelated noises at the base
+    /// frequency. 0 leaves `p` alone.
+    pub distortion: f32,
 }
 
 impl FractalParams {
@@ -31,6 +35,7 @@ impl Default for FractalParams {
             amplitude: 1.0,
             persistence: 0.5,
             lacunarity: 2.0,
+            distortion: 0.0,
         }
     }
 }
@@ -52,9 +57,56 @@ pub fn noise(p: Vec3, kind: NoiseKind, hash: HashKind) -> f32 {
     }
 }
 
-/// Sums `shape(noise)` over the octaves; `shape` is the identity for fBm and
-/// `abs` for turbulence.
-fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: impl Fn(f32) -> f32) -> f32 {
+/// What each octave adds: the signed noise (fBm), its absolute value
+/// (turbulence), or `(1 - |noise|)²`, sharp ridges where noise crosses 0
+/// (ridged, after Musgrave).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum FractalShape {
+    Signed,
+    Absolute,
+    Ridged,
+}
+
+impl FractalShape {
+    /// The id the shader switches on (`NoiseParams::shape`).
+    pub fn id(self) -> u32 {
+        match self {
+            FractalShape::Signed => 0,
+            FractalShape::Absolute => 1,
+            FractalShape::Ridged => 2,
+        }
+    }
+
+    fn apply(self, v: f32) -> f32 {
+        match self {
+            FractalShape::Signed => v,
+            FractalShape::Absolute => v.abs(),
+            FractalShape::Ridged => (1.0 - v.abs()) * (1.0 - v.abs()),
+        }
+    }
+}
+
+/// Offsets that decorrelate the three components of the domain warp.
+const WARP_OFFSETS: [Vec3; 3] = [
+    Vec3::new(5.2, 1.3, 7.1),
+    Vec3::new(1.7, 9.2, 3.4),
+    Vec3::new(8.3, 2.8, 4.9),
+];
+
+/// `p` moved by the domain warp of `s` (unchanged without distortion).
+pub fn warped(p: Vec3, s: &NoiseSettings) -> Vec3 {
+    let amount = s.fractal.distortion;
+    if amount == 0.0 {
+        return p;
+    }
+    let q = p * s.fractal.frequency;
+    let [a, b, c] = WARP_OFFSETS.map(|o| noise(q + o, s.kind, s.hash));
+    p + amount * Vec3::new(a, b, c)
+}
+
+/// Sums `shape(noise)` over the octaves, at the warped point.
+pub fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: FractalShape) -> f32 {
+    let p = warped(p, s);
     let f = &s.fractal;
     let octaves = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES);
     let whole = octaves.ceil() as u32;
@@ -64,7 +116,7 @@ fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: impl Fn(f32) -> f32) -> f32 {
     for i in 0..whole {
         // The last octave fades in with the fractional part of `octaves`.
         let weight = (octaves - i as f32).min(1.0);
-        sum += weight * amplitude * shape(noise(p * frequency, s.kind, s.hash));
+        sum += weight * amplitude * shape.apply(noise(p * frequency, s.kind, s.hash));
         frequency *= f.lacunarity;
         amplitude *= f.persistence;
     }
@@ -73,12 +125,17 @@ fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: impl Fn(f32) -> f32) -> f32 {
 
 /// Fractional Brownian motion: a sum of octaves of signed noise.
 pub fn fbm(p: Vec3, s: &NoiseSettings) -> f32 {
-    fractal_sum(p, s, |n| n)
+    fractal_sum(p, s, FractalShape::Signed)
 }
 
 /// Turbulence: a sum of octaves of |noise|, with creases where noise crosses 0.
 pub fn turbulence(p: Vec3, s: &NoiseSettings) -> f32 {
-    fractal_sum(p, s, f32::abs)
+    fractal_sum(p, s, FractalShape::Absolute)
+}
+
+/// Ridged noise: a sum of octaves of `(1 - |noise|)²`.
+pub fn ridged(p: Vec3, s: &NoiseSettings) -> f32 {
+    fractal_sum(p, s, FractalShape::Ridged)
 }
 
 /// The lab's marble: `sin(p.x · stripe_frequency + fbm(p))`, in [-1, 1].
@@ -107,6 +164,51 @@ mod tests {
             let k = k as f32;
             Vec3::new(k * 0.37, k * 0.11 - 20.0, 3.0 - k * 0.053)
         })
+    }
+
+    /// One octave of ridged noise is `(1 - |noise|)²`, in [0, 1], and
+    /// equal to 1 exactly where the noise crosses 0 (at lattice points).
+    #[test]
+    fn one_ridged_octave_is_the_squared_complement_of_abs_noise() {
+        for kind in NoiseKind::ALL {
+            let s = settings(kind, 1.0, 1.0);
+            for p in points() {
+                let n = noise(p, kind, HashKind::Pcg);
+                let r = ridged(p, &s);
+                assert_eq!(r, (1.0 - n.abs()) * (1.0 - n.abs()));
+                assert!((0.0..=1.0).contains(&r));
+            }
+            assert_eq!(ridged(Vec3::new(3.0, -2.0, 5.0), &s), 1.0);
+        }
+    }
+
+    /// Without distortion the warp is the identity; with it, the sum is
+    /// the plain sum at a point moved by at most `distortion · max |noise|`.
+    #[test]
+    fn domain_warp_moves_the_point_by_at_most_the_distortion() {
+        for kind in NoiseKind::ALL {
+            let mut s = settings(kind, 4.0, 1.0);
+            for p in points() {
+                assert_eq!(warped(p, &s), p);
+            }
+            s.fractal.distortion = 0.5;
+            let mut moved = 0;
+            for p in points() {
+                let q = warped(p, &s);
+                // Each noise is within about ±1.1 (Perlin's bound, ~1.04).
+                assert!((q - p).abs().max_element() <= 0.5 * 1.1, "{p} -> {q}");
+                moved += usize::from(q != p);
+                let plain = NoiseSettings {
+                    fractal: FractalParams {
+                        distortion: 0.0,
+                        ..s.fractal
+                    },
+                    ..s
+                };
+                assert_eq!(fbm(p, &s), fbm(q, &plain));
+            }
+            assert!(moved > 400, "{kind:?}: only {moved} points moved");
+        }
     }
 
     #[test]

@@ -11,7 +11,10 @@ pub mod gradient;
 pub mod hash;
 pub mod perlin;
 
-pub use fractal::{FractalParams, NoiseSettings, fbm, marble, noise, turbulence};
+pub use fractal::{
+    FractalParams, FractalShape, NoiseSettings, fbm, fractal_sum, marble, noise, ridged,
+    turbulence, warped,
+};
 pub use gradient::gradient_noise;
 pub use hash::HashKind;
 pub use perlin::{improved_noise, improved_noise_f32};

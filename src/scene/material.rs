@@ -1,13 +1,7 @@
-//! Materials and the procedural textures that drive their properties.
-//!
-//! A texture is a small tree: a pattern gives a blend factor `t` in [0, 1]
-//! between two children, each a value or a whole texture of its own (a
-//! checker of marbles, bricks of turbulence). Cell patterns (the 2D checker,
-//! bricks) hand their children the point in the cell's own unit square, so
-//! a texture nested in a cell repeats once per cell.
+//! Materials: which texture drives which surface property.
 
-use crate::noise::{FractalParams, NoiseSettings, fbm, turbulence};
-use crate::texture;
+use super::pattern::Pattern;
+use super::texture_tree::Texture;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -16,664 +10,83 @@ use serde::{Deserialize, Serialize};
 /// shaders/scene.wgsl).
 pub const MAX_SIGNALS: usize = 4;
 
-/// What drives a property across a surface. Each pattern yields a blend
-/// factor `t` in [0, 1] between the texture's two children: `a` where
-/// `t = 0`, `b` where `t = 1`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
-pub enum Pattern {
-    /// `t = 0`: the first value everywhere.
-    #[default]
-    Constant,
-    /// A 3D checkerboard of cubes of side `size`: `t` is 0 or 1.
-    Checker { size: f32 },
-    /// `t = 0.5 + 0.5 · fbm(p)`, clamped.
-    Fbm { noise: NoiseSettings },
-    /// `t = turbulence(p)` (a sum of |noise|), clamped.
-    Turbulence { noise: NoiseSettings },
-    /// `t = 0.5 + 0.5 · sin(p.x · stripe_frequency + fbm(p))`.
-    Marble {
-        noise: NoiseSettings,
-        stripe_frequency: f32,
-    },
-    /// A board over the surface's (u, v) with cells of `size`, odd rows
-    /// shifted by `phase` of a cell: `a` in even cells, `b` in odd ones, each
-    /// seeing the cell as its whole (u, v) square.
-    Checker2d { size: Vec2, phase: f32 },
-    /// Bricks of `size` in (u, v), `mortar` wide joints, odd rows shifted by
-    /// `row_offset`: `a` is the mortar, `b` the bricks (each brick its own
-    /// unit square for a nested texture).
-    Brick {
-        size: Vec2,
-        mortar: f32,
-        row_offset: f32,
-    },
-    /// One tile per unit (u, v) square (lay it in a checker): `a` the mortar
-    /// `mortar_half_width` wide along the edges, `b` the tile, which rises
-    /// from the mortar over a `bevel` wide edge (0: a step). As a bump
-    /// texture it raises the tiles.
-    Tile {
-        mortar_half_width: f32,
-        #[serde(default)]
-        bevel: f32,
-    },
-    /// Parallel waves across (u, v): `t = 0.5 + 0.5 · sin(2π · frequency ·
-    /// direction·uv)`. As a bump texture it ripples the surface.
-    Waves { frequency: f32, direction: Vec2 },
-    /// A regular polygon of `sides` sides (a disc below 3) of circumradius
-    /// `radius`, centred in every unit (u, v) square: `a` outside, `b` inside.
-    Cutout { sides: u32, radius: f32 },
-    /// Rings of `ring_width` around an axis tilted 15° from z, their radius
-    /// perturbed by `turbulence_amount · turbulence(p)`: `a` dark, `b` pale.
-    Wood {
-        noise: NoiseSettings,
-        ring_width: f32,
-        turbulence_amount: f32,
-    },
-    /// The texture report's marble: `t = max(0, sin(frequency · x +
-    /// turbulence_amount · turbulence(p)))`: `a` the dominant colour, `b` the
-    /// veins.
-    Veins {
-        noise: NoiseSettings,
-        frequency: f32,
-        turbulence_amount: f32,
-    },
+/// A surface property a texture can drive. Colours use all three channels,
+/// scalars the first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Property {
+    Diffuse,
+    Specular,
+    Roughness,
+    Mirror,
+    Opacity,
+    Emission,
 }
 
-impl Pattern {
-    pub const NAMES: [&'static str; 12] = [
-        "constant",
-        "checker 3D",
-        "fBm",
-        "turbulence",
-        "marble",
-        "checker (uv)",
-        "brick",
-        "tile",
-        "cutout",
-        "wood",
-        "veins",
-        "waves",
+impl Property {
+    /// In the order the generated shader returns them (`SurfaceTextures`).
+    pub const ALL: [Property; 6] = [
+        Property::Diffuse,
+        Property::Specular,
+        Property::Roughness,
+        Property::Mirror,
+        Property::Opacity,
+        Property::Emission,
     ];
 
-    /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
-    pub fn index(&self) -> usize {
+    pub fn name(self) -> &'static str {
         match self {
-            Pattern::Constant => 0,
-            Pattern::Checker { .. } => 1,
-            Pattern::Fbm { .. } => 2,
-            Pattern::Turbulence { .. } => 3,
-            Pattern::Marble { .. } => 4,
-            Pattern::Checker2d { .. } => 5,
-            Pattern::Brick { .. } => 6,
-            Pattern::Tile { .. } => 7,
-            Pattern::Cutout { .. } => 8,
-            Pattern::Wood { .. } => 9,
-            Pattern::Veins { .. } => 10,
-            Pattern::Waves { .. } => 11,
+            Property::Diffuse => "diffuse",
+            Property::Specular => "specular",
+            Property::Roughness => "roughness",
+            Property::Mirror => "mirror",
+            Property::Opacity => "opacity",
+            Property::Emission => "emission",
         }
     }
 
-    /// The pattern with index `i`, keeping the noise settings of `self` where
-    /// both have some, so switching the dropdown does not lose the tuning.
-    pub fn with_index(&self, i: usize) -> Pattern {
-        let noise = self.noise().copied().unwrap_or_default();
-        match i {
-            1 => Pattern::Checker { size: 1.0 },
-            2 => Pattern::Fbm { noise },
-            3 => Pattern::Turbulence { noise },
-            4 => Pattern::Marble {
-                noise,
-                stripe_frequency: 4.0,
-            },
-            5 => Pattern::Checker2d {
-                size: Vec2::splat(0.125),
-                phase: 0.0,
-            },
-            6 => Pattern::Brick {
-                size: Vec2::new(0.25, 0.1),
-                mortar: 0.01,
-                row_offset: 0.5,
-            },
-            7 => Pattern::Tile {
-                mortar_half_width: 0.02,
-                bevel: 0.02,
-            },
-            8 => Pattern::Cutout {
-                sides: 0,
-                radius: 0.4,
-            },
-            9 => Pattern::Wood {
-                noise,
-                ring_width: 0.12,
-                turbulence_amount: 0.3,
-            },
-            10 => Pattern::Veins {
-                noise,
-                frequency: 10.0,
-                turbulence_amount: 5.0,
-            },
-            11 => Pattern::Waves {
-                frequency: 4.0,
-                direction: Vec2::X,
-            },
-            _ => Pattern::Constant,
-        }
-    }
-
-    pub fn noise(&self) -> Option<&NoiseSettings> {
-        match self {
-            Pattern::Fbm { noise }
-            | Pattern::Turbulence { noise }
-            | Pattern::Marble { noise, .. }
-            | Pattern::Wood { noise, .. }
-            | Pattern::Veins { noise, .. } => Some(noise),
-            _ => None,
-        }
-    }
-
-    pub fn noise_mut(&mut self) -> Option<&mut NoiseSettings> {
-        match self {
-            Pattern::Fbm { noise }
-            | Pattern::Turbulence { noise }
-            | Pattern::Marble { noise, .. }
-            | Pattern::Wood { noise, .. }
-            | Pattern::Veins { noise, .. } => Some(noise),
-            _ => None,
-        }
-    }
-
-    /// The fractal sum this pattern reads, as (settings, sums |noise|):
-    /// the shader evaluates each distinct one once per hit (a signal).
-    pub fn signal(&self) -> Option<(NoiseSettings, bool)> {
-        let noise = *self.noise()?;
-        let absolute = matches!(
+    /// Whether the property is a colour (else a scalar, the first channel).
+    pub fn is_color(self) -> bool {
+        matches!(
             self,
-            Pattern::Turbulence { .. } | Pattern::Wood { .. } | Pattern::Veins { .. }
-        );
-        Some((noise, absolute))
-    }
-
-    /// The blend factor at a point, given the pattern's signal value there,
-    /// and the (u, v) its children see. CPU twin of the generated WGSL.
-    fn blend(&self, p: Vec3, uv: Vec2, signal: f32) -> (f32, Vec2) {
-        match *self {
-            Pattern::Constant => (0.0, uv),
-            Pattern::Checker { size } => (texture::checker_3d(p, Vec3::splat(size)), uv),
-            Pattern::Fbm { .. } => ((0.5 + 0.5 * signal).clamp(0.0, 1.0), uv),
-            Pattern::Turbulence { .. } => (signal.clamp(0.0, 1.0), uv),
-            Pattern::Marble {
-                stripe_frequency, ..
-            } => (0.5 + 0.5 * (p.x * stripe_frequency + signal).sin(), uv),
-            Pattern::Checker2d { size, phase } => {
-                let cell = texture::checker_2d(uv, size, phase);
-                (cell.select, cell.local)
-            }
-            Pattern::Brick {
-                size,
-                mortar,
-                row_offset,
-            } => {
-                let cell = texture::brick(uv, size, mortar, row_offset);
-                (cell.select, cell.local)
-            }
-            Pattern::Tile {
-                mortar_half_width,
-                bevel,
-            } => (texture::tile_height(uv, mortar_half_width, bevel), uv),
-            Pattern::Waves {
-                frequency,
-                direction,
-            } => (texture::waves(uv, frequency, direction), uv),
-            Pattern::Cutout { sides, radius } => (texture::cutout(uv, sides, radius), uv),
-            Pattern::Wood {
-                ring_width,
-                turbulence_amount,
-                ..
-            } => (
-                texture::wood::rings(
-                    p,
-                    texture::default_axis(),
-                    ring_width,
-                    turbulence_amount * signal,
-                ),
-                uv,
-            ),
-            Pattern::Veins {
-                frequency,
-                turbulence_amount,
-                ..
-            } => (
-                (frequency * p.x + turbulence_amount * signal)
-                    .sin()
-                    .max(0.0),
-                uv,
-            ),
-        }
-    }
-
-    fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
-        if let Pattern::Checker { size } = self
-            && !(size.is_finite() && *size > 1e-4)
-        {
-            notes.push(format!("{what}: checker size {size} set to 1"));
-            *size = 1.0;
-        }
-        if let Pattern::Marble {
-            stripe_frequency, ..
-        } = self
-            && !stripe_frequency.is_finite()
-        {
-            notes.push(format!("{what}: marble stripe frequency reset"));
-            *stripe_frequency = 4.0;
-        }
-        let mut positive = |name: &str, v: &mut f32, fallback: f32| {
-            if !(v.is_finite() && *v > 1e-4) {
-                notes.push(format!("{what}: {name} {v} set to {fallback}"));
-                *v = fallback;
-            }
-        };
-        match self {
-            Pattern::Checker2d { size, .. } | Pattern::Brick { size, .. } => {
-                positive("cell width", &mut size.x, 0.125);
-                positive("cell height", &mut size.y, 0.125);
-            }
-            Pattern::Wood { ring_width, .. } => positive("ring width", ring_width, 0.12),
-            _ => {}
-        }
-        let mut finite = |name: &str, v: &mut f32| {
-            if !v.is_finite() {
-                notes.push(format!("{what}: non-finite {name} set to 0"));
-                *v = 0.0;
-            }
-        };
-        match self {
-            Pattern::Checker2d { phase, .. } => finite("phase", phase),
-            Pattern::Brick {
-                mortar, row_offset, ..
-            } => {
-                finite("mortar", mortar);
-                finite("row offset", row_offset);
-            }
-            Pattern::Tile {
-                mortar_half_width,
-                bevel,
-            } => {
-                finite("mortar", mortar_half_width);
-                finite("bevel", bevel);
-                *bevel = bevel.max(0.0);
-            }
-            Pattern::Waves {
-                frequency,
-                direction,
-            } => {
-                finite("frequency", frequency);
-                let d = direction.normalize_or(Vec2::X);
-                if d != *direction {
-                    notes.push(format!(
-                        "{what}: wave direction {direction} made unit length"
-                    ));
-                    *direction = d;
-                }
-            }
-            Pattern::Cutout { radius, .. } => finite("radius", radius),
-            Pattern::Wood {
-                turbulence_amount, ..
-            } => finite("turbulence", turbulence_amount),
-            Pattern::Veins {
-                frequency,
-                turbulence_amount,
-                ..
-            } => {
-                finite("frequency", frequency);
-                finite("turbulence", turbulence_amount);
-            }
-            _ => {}
-        }
-        if let Some(n) = self.noise_mut() {
-            sanitize_fractal(&mut n.fractal, what, notes);
-        }
+            Property::Diffuse | Property::Specular | Property::Emission
+        )
     }
 }
 
-fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) {
-    let d = FractalParams::default();
-    let mut clamp = |name: &str, v: &mut f32, lo: f32, hi: f32, fallback: f32| {
-        let c = if v.is_finite() {
-            v.clamp(lo, hi)
-        } else {
-            fallback
-        };
-        if c != *v {
-            notes.push(format!("{what}: {name} {v} clamped to {c}"));
-            *v = c;
-        }
-    };
-    clamp(
-        "octaves",
-        &mut f.octaves,
-        0.0,
-        FractalParams::MAX_OCTAVES,
-        d.octaves,
-    );
-    clamp("frequency", &mut f.frequency, 0.0, 1e6, d.frequency);
-    clamp("amplitude", &mut f.amplitude, -100.0, 100.0, d.amplitude);
-    clamp("persistence", &mut f.persistence, 0.0, 1.5, d.persistence);
-    clamp("lacunarity", &mut f.lacunarity, 1.0, 8.0, d.lacunarity);
-}
-
-/// One side of a blend: a scalar, a colour, or a whole nested texture.
-///
-/// In a preset it is written as what it is: `0.3`, `(0.8, 0.1, 0.1)`, or
-/// `(pattern: …, a: …, b: …)`, so files from before nesting existed read
-/// unchanged.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Child {
-    Scalar(f32),
-    Color(Vec3),
-    Texture(Box<Texture>),
-}
-
-impl From<f32> for Child {
-    fn from(v: f32) -> Self {
-        Child::Scalar(v)
-    }
-}
-
-impl From<Vec3> for Child {
-    fn from(c: Vec3) -> Self {
-        Child::Color(c)
-    }
-}
-
-impl From<Texture> for Child {
-    fn from(t: Texture) -> Self {
-        Child::Texture(Box::new(t))
-    }
-}
-
-impl Serialize for Child {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match self {
-            Child::Scalar(v) => v.serialize(s),
-            Child::Color(c) => c.serialize(s),
-            Child::Texture(t) => t.serialize(s),
-        }
-    }
-}
-
-impl<'de> Deserialize<'de> for Child {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct ChildVisitor;
-        impl<'de> serde::de::Visitor<'de> for ChildVisitor {
-            type Value = Child;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a number, an (r, g, b) colour, or a (pattern: …, a: …, b: …) texture")
-            }
-            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Child, A::Error> {
-                Vec3::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
-                    .map(Child::Color)
-            }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Child, A::Error> {
-                Texture::deserialize(serde::de::value::MapAccessDeserializer::new(map))
-                    .map(|t| Child::Texture(Box::new(t)))
-            }
-        }
-        d.deserialize_any(ChildVisitor)
-    }
-}
-
-impl Child {
-    /// The child's colour at a point (a scalar is grey).
-    pub fn eval(&self, p: Vec3, uv: Vec2) -> Vec3 {
-        match self {
-            Child::Scalar(v) => Vec3::splat(*v),
-            Child::Color(c) => *c,
-            Child::Texture(t) => t.eval(p, uv),
-        }
-    }
-
-    /// The nested texture, if any.
-    pub fn texture(&self) -> Option<&Texture> {
-        match self {
-            Child::Texture(t) => Some(t),
-            _ => None,
-        }
-    }
-}
-
-/// A property across a surface: `mix(a, b, t)` with `t` from the pattern,
-/// or, when `ramp` has stops, the ramp's colour at `t` (Blender's
-/// ColorRamp after a pattern: a noise mapped through chosen colours).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Texture {
-    pub pattern: Pattern,
-    pub a: Child,
-    pub b: Child,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub ramp: Vec<texture::RampStop>,
-}
-
-impl Texture {
-    /// The same colour everywhere.
-    pub fn color(c: Vec3) -> Self {
-        Self {
-            pattern: Pattern::Constant,
-            a: Child::Color(c),
-            b: Child::Color(c),
-
-            ramp: Vec::new(),
-        }
-    }
-
-    /// The same value everywhere (a scalar property).
-    pub fn scalar(v: f32) -> Self {
-        Self {
-            pattern: Pattern::Constant,
-            a: Child::Scalar(v),
-            b: Child::Scalar(v),
-
-            ramp: Vec::new(),
-        }
-    }
-
-    /// `pattern` blending two children.
-    pub fn blend(pattern: Pattern, a: impl Into<Child>, b: impl Into<Child>) -> Self {
-        Self {
-            pattern,
-            a: a.into(),
-            b: b.into(),
-
-            ramp: Vec::new(),
-        }
-    }
-
-    /// The colour at a surface point `p` (texture space) with coordinates
-    /// `uv`: the CPU reference of the shader code generated from this tree.
-    /// A constant pattern never evaluates `b`.
-    pub fn eval(&self, p: Vec3, uv: Vec2) -> Vec3 {
-        let signal = self.pattern.signal().map_or(0.0, |(noise, absolute)| {
-            if absolute {
-                turbulence(p, &noise)
-            } else {
-                fbm(p, &noise)
-            }
-        });
-        let (t, child_uv) = self.pattern.blend(p, uv, signal);
-        if !self.ramp.is_empty() {
-            return texture::ramp(&self.ramp, t);
-        }
-        let a = self.a.eval(p, child_uv);
-        if self.pattern == Pattern::Constant {
-            return a;
-        }
-        a.lerp(self.b.eval(p, child_uv), t)
-    }
-
-    /// Whether any texture in the tree maps its blend factor through a ramp.
-    pub fn has_ramp(&self) -> bool {
-        !self.ramp.is_empty()
-            || [&self.a, &self.b]
-                .iter()
-                .filter_map(|c| c.texture())
-                .any(Texture::has_ramp)
-    }
-
-    /// Every pattern in the tree, this one first.
-    pub fn patterns(&self) -> Vec<&Pattern> {
-        let mut out = vec![&self.pattern];
-        for child in [&self.a, &self.b] {
-            if let Some(t) = child.texture() {
-                out.extend(t.patterns());
-            }
-        }
-        out
-    }
-
-    /// How deep the tree goes: 1 for a texture with value children.
-    pub fn depth(&self) -> usize {
-        1 + [&self.a, &self.b]
-            .iter()
-            .filter_map(|c| c.texture())
-            .map(Texture::depth)
-            .max()
-            .unwrap_or(0)
-    }
-
-    /// Clamps values into range: colours and scalars to [0, 1], each
-    /// pattern's parameters to what its code handles. Trees deeper than
-    /// [`Texture::MAX_DEPTH`] are cut there (the deepest textures become
-    /// their `a` value).
-    fn sanitize(&mut self, what: &str, notes: &mut Vec<String>, depth: usize) {
-        self.pattern.sanitize(what, notes);
-        self.sanitize_ramp(what, notes);
-        for (name, child) in [("a", &mut self.a), ("b", &mut self.b)] {
-            let path = format!("{what}.{name}");
-            match child {
-                Child::Scalar(v) => {
-                    let s = if v.is_finite() {
-                        v.clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    if s != *v {
-                        notes.push(format!("{path}: {v} clamped to [0, 1]"));
-                        *v = s;
-                    }
-                }
-                Child::Color(c) => {
-                    let s = if c.is_finite() {
-                        c.clamp(Vec3::ZERO, Vec3::ONE)
-                    } else {
-                        Vec3::ZERO
-                    };
-                    if s != *c {
-                        notes.push(format!("{path}: colour {c} clamped to [0, 1]"));
-                        *c = s;
-                    }
-                }
-                Child::Texture(t) if depth >= Self::MAX_DEPTH => {
-                    notes.push(format!(
-                        "{path}: textures nest at most {} deep; this one is cut",
-                        Self::MAX_DEPTH
-                    ));
-                    *child = Child::Color(t.eval(Vec3::ZERO, Vec2::ZERO));
-                }
-                Child::Texture(t) => t.sanitize(&path, notes, depth + 1),
-            }
-        }
-    }
-
-    /// Ramp stops: at most [`texture::MAX_RAMP_STOPS`], finite, colours in
-    /// [0, 1], sorted by position (the shader interpolates neighbours).
-    fn sanitize_ramp(&mut self, what: &str, notes: &mut Vec<String>) {
-        if self.ramp.len() > texture::MAX_RAMP_STOPS {
-            notes.push(format!(
-                "{what}: a ramp holds at most {} stops; the rest are dropped",
-                texture::MAX_RAMP_STOPS
-            ));
-            self.ramp.truncate(texture::MAX_RAMP_STOPS);
-        }
-        for stop in &mut self.ramp {
-            if !stop.position.is_finite() || !stop.color.is_finite() {
-                notes.push(format!("{what}: a non-finite ramp stop set to 0"));
-                *stop = texture::RampStop {
-                    position: 0.0,
-                    color: Vec3::ZERO,
-                };
-            }
-            stop.color = stop.color.clamp(Vec3::ZERO, Vec3::ONE);
-        }
-        if !self.ramp.is_sorted_by(|x, y| x.position <= y.position) {
-            notes.push(format!("{what}: ramp stops sorted by position"));
-            self.ramp.sort_by(|x, y| x.position.total_cmp(&y.position));
-        }
-    }
-
-    /// Patterns reading a fractal sum beyond the first [`MAX_SIGNALS`]
-    /// distinct ones (in `seen`) become constant, with a note.
-    fn limit_signals(
-        &mut self,
-        seen: &mut Vec<(NoiseSettings, bool)>,
-        what: &str,
-        notes: &mut Vec<String>,
-    ) {
-        if let Some(signal) = self.pattern.signal()
-            && !seen.contains(&signal)
-        {
-            if seen.len() < MAX_SIGNALS {
-                seen.push(signal);
-            } else {
-                notes.push(format!(
-                    "{what}: a material reads at most {MAX_SIGNALS} distinct noises; a {} pattern became constant",
-                    Pattern::NAMES[self.pattern.index()]
-                ));
-                self.pattern = Pattern::Constant;
-            }
-        }
-        for child in [&mut self.a, &mut self.b] {
-            if let Child::Texture(t) = child {
-                t.limit_signals(seen, what, notes);
-            }
-        }
-    }
-
-    /// The deepest nesting the panel and the shader generator accept.
-    pub const MAX_DEPTH: usize = 6;
-}
-
-impl Default for Texture {
-    fn default() -> Self {
-        Self::color(Vec3::splat(0.5))
-    }
-}
-
-/// A Lambert diffuse lobe plus a GGX specular lobe, and an optional perfect
-/// mirror that takes a fraction `mirror` of the light.
+/// A Lambert diffuse lobe plus a GGX specular lobe, an optional perfect
+/// mirror, opacity (holes, without refraction), emission and bump. Every
+/// property is a texture; in a preset a constant one may be written as its
+/// value (`roughness: 0.4`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Material {
+    #[serde(with = "property_serde")]
     pub diffuse: Texture,
+    #[serde(with = "property_serde")]
     pub specular: Texture,
-    /// GGX roughness (perceptual; α = roughness²), 0 (polished) to 1: the
-    /// texture's first channel.
+    /// GGX roughness (perceptual; α = roughness²), 0 (polished) to 1.
+    #[serde(with = "property_serde")]
     pub roughness: Texture,
     /// Fraction of light reflected by a perfect mirror, 0 to 1.
-    pub mirror: f32,
+    #[serde(with = "property_serde")]
+    pub mirror: Texture,
+    /// 1 is solid; below, a ray passes straight through with probability
+    /// `1 - opacity` (a cutout's holes), and shadows thin accordingly.
+    #[serde(with = "property_serde")]
+    pub opacity: Texture,
+    /// Emitted radiance is this colour times `emission_strength`.
+    #[serde(with = "property_serde")]
+    pub emission: Texture,
+    pub emission_strength: f32,
     /// A height field over the surface (its first channel) that tilts the
     /// shading normal: bump mapping. Constant: no bump.
+    #[serde(with = "property_serde")]
     pub bump: Texture,
     /// The height, in scene units, of a bump value of 1.
     pub bump_height: f32,
+    /// Applied in order over the properties above, each where its mask is.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub layers: Vec<Layer>,
 }
 
 impl Default for Material {
@@ -682,17 +95,159 @@ impl Default for Material {
             diffuse: Texture::color(Vec3::splat(0.7)),
             specular: Texture::color(Vec3::splat(0.04)),
             roughness: Texture::scalar(0.4),
-            mirror: 0.0,
+            mirror: Texture::scalar(0.0),
+            opacity: Texture::scalar(1.0),
+            emission: Texture::color(Vec3::ZERO),
+            emission_strength: 1.0,
             bump: Texture::scalar(0.0),
             bump_height: 0.0,
+            layers: Vec::new(),
         }
     }
 }
 
+/// A layer of a material (Blender's mix of two shaders, one property at a
+/// time): over the properties it defines, it replaces what lies below by
+/// `mix(below, its value, mask)`; the properties it leaves out show through.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Layer {
+    pub name: String,
+    /// Where the layer lies, 0 to 1 (first channel).
+    #[serde(with = "property_serde")]
+    pub mask: Texture,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub diffuse: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub specular: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub roughness: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub mirror: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub opacity: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub emission: Option<Texture>,
+}
+
+impl Default for Layer {
+    fn default() -> Self {
+        Self {
+            name: "layer".into(),
+            mask: Texture::scalar(1.0),
+            diffuse: None,
+            specular: None,
+            roughness: None,
+            mirror: None,
+            opacity: None,
+            emission: None,
+        }
+    }
+}
+
+impl Layer {
+    pub fn texture(&self, property: Property) -> Option<&Texture> {
+        self.slot(property).as_ref()
+    }
+
+    /// The layer's binding of `property`: None leaves it to the layers below.
+    pub fn slot_mut(&mut self, property: Property) -> &mut Option<Texture> {
+        match property {
+            Property::Diffuse => &mut self.diffuse,
+            Property::Specular => &mut self.specular,
+            Property::Roughness => &mut self.roughness,
+            Property::Mirror => &mut self.mirror,
+            Property::Opacity => &mut self.opacity,
+            Property::Emission => &mut self.emission,
+        }
+    }
+
+    fn slot(&self, property: Property) -> &Option<Texture> {
+        match property {
+            Property::Diffuse => &self.diffuse,
+            Property::Specular => &self.specular,
+            Property::Roughness => &self.roughness,
+            Property::Mirror => &self.mirror,
+            Property::Opacity => &self.opacity,
+            Property::Emission => &self.emission,
+        }
+    }
+
+    /// The mask, then every property the layer defines.
+    fn textures_mut(&mut self) -> Vec<&mut Texture> {
+        let mut out = vec![&mut self.mask];
+        out.extend(
+            [
+                &mut self.diffuse,
+                &mut self.specular,
+                &mut self.roughness,
+                &mut self.mirror,
+                &mut self.opacity,
+                &mut self.emission,
+            ]
+            .into_iter()
+            .flatten(),
+        );
+        out
+    }
+}
+
 impl Material {
-    /// The material's colour and roughness textures, in shader order.
-    pub fn textures(&self) -> [&Texture; 3] {
-        [&self.diffuse, &self.specular, &self.roughness]
+    /// The base texture of `property` (before layers).
+    pub fn texture(&self, property: Property) -> &Texture {
+        match property {
+            Property::Diffuse => &self.diffuse,
+            Property::Specular => &self.specular,
+            Property::Roughness => &self.roughness,
+            Property::Mirror => &self.mirror,
+            Property::Opacity => &self.opacity,
+            Property::Emission => &self.emission,
+        }
+    }
+
+    pub fn texture_mut(&mut self, property: Property) -> &mut Texture {
+        match property {
+            Property::Diffuse => &mut self.diffuse,
+            Property::Specular => &mut self.specular,
+            Property::Roughness => &mut self.roughness,
+            Property::Mirror => &mut self.mirror,
+            Property::Opacity => &mut self.opacity,
+            Property::Emission => &mut self.emission,
+        }
+    }
+
+    /// The value of `property` at a point, layers applied, before the
+    /// renderer's clamping: the CPU reference of the generated shader.
+    pub fn value(&self, property: Property, p: Vec3, uv: Vec2) -> Vec3 {
+        let mut v = self.texture(property).eval(p, uv);
+        for layer in &self.layers {
+            if let Some(t) = layer.texture(property) {
+                let mask = layer.mask.eval(p, uv).x.clamp(0.0, 1.0);
+                v = v.lerp(t.eval(p, uv), mask);
+            }
+        }
+        if property == Property::Emission {
+            v *= self.emission_strength;
+        }
+        v
     }
 
     /// Whether the bump texture varies: only then is bump code compiled in.
@@ -700,41 +255,262 @@ impl Material {
         self.bump.pattern != Pattern::Constant
     }
 
-    /// Every pattern of every texture, bump and nested ones included.
-    pub fn patterns(&self) -> Vec<&Pattern> {
-        let mut out: Vec<&Pattern> = self.textures().iter().flat_map(|t| t.patterns()).collect();
-        out.extend(self.bump.patterns());
+    /// Whether any point may be less than fully opaque.
+    pub fn has_opacity(&self) -> bool {
+        self.bindings(Property::Opacity)
+            .any(|t| !t.is_constant_value(Vec3::ONE))
+    }
+
+    /// Whether any point may emit.
+    pub fn has_emission(&self) -> bool {
+        self.emission_strength != 0.0
+            && self
+                .bindings(Property::Emission)
+                .any(|t| !t.is_constant_value(Vec3::ZERO))
+    }
+
+    /// The base texture of `property` and the layers' bindings of it.
+    fn bindings(&self, property: Property) -> impl Iterator<Item = &Texture> {
+        std::iter::once(self.texture(property))
+            .chain(self.layers.iter().filter_map(move |l| l.texture(property)))
+    }
+
+    /// Every texture the material holds: properties, bump, layers.
+    pub fn all_textures(&self) -> Vec<&Texture> {
+        let mut out: Vec<&Texture> = Property::ALL.iter().map(|&p| self.texture(p)).collect();
+        out.push(&self.bump);
+        for layer in &self.layers {
+            out.push(&layer.mask);
+            out.extend(Property::ALL.iter().filter_map(|&p| layer.texture(p)));
+        }
         out
     }
 
+    /// Every pattern of every texture, nested ones included.
+    pub fn patterns(&self) -> Vec<&Pattern> {
+        self.all_textures()
+            .into_iter()
+            .flat_map(Texture::patterns)
+            .collect()
+    }
+
     pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
-        self.diffuse.sanitize(&format!("{what} diffuse"), notes, 1);
-        self.specular
-            .sanitize(&format!("{what} specular"), notes, 1);
-        self.roughness
-            .sanitize(&format!("{what} roughness"), notes, 1);
-        self.bump.sanitize(&format!("{what} bump"), notes, 1);
+        let mut textures: Vec<(String, &mut Texture)> = vec![
+            (format!("{what} diffuse"), &mut self.diffuse),
+            (format!("{what} specular"), &mut self.specular),
+            (format!("{what} roughness"), &mut self.roughness),
+            (format!("{what} mirror"), &mut self.mirror),
+            (format!("{what} opacity"), &mut self.opacity),
+            (format!("{what} emission"), &mut self.emission),
+            (format!("{what} bump"), &mut self.bump),
+        ];
+        for layer in &mut self.layers {
+            let name = format!("{what} layer `{}`", layer.name);
+            textures.extend(layer.textures_mut().into_iter().map(|t| (name.clone(), t)));
+        }
+        for (name, texture) in &mut textures {
+            texture.sanitize(name, notes, 1);
+        }
         let mut signals = Vec::new();
-        for texture in [
-            &mut self.diffuse,
-            &mut self.specular,
-            &mut self.roughness,
-            &mut self.bump,
-        ] {
+        for (_, texture) in &mut textures {
             texture.limit_signals(&mut signals, what, notes);
         }
-        if !self.bump_height.is_finite() {
-            notes.push(format!("{what}: non-finite bump height set to 0"));
-            self.bump_height = 0.0;
+        for (name, v) in [
+            ("bump height", &mut self.bump_height),
+            ("emission strength", &mut self.emission_strength),
+        ] {
+            if !v.is_finite() {
+                notes.push(format!("{what}: non-finite {name} set to 0"));
+                *v = 0.0;
+            }
         }
-        let s = if self.mirror.is_finite() {
-            self.mirror.clamp(0.0, 1.0)
-        } else {
-            0.0
+        if self.emission_strength < 0.0 {
+            notes.push(format!("{what}: negative emission strength set to 0"));
+            self.emission_strength = 0.0;
+        }
+    }
+}
+
+/// A property texture in a preset: a constant one is written as its value
+/// (`0.4`, `(0.8, 0.1, 0.1)`), any other as a texture; both read back.
+mod property_serde {
+    use super::super::texture_tree::{Child, Texture};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(texture: &Texture, s: S) -> Result<S::Ok, S::Error> {
+        match texture.as_constant() {
+            Some(value) => value.serialize(s),
+            None => texture.serialize(s),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Texture, D::Error> {
+        Ok(Texture::from(Child::deserialize(d)?))
+    }
+}
+
+/// [`property_serde`] for a layer's optional bindings: absent is None.
+mod optional_property_serde {
+    use super::super::texture_tree::{Child, Texture};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(texture: &Option<Texture>, s: S) -> Result<S::Ok, S::Error> {
+        match texture {
+            Some(t) => super::property_serde::serialize(t, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Texture>, D::Error> {
+        Ok(Some(Texture::from(Child::deserialize(d)?)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Child, MathOp};
+
+    fn to_ron(m: &Material) -> String {
+        ron::ser::to_string_pretty(m, ron::ser::PrettyConfig::default()).unwrap()
+    }
+
+    /// Constant properties are written as their values, textured ones as
+    /// trees, and both read back to the same material.
+    #[test]
+    fn constant_properties_are_written_as_values_and_read_back() {
+        let mut m = Material {
+            diffuse: Texture::blend(
+                Pattern::Checker { size: 0.5 },
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::ONE,
+            ),
+            ..Material::default()
         };
-        if s != self.mirror {
-            notes.push(format!("{what}: mirror {} clamped to [0, 1]", self.mirror));
-            self.mirror = s;
-        }
+        m.layers.push(Layer {
+            diffuse: Some(Texture::color(Vec3::Z)),
+            ..Layer::default()
+        });
+        let text = to_ron(&m);
+        assert!(text.contains("roughness: 0.4"), "{text}");
+        assert!(text.contains("opacity: 1.0"), "{text}");
+        assert!(
+            text.contains("Checker(") && text.contains("size: 0.5"),
+            "{text}"
+        );
+        assert!(!text.contains("specular: None"), "{text}");
+        let back: Material = ron::from_str(&text).unwrap();
+        assert_eq!(back, m);
+    }
+
+    /// Files from before properties were textures (`mirror: 0.25`, full
+    /// constant trees) read unchanged, with the new properties defaulted.
+    #[test]
+    fn older_materials_read_unchanged() {
+        let m: Material = ron::from_str(
+            "(diffuse: (pattern: Constant, a: (0.8, 0.1, 0.1), b: (0.8, 0.1, 0.1)), roughness: (pattern: Constant, a: 0.3, b: 0.3), mirror: 0.25)",
+        )
+        .unwrap();
+        assert_eq!(m.diffuse, Texture::color(Vec3::new(0.8, 0.1, 0.1)));
+        assert_eq!(m.roughness, Texture::scalar(0.3));
+        assert_eq!(m.mirror, Texture::scalar(0.25));
+        assert_eq!(m.opacity, Texture::scalar(1.0));
+        assert!(!m.has_opacity() && !m.has_emission());
+    }
+
+    /// A layer replaces what lies below where its mask is 1, keeps it where
+    /// it is 0, and leaves the properties it does not set alone.
+    #[test]
+    fn layers_replace_only_what_they_set_where_their_mask_lies() {
+        let red = Vec3::new(0.8, 0.0, 0.0);
+        let blue = Vec3::new(0.0, 0.0, 0.8);
+        let mut m = Material {
+            diffuse: Texture::color(red),
+            ..Material::default()
+        };
+        m.layers.push(Layer {
+            mask: Texture::blend(
+                Pattern::Checker2d {
+                    size: Vec2::ONE,
+                    phase: 0.0,
+                },
+                0.0,
+                0.5,
+            ),
+            diffuse: Some(Texture::color(blue)),
+            ..Layer::default()
+        });
+        let even = Vec2::new(0.5, 0.5);
+        let odd = Vec2::new(1.5, 0.5);
+        assert_eq!(m.value(Property::Diffuse, Vec3::ZERO, even), red);
+        assert_eq!(
+            m.value(Property::Diffuse, Vec3::ZERO, odd),
+            red.lerp(blue, 0.5)
+        );
+        assert_eq!(
+            m.value(Property::Roughness, Vec3::ZERO, odd),
+            Vec3::splat(0.4)
+        );
+    }
+
+    /// Each math step against its formula, applied in order after the
+    /// blend; a mix takes t from its factor's first channel.
+    #[test]
+    fn math_steps_and_mix_follow_their_formulas() {
+        let v = Vec3::new(-0.5, 0.25, 2.0);
+        assert_eq!(MathOp::Scale(2.0).apply(v), Vec3::new(-1.0, 0.5, 4.0));
+        assert_eq!(MathOp::Bias(0.5).apply(v), Vec3::new(0.0, 0.75, 2.5));
+        assert_eq!(MathOp::Abs.apply(v), Vec3::new(0.5, 0.25, 2.0));
+        assert_eq!(MathOp::Invert.apply(v), Vec3::new(1.5, 0.75, -1.0));
+        assert_eq!(
+            MathOp::Clamp { min: 0.0, max: 1.0 }.apply(v),
+            Vec3::new(0.0, 0.25, 1.0)
+        );
+        assert_eq!(MathOp::Power(2.0).apply(v), Vec3::new(0.0, 0.0625, 4.0));
+
+        let mut t = Texture::mix(Texture::scalar(0.25), Vec3::ZERO, Vec3::ONE);
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::ZERO), Vec3::splat(0.25));
+        t.ops = vec![MathOp::Scale(2.0), MathOp::Invert];
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::ZERO), Vec3::splat(0.5));
+    }
+
+    /// Sanitising gives a mix without a factor one, drops a factor the
+    /// pattern does not read, orders clamp bounds, and keeps exponents
+    /// positive (0⁰ has no value on the GPU).
+    #[test]
+    fn sanitising_repairs_mix_and_math() {
+        let mut m = Material {
+            diffuse: Texture::blend(Pattern::Mix, Vec3::ZERO, Vec3::ONE),
+            ..Material::default()
+        };
+        m.specular.factor = Some(Box::new(Texture::scalar(1.0)));
+        m.roughness.ops = vec![MathOp::Power(0.0), MathOp::Clamp { min: 1.0, max: 0.0 }];
+        let mut notes = Vec::new();
+        m.sanitize("m", &mut notes);
+        assert_eq!(m.diffuse.factor.as_deref(), Some(&Texture::scalar(0.5)));
+        assert_eq!(m.specular.factor, None);
+        assert_eq!(
+            m.roughness.ops,
+            vec![
+                MathOp::Power(MathOp::MIN_EXPONENT),
+                MathOp::Clamp { min: 0.0, max: 1.0 }
+            ]
+        );
+        assert_eq!(notes.len(), 4, "{notes:?}");
+    }
+
+    #[test]
+    fn opacity_and_emission_are_detected_from_the_bindings() {
+        let mut m = Material::default();
+        assert!(!m.has_opacity() && !m.has_emission());
+        m.layers.push(Layer {
+            opacity: Some(Texture::scalar(0.5)),
+            ..Layer::default()
+        });
+        assert!(m.has_opacity());
+        m.emission = Texture::from(Child::Color(Vec3::X));
+        assert!(m.has_emission());
+        m.emission_strength = 0.0;
+        assert!(!m.has_emission());
     }
 }

@@ -8,12 +8,16 @@
 pub mod camera;
 pub mod environment;
 pub mod material;
+pub mod pattern;
 pub mod render_settings;
+pub mod texture_tree;
 
 pub use camera::OrbitCamera;
 pub use environment::{EnvSource, Environment};
-pub use material::{Child, Material, Pattern, Texture};
+pub use material::{Layer, Material, Property};
+pub use pattern::{Pattern, Signal};
 pub use render_settings::{RenderSettings, ToneMap};
+pub use texture_tree::{Child, MathOp, Texture};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};

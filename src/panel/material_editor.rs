@@ -1,0 +1,526 @@
+//! The material editor: each property's texture tree, its layers, and the
+//! tree operations (nest, unnest, copy a subtree, paste it over another).
+
+use super::{color_button, labelled_color, slider};
+use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
+use crate::scene::{Child, Layer, Material, MathOp, Pattern, Property, Texture};
+use crate::texture::{MAX_RAMP_STOPS, RampStop};
+use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, Ui};
+use glam::Vec3;
+
+/// Every property's texture, the bump, the emission strength and layers.
+pub fn material_ui(ui: &mut Ui, m: &mut Material) {
+    for property in Property::ALL {
+        let (kind, hint) = property_ui_info(property);
+        texture_ui(ui, property.name(), hint, m.texture_mut(property), kind, 1);
+        if property == Property::Emission {
+            ui.add(
+                slider(&mut m.emission_strength, 0.0..=100.0, "emission strength")
+                    .logarithmic(true),
+            )
+            .on_hover_text("Emitted radiance is the emission colour times this");
+        }
+    }
+    texture_ui(
+        ui,
+        "bump",
+        "A height field that tilts the shading normal (tiles with a bevel, waves, noise)",
+        &mut m.bump,
+        ValueKind::Scalar,
+        1,
+    );
+    ui.add(slider(&mut m.bump_height, -0.5..=0.5, "bump height"))
+        .on_hover_text("Height in scene units of a bump value of 1; 0 turns the bump off");
+    layers_ui(ui, &mut m.layers);
+}
+
+/// What a property's values are, and its tooltip.
+fn property_ui_info(property: Property) -> (ValueKind, &'static str) {
+    let kind = if property.is_color() {
+        ValueKind::Color
+    } else {
+        ValueKind::Scalar
+    };
+    let hint = match property {
+        Property::Diffuse => "Lambert colour: the light scattered evenly in all directions",
+        Property::Specular => {
+            "GGX reflectance at normal incidence (about 0.04 for plastics and stone)"
+        }
+        Property::Roughness => "GGX roughness: 0 is polished, 1 is matte",
+        Property::Mirror => "Fraction of the light reflected by a perfect mirror, on top of GGX",
+        Property::Opacity => {
+            "1 is solid; below, rays and shadows pass straight through (a cutout's holes)"
+        }
+        Property::Emission => "Light the surface gives off (times the strength below)",
+    };
+    (kind, hint)
+}
+
+/// The material's layers, each over everything before it: a mask and the
+/// properties it sets.
+fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
+    let mut remove = None;
+    for (i, layer) in layers.iter_mut().enumerate() {
+        ui.push_id(("layer", i), |ui| {
+            CollapsingHeader::new(format!("layer “{}”", layer.name))
+                .id_salt("layer")
+                .show(ui, |ui| {
+                    ui.horizontal(|ui| {
+                        ui.text_edit_singleline(&mut layer.name);
+                        if ui
+                            .small_button("remove layer")
+                            .on_hover_text("Delete this layer")
+                            .clicked()
+                        {
+                            remove = Some(i);
+                        }
+                    });
+                    texture_ui(
+                        ui,
+                        "mask",
+                        "Where the layer lies: 1 replaces what is below, 0 leaves it",
+                        &mut layer.mask,
+                        ValueKind::Scalar,
+                        1,
+                    );
+                    for property in Property::ALL {
+                        let (kind, hint) = property_ui_info(property);
+                        let slot = layer.slot_mut(property);
+                        let mut set = slot.is_some();
+                        if ui
+                            .checkbox(&mut set, format!("sets {}", property.name()))
+                            .on_hover_text("Ticked, the layer sets this property where its mask is")
+                            .changed()
+                        {
+                            *slot = set.then(|| match kind {
+                                ValueKind::Color => Texture::color(Vec3::splat(0.5)),
+                                ValueKind::Scalar => Texture::scalar(0.5),
+                            });
+                        }
+                        if let Some(texture) = slot {
+                            texture_ui(ui, property.name(), hint, texture, kind, 1);
+                        }
+                    }
+                });
+        });
+    }
+    if let Some(i) = remove {
+        layers.remove(i);
+    }
+    if ui
+        .button("add layer")
+        .on_hover_text("A layer over the material: a mask and the properties it sets")
+        .clicked()
+    {
+        layers.push(Layer {
+            name: format!("layer {}", layers.len() + 1),
+            ..Layer::default()
+        });
+    }
+}
+
+/// What a property's values are: colours, or scalars (the first channel).
+#[derive(Clone, Copy, PartialEq)]
+enum ValueKind {
+    Color,
+    Scalar,
+}
+
+/// The subtree last copied from any texture's menu, for pasting elsewhere
+/// (duplicating a subtree, or replacing one by another).
+fn clipboard_id() -> egui::Id {
+    egui::Id::NULL.with("texture clipboard")
+}
+
+/// A texture: its pattern, then its two children (a constant pattern only
+/// uses the first), then its math steps. `depth` is 1 for a property's own
+/// texture. Right-click the header to copy, paste over or reset the subtree.
+fn texture_ui(
+    ui: &mut Ui,
+    title: &str,
+    hint: &str,
+    texture: &mut Texture,
+    kind: ValueKind,
+    depth: usize,
+) {
+    ui.push_id(title, |ui| {
+        let header = CollapsingHeader::new(title)
+            .id_salt("texture")
+            .default_open(depth == 1)
+            .show(ui, |ui| {
+                pattern_ui(ui, &mut texture.pattern);
+                if texture.pattern == Pattern::Mix {
+                    let factor = texture
+                        .factor
+                        .get_or_insert_with(|| Box::new(Texture::scalar(0.5)));
+                    texture_ui(
+                        ui,
+                        "factor",
+                        "How much of b: its first channel, 0 to 1",
+                        factor,
+                        ValueKind::Scalar,
+                        depth + 1,
+                    );
+                }
+                ramp_ui(ui, texture);
+                if texture.ramp.is_empty() {
+                    if texture.pattern == Pattern::Constant {
+                        child_ui(ui, "value", &mut texture.a, kind, depth);
+                    } else {
+                        child_ui(ui, "a (t = 0)", &mut texture.a, kind, depth);
+                        child_ui(ui, "b (t = 1)", &mut texture.b, kind, depth);
+                    }
+                }
+                math_ui(ui, &mut texture.ops);
+            });
+        header
+            .header_response
+            .on_hover_text(hint)
+            .context_menu(|ui| {
+                if ui.button("copy subtree").clicked() {
+                    ui.ctx()
+                        .data_mut(|d| d.insert_temp(clipboard_id(), texture.clone()));
+                    ui.close();
+                }
+                let copied: Option<Texture> = ui.ctx().data(|d| d.get_temp(clipboard_id()));
+                if ui
+                    .add_enabled(copied.is_some(), egui::Button::new("paste over this"))
+                    .clicked()
+                {
+                    if let Some(copied) = copied {
+                        *texture = copied;
+                    }
+                    ui.close();
+                }
+                if ui.button("reset to a constant").clicked() {
+                    let value = texture.eval(Vec3::ZERO, glam::Vec2::ZERO);
+                    *texture = match kind {
+                        ValueKind::Color => Texture::color(value),
+                        ValueKind::Scalar => Texture::scalar(value.x),
+                    };
+                    ui.close();
+                }
+            });
+    });
+}
+
+/// The math steps after a texture: each a dropdown, its parameters, and a
+/// remove button.
+fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
+    let mut remove = None;
+    for (i, op) in ops.iter_mut().enumerate() {
+        ui.push_id(("op", i), |ui| {
+            ui.horizontal(|ui| {
+                let mut index = op.index();
+                ComboBox::new("math", "")
+                    .show_index(ui, &mut index, MathOp::NAMES.len(), |i| MathOp::NAMES[i])
+                    .on_hover_text("A step applied to the texture's value, channel by channel");
+                if index != op.index() {
+                    *op = MathOp::with_index(index);
+                }
+                match op {
+                    MathOp::Scale(x) => {
+                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("× "));
+                    }
+                    MathOp::Bias(x) => {
+                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("+ "));
+                    }
+                    MathOp::Clamp { min, max } => {
+                        ui.add(egui::DragValue::new(min).speed(0.01).prefix("min "));
+                        ui.add(egui::DragValue::new(max).speed(0.01).prefix("max "));
+                    }
+                    MathOp::Power(e) => {
+                        ui.add(
+                            egui::DragValue::new(e)
+                                .speed(0.01)
+                                .range(MathOp::MIN_EXPONENT..=100.0)
+                                .prefix("^ "),
+                        );
+                    }
+                    MathOp::Abs | MathOp::Invert => {}
+                }
+                if ui
+                    .small_button("✕")
+                    .on_hover_text("Remove this step")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+            });
+        });
+    }
+    if let Some(i) = remove {
+        ops.remove(i);
+    }
+    if ops.len() < Texture::MAX_OPS
+        && ui
+            .small_button("add math step")
+            .on_hover_text("Scale, bias, abs, invert, clamp or power the value")
+            .clicked()
+    {
+        ops.push(MathOp::Scale(1.0));
+    }
+}
+
+/// The colour ramp: ticked, the pattern's blend factor picks a colour from
+/// the stops instead of blending `a` and `b` (which seed the first two).
+fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
+    let mut on = !texture.ramp.is_empty();
+    if ui
+        .checkbox(&mut on, "colour ramp")
+        .on_hover_text("Map the pattern's t through colour stops (like Blender's ColorRamp)")
+        .changed()
+    {
+        texture.ramp = if on {
+            let at = |c: &Child| c.eval(Vec3::ZERO, glam::Vec2::ZERO);
+            vec![
+                RampStop {
+                    position: 0.0,
+                    color: at(&texture.a),
+                },
+                RampStop {
+                    position: 1.0,
+                    color: at(&texture.b),
+                },
+            ]
+        } else {
+            Vec::new()
+        };
+    }
+    let mut remove = None;
+    for (i, stop) in texture.ramp.iter_mut().enumerate() {
+        ui.push_id(("stop", i), |ui| {
+            ui.horizontal(|ui| {
+                color_button(ui, &mut stop.color);
+                ui.add(slider(&mut stop.position, 0.0..=1.0, "at"));
+                if ui
+                    .small_button("✕")
+                    .on_hover_text("Remove this stop")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+            });
+        });
+    }
+    if let Some(i) = remove.filter(|_| texture.ramp.len() > 1) {
+        texture.ramp.remove(i);
+    }
+    if !texture.ramp.is_empty()
+        && texture.ramp.len() < MAX_RAMP_STOPS
+        && ui.small_button("add stop").clicked()
+    {
+        let last = texture.ramp[texture.ramp.len() - 1];
+        texture.ramp.push(RampStop {
+            position: (last.position + 0.1).min(1.0),
+            ..last
+        });
+    }
+    // The shader interpolates neighbours: keep the stops in order.
+    texture
+        .ramp
+        .sort_by(|x, y| x.position.total_cmp(&y.position));
+}
+
+/// One side of a blend: its value, or (ticked "texture") a nested texture
+/// edited in place. Unticking keeps the nested texture's colour at the
+/// origin as the value.
+fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth: usize) {
+    ui.push_id(label, |ui| {
+        ui.horizontal(|ui| {
+            let mut nested = matches!(child, Child::Texture(_));
+            let can_nest = depth < Texture::MAX_DEPTH;
+            if (can_nest || nested)
+                && ui
+                    .checkbox(&mut nested, "texture")
+                    .on_hover_text(
+                        "Nest a whole texture here (a checker of marbles, bricks of noise)",
+                    )
+                    .changed()
+            {
+                *child = if nested {
+                    Child::Texture(Box::new(Texture::blend(
+                        Pattern::Checker2d {
+                            size: glam::Vec2::splat(0.5),
+                            phase: 0.0,
+                        },
+                        child.clone(),
+                        child.clone(),
+                    )))
+                } else {
+                    let c = child.eval(Vec3::ZERO, glam::Vec2::ZERO);
+                    match kind {
+                        ValueKind::Color => Child::Color(c),
+                        ValueKind::Scalar => Child::Scalar(c.x),
+                    }
+                };
+            }
+            match child {
+                Child::Color(c) if kind == ValueKind::Color => {
+                    labelled_color(ui, c, label);
+                }
+                Child::Color(c) => {
+                    ui.add(slider(&mut c.x, 0.0..=1.0, label));
+                }
+                Child::Scalar(v) => {
+                    ui.add(slider(v, 0.0..=1.0, label));
+                }
+                Child::Texture(_) => {}
+            }
+        });
+        if let Child::Texture(t) = child {
+            texture_ui(ui, label, "A nested texture", t, kind, depth + 1);
+        }
+    });
+}
+
+/// The pattern dropdown and the chosen pattern's parameters.
+fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
+    let mut index = pattern.index();
+    ComboBox::new("pattern", "pattern")
+        .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])
+        .on_hover_text("What blends between the two values across the surface");
+    if index != pattern.index() {
+        // `with_index` carries the noise settings over, so tuning survives.
+        *pattern = pattern.with_index(index);
+    }
+    match pattern {
+        Pattern::Constant => {}
+        Pattern::Checker { size } => {
+            ui.add(slider(size, 0.01..=10.0, "cube size").logarithmic(true))
+                .on_hover_text("Side of the checkerboard's cubes, in scene units");
+        }
+        Pattern::Fbm { noise } | Pattern::Turbulence { noise } | Pattern::Ridged { noise } => {
+            noise_ui(ui, noise)
+        }
+        Pattern::Mix => {}
+        Pattern::Marble {
+            noise,
+            stripe_frequency,
+        } => {
+            noise_ui(ui, noise);
+            ui.add(slider(stripe_frequency, 0.0..=32.0, "stripe frequency"))
+                .on_hover_text(
+                    "t = 0.5 + 0.5·sin(x · stripe frequency + fBm): veins per 2π units along x",
+                );
+        }
+        Pattern::Checker2d { size, phase } => {
+            ui.add(slider(&mut size.x, 0.01..=4.0, "cell width (u)").logarithmic(true))
+                .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
+            ui.add(slider(&mut size.y, 0.01..=4.0, "cell height (v)").logarithmic(true));
+            ui.add(slider(phase, 0.0..=1.0, "row phase"))
+                .on_hover_text("Shift of every other row, in cells: 0.5 lays them like bricks");
+        }
+        Pattern::Brick {
+            size,
+            mortar,
+            row_offset,
+        } => {
+            ui.add(slider(&mut size.x, 0.01..=4.0, "brick width (u)").logarithmic(true));
+            ui.add(slider(&mut size.y, 0.01..=4.0, "brick height (v)").logarithmic(true));
+            ui.add(slider(mortar, 0.0..=0.2, "mortar width"))
+                .on_hover_text(
+                    "Width of the joints, in (u, v) units; a is the mortar, b the bricks",
+                );
+            ui.add(slider(row_offset, 0.0..=1.0, "row offset"));
+        }
+        Pattern::Tile {
+            mortar_half_width,
+            bevel,
+        } => {
+            ui.add(slider(mortar_half_width, 0.0..=0.5, "mortar half-width"))
+                .on_hover_text("One tile per unit (u, v) square: lay it in a checker cell");
+            ui.add(slider(bevel, 0.0..=0.5, "bevel")).on_hover_text(
+                "Width over which the tile rises from the mortar: bump it to raise the tiles",
+            );
+        }
+        Pattern::Waves {
+            frequency,
+            direction,
+        } => {
+            ui.add(slider(frequency, 0.0..=64.0, "frequency"))
+                .on_hover_text("Crests per unit of (u, v) along the direction");
+            let mut angle = direction.y.atan2(direction.x).to_degrees();
+            if ui
+                .add(slider(&mut angle, -180.0..=180.0, "direction (°)"))
+                .changed()
+            {
+                let a = angle.to_radians();
+                *direction = glam::Vec2::new(a.cos(), a.sin());
+            }
+        }
+        Pattern::Cutout { sides, radius } => {
+            ui.add(Slider::new(sides, 0..=12).text("sides"))
+                .on_hover_text("A regular polygon; below 3, a disc. a is outside, b inside");
+            ui.add(slider(radius, 0.0..=0.71, "radius"));
+        }
+        Pattern::Wood {
+            noise,
+            ring_width,
+            turbulence_amount,
+        } => {
+            ui.add(slider(ring_width, 0.01..=1.0, "ring width").logarithmic(true));
+            ui.add(slider(turbulence_amount, 0.0..=2.0, "turbulence"))
+                .on_hover_text("How far turbulence moves the rings; a dark, b pale");
+            noise_ui(ui, noise);
+        }
+        Pattern::Veins {
+            noise,
+            frequency,
+            turbulence_amount,
+        } => {
+            ui.add(slider(frequency, 0.0..=32.0, "frequency"))
+                .on_hover_text(
+                    "t = max(0, sin(frequency · x + turbulence · T(p))): a dominant, b veins",
+                );
+            ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"));
+            noise_ui(ui, noise);
+        }
+    }
+}
+
+/// The lattice noise, its hash and the fractal sum of a noise pattern.
+fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
+    ComboBox::new("noise kind", "noise")
+        .selected_text(noise.kind.label())
+        .show_ui(ui, |ui| {
+            for kind in NoiseKind::ALL {
+                ui.selectable_value(&mut noise.kind, kind, kind.label());
+            }
+        })
+        .response
+        .on_hover_text("The lattice noise the fractal sum is built from");
+    let hash_used = noise.kind != NoiseKind::Perlin;
+    ui.add_enabled_ui(hash_used, |ui| {
+        ComboBox::new("hash", "hash")
+            .selected_text(noise.hash.label())
+            .show_ui(ui, |ui| {
+                for hash in HashKind::ALL {
+                    ui.selectable_value(&mut noise.hash, hash, hash.label());
+                }
+            })
+            .response
+            .on_hover_text(
+                "How gradient noise picks a corner's gradient: pcg3d agrees bit for bit \
+                 on every GPU, fract(sin) is the lab's and drifts far from the origin",
+            )
+            .on_disabled_hover_text("Unused: Perlin noise hashes with its permutation table");
+    });
+    let f = &mut noise.fractal;
+    ui.add(slider(
+        &mut f.octaves,
+        0.0..=FractalParams::MAX_OCTAVES,
+        "octaves",
+    ))
+    .on_hover_text("Number of noise layers; a fractional part fades the last one in");
+    ui.add(slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true))
+        .on_hover_text("Frequency of the first octave, in cycles per scene unit");
+    ui.add(slider(&mut f.amplitude, 0.0..=2.0, "amplitude").clamping(SliderClamping::Never))
+        .on_hover_text("Amplitude of the first octave (type any value in the number)");
+    ui.add(slider(&mut f.persistence, 0.0..=1.5, "persistence"))
+        .on_hover_text("Amplitude ratio between successive octaves (0.5: each half as strong)");
+    ui.add(slider(&mut f.lacunarity, 1.0..=4.0, "lacunarity"))
+        .on_hover_text("Frequency ratio between successive octaves (2: each twice as fine)");
+    ui.add(slider(&mut f.distortion, 0.0..=4.0, "distortion"))
+        .on_hover_text("Domain warp: moves the point by noise before summing (0: none)");
+}

@@ -1,0 +1,387 @@
+//! Patterns: where a surface point falls between a texture's two children.
+//!
+//! A pattern turns a point (3D texture point and 2D (u, v)) into a blend
+//! factor `t` in [0, 1], and for cell patterns the (u, v) the children see.
+//! The functions themselves live in the texture library (`crate::texture`);
+//! this is the scene's record of which one and with what parameters.
+
+use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum};
+use crate::texture;
+use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// What drives a property across a surface. Each pattern yields a blend
+/// factor `t` in [0, 1] between the texture's two children: `a` where
+/// `t = 0`, `b` where `t = 1`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub enum Pattern {
+    /// `t = 0`: the first value everywhere.
+    #[default]
+    Constant,
+    /// A 3D checkerboard of cubes of side `size`: `t` is 0 or 1.
+    Checker { size: f32 },
+    /// `t = 0.5 + 0.5 · fbm(p)`, clamped.
+    Fbm { noise: NoiseSettings },
+    /// `t = turbulence(p)` (a sum of |noise|), clamped.
+    Turbulence { noise: NoiseSettings },
+    /// `t = ridged(p)` (a sum of `(1 - |noise|)²`), clamped.
+    Ridged { noise: NoiseSettings },
+    /// `t` is the first channel of the texture's `factor` (Blender's Mix).
+    Mix,
+    /// `t = 0.5 + 0.5 · sin(p.x · stripe_frequency + fbm(p))`.
+    Marble {
+        noise: NoiseSettings,
+        stripe_frequency: f32,
+    },
+    /// A board over the surface's (u, v) with cells of `size`, odd rows
+    /// shifted by `phase` of a cell: `a` in even cells, `b` in odd ones, each
+    /// seeing the cell as its whole (u, v) square.
+    Checker2d { size: Vec2, phase: f32 },
+    /// Bricks of `size` in (u, v), `mortar` wide joints, odd rows shifted by
+    /// `row_offset`: `a` is the mortar, `b` the bricks (each brick its own
+    /// unit square for a nested texture).
+    Brick {
+        size: Vec2,
+        mortar: f32,
+        row_offset: f32,
+    },
+    /// One tile per unit (u, v) square (lay it in a checker): `a` the mortar
+    /// `mortar_half_width` wide along the edges, `b` the tile, which rises
+    /// from the mortar over a `bevel` wide edge (0: a step). As a bump
+    /// texture it raises the tiles.
+    Tile {
+        mortar_half_width: f32,
+        #[serde(default)]
+        bevel: f32,
+    },
+    /// Parallel waves across (u, v): `t = 0.5 + 0.5 · sin(2π · frequency ·
+    /// direction·uv)`. As a bump texture it ripples the surface.
+    Waves { frequency: f32, direction: Vec2 },
+    /// A regular polygon of `sides` sides (a disc below 3) of circumradius
+    /// `radius`, centred in every unit (u, v) square: `a` outside, `b` inside.
+    Cutout { sides: u32, radius: f32 },
+    /// Rings of `ring_width` around an axis tilted 15° from z, their radius
+    /// perturbed by `turbulence_amount · turbulence(p)`: `a` dark, `b` pale.
+    Wood {
+        noise: NoiseSettings,
+        ring_width: f32,
+        turbulence_amount: f32,
+    },
+    /// The texture report's marble: `t = max(0, sin(frequency · x +
+    /// turbulence_amount · turbulence(p)))`: `a` the dominant colour, `b` the
+    /// veins.
+    Veins {
+        noise: NoiseSettings,
+        frequency: f32,
+        turbulence_amount: f32,
+    },
+}
+
+/// A fractal sum a pattern reads: the noise and what each octave adds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Signal {
+    pub noise: NoiseSettings,
+    pub shape: FractalShape,
+}
+
+impl Signal {
+    pub fn eval(&self, p: Vec3) -> f32 {
+        fractal_sum(p, &self.noise, self.shape)
+    }
+}
+
+impl Pattern {
+    pub const NAMES: [&'static str; 14] = [
+        "constant",
+        "checker 3D",
+        "fBm",
+        "turbulence",
+        "marble",
+        "checker (uv)",
+        "brick",
+        "tile",
+        "cutout",
+        "wood",
+        "veins",
+        "waves",
+        "ridged",
+        "mix",
+    ];
+
+    /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
+    pub fn index(&self) -> usize {
+        match self {
+            Pattern::Constant => 0,
+            Pattern::Checker { .. } => 1,
+            Pattern::Fbm { .. } => 2,
+            Pattern::Turbulence { .. } => 3,
+            Pattern::Marble { .. } => 4,
+            Pattern::Checker2d { .. } => 5,
+            Pattern::Brick { .. } => 6,
+            Pattern::Tile { .. } => 7,
+            Pattern::Cutout { .. } => 8,
+            Pattern::Wood { .. } => 9,
+            Pattern::Veins { .. } => 10,
+            Pattern::Waves { .. } => 11,
+            Pattern::Ridged { .. } => 12,
+            Pattern::Mix => 13,
+        }
+    }
+
+    /// The pattern with index `i`, keeping the noise settings of `self` where
+    /// both have some, so switching the dropdown does not lose the tuning.
+    pub fn with_index(&self, i: usize) -> Pattern {
+        let noise = self.noise().copied().unwrap_or_default();
+        match i {
+            1 => Pattern::Checker { size: 1.0 },
+            2 => Pattern::Fbm { noise },
+            3 => Pattern::Turbulence { noise },
+            4 => Pattern::Marble {
+                noise,
+                stripe_frequency: 4.0,
+            },
+            5 => Pattern::Checker2d {
+                size: Vec2::splat(0.125),
+                phase: 0.0,
+            },
+            6 => Pattern::Brick {
+                size: Vec2::new(0.25, 0.1),
+                mortar: 0.01,
+                row_offset: 0.5,
+            },
+            7 => Pattern::Tile {
+                mortar_half_width: 0.02,
+                bevel: 0.02,
+            },
+            8 => Pattern::Cutout {
+                sides: 0,
+                radius: 0.4,
+            },
+            9 => Pattern::Wood {
+                noise,
+                ring_width: 0.12,
+                turbulence_amount: 0.3,
+            },
+            10 => Pattern::Veins {
+                noise,
+                frequency: 10.0,
+                turbulence_amount: 5.0,
+            },
+            11 => Pattern::Waves {
+                frequency: 4.0,
+                direction: Vec2::X,
+            },
+            12 => Pattern::Ridged { noise },
+            13 => Pattern::Mix,
+            _ => Pattern::Constant,
+        }
+    }
+
+    pub fn noise(&self) -> Option<&NoiseSettings> {
+        match self {
+            Pattern::Fbm { noise }
+            | Pattern::Turbulence { noise }
+            | Pattern::Ridged { noise }
+            | Pattern::Marble { noise, .. }
+            | Pattern::Wood { noise, .. }
+            | Pattern::Veins { noise, .. } => Some(noise),
+            _ => None,
+        }
+    }
+
+    pub fn noise_mut(&mut self) -> Option<&mut NoiseSettings> {
+        match self {
+            Pattern::Fbm { noise }
+            | Pattern::Turbulence { noise }
+            | Pattern::Ridged { noise }
+            | Pattern::Marble { noise, .. }
+            | Pattern::Wood { noise, .. }
+            | Pattern::Veins { noise, .. } => Some(noise),
+            _ => None,
+        }
+    }
+
+    /// The fractal sum this pattern reads: the shader evaluates each
+    /// distinct one once per hit (a signal).
+    pub fn signal(&self) -> Option<Signal> {
+        let noise = *self.noise()?;
+        let shape = match self {
+            Pattern::Turbulence { .. } | Pattern::Wood { .. } | Pattern::Veins { .. } => {
+                FractalShape::Absolute
+            }
+            Pattern::Ridged { .. } => FractalShape::Ridged,
+            _ => FractalShape::Signed,
+        };
+        Some(Signal { noise, shape })
+    }
+
+    /// The blend factor at a point, given the pattern's signal value there,
+    /// and the (u, v) its children see. CPU twin of the generated WGSL.
+    pub(crate) fn blend(&self, p: Vec3, uv: Vec2, signal: f32) -> (f32, Vec2) {
+        match *self {
+            Pattern::Constant => (0.0, uv),
+            Pattern::Checker { size } => (texture::checker_3d(p, Vec3::splat(size)), uv),
+            Pattern::Fbm { .. } => ((0.5 + 0.5 * signal).clamp(0.0, 1.0), uv),
+            Pattern::Turbulence { .. } | Pattern::Ridged { .. } => (signal.clamp(0.0, 1.0), uv),
+            // The texture tree takes t from the factor texture.
+            Pattern::Mix => (0.0, uv),
+            Pattern::Marble {
+                stripe_frequency, ..
+            } => (0.5 + 0.5 * (p.x * stripe_frequency + signal).sin(), uv),
+            Pattern::Checker2d { size, phase } => {
+                let cell = texture::checker_2d(uv, size, phase);
+                (cell.select, cell.local)
+            }
+            Pattern::Brick {
+                size,
+                mortar,
+                row_offset,
+            } => {
+                let cell = texture::brick(uv, size, mortar, row_offset);
+                (cell.select, cell.local)
+            }
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => (texture::tile_height(uv, mortar_half_width, bevel), uv),
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => (texture::waves(uv, frequency, direction), uv),
+            Pattern::Cutout { sides, radius } => (texture::cutout(uv, sides, radius), uv),
+            Pattern::Wood {
+                ring_width,
+                turbulence_amount,
+                ..
+            } => (
+                texture::wood::rings(
+                    p,
+                    texture::default_axis(),
+                    ring_width,
+                    turbulence_amount * signal,
+                ),
+                uv,
+            ),
+            Pattern::Veins {
+                frequency,
+                turbulence_amount,
+                ..
+            } => (
+                (frequency * p.x + turbulence_amount * signal)
+                    .sin()
+                    .max(0.0),
+                uv,
+            ),
+        }
+    }
+
+    pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
+        if let Pattern::Checker { size } = self
+            && !(size.is_finite() && *size > 1e-4)
+        {
+            notes.push(format!("{what}: checker size {size} set to 1"));
+            *size = 1.0;
+        }
+        if let Pattern::Marble {
+            stripe_frequency, ..
+        } = self
+            && !stripe_frequency.is_finite()
+        {
+            notes.push(format!("{what}: marble stripe frequency reset"));
+            *stripe_frequency = 4.0;
+        }
+        let mut positive = |name: &str, v: &mut f32, fallback: f32| {
+            if !(v.is_finite() && *v > 1e-4) {
+                notes.push(format!("{what}: {name} {v} set to {fallback}"));
+                *v = fallback;
+            }
+        };
+        match self {
+            Pattern::Checker2d { size, .. } | Pattern::Brick { size, .. } => {
+                positive("cell width", &mut size.x, 0.125);
+                positive("cell height", &mut size.y, 0.125);
+            }
+            Pattern::Wood { ring_width, .. } => positive("ring width", ring_width, 0.12),
+            _ => {}
+        }
+        let mut finite = |name: &str, v: &mut f32| {
+            if !v.is_finite() {
+                notes.push(format!("{what}: non-finite {name} set to 0"));
+                *v = 0.0;
+            }
+        };
+        match self {
+            Pattern::Checker2d { phase, .. } => finite("phase", phase),
+            Pattern::Brick {
+                mortar, row_offset, ..
+            } => {
+                finite("mortar", mortar);
+                finite("row offset", row_offset);
+            }
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => {
+                finite("mortar", mortar_half_width);
+                finite("bevel", bevel);
+                *bevel = bevel.max(0.0);
+            }
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => {
+                finite("frequency", frequency);
+                let d = direction.normalize_or(Vec2::X);
+                if d != *direction {
+                    notes.push(format!(
+                        "{what}: wave direction {direction} made unit length"
+                    ));
+                    *direction = d;
+                }
+            }
+            Pattern::Cutout { radius, .. } => finite("radius", radius),
+            Pattern::Wood {
+                turbulence_amount, ..
+            } => finite("turbulence", turbulence_amount),
+            Pattern::Veins {
+                frequency,
+                turbulence_amount,
+                ..
+            } => {
+                finite("frequency", frequency);
+                finite("turbulence", turbulence_amount);
+            }
+            _ => {}
+        }
+        if let Some(n) = self.noise_mut() {
+            sanitize_fractal(&mut n.fractal, what, notes);
+        }
+    }
+}
+
+fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) {
+    let d = FractalParams::default();
+    let mut clamp = |name: &str, v: &mut f32, lo: f32, hi: f32, fallback: f32| {
+        let c = if v.is_finite() {
+            v.clamp(lo, hi)
+        } else {
+            fallback
+        };
+        if c != *v {
+            notes.push(format!("{what}: {name} {v} clamped to {c}"));
+            *v = c;
+        }
+    };
+    clamp(
+        "octaves",
+        &mut f.octaves,
+        0.0,
+        FractalParams::MAX_OCTAVES,
+        d.octaves,
+    );
+    clamp("frequency", &mut f.frequency, 0.0, 1e6, d.frequency);
+    clamp("amplitude", &mut f.amplitude, -100.0, 100.0, d.amplitude);
+    clamp("persistence", &mut f.persistence, 0.0, 1.5, d.persistence);
+    clamp("lacunarity", &mut f.lacunarity, 1.0, 8.0, d.lacunarity);
+    clamp("distortion", &mut f.distortion, -100.0, 100.0, d.distortion);
+}

@@ -1,0 +1,125 @@
+//! Helpers shared by the offscreen render tests.
+// Each test crate uses only some of them.
+#![allow(dead_code)]
+
+use glam::{Vec2, Vec3};
+use marbre::commands::session::accumulate;
+use marbre::gpu::{GpuContext, Renderer};
+use marbre::scene::{EnvSource, Ground, Material, Scene, Texture};
+
+pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
+    render_with(ctx, scene, size, spp, None)
+}
+
+pub fn render_with(
+    ctx: &GpuContext,
+    scene: &Scene,
+    size: (u32, u32),
+    spp: u32,
+    features: Option<marbre::gpu::FeatureSet>,
+) -> Vec<[f32; 4]> {
+    let mut r = Renderer::new(ctx, scene, None, size).unwrap();
+    r.set_feature_override(ctx, features).unwrap();
+    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+    let (w, h, pixels) = r.read_radiance(ctx).unwrap();
+    assert_eq!((w, h), size);
+    for p in &pixels {
+        assert!(p.iter().all(|c| c.is_finite()), "non-finite pixel {p:?}");
+    }
+    pixels
+}
+
+/// Every colour channel of `pixel` within `relative` of `expected`.
+pub fn assert_channels_near(pixel: [f32; 4], expected: f32, relative: f32, what: &str) {
+    for c in &pixel[..3] {
+        assert!(
+            (c - expected).abs() < relative * expected,
+            "{what}: {pixel:?}, expected {expected}"
+        );
+    }
+}
+
+pub fn lambert(albedo: f32) -> Material {
+    Material {
+        diffuse: Texture::color(Vec3::splat(albedo)),
+        specular: Texture::color(Vec3::ZERO),
+        roughness: Texture::scalar(1.0),
+        mirror: Texture::scalar(0.0),
+        ..Material::default()
+    }
+}
+
+/// Where the camera ray through image point `at` (in pixels) meets the
+/// ground y = 0: the shader's `camera_ray`, on the CPU.
+pub fn ground_point(scene: &Scene, (w, h): (u32, u32), at: glam::Vec2) -> Vec3 {
+    let frame = scene.camera.frame();
+    let ndc = glam::Vec2::new(at.x / w as f32 * 2.0 - 1.0, 1.0 - at.y / h as f32 * 2.0);
+    let d = (frame.forward
+        + ndc.x * frame.tan_half_fov * (w as f32 / h as f32) * frame.right
+        + ndc.y * frame.tan_half_fov * frame.up)
+        .normalize();
+    let p = frame.position - frame.position.y / d.y * d;
+    Vec3::new(p.x, 0.0, p.z)
+}
+
+/// A Lambert ground with `diffuse` under a constant white environment of
+/// radiance 1: each point reflects exactly its diffuse colour.
+pub fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: Material {
+                diffuse,
+                ..lambert(0.5)
+            },
+        }),
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    scene
+}
+
+/// Checks that every pixel whose footprint lies in one region of
+/// `reference` (its value at a 10×10 grid over the pixel agrees) shows that
+/// value, on a ground seen by `scene`'s camera; more than `min_fraction` of
+/// the pixels must qualify.
+pub fn assert_ground_matches(
+    scene: &Scene,
+    pixels: &[[f32; 4]],
+    (w, h): (u32, u32),
+    min_fraction: f32,
+    reference: impl Fn(Vec3, Vec2) -> Vec3,
+) {
+    let mut checked = 0;
+    for y in 0..h {
+        for x in 0..w {
+            // A 10×10 grid over the pixel: thin mortar lines must not slip
+            // between the samples.
+            let samples: Vec<Vec3> = (0..100)
+                .map(|k| {
+                    let (dx, dy) = ((k % 10) as f32 / 9.0, (k / 10) as f32 / 9.0);
+                    let p = ground_point(scene, (w, h), Vec2::new(x as f32 + dx, y as f32 + dy));
+                    reference(p, Vec2::new(p.x, p.z))
+                })
+                .collect();
+            if samples.iter().any(|c| (*c - samples[0]).length() > 1e-6) {
+                continue;
+            }
+            let got = pixels[(y * w + x) as usize];
+            let expected = samples[0];
+            for c in 0..3 {
+                assert!(
+                    (got[c] - expected[c]).abs() < 2e-3,
+                    "pixel {x},{y}: rendered {got:?}, the CPU reference gives {expected}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        checked as f32 > min_fraction * (w * h) as f32,
+        "only {checked} pixels lie inside one region"
+    );
+}
