@@ -1,20 +1,28 @@
 // Bump mapping: the material's height texture (generated `surface_height`)
 // tilts the shading normal. Its gradient over (u, v) comes from central
-// differences, one texel-sized step of 1e-3 in uv; the fractal-sum signals
-// are taken at the hit itself, so only the non-noise part of a height field
-// bumps (noise bumps need the signals at the offset points: issue 3).
+// differences, one step of 1e-3 in uv, moving the 3D texture point along
+// ∂p/∂u and ∂p/∂v with it. A height that reads noise (generated
+// BUMP_READS_NOISE) needs the fractal-sum signals at each offset point too;
+// otherwise the hit's own signals serve, and the four extra sums are
+// compiled out.
 
 const BUMP_STEP: f32 = 1e-3;
 
+fn height_at(hit: Hit, signals: vec4f, du: f32, dv: f32) -> f32 {
+    let p = hit.texture_point + du * hit.dp_du + dv * hit.dp_dv;
+    var offset_signals = signals;
+#if NOISE
+    if BUMP_READS_NOISE {
+        offset_signals = material_signals(hit.material, p);
+    }
+#endif
+    return surface_height(hit.material, p, hit.uv + vec2f(du, dv), offset_signals);
+}
+
 fn bumped_shading_normal(hit: Hit, signals: vec4f) -> vec3f {
     let height = materials[hit.material].bump_height;
-    let p = hit.texture_point;
-    let du = vec2f(BUMP_STEP, 0.0);
-    let dv = vec2f(0.0, BUMP_STEP);
-    let dh_du = surface_height(hit.material, p, hit.uv + du, signals)
-        - surface_height(hit.material, p, hit.uv - du, signals);
-    let dh_dv = surface_height(hit.material, p, hit.uv + dv, signals)
-        - surface_height(hit.material, p, hit.uv - dv, signals);
+    let dh_du = height_at(hit, signals, BUMP_STEP, 0.0) - height_at(hit, signals, -BUMP_STEP, 0.0);
+    let dh_dv = height_at(hit, signals, 0.0, BUMP_STEP) - height_at(hit, signals, 0.0, -BUMP_STEP);
     let scale = height / (2.0 * BUMP_STEP);
     return bumped_normal(hit.n, hit.dp_du, hit.dp_dv, scale * dh_du, scale * dh_dv);
 }

@@ -185,3 +185,97 @@ fn a_half_opaque_sphere_lets_a_quarter_of_the_light_through() {
         );
     }
 }
+
+/// A noise bump: a Lambert ground whose height is fBm, lit by a point light
+/// straight above. Each pixel must show ρ/π · I/d² · n·l with n the normal
+/// the CPU gets from central differences of the same height texture (the
+/// fractal sums taken at the offset points, as the shader must), averaged
+/// over the pixel.
+#[test]
+fn noise_bump_renders_the_cpu_finite_difference_normal() {
+    let Some(ctx) = gpu_or_skip("noise_bump_renders_the_cpu_finite_difference_normal") else {
+        return;
+    };
+    let (albedo, intensity, bump_height) = (0.5_f32, 20.0_f32, 0.3_f32);
+    let light = Vec3::new(0.0, 2.0, 0.0);
+    let mut material = lambert(albedo);
+    material.bump = Texture::blend(
+        Pattern::Fbm {
+            noise: marbre::noise::NoiseSettings {
+                fractal: marbre::noise::FractalParams {
+                    octaves: 2.0,
+                    frequency: 2.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        },
+        0.0,
+        1.0,
+    );
+    material.bump_height = bump_height;
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: 0.0,
+            material: material.clone(),
+        }),
+        point_light: Some(PointLight {
+            position: light,
+            color: Vec3::ONE,
+            intensity,
+        }),
+        camera: OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 5.0,
+            yaw_degrees: 0.0,
+            pitch_degrees: 89.0,
+            fov_degrees: 20.0,
+        },
+        ..Scene::default()
+    };
+    scene.render.max_bounces = 1;
+    let (w, h) = (48, 48);
+    let pixels = render(&ctx, &scene, (w, h), 64);
+    let height = |p: Vec3| material.bump.eval(p, Vec2::new(p.x, p.z)).x;
+    let step = 1e-3;
+    let mut tilted = 0;
+    for y in 0..h {
+        for x in 0..w {
+            // The pixel's mean over an 8×8 grid of points, as the jittered
+            // samples average it.
+            let (mut expected, mut n) = (0.0, Vec3::ZERO);
+            for k in 0..64 {
+                let at = Vec2::new(
+                    x as f32 + (k % 8) as f32 / 8.0 + 0.0625,
+                    y as f32 + (k / 8) as f32 / 8.0 + 0.0625,
+                );
+                let p = ground_point(&scene, (w, h), at);
+                let dh_du =
+                    (height(p + step * Vec3::X) - height(p - step * Vec3::X)) / (2.0 * step);
+                let dh_dv =
+                    (height(p + step * Vec3::Z) - height(p - step * Vec3::Z)) / (2.0 * step);
+                n = marbre::texture::bumped_normal(
+                    Vec3::Y,
+                    Vec3::X,
+                    Vec3::Z,
+                    bump_height * dh_du,
+                    bump_height * dh_dv,
+                );
+                let to_light = light - p;
+                expected += albedo / std::f32::consts::PI * intensity / to_light.length_squared()
+                    * n.dot(to_light.normalize()).max(0.0)
+                    / 64.0;
+            }
+            let got = pixels[(y * w + x) as usize][0];
+            assert!(
+                (got - expected).abs() < 0.02 * expected + 1e-3,
+                "pixel {x},{y}: rendered {got}, CPU normal {n} gives {expected}"
+            );
+            tilted += usize::from(n.y < 0.98);
+        }
+    }
+    assert!(
+        tilted > (w * h / 4) as usize,
+        "only {tilted} pixels are tilted"
+    );
+}

@@ -95,6 +95,15 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
         wgsl,
         "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
     )?;
+    let bump_reads_noise = scene
+        .materials()
+        .filter(|m| m.has_bump())
+        .flat_map(|m| m.bump.patterns())
+        .any(|p| p.signal().is_some());
+    write!(
+        wgsl,
+        "\n// Whether a bump height reads noise (bump.wgsl then evaluates the\n// signals at its offset points).\nconst BUMP_READS_NOISE: bool = {bump_reads_noise};\n"
+    )?;
     // Always defined, so that a shader with the bump feature forced on (the
     // uber shader) builds for any scene.
     write!(
