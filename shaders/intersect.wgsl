@@ -50,6 +50,73 @@ fn intersect_sphere(o: vec3f, d: vec3f, s: Sphere) -> f32 {
     return NO_HIT;
 }
 
+#if CYLINDER
+// Where a ray meets a cylinder: the distance, and which part (0 the side,
+// 1 the bottom cap, 2 the top), or NO_HIT. The side solves the quadratic in
+// the xz plane with the same stable form as the sphere.
+struct CylinderHit {
+    t: f32,
+    part: u32,
+}
+
+fn intersect_cylinder(o: vec3f, d: vec3f, c: Cylinder) -> CylinderHit {
+    let f = o - c.base;
+    var best = CylinderHit(NO_HIT, 0u);
+    let a = dot(d.xz, d.xz);
+    if a > 0.0 {
+        let b = -dot(f.xz, d.xz) / a;
+        let perp = f.xz + b * d.xz;
+        let disc = (c.radius * c.radius - dot(perp, perp)) / a;
+        if disc >= 0.0 {
+            let root = sqrt(disc);
+            for (var k = 0u; k < 2u; k++) {
+                let t = select(b + root, b - root, k == 0u);
+                let y = f.y + t * d.y;
+                if t > 0.0 && t < best.t && y >= 0.0 && y <= c.height {
+                    best = CylinderHit(t, 0u);
+                }
+            }
+        }
+    }
+    if d.y != 0.0 {
+        for (var k = 0u; k < 2u; k++) {
+            let y = select(c.height, 0.0, k == 0u);
+            let t = (y - f.y) / d.y;
+            let q = f.xz + t * d.xz;
+            if t > 0.0 && t < best.t && dot(q, q) <= c.radius * c.radius {
+                best = CylinderHit(t, 1u + k);
+            }
+        }
+    }
+    return best;
+}
+#endif
+
+#if POLYGON
+// Distance along the ray to a convex polygon, or NO_HIT: the plane, then
+// the point on the inner side of every edge.
+fn intersect_polygon(o: vec3f, d: vec3f, poly: Polygon) -> f32 {
+    let denominator = dot(d, poly.normal);
+    if denominator == 0.0 {
+        return NO_HIT;
+    }
+    let t = dot(poly.vertices[0].xyz - o, poly.normal) / denominator;
+    if !(t > 0.0) {
+        return NO_HIT;
+    }
+    let p = o + t * d;
+    let n = min(poly.vertex_count, MAX_POLYGON_VERTICES);
+    for (var i = 0u; i < n; i++) {
+        let a = poly.vertices[i].xyz;
+        let b = poly.vertices[(i + 1u) % n].xyz;
+        if dot(cross(b - a, p - a), poly.normal) < 0.0 {
+            return NO_HIT;
+        }
+    }
+    return t;
+}
+#endif
+
 fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
     var hit: Hit;
     hit.t = NO_HIT;
@@ -82,6 +149,62 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #endif
         hit.material = index;
     }
+#if CYLINDER
+    for (var i = 0u; i < frame.cylinder_count; i++) {
+        let c = cylinders[i];
+        let ch = intersect_cylinder(o, d, c);
+        if ch.t < hit.t {
+            hit.t = ch.t;
+            hit.p = o + ch.t * d;
+            let local = hit.p - c.base;
+            hit.texture_point = local;
+            let ring = local.xz / c.radius;
+            if ch.part == 0u {
+                hit.n = normalize(vec3f(ring.x, 0.0, ring.y));
+#if TEXTURE_UV
+                hit.uv = cylinder_uv(local, c.height);
+#endif
+#if BUMP
+                hit.dp_du = TWO_PI * c.radius * vec3f(hit.n.z, 0.0, -hit.n.x);
+                hit.dp_dv = vec3f(0.0, c.height, 0.0);
+#endif
+            } else {
+                // The caps: the disc onto the unit square.
+                hit.n = vec3f(0.0, select(-1.0, 1.0, ch.part == 2u), 0.0);
+#if TEXTURE_UV
+                hit.uv = 0.5 + 0.5 * ring;
+#endif
+#if BUMP
+                hit.dp_du = vec3f(2.0 * c.radius, 0.0, 0.0);
+                hit.dp_dv = vec3f(0.0, 0.0, 2.0 * c.radius);
+#endif
+            }
+            hit.material = frame.sphere_count + i;
+        }
+    }
+#endif
+#if POLYGON
+    for (var i = 0u; i < frame.polygon_count; i++) {
+        let t = intersect_polygon(o, d, polygons[i]);
+        if t < hit.t {
+            let poly = polygons[i];
+            hit.t = t;
+            // On the plane exactly, whatever the rounding of t.
+            let q = o + t * d;
+            hit.p = q - dot(q - poly.vertices[0].xyz, poly.normal) * poly.normal;
+            hit.n = poly.normal;
+            hit.texture_point = hit.p;
+#if TEXTURE_UV
+            hit.uv = plane_uv(hit.p, poly.uv_origin, poly.uv_u, poly.uv_v);
+#endif
+#if BUMP
+            hit.dp_du = poly.uv_u;
+            hit.dp_dv = poly.uv_v;
+#endif
+            hit.material = frame.sphere_count + frame.cylinder_count + i;
+        }
+    }
+#endif
 #if GROUND
     if frame.has_ground != 0u && d.y != 0.0 {
         let t = (frame.ground_height - o.y) / d.y;
@@ -95,7 +218,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.dp_du = vec3f(1.0, 0.0, 0.0);
             hit.dp_dv = vec3f(0.0, 0.0, 1.0);
 #endif
-            hit.material = frame.sphere_count;
+            hit.material = frame.sphere_count + frame.cylinder_count + frame.polygon_count;
         }
     }
 #endif
@@ -112,6 +235,20 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
             return true;
         }
     }
+#if CYLINDER
+    for (var i = 0u; i < frame.cylinder_count; i++) {
+        if intersect_cylinder(o, d, cylinders[i]).t < t_max {
+            return true;
+        }
+    }
+#endif
+#if POLYGON
+    for (var i = 0u; i < frame.polygon_count; i++) {
+        if intersect_polygon(o, d, polygons[i]) < t_max {
+            return true;
+        }
+    }
+#endif
 #if GROUND
     if frame.has_ground != 0u && d.y != 0.0 {
         let t = (frame.ground_height - o.y) / d.y;

@@ -25,6 +25,8 @@ struct Frame {
     // renders exactly the scene: 0 none, 1 constant, 2 map.
     env_kind: u32,
     has_ground: u32,
+    cylinder_count: u32,
+    polygon_count: u32,
 }
 
 const MAX_SIGNALS: u32 = 4u;
@@ -46,14 +48,37 @@ struct Sphere {
     radius: f32,
 }
 
+// A closed cylinder standing on `base` along +y.
+struct Cylinder {
+    base: vec3f,
+    radius: f32,
+    height: f32,
+}
+
+// A flat convex polygon, its vertices counter-clockwise about `normal`,
+// and its (u, v) frame (Rust: scene::Polygon::frame).
+const MAX_POLYGON_VERTICES: u32 = 8u;
+
+struct Polygon {
+    vertices: array<vec4f, 8>,
+    normal: vec3f,
+    vertex_count: u32,
+    uv_origin: vec3f,
+    uv_u: vec3f,
+    uv_v: vec3f,
+}
+
 @group(0) @binding(0) var<uniform> frame: Frame;
 // Uniform arrays of fixed size (Rust: scene::MAX_SPHERES). Lanes of one SIMD
 // group read different elements; lavapipe does that far faster from a
 // uniform buffer than from a storage buffer (measured: 14 % of the frame).
 const MAX_SPHERES: u32 = 63u;
 @group(0) @binding(1) var<uniform> spheres: array<Sphere, 63>;
-// The spheres' materials, then the ground's.
-@group(0) @binding(2) var<uniform> materials: array<Material, 64>;
+// The materials of the spheres, cylinders and polygons, then the ground's
+// (Rust: gpu::scene_gpu::MAX_MATERIALS).
+@group(0) @binding(2) var<uniform> materials: array<Material, 88>;
+@group(0) @binding(9) var<uniform> cylinders: array<Cylinder, 8>;
+@group(0) @binding(10) var<uniform> polygons: array<Polygon, 16>;
 // The numbers of the scene's texture trees, read at constant indices by the
 // generated texture functions (Rust: gpu::texture_codegen).
 @group(0) @binding(7) var<uniform> texture_params: array<vec4f, 1024>;

@@ -8,6 +8,8 @@ use std::collections::BTreeSet;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Feature {
     Ground,
+    Cylinder,
+    Polygon,
     PointLight,
     EnvMap,
     EnvConstant,
@@ -35,8 +37,10 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 25] = [
+    pub const ALL: [Feature; 27] = [
         Feature::Ground,
+        Feature::Cylinder,
+        Feature::Polygon,
         Feature::PointLight,
         Feature::EnvMap,
         Feature::EnvConstant,
@@ -81,6 +85,8 @@ impl Feature {
     pub fn define(self) -> &'static str {
         match self {
             Feature::Ground => "GROUND",
+            Feature::Cylinder => "CYLINDER",
+            Feature::Polygon => "POLYGON",
             Feature::PointLight => "POINT_LIGHT",
             Feature::EnvMap => "ENV_MAP",
             Feature::EnvConstant => "ENV_CONSTANT",
@@ -151,6 +157,12 @@ impl FeatureSet {
         let mut set = BTreeSet::new();
         if scene.ground.is_some() {
             set.insert(Feature::Ground);
+        }
+        if !scene.cylinders.is_empty() {
+            set.insert(Feature::Cylinder);
+        }
+        if !scene.polygons.is_empty() {
+            set.insert(Feature::Polygon);
         }
         if scene.point_light.is_some() {
             set.insert(Feature::PointLight);

@@ -4,6 +4,7 @@
 
 use super::context::GpuContext;
 use super::features::FeatureSet;
+use super::geometry_buffers::GeometryBuffers;
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
     uniform,
@@ -62,8 +63,7 @@ pub struct Renderer {
     display_module: wgpu::ShaderModule,
     frame_buffer: wgpu::Buffer,
     display_buffer: wgpu::Buffer,
-    sphere_buffer: wgpu::Buffer,
-    material_buffer: wgpu::Buffer,
+    geometry: GeometryBuffers,
     perm_buffer: wgpu::Buffer,
     texture_param_buffer: wgpu::Buffer,
     /// The generated texture code the trace pipeline was built with: a
@@ -93,8 +93,10 @@ impl Renderer {
             label: Some("trace"),
             entries: &[
                 entry(0, uniform()),
-                entry(1, uniform()),
-                entry(2, uniform()),
+                entry(GeometryBuffers::BINDINGS[0], uniform()),
+                entry(GeometryBuffers::BINDINGS[1], uniform()),
+                entry(GeometryBuffers::BINDINGS[2], uniform()),
+                entry(GeometryBuffers::BINDINGS[3], uniform()),
                 entry(3, float_texture(true)),
                 entry(
                     4,
@@ -130,16 +132,7 @@ impl Renderer {
             bytemuck::bytes_of(&DisplayUniform::zeroed()),
             wgpu::BufferUsages::UNIFORM,
         );
-        let sphere_buffer = buffer(
-            "spheres",
-            bytemuck::cast_slice(&scene_gpu::spheres(scene)),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        let material_buffer = buffer(
-            "materials",
-            bytemuck::cast_slice(&scene_gpu::materials(scene)),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let geometry = GeometryBuffers::new(device, scene);
         let perm_buffer = buffer(
             "permutation",
             bytemuck::cast_slice(&permutation_table()),
@@ -172,8 +165,7 @@ impl Renderer {
             display_module,
             frame_buffer,
             display_buffer,
-            sphere_buffer,
-            material_buffer,
+            geometry,
             perm_buffer,
             texture_param_buffer,
             texture_code: textures.wgsl,
@@ -267,13 +259,7 @@ impl Renderer {
             );
             self.texture_code = textures.wgsl;
         }
-        // Fixed-size arrays: the buffers never grow.
-        let spheres = scene_gpu::spheres(scene);
-        let materials = scene_gpu::materials(scene);
-        ctx.queue
-            .write_buffer(&self.sphere_buffer, 0, bytemuck::cast_slice(&spheres));
-        ctx.queue
-            .write_buffer(&self.material_buffer, 0, bytemuck::cast_slice(&materials));
+        self.geometry.write(&ctx.queue, scene);
         // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
         let mut traced_now = scene.clone();
@@ -345,22 +331,22 @@ impl Renderer {
             .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
         let read = self.accumulation.latest;
         let write = 1 - read;
+        let mut entries = vec![
+            bind(0, self.frame_buffer.as_entire_binding()),
+            bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
+            bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
+            bind(
+                5,
+                wgpu::BindingResource::TextureView(&self.accumulation.views[read]),
+            ),
+            bind(6, self.perm_buffer.as_entire_binding()),
+            bind(7, self.texture_param_buffer.as_entire_binding()),
+        ];
+        entries.extend(self.geometry.entries());
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("trace"),
             layout: &self.trace_layout,
-            entries: &[
-                bind(0, self.frame_buffer.as_entire_binding()),
-                bind(1, self.sphere_buffer.as_entire_binding()),
-                bind(2, self.material_buffer.as_entire_binding()),
-                bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
-                bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
-                bind(
-                    5,
-                    wgpu::BindingResource::TextureView(&self.accumulation.views[read]),
-                ),
-                bind(6, self.perm_buffer.as_entire_binding()),
-                bind(7, self.texture_param_buffer.as_entire_binding()),
-            ],
+            entries: &entries,
         });
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -3,8 +3,10 @@
 use super::texture_codegen;
 use crate::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::material::MAX_SIGNALS;
-use crate::scene::{EnvSource, MAX_SPHERES, Material, Scene};
+use crate::scene::primitives::MAX_POLYGON_VERTICES;
+use crate::scene::{EnvSource, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, Material, Scene};
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -30,6 +32,9 @@ pub struct FrameUniform {
     pub render_size: [f32; 2],
     pub env_kind: u32,
     pub has_ground: u32,
+    pub cylinder_count: u32,
+    pub polygon_count: u32,
+    pub _pad: [u32; 2],
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -76,6 +81,28 @@ pub struct MaterialGpu {
     pub first_perlin: u32,
     pub bump_height: f32,
     pub _pad: f32,
+}
+
+/// `Cylinder` of `shaders/scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct CylinderGpu {
+    pub base: [f32; 3],
+    pub radius: f32,
+    pub height: f32,
+    pub _pad: [f32; 3],
+}
+
+/// `Polygon` of `shaders/scene.wgsl`: vertices, plane and (u, v) frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct PolygonGpu {
+    pub vertices: [[f32; 4]; MAX_POLYGON_VERTICES],
+    pub normal: [f32; 3],
+    pub vertex_count: u32,
+    pub uv_origin: [f32; 4],
+    pub uv_u: [f32; 4],
+    pub uv_v: [f32; 4],
 }
 
 #[repr(C)]
@@ -125,7 +152,56 @@ pub fn material(m: &Material) -> MaterialGpu {
 /// array's length.
 pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
     let mut out: Vec<_> = scene.materials().map(material).collect();
-    out.resize(MAX_SPHERES + 1, MaterialGpu::default());
+    out.resize(MAX_MATERIALS, MaterialGpu::default());
+    out
+}
+
+/// Entries of the `materials` uniform array: every primitive's, and the
+/// ground's.
+pub const MAX_MATERIALS: usize = MAX_SPHERES + MAX_CYLINDERS + MAX_POLYGONS + 1;
+
+/// Cylinders, padded to the uniform array's length.
+pub fn cylinders(scene: &Scene) -> Vec<CylinderGpu> {
+    let mut out: Vec<_> = scene
+        .cylinders
+        .iter()
+        .take(MAX_CYLINDERS)
+        .map(|c| CylinderGpu {
+            base: c.base.to_array(),
+            radius: c.radius,
+            height: c.height,
+            _pad: [0.0; 3],
+        })
+        .collect();
+    out.resize(MAX_CYLINDERS, CylinderGpu::default());
+    out
+}
+
+/// Polygons (those `Scene::sanitize` kept: convex, flat), padded to the
+/// uniform array's length.
+pub fn polygons(scene: &Scene) -> Vec<PolygonGpu> {
+    let mut out: Vec<_> = scene
+        .polygons
+        .iter()
+        .take(MAX_POLYGONS)
+        .map(|p| {
+            let mut gpu = PolygonGpu {
+                normal: p.normal().unwrap_or(Vec3::Y).to_array(),
+                vertex_count: p.vertices.len().min(MAX_POLYGON_VERTICES) as u32,
+                ..Default::default()
+            };
+            for (slot, v) in gpu.vertices.iter_mut().zip(&p.vertices) {
+                *slot = v.extend(0.0).to_array();
+            }
+            if let Some(frame) = p.frame() {
+                gpu.uv_origin = frame.origin.extend(0.0).to_array();
+                gpu.uv_u = frame.u_axis.extend(0.0).to_array();
+                gpu.uv_v = frame.v_axis.extend(0.0).to_array();
+            }
+            gpu
+        })
+        .collect();
+    out.resize(MAX_POLYGONS, PolygonGpu::default());
     out
 }
 
@@ -191,6 +267,9 @@ pub fn frame_uniform(
             EnvSource::LatLong { .. } => 2,
         },
         has_ground: u32::from(scene.ground.is_some()),
+        cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
+        polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
+        _pad: [0; 2],
     }
 }
 
@@ -203,7 +282,9 @@ mod tests {
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 144);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 160);
+        assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
+        assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 208);
         assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
@@ -242,6 +323,11 @@ mod tests {
             materials(&scene).len()
         );
         assert_eq!(spheres(&scene).len(), MAX_SPHERES);
+        assert_eq!(
+            wgsl_array_len("cylinders") as usize,
+            cylinders(&scene).len()
+        );
+        assert_eq!(wgsl_array_len("polygons") as usize, polygons(&scene).len());
         assert_eq!(
             wgsl_array_len("texture_params") as usize,
             texture_codegen::generate(&scene).unwrap().params.len()

@@ -9,6 +9,7 @@ pub mod camera;
 pub mod environment;
 pub mod material;
 pub mod pattern;
+pub mod primitives;
 pub mod render_settings;
 pub mod texture_tree;
 
@@ -16,6 +17,7 @@ pub use camera::OrbitCamera;
 pub use environment::{EnvSource, Environment};
 pub use material::{Layer, Material, Property};
 pub use pattern::{Pattern, Signal};
+pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
 pub use render_settings::{RenderSettings, ToneMap};
 pub use texture_tree::{Child, MathOp, Texture};
 
@@ -89,6 +91,10 @@ pub const MAX_SPHERES: usize = 63;
 pub struct Scene {
     pub camera: OrbitCamera,
     pub spheres: Vec<Sphere>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cylinders: Vec<Cylinder>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub polygons: Vec<Polygon>,
     pub ground: Option<Ground>,
     pub point_light: Option<PointLight>,
     pub environment: Environment,
@@ -96,11 +102,14 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Every material in GPU order: the spheres', then the ground's.
+    /// Every material in GPU order: the spheres', the cylinders', the
+    /// polygons', then the ground's.
     pub fn materials(&self) -> impl Iterator<Item = &Material> {
         self.spheres
             .iter()
             .map(|s| &s.material)
+            .chain(self.cylinders.iter().map(|c| &c.material))
+            .chain(self.polygons.iter().map(|p| &p.material))
             .chain(self.ground.iter().map(|g| &g.material))
     }
 
@@ -127,6 +136,8 @@ impl Scene {
             s.material
                 .sanitize(&format!("sphere `{}`", s.name), &mut notes);
         }
+        self.sanitize_cylinders(&mut notes);
+        self.sanitize_polygons(&mut notes);
         if let Some(g) = &mut self.ground {
             if !g.height.is_finite() {
                 notes.push("ground: non-finite height set to 0".into());
@@ -137,6 +148,52 @@ impl Scene {
         self.render.sanitize(&mut notes);
         self.camera.sanitize(&mut notes);
         notes
+    }
+
+    fn sanitize_cylinders(&mut self, notes: &mut Vec<String>) {
+        if self.cylinders.len() > MAX_CYLINDERS {
+            notes.push(format!(
+                "{} cylinders: only the first {MAX_CYLINDERS} are kept (the renderer's limit)",
+                self.cylinders.len()
+            ));
+            self.cylinders.truncate(MAX_CYLINDERS);
+        }
+        for c in &mut self.cylinders {
+            for (what, v) in [("radius", &mut c.radius), ("height", &mut c.height)] {
+                if !(v.is_finite() && *v > 0.0) {
+                    notes.push(format!("cylinder `{}`: {what} {v} set to 1", c.name));
+                    *v = 1.0;
+                }
+            }
+            if !c.base.is_finite() {
+                notes.push(format!("cylinder `{}`: non-finite base set to 0", c.name));
+                c.base = Vec3::ZERO;
+            }
+            c.material
+                .sanitize(&format!("cylinder `{}`", c.name), notes);
+        }
+    }
+
+    /// Polygons the renderer cannot draw (too few vertices, warped,
+    /// concave) are dropped, each with the reason.
+    fn sanitize_polygons(&mut self, notes: &mut Vec<String>) {
+        self.polygons.retain(|p| match p.problem() {
+            Some(problem) => {
+                notes.push(format!("polygon `{}` dropped: {problem}", p.name));
+                false
+            }
+            None => true,
+        });
+        if self.polygons.len() > MAX_POLYGONS {
+            notes.push(format!(
+                "{} polygons: only the first {MAX_POLYGONS} are kept (the renderer's limit)",
+                self.polygons.len()
+            ));
+            self.polygons.truncate(MAX_POLYGONS);
+        }
+        for p in &mut self.polygons {
+            p.material.sanitize(&format!("polygon `{}`", p.name), notes);
+        }
     }
 }
 
