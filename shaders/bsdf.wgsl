@@ -17,11 +17,11 @@ struct SurfacePoint {
 fn surface_at(hit: Hit) -> SurfacePoint {
     let p = hit.texture_point;
 #if NOISE
-    let signals = material_signals(hit.material, p);
+    let signals = material_signals(hit.material, p, hit.p);
 #else
     let signals = vec4f(0.0);
 #endif
-    let textures = surface_textures(hit.material, p, hit.uv, signals);
+    let textures = surface_textures(hit.material, p, hit.p, hit.uv, signals);
     var s: SurfacePoint;
     // Math steps can leave [0, 1]: reflectances stay within it, so no
     // bounce ever adds energy.

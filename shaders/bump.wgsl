@@ -9,14 +9,16 @@
 const BUMP_STEP: f32 = 1e-3;
 
 fn height_at(hit: Hit, signals: vec4f, du: f32, dv: f32) -> f32 {
-    let p = hit.texture_point + du * hit.dp_du + dv * hit.dp_dv;
+    let offset = du * hit.dp_du + dv * hit.dp_dv;
+    let p = hit.texture_point + offset;
+    let pw = hit.p + offset;
     var offset_signals = signals;
 #if NOISE
     if BUMP_READS_NOISE {
-        offset_signals = material_signals(hit.material, p);
+        offset_signals = material_signals(hit.material, p, pw);
     }
 #endif
-    return surface_height(hit.material, p, hit.uv + vec2f(du, dv), offset_signals);
+    return surface_height(hit.material, p, pw, hit.uv + vec2f(du, dv), offset_signals);
 }
 
 fn bumped_shading_normal(hit: Hit, signals: vec4f) -> vec3f {

@@ -13,9 +13,10 @@ struct NoiseParams {
     shape: u32,
     // Domain warp amount (0: none); compiled in with NOISE_WARP only.
     distortion: f32,
+    // 1: the renderer takes the signal at world coordinates, 0: object ones.
+    world: u32,
     _pad0: f32,
     _pad1: f32,
-    _pad2: f32,
 }
 
 const MAX_OCTAVES: f32 = 16.0;

@@ -35,6 +35,9 @@ struct Material {
     // The distinct fractal sums the material's textures read, each evaluated
     // once per hit (see textures.wgsl).
     signals: array<NoiseParams, 4>,
+    // Signal k is taken at its mapping of the hit: rows 3k to 3k + 2 of an
+    // affine map, applied to the object point or (`world`) the world one.
+    signal_rows: array<vec4f, 12>,
     signal_count: u32,
     // Signals before this index are gradient noise, from it on Perlin noise.
     first_perlin: u32,

@@ -40,3 +40,9 @@ fn triangle_uv(p: vec3f, v0: vec3f, v1: vec3f, v2: vec3f, uv0: vec2f, uv1: vec2f
 fn to_texture_space(p: vec3f, linear: mat3x3f, translation: vec3f) -> vec3f {
     return linear * p + translation;
 }
+
+// An affine map given as three rows: (dot(r0.xyz, p) + r0.w, …); Rust:
+// TextureMapping::rows.
+fn affine_rows(p: vec3f, r0: vec4f, r1: vec4f, r2: vec4f) -> vec3f {
+    return vec3f(dot(r0.xyz, p) + r0.w, dot(r1.xyz, p) + r1.w, dot(r2.xyz, p) + r2.w);
+}

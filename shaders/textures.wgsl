@@ -23,20 +23,32 @@ struct SurfaceTextures {
 // first, then Perlin ones from `first_perlin` on. Each kind's loop holds only
 // its own noise, so a hit pays for Perlin octaves only where some lane reads
 // a Perlin signal.
-fn material_signals(material: u32, p: vec3f) -> vec4f {
+fn material_signals(material: u32, p: vec3f, pw: vec3f) -> vec4f {
     var values = vec4f(0.0);
     let count = min(materials[material].signal_count, MAX_SIGNALS);
     let first_perlin = min(materials[material].first_perlin, count);
 #if NOISE_GRADIENT
     for (var k = 0u; k < first_perlin; k++) {
-        values[k] = fractal_sum_gradient(p, materials[material].signals[k]);
+        values[k] = fractal_sum_gradient(signal_point(material, k, p, pw), materials[material].signals[k]);
     }
 #endif
 #if NOISE_PERLIN
     for (var k = first_perlin; k < count; k++) {
-        values[k] = fractal_sum_perlin(p, materials[material].signals[k]);
+        values[k] = fractal_sum_perlin(signal_point(material, k, p, pw), materials[material].signals[k]);
     }
 #endif
     return values;
+}
+
+// Where signal k of a material is taken: its mapping of the object point p
+// or of the world point pw.
+fn signal_point(material: u32, k: u32, p: vec3f, pw: vec3f) -> vec3f {
+    let q = select(p, pw, materials[material].signals[k].world != 0u);
+    return affine_rows(
+        q,
+        materials[material].signal_rows[3u * k],
+        materials[material].signal_rows[3u * k + 1u],
+        materials[material].signal_rows[3u * k + 2u],
+    );
 }
 #endif

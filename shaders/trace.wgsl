@@ -47,7 +47,7 @@ fn transmittance(o: vec3f, d: vec3f, light: vec3f) -> f32 {
         if h.t >= length(light - origin) {
             break;
         }
-        through *= 1.0 - clamp(surface_opacity(h.material, h.texture_point, h.uv), 0.0, 1.0);
+        through *= 1.0 - clamp(surface_opacity(h.material, h.texture_point, h.p, h.uv), 0.0, 1.0);
         origin = offset_ray(h.p, -h.n);
         crossings++;
         continuing {

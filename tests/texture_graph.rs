@@ -378,3 +378,97 @@ fn polygon_and_cylinder_map_uv_as_the_cpu() {
         })
     });
 }
+
+/// Mappings: on a sphere away from the origin, a uv checker whose cells
+/// hold wood rings taken in world coordinates through a rotation and scale
+/// (their turbulence signal mapped the same way) and a 3D checker taken in
+/// the object's frame through a translation. Every pixel lying in one region
+/// must show `Material::value_at` of the hit, with the object point relative
+/// to the centre and the world point as is.
+#[test]
+fn mapped_textures_render_the_cpu_reference() {
+    let Some(ctx) = gpu_or_skip("mapped_textures_render_the_cpu_reference") else {
+        return;
+    };
+    use marbre::scene::{MappingSpace, SurfacePoint, TextureMapping};
+    use marbre::texture::TextureTransform;
+    let mut wood = Texture::blend(
+        Pattern::Wood {
+            noise: marbre::noise::NoiseSettings::default(),
+            ring_width: 0.15,
+            turbulence_amount: 0.3,
+        },
+        Vec3::new(0.4, 0.2, 0.05),
+        Vec3::new(0.8, 0.6, 0.3),
+    );
+    wood.mapping = Some(TextureMapping {
+        space: MappingSpace::World,
+        transform: TextureTransform {
+            translate: Vec3::new(0.2, 0.0, 0.0),
+            rotate_degrees: Vec3::new(0.0, 30.0, 10.0),
+            scale: Vec3::splat(0.7),
+        },
+    });
+    let mut cubes = Texture::blend(
+        Pattern::Checker { size: 0.5 },
+        Vec3::new(0.1, 0.5, 0.2),
+        Vec3::new(0.9, 0.9, 0.9),
+    );
+    cubes.mapping = Some(TextureMapping {
+        space: MappingSpace::Object,
+        transform: TextureTransform {
+            translate: Vec3::new(0.25, 0.1, 0.0),
+            ..TextureTransform::default()
+        },
+    });
+    let diffuse = Texture::blend(
+        Pattern::Checker2d {
+            size: Vec2::new(0.25, 0.5),
+            phase: 0.0,
+        },
+        wood,
+        cubes,
+    );
+    let center = Vec3::new(0.4, 0.1, 0.0);
+    let sphere = Sphere {
+        center,
+        radius: 1.0,
+        material: Material {
+            diffuse,
+            ..lambert(0.5)
+        },
+        ..Sphere::default()
+    };
+    let mut scene = Scene {
+        spheres: vec![sphere.clone()],
+        camera: OrbitCamera {
+            target: center,
+            distance: 3.5,
+            yaw_degrees: 30.0,
+            pitch_degrees: 20.0,
+            fov_degrees: 40.0,
+        },
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    let (w, h) = (64, 64);
+    let pixels = render(&ctx, &scene, (w, h), 4);
+    assert_pixels_match(&pixels, (w, h), 0.15, |at| {
+        let (o, d) = camera_ray(&scene, (w, h), at);
+        let f = o - center;
+        let b = f.dot(d);
+        let disc = b * b - (f.length_squared() - 1.0);
+        (disc > 0.0).then(|| {
+            let p = o + (-b - disc.sqrt()) * d;
+            let offset = p - center;
+            let point = SurfacePoint {
+                object: offset,
+                world: p,
+                uv: marbre::texture::sphere_uv(offset),
+            };
+            sphere.material.value_at(Property::Diffuse, &point)
+        })
+    });
+}

@@ -4,7 +4,9 @@ use super::texture_codegen;
 use crate::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::material::MAX_SIGNALS;
 use crate::scene::primitives::MAX_POLYGON_VERTICES;
-use crate::scene::{EnvSource, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, Material, Scene};
+use crate::scene::{
+    EnvSource, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,
+};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -51,7 +53,9 @@ pub struct NoiseParamsGpu {
     /// [`FractalShape::id`]: fBm, turbulence or ridged.
     pub shape: u32,
     pub distortion: f32,
-    pub _pad: [f32; 3],
+    /// 1: the signal's mapping reads world coordinates, 0: object ones.
+    pub world: u32,
+    pub _pad: [f32; 2],
 }
 
 impl NoiseParamsGpu {
@@ -67,7 +71,8 @@ impl NoiseParamsGpu {
             lacunarity: f.lacunarity,
             shape: shape.id(),
             distortion: f.distortion,
-            _pad: [0.0; 3],
+            world: 0,
+            _pad: [0.0; 2],
         }
     }
 }
@@ -76,6 +81,8 @@ impl NoiseParamsGpu {
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct MaterialGpu {
     pub signals: [NoiseParamsGpu; MAX_SIGNALS],
+    /// Each signal's mapping as three affine rows (identity without one).
+    pub signal_rows: [[f32; 4]; 3 * MAX_SIGNALS],
     pub signal_count: u32,
     /// Signals before this index are gradient noise, from it on Perlin.
     pub first_perlin: u32,
@@ -131,20 +138,22 @@ pub fn hash_id(h: HashKind) -> u32 {
 /// evaluation per hit, gradient noise first) and its bump height. The
 /// textures themselves are generated code (`texture_codegen`).
 pub fn material(m: &Material) -> MaterialGpu {
-    let signals: Vec<NoiseParamsGpu> = texture_codegen::material_signals(m)
-        .iter()
-        .map(|signal| NoiseParamsGpu::new(&signal.noise, signal.shape))
-        .collect();
+    let signals = texture_codegen::material_signals(m);
     let mut out = MaterialGpu {
         signal_count: signals.len() as u32,
         first_perlin: signals
             .iter()
-            .position(|s| s.kind == noise_kind_id(NoiseKind::Perlin))
+            .position(|s| s.noise.kind == NoiseKind::Perlin)
             .unwrap_or(signals.len()) as u32,
         bump_height: m.bump_height,
         ..Default::default()
     };
-    out.signals[..signals.len()].copy_from_slice(&signals);
+    for (k, signal) in signals.iter().enumerate() {
+        out.signals[k] = NoiseParamsGpu::new(&signal.noise, signal.shape);
+        let mapping = signal.mapping.unwrap_or_default();
+        out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
+        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&mapping.rows());
+    }
     out
 }
 
@@ -286,7 +295,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 208);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 400);
         assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
     }
 

@@ -15,7 +15,10 @@
 //! generated code reads them from `signals`.
 
 use crate::scene::material::MAX_SIGNALS;
-use crate::scene::{Child, Material, MathOp, Pattern, Property, Scene, Signal, Texture};
+use crate::scene::{
+    Child, MappingSpace, Material, MathOp, Pattern, Property, Scene, Signal, Texture,
+    TextureMapping,
+};
 use anyhow::{Result, ensure};
 use std::fmt::Write;
 
@@ -57,7 +60,7 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
             generator.function(&name, &material.bump, &material_signals(material));
             writeln!(
                 heights,
-                "        case {index}u: {{\n            return {name}(p, uv, signals).x;\n        }}"
+                "        case {index}u: {{\n            return {name}(p, pw, uv, signals).x;\n        }}"
             )?;
         }
     }
@@ -71,7 +74,7 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     wgsl.push_str(&generator.code);
     write!(
         wgsl,
-        "fn surface_textures(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
     )?;
     // Shadow rays read opacity alone; they evaluate the noise signals only
     // if some opacity texture reads one.
@@ -87,13 +90,13 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
             .any(|p| p.signal().is_some())
     });
     let signals = if opacity_reads_noise {
-        "material_signals(material, p)"
+        "material_signals(material, p, pw)"
     } else {
         "vec4f(0.0)"
     };
     write!(
         wgsl,
-        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
+        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
     )?;
     let bump_reads_noise = scene
         .materials()
@@ -108,7 +111,7 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
     // uber shader) builds for any scene.
     write!(
         wgsl,
-        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, uv: vec2f, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
+        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
     )?;
     let mut params = generator.params;
     params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
@@ -120,7 +123,7 @@ pub fn generate(scene: &Scene) -> Result<GeneratedTextures> {
 /// (`Scene::sanitize` keeps materials within it).
 pub fn material_signals(material: &Material) -> Vec<Signal> {
     let mut signals = Vec::new();
-    for signal in material.patterns().iter().filter_map(|p| p.signal()) {
+    for signal in material.all_textures().iter().flat_map(|t| t.signals(None)) {
         if !signals.contains(&signal) {
             signals.push(signal);
         }
@@ -128,6 +131,16 @@ pub fn material_signals(material: &Material) -> Vec<Signal> {
     signals.truncate(MAX_SIGNALS);
     signals.sort_by_key(|s| s.noise.kind as u8);
     signals
+}
+
+/// Where a texture node is evaluated: the WGSL expressions of its 3D point
+/// and (u, v), and the mapping they came through (which its noise signals
+/// are taken through too).
+#[derive(Clone)]
+struct Site {
+    p: String,
+    uv: String,
+    mapping: Option<TextureMapping>,
 }
 
 /// What [`Generator::material`] returns: a material's statements in the
@@ -157,7 +170,7 @@ impl Generator {
             let name = format!("texture_{index}_layer{l}_mask");
             self.function(&name, &layer.mask, &signals);
             masks.push(format!(
-                "            let mask{l} = clamp({name}(p, uv, signals).x, 0.0, 1.0);\n"
+                "            let mask{l} = clamp({name}(p, pw, uv, signals).x, 0.0, 1.0);\n"
             ));
         }
         let mut cases = MaterialCases {
@@ -168,7 +181,7 @@ impl Generator {
             let value = property.name();
             let name = format!("texture_{index}_{value}");
             self.function(&name, material.texture(property), &signals);
-            let mut statements = format!("            var {value} = {name}(p, uv, signals);\n");
+            let mut statements = format!("            var {value} = {name}(p, pw, uv, signals);\n");
             let mut masks_read = String::new();
             for (l, layer) in material.layers.iter().enumerate() {
                 if let Some(texture) = layer.texture(property) {
@@ -176,7 +189,7 @@ impl Generator {
                     self.function(&name, texture, &signals);
                     let _ = writeln!(
                         statements,
-                        "            {value} = mix({value}, {name}(p, uv, signals), mask{l});"
+                        "            {value} = mix({value}, {name}(p, pw, uv, signals), mask{l});"
                     );
                     masks_read.push_str(&masks[l]);
                 }
@@ -197,10 +210,15 @@ impl Generator {
     fn function(&mut self, name: &str, texture: &Texture, signals: &[Signal]) {
         self.next = 0;
         let mut body = String::new();
-        let value = self.texture(texture, "p", "uv", signals, &mut body);
+        let site = Site {
+            p: "p".into(),
+            uv: "uv".into(),
+            mapping: None,
+        };
+        let value = self.texture(texture, &site, signals, &mut body);
         let _ = write!(
             self.code,
-            "fn {name}(p: vec3f, uv: vec2f, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
+            "fn {name}(p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
         );
     }
 
@@ -213,15 +231,14 @@ impl Generator {
     fn child(
         &mut self,
         child: &Child,
-        p: &str,
-        uv: &str,
+        site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
         match child {
             Child::Scalar(v) => format!("{}.xyz", self.param([*v, *v, *v, 0.0])),
             Child::Color(c) => format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0])),
-            Child::Texture(t) => self.texture(t, p, uv, signals, body),
+            Child::Texture(t) => self.texture(t, site, signals, body),
         }
     }
 
@@ -244,19 +261,41 @@ impl Generator {
         format!("ramp{k}")
     }
 
-    /// Appends the statements evaluating `texture` at (p, uv) to `body` and
-    /// returns the expression holding its colour.
+    /// Appends the statements evaluating `texture` at `site` to `body` and
+    /// returns the expression holding its colour. A mapped texture reads the
+    /// surface's coordinates (the function's `p` or `pw`, and `uv`) afresh
+    /// through its map, whose rows are parameters.
     fn texture(
         &mut self,
         texture: &Texture,
-        p: &str,
-        uv: &str,
+        site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
         let k = self.next;
         self.next += 1;
-        let value = self.blended(texture, k, p, uv, signals, body);
+        let mapped;
+        let site = match &texture.mapping {
+            Some(mapping) => {
+                let [r0, r1, r2] = mapping.rows().map(|row| self.param(row));
+                let point = match mapping.space {
+                    MappingSpace::Object => "p",
+                    MappingSpace::World => "pw",
+                };
+                let _ = writeln!(
+                    body,
+                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;"
+                );
+                mapped = Site {
+                    p: format!("p{k}"),
+                    uv: format!("uv{k}"),
+                    mapping: Some(*mapping),
+                };
+                &mapped
+            }
+            None => site,
+        };
+        let value = self.blended(texture, k, site, signals, body);
         if texture.ops.is_empty() {
             return value;
         }
@@ -288,17 +327,21 @@ impl Generator {
         &mut self,
         texture: &Texture,
         k: usize,
-        p: &str,
-        uv: &str,
+        site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
         if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
-            return self.child(&texture.a, p, uv, signals, body);
+            return self.child(&texture.a, site, signals, body);
         }
+        let (p, uv) = (site.p.as_str(), site.uv.as_str());
         let signal = texture
             .pattern
             .signal()
+            .map(|s| Signal {
+                mapping: site.mapping,
+                ..s
+            })
             .and_then(|s| signals.iter().position(|x| *x == s))
             .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
         let mut child_uv = uv.to_string();
@@ -314,7 +357,7 @@ impl Generator {
             }
             Pattern::Mix => match &texture.factor {
                 Some(factor) => {
-                    let f = self.texture(factor, p, uv, signals, body);
+                    let f = self.texture(factor, site, signals, body);
                     format!("clamp({f}.x, 0.0, 1.0)")
                 }
                 None => "0.0".to_string(),
@@ -380,8 +423,12 @@ impl Generator {
         if !texture.ramp.is_empty() {
             return self.ramp(&texture.ramp, k, body);
         }
-        let a = self.child(&texture.a, p, &child_uv, signals, body);
-        let b = self.child(&texture.b, p, &child_uv, signals, body);
+        let child_site = Site {
+            uv: child_uv,
+            ..site.clone()
+        };
+        let a = self.child(&texture.a, &child_site, signals, body);
+        let b = self.child(&texture.b, &child_site, signals, body);
         let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
         format!("v{k}")
     }

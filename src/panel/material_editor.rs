@@ -1,9 +1,11 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
-use super::{color_button, labelled_color, slider};
+use super::{color_button, labelled_color, slider, vec3_ui};
 use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
-use crate::scene::{Child, Layer, Material, MathOp, Pattern, Property, Texture};
+use crate::scene::{
+    Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
+};
 use crate::texture::{MAX_RAMP_STOPS, RampStop};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, Ui};
 use glam::Vec3;
@@ -149,6 +151,7 @@ fn texture_ui(
             .default_open(depth == 1)
             .show(ui, |ui| {
                 pattern_ui(ui, &mut texture.pattern);
+                mapping_ui(ui, &mut texture.mapping);
                 if texture.pattern == Pattern::Mix {
                     let factor = texture
                         .factor
@@ -202,6 +205,51 @@ fn texture_ui(
                 }
             });
     });
+}
+
+/// The texture's own mapping: ticked, it and its subtree read the surface's
+/// coordinates (object or world for 3D patterns, the primitive's (u, v) for
+/// 2D ones) through a transform.
+fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
+    let mut on = mapping.is_some();
+    if ui
+        .checkbox(&mut on, "mapping")
+        .on_hover_text("Place this texture with its own transform, in object or world space")
+        .changed()
+    {
+        *mapping = on.then(TextureMapping::default);
+    }
+    let Some(m) = mapping else {
+        return;
+    };
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut m.space, MappingSpace::Object, "object")
+            .on_hover_text("3D patterns move with the object");
+        ui.selectable_value(&mut m.space, MappingSpace::World, "world")
+            .on_hover_text("Objects move through the 3D pattern");
+    });
+    let t = &mut m.transform;
+    vec3_ui(
+        ui,
+        "translate",
+        &mut t.translate,
+        0.01,
+        "Where the texture's origin sits",
+    );
+    vec3_ui(
+        ui,
+        "rotate °",
+        &mut t.rotate_degrees,
+        0.5,
+        "Turns about x, then y, then z, in degrees",
+    );
+    vec3_ui(
+        ui,
+        "scale",
+        &mut t.scale,
+        0.01,
+        "Size of the texture: 2 makes its features twice as large",
+    );
 }
 
 /// The math steps after a texture: each a dropdown, its parameters, and a

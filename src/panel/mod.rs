@@ -236,25 +236,62 @@ fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>
     }
 }
 
-/// One collapsible block per sphere, then the ground. Only the first is open
-/// at start, so a scene with many spheres still fits on screen.
+/// One collapsible block per object (spheres, cylinders, polygons), then
+/// the ground. Only the first is open at start, so a scene with many
+/// objects still fits on screen.
 fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
-    let ground_first = scene.spheres.is_empty();
+    let mut first = true;
+    let mut object =
+        |ui: &mut Ui, key: (&str, usize), title: String, body: &mut dyn FnMut(&mut Ui)| {
+            // Keyed by index: names come from the preset and need not be unique.
+            ui.push_id(key, |ui| {
+                CollapsingHeader::new(title)
+                    .id_salt("object")
+                    .default_open(std::mem::take(&mut first))
+                    .show(ui, |ui| body(ui));
+            });
+        };
     for (i, sphere) in scene.spheres.iter_mut().enumerate() {
-        // Keyed by index: names come from the preset and need not be unique.
-        ui.push_id(("sphere", i), |ui| {
-            CollapsingHeader::new(format!("sphere “{}”", sphere.name))
-                .id_salt("object")
-                .default_open(i == 0)
-                .show(ui, |ui| material_ui(ui, &mut sphere.material));
-        });
+        object(
+            ui,
+            ("sphere", i),
+            format!("sphere “{}”", sphere.name),
+            &mut |ui| material_ui(ui, &mut sphere.material),
+        );
+    }
+    for (i, cylinder) in scene.cylinders.iter_mut().enumerate() {
+        object(
+            ui,
+            ("cylinder", i),
+            format!("cylinder “{}”", cylinder.name),
+            &mut |ui| {
+                vec3_ui(
+                    ui,
+                    "base",
+                    &mut cylinder.base,
+                    0.01,
+                    "Centre of the bottom cap",
+                );
+                ui.add(slider(&mut cylinder.radius, 0.01..=10.0, "radius").logarithmic(true));
+                ui.add(slider(&mut cylinder.height, 0.01..=10.0, "height").logarithmic(true))
+                    .on_hover_text(
+                        "Along +y; the side's v runs from 0 at the base to 1 at the top",
+                    );
+                material_ui(ui, &mut cylinder.material);
+            },
+        );
+    }
+    for (i, polygon) in scene.polygons.iter_mut().enumerate() {
+        object(
+            ui,
+            ("polygon", i),
+            format!("polygon “{}”", polygon.name),
+            &mut |ui| material_ui(ui, &mut polygon.material),
+        );
     }
     if let Some(ground) = &mut scene.ground {
-        ui.push_id("ground", |ui| {
-            CollapsingHeader::new("ground")
-                .id_salt("object")
-                .default_open(ground_first)
-                .show(ui, |ui| material_ui(ui, &mut ground.material));
+        object(ui, ("ground", 0), "ground".into(), &mut |ui| {
+            material_ui(ui, &mut ground.material)
         });
     }
 }

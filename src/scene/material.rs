@@ -1,6 +1,6 @@
 //! Materials: which texture drives which surface property.
 
-use super::pattern::Pattern;
+use super::pattern::{Pattern, SurfacePoint};
 use super::texture_tree::Texture;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -234,14 +234,20 @@ impl Material {
         }
     }
 
-    /// The value of `property` at a point, layers applied, before the
-    /// renderer's clamping: the CPU reference of the generated shader.
+    /// The value of `property` at a point whose object and world
+    /// coordinates agree (the ground); see [`Material::value_at`].
     pub fn value(&self, property: Property, p: Vec3, uv: Vec2) -> Vec3 {
-        let mut v = self.texture(property).eval(p, uv);
+        self.value_at(property, &SurfacePoint::new(p, uv))
+    }
+
+    /// The value of `property` at a surface point, layers applied, before
+    /// the renderer's clamping: the CPU reference of the generated shader.
+    pub fn value_at(&self, property: Property, point: &SurfacePoint) -> Vec3 {
+        let mut v = self.texture(property).eval_at(point);
         for layer in &self.layers {
             if let Some(t) = layer.texture(property) {
-                let mask = layer.mask.eval(p, uv).x.clamp(0.0, 1.0);
-                v = v.lerp(t.eval(p, uv), mask);
+                let mask = layer.mask.eval_at(point).x.clamp(0.0, 1.0);
+                v = v.lerp(t.eval_at(point), mask);
             }
         }
         if property == Property::Emission {
@@ -313,7 +319,7 @@ impl Material {
         }
         let mut signals = Vec::new();
         for (_, texture) in &mut textures {
-            texture.limit_signals(&mut signals, what, notes);
+            texture.limit_signals(&mut signals, None, what, notes);
         }
         for (name, v) in [
             ("bump height", &mut self.bump_height),

@@ -16,7 +16,7 @@ pub mod texture_tree;
 pub use camera::OrbitCamera;
 pub use environment::{EnvSource, Environment};
 pub use material::{Layer, Material, Property};
-pub use pattern::{Pattern, Signal};
+pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
 pub use render_settings::{RenderSettings, ToneMap};
 pub use texture_tree::{Child, MathOp, Texture};

@@ -77,16 +77,90 @@ pub enum Pattern {
     },
 }
 
-/// A fractal sum a pattern reads: the noise and what each octave adds.
+/// A fractal sum a pattern reads: the noise, what each octave adds, and
+/// where it is taken (the mapping of the nearest mapped texture above it).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Signal {
     pub noise: NoiseSettings,
     pub shape: FractalShape,
+    pub mapping: Option<TextureMapping>,
 }
 
 impl Signal {
-    pub fn eval(&self, p: Vec3) -> f32 {
+    /// The sum at a surface point given in object and world coordinates.
+    pub fn eval(&self, point: &SurfacePoint) -> f32 {
+        let p = self.mapping.map_or(point.object, |m| m.point(point));
         fractal_sum(p, &self.noise, self.shape)
+    }
+}
+
+/// Where a texture is evaluated: the surface point in the object's own
+/// frame and in the world, and the primitive's (u, v).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub object: Vec3,
+    pub world: Vec3,
+    pub uv: Vec2,
+}
+
+impl SurfacePoint {
+    /// A point whose object and world coordinates agree (the ground).
+    pub fn new(p: Vec3, uv: Vec2) -> Self {
+        Self {
+            object: p,
+            world: p,
+            uv,
+        }
+    }
+}
+
+/// Which coordinates a mapped texture reads its 3D point from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum MappingSpace {
+    /// The object's own frame: the texture moves with the object.
+    #[default]
+    Object,
+    /// World coordinates: objects move through the texture.
+    World,
+}
+
+/// Blender's Texture Coordinate and Mapping nodes in one: a texture with a
+/// mapping, and its whole subtree, read the surface's coordinates afresh
+/// (3D from `space`, 2D from the primitive) through `transform`; (u, v) are
+/// transformed as the point (u, v, 0).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TextureMapping {
+    pub space: MappingSpace,
+    pub transform: texture::TextureTransform,
+}
+
+impl TextureMapping {
+    pub fn point(&self, at: &SurfacePoint) -> Vec3 {
+        let p = match self.space {
+            MappingSpace::Object => at.object,
+            MappingSpace::World => at.world,
+        };
+        self.transform.to_texture().transform_point3(p)
+    }
+
+    pub fn uv(&self, at: &SurfacePoint) -> Vec2 {
+        self.transform
+            .to_texture()
+            .transform_point3(at.uv.extend(0.0))
+            .truncate()
+    }
+
+    /// The three rows of the affine map, as the shader reads them:
+    /// `p' = (dot(r0.xyz, p) + r0.w, …)`.
+    pub fn rows(&self) -> [[f32; 4]; 3] {
+        let m = self.transform.to_texture();
+        let (l, t) = (m.matrix3, m.translation);
+        [
+            [l.x_axis.x, l.y_axis.x, l.z_axis.x, t.x],
+            [l.x_axis.y, l.y_axis.y, l.z_axis.y, t.y],
+            [l.x_axis.z, l.y_axis.z, l.z_axis.z, t.z],
+        ]
     }
 }
 
@@ -212,7 +286,11 @@ impl Pattern {
             Pattern::Ridged { .. } => FractalShape::Ridged,
             _ => FractalShape::Signed,
         };
-        Some(Signal { noise, shape })
+        Some(Signal {
+            noise,
+            shape,
+            mapping: None,
+        })
     }
 
     /// The blend factor at a point, given the pattern's signal value there,

@@ -5,10 +5,32 @@
 //! cell.
 
 use super::material::MAX_SIGNALS;
-use super::pattern::{Pattern, Signal};
+use super::pattern::{Pattern, Signal, SurfacePoint, TextureMapping};
 use crate::texture;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
+
+/// What a texture node reads while the tree is evaluated: the surface point
+/// (for mappings below, which start afresh from it), the current 3D point
+/// and (u, v), and the mapping they came through.
+#[derive(Debug, Clone, Copy)]
+struct Coordinates {
+    surface: SurfacePoint,
+    p: Vec3,
+    uv: Vec2,
+    mapping: Option<TextureMapping>,
+}
+
+impl Coordinates {
+    fn surface(point: &SurfacePoint) -> Self {
+        Self {
+            surface: *point,
+            p: point.object,
+            uv: point.uv,
+            mapping: None,
+        }
+    }
+}
 
 /// One side of a blend: a scalar, a colour, or a whole nested texture.
 ///
@@ -83,10 +105,14 @@ impl<'de> Deserialize<'de> for Child {
 impl Child {
     /// The child's colour at a point (a scalar is grey).
     pub fn eval(&self, p: Vec3, uv: Vec2) -> Vec3 {
+        self.eval_in(&Coordinates::surface(&SurfacePoint::new(p, uv)))
+    }
+
+    fn eval_in(&self, at: &Coordinates) -> Vec3 {
         match self {
             Child::Scalar(v) => Vec3::splat(*v),
             Child::Color(c) => *c,
-            Child::Texture(t) => t.eval(p, uv),
+            Child::Texture(t) => t.eval_in(at),
         }
     }
 
@@ -211,6 +237,10 @@ pub struct Texture {
     /// The blend factor of [`Pattern::Mix`]: this texture's first channel.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub factor: Option<Box<Texture>>,
+    /// Set, this texture and its subtree read the surface's coordinates
+    /// through it; unset, they read what the texture above them reads.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mapping: Option<TextureMapping>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ramp: Vec<texture::RampStop>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -245,6 +275,7 @@ impl Texture {
             a: a.into(),
             b: b.into(),
             factor: None,
+            mapping: None,
             ramp: Vec::new(),
             ops: Vec::new(),
         }
@@ -265,6 +296,7 @@ impl Texture {
             && self.ramp.is_empty()
             && self.ops.is_empty()
             && self.factor.is_none()
+            && self.mapping.is_none()
             && self.a == self.b;
         (plain && !matches!(self.a, Child::Texture(_))).then_some(&self.a)
     }
@@ -282,32 +314,81 @@ impl Texture {
             }
     }
 
-    /// The colour at a surface point `p` (texture space) with coordinates
-    /// `uv`: the CPU reference of the shader code generated from this tree.
-    /// A constant pattern never evaluates `b`.
+    /// The colour at a surface point `p` with coordinates `uv`, object and
+    /// world coordinates being the same (the ground).
     pub fn eval(&self, p: Vec3, uv: Vec2) -> Vec3 {
-        let value = self.blended(p, uv);
+        self.eval_at(&SurfacePoint::new(p, uv))
+    }
+
+    /// The colour at a surface point: the CPU reference of the shader code
+    /// generated from this tree. A constant pattern never evaluates `b`.
+    pub fn eval_at(&self, point: &SurfacePoint) -> Vec3 {
+        self.eval_in(&Coordinates::surface(point))
+    }
+
+    fn eval_in(&self, at: &Coordinates) -> Vec3 {
+        let mapped;
+        let at = match &self.mapping {
+            Some(m) => {
+                mapped = Coordinates {
+                    surface: at.surface,
+                    p: m.point(&at.surface),
+                    uv: m.uv(&at.surface),
+                    mapping: Some(*m),
+                };
+                &mapped
+            }
+            None => at,
+        };
+        let value = self.blended(at);
         self.ops.iter().fold(value, |v, op| op.apply(v))
     }
 
     /// The value before the `ops`.
-    fn blended(&self, p: Vec3, uv: Vec2) -> Vec3 {
+    fn blended(&self, at: &Coordinates) -> Vec3 {
         let (t, child_uv) = match (&self.pattern, &self.factor) {
-            (Pattern::Mix, Some(factor)) => (factor.eval(p, uv).x.clamp(0.0, 1.0), uv),
-            (Pattern::Mix, None) => (0.0, uv),
+            (Pattern::Mix, Some(factor)) => (factor.eval_in(at).x.clamp(0.0, 1.0), at.uv),
+            (Pattern::Mix, None) => (0.0, at.uv),
             (pattern, _) => {
-                let signal = pattern.signal().map_or(0.0, |signal| signal.eval(p));
-                pattern.blend(p, uv, signal)
+                let signal = pattern.signal().map_or(0.0, |signal| {
+                    Signal {
+                        mapping: at.mapping,
+                        ..signal
+                    }
+                    .eval(&at.surface)
+                });
+                pattern.blend(at.p, at.uv, signal)
             }
         };
         if !self.ramp.is_empty() {
             return texture::ramp(&self.ramp, t);
         }
-        let a = self.a.eval(p, child_uv);
+        let child_at = Coordinates {
+            uv: child_uv,
+            ..*at
+        };
+        let a = self.a.eval_in(&child_at);
         if self.pattern == Pattern::Constant {
             return a;
         }
-        a.lerp(self.b.eval(p, child_uv), t)
+        a.lerp(self.b.eval_in(&child_at), t)
+    }
+
+    /// The fractal sums the tree reads, each with the mapping it is taken
+    /// through (the nearest above it, from `inherited` on), in tree order,
+    /// repeats included.
+    pub fn signals(&self, inherited: Option<TextureMapping>) -> Vec<Signal> {
+        let mapping = self.mapping.or(inherited);
+        let mut out: Vec<Signal> = self
+            .pattern
+            .signal()
+            .map(|s| Signal { mapping, ..s })
+            .into_iter()
+            .collect();
+        for t in self.subtrees() {
+            out.extend(t.signals(mapping));
+        }
+        out
     }
 
     /// The nested textures: the children's, then the mix factor.
@@ -444,14 +525,17 @@ impl Texture {
     }
 
     /// Patterns reading a fractal sum beyond the first [`MAX_SIGNALS`]
-    /// distinct ones (in `seen`) become constant, with a note.
+    /// distinct ones (in `seen`) become constant, with a note. `inherited`
+    /// is the mapping the texture above reads through.
     pub(crate) fn limit_signals(
         &mut self,
         seen: &mut Vec<Signal>,
+        inherited: Option<TextureMapping>,
         what: &str,
         notes: &mut Vec<String>,
     ) {
-        if let Some(signal) = self.pattern.signal()
+        let mapping = self.mapping.or(inherited);
+        if let Some(signal) = self.pattern.signal().map(|s| Signal { mapping, ..s })
             && !seen.contains(&signal)
         {
             if seen.len() < MAX_SIGNALS {
@@ -466,11 +550,11 @@ impl Texture {
         }
         for child in [&mut self.a, &mut self.b] {
             if let Child::Texture(t) = child {
-                t.limit_signals(seen, what, notes);
+                t.limit_signals(seen, mapping, what, notes);
             }
         }
         if let Some(factor) = &mut self.factor {
-            factor.limit_signals(seen, what, notes);
+            factor.limit_signals(seen, mapping, what, notes);
         }
     }
 
