@@ -230,6 +230,37 @@ pub fn constant(width: u32, height: u32, rgb: [f32; 3]) -> EnvImage {
     EnvImage::constant(width, height, rgb)
 }
 
+/// How [`load_with`] turns the integer codes of an 8- or 16-bit PNG or JPEG
+/// into floats. Float files (EXR, Radiance HDR) are linear either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IntegerDecode {
+    /// Colour: the exact sRGB EOTF ([`srgb_to_linear`]) of code / max code.
+    Srgb,
+    /// Data such as roughness or height: code / max code, as it is.
+    Linear,
+}
+
+impl IntegerDecode {
+    fn code8(self, c: u8) -> f32 {
+        match self {
+            IntegerDecode::Srgb => SRGB8_TO_LINEAR[c as usize],
+            IntegerDecode::Linear => f32::from(c) / 255.0,
+        }
+    }
+
+    fn code16(self, c: u16) -> f32 {
+        self.unit(f32::from(c) / 65535.0)
+    }
+
+    /// An integer code already scaled to [0, 1].
+    fn unit(self, c: f32) -> f32 {
+        match self {
+            IntegerDecode::Srgb => srgb_to_linear(c),
+            IntegerDecode::Linear => c,
+        }
+    }
+}
+
 /// Loads and sanitises a lat-long environment map. The format is chosen by
 /// extension (case-insensitive): `.exr` (any compression the `exr` crate
 /// reads; RGB(A) or luminance-only `Y`), `.hdr` (Radiance RGBE), `.png` and
@@ -237,6 +268,13 @@ pub fn constant(width: u32, height: u32, rgb: [f32; 3]) -> EnvImage {
 /// decoded to linear with the exact sRGB EOTF; grey images become RGB; alpha
 /// is dropped.
 pub fn load(path: &Path) -> Result<EnvLoad, EnvMapError> {
+    load_with(path, IntegerDecode::Srgb)
+}
+
+/// [`load`], with the integer codes of PNG and JPEG files decoded as
+/// `decode` says: image textures holding data rather than colour are read
+/// with [`IntegerDecode::Linear`].
+pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapError> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -253,9 +291,15 @@ pub fn load(path: &Path) -> Result<EnvLoad, EnvMapError> {
     })?;
     let mut image = match extension.as_str() {
         "exr" => decode_exr(path, &bytes)?,
-        "hdr" => decode_with_image(path, &bytes, image::ImageFormat::Hdr, "Radiance HDR")?,
-        "png" => decode_with_image(path, &bytes, image::ImageFormat::Png, "PNG")?,
-        _ => decode_with_image(path, &bytes, image::ImageFormat::Jpeg, "JPEG")?,
+        "hdr" => decode_with_image(
+            path,
+            &bytes,
+            image::ImageFormat::Hdr,
+            "Radiance HDR",
+            decode,
+        )?,
+        "png" => decode_with_image(path, &bytes, image::ImageFormat::Png, "PNG", decode)?,
+        _ => decode_with_image(path, &bytes, image::ImageFormat::Jpeg, "JPEG", decode)?,
     };
     if image.width == 0 || image.height == 0 || image.pixels.is_empty() {
         return Err(EnvMapError::Empty {
@@ -383,6 +427,7 @@ fn decode_with_image(
     bytes: &[u8],
     format: image::ImageFormat,
     format_name: &'static str,
+    decode: IntegerDecode,
 ) -> Result<EnvImage, EnvMapError> {
     use image::DynamicImage as D;
 
@@ -403,29 +448,29 @@ fn decode_with_image(
         // Radiance HDR (and any other float source) is already linear.
         D::ImageRgb32F(img) => img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
         D::ImageRgba32F(img) => img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
-        D::ImageLuma8(img) => img
+        D::ImageLuma8(img) => img.pixels().map(|p| grey(decode.code8(p[0]))).collect(),
+        D::ImageLumaA8(img) => img.pixels().map(|p| grey(decode.code8(p[0]))).collect(),
+        D::ImageRgb8(img) => img
             .pixels()
-            .map(|p| grey(SRGB8_TO_LINEAR[p[0] as usize]))
+            .map(|p| rgb8(decode, p[0], p[1], p[2]))
             .collect(),
-        D::ImageLumaA8(img) => img
+        D::ImageRgba8(img) => img
             .pixels()
-            .map(|p| grey(SRGB8_TO_LINEAR[p[0] as usize]))
+            .map(|p| rgb8(decode, p[0], p[1], p[2]))
             .collect(),
-        D::ImageRgb8(img) => img.pixels().map(|p| srgb8(p[0], p[1], p[2])).collect(),
-        D::ImageRgba8(img) => img.pixels().map(|p| srgb8(p[0], p[1], p[2])).collect(),
-        D::ImageLuma16(img) => img.pixels().map(|p| grey(srgb16(p[0]))).collect(),
-        D::ImageLumaA16(img) => img.pixels().map(|p| grey(srgb16(p[0]))).collect(),
+        D::ImageLuma16(img) => img.pixels().map(|p| grey(decode.code16(p[0]))).collect(),
+        D::ImageLumaA16(img) => img.pixels().map(|p| grey(decode.code16(p[0]))).collect(),
         D::ImageRgb16(img) => img
             .pixels()
-            .map(|p| [srgb16(p[0]), srgb16(p[1]), srgb16(p[2]), 1.0])
+            .map(|p| rgb16(decode, p[0], p[1], p[2]))
             .collect(),
         D::ImageRgba16(img) => img
             .pixels()
-            .map(|p| [srgb16(p[0]), srgb16(p[1]), srgb16(p[2]), 1.0])
+            .map(|p| rgb16(decode, p[0], p[1], p[2]))
             .collect(),
         other => {
             // A layout this code does not know yet (DynamicImage is
-            // non-exhaustive): an integer image is sRGB, a float one linear.
+            // non-exhaustive): an integer image is decoded, a float one linear.
             let rgb = other.to_rgb32f();
             let color = other.color();
             let linear = color.bytes_per_pixel() / color.channel_count().max(1) >= 4;
@@ -434,12 +479,7 @@ fn decode_with_image(
                     if linear {
                         [p[0], p[1], p[2], 1.0]
                     } else {
-                        [
-                            srgb_to_linear(p[0]),
-                            srgb_to_linear(p[1]),
-                            srgb_to_linear(p[2]),
-                            1.0,
-                        ]
+                        [decode.unit(p[0]), decode.unit(p[1]), decode.unit(p[2]), 1.0]
                     }
                 })
                 .collect()
@@ -462,17 +502,12 @@ fn grey(v: f32) -> [f32; 4] {
     [v, v, v, 1.0]
 }
 
-fn srgb8(r: u8, g: u8, b: u8) -> [f32; 4] {
-    [
-        SRGB8_TO_LINEAR[r as usize],
-        SRGB8_TO_LINEAR[g as usize],
-        SRGB8_TO_LINEAR[b as usize],
-        1.0,
-    ]
+fn rgb8(decode: IntegerDecode, r: u8, g: u8, b: u8) -> [f32; 4] {
+    [decode.code8(r), decode.code8(g), decode.code8(b), 1.0]
 }
 
-fn srgb16(v: u16) -> f32 {
-    srgb_to_linear(f32::from(v) / 65535.0)
+fn rgb16(decode: IntegerDecode, r: u16, g: u16, b: u16) -> [f32; 4] {
+    [decode.code16(r), decode.code16(g), decode.code16(b), 1.0]
 }
 
 /// The exact sRGB EOTF (IEC 61966-2-1): encoded value in [0, 1] to linear.

@@ -12,12 +12,17 @@ pub mod brick;
 pub mod bump;
 pub mod checker;
 pub mod cutout;
+pub mod image;
 pub mod mapping;
 pub mod marble;
 pub mod ramp;
 pub mod waves;
 pub mod wood;
 
+pub use self::image::{
+    AtlasEntry, AtlasTooLarge, ColorSpace, ImageAtlas, ImageError, ImageFilter, ImageLevel,
+    ImageLoad, ImageWrap, MAX_IMAGE_SIDE, MipImage, load_image,
+};
 pub use brick::{TileSample, brick, brick_mortar_fraction, tile, tile_height};
 pub use bump::bumped_normal;
 pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
