@@ -85,3 +85,9 @@ const MAX_SPHERES: u32 = 63u;
 // The numbers of the scene's texture trees, read at constant indices by the
 // generated texture functions (Rust: gpu::texture_codegen).
 @group(0) @binding(7) var<uniform> texture_params: array<vec4f, 1024>;
+
+#if IMAGE
+// Every image of the scene with its mip levels (Rust: texture::ImageAtlas),
+// read with textureLoad and filtered by hand (texture_image.wgsl).
+@group(0) @binding(8) var image_atlas: texture_2d<f32>;
+#endif

@@ -18,6 +18,7 @@ struct TextureHarness {
 @group(0) @binding(0) var<uniform> harness: TextureHarness;
 @group(0) @binding(1) var<storage, read> points: array<vec4f>;
 @group(0) @binding(2) var<storage, read_write> results: array<vec4f>;
+@group(0) @binding(8) var image_atlas: texture_2d<f32>;
 
 @compute @workgroup_size(64)
 fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
@@ -31,6 +32,9 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
     let c = harness.c;
     var r = vec4f(0.0);
     switch harness.mode {
+        case 16u: {
+            r = image_sample(a, p.xy, u32(b.x), u32(b.y), p.z);
+        }
         case 0u: {
             let cell = checker_2d(p.xy, a.xy, a.z);
             r = vec4f(cell.select, cell.local, 0.0);

@@ -99,11 +99,17 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         });
     }
     preset.format_version = FORMAT_VERSION;
+    let folder = path.parent().unwrap_or(Path::new("."));
     if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source
         && env.is_relative()
     {
-        *env = path.parent().unwrap_or(Path::new(".")).join(&*env);
+        *env = folder.join(&*env);
     }
+    for_each_image_path(&mut preset.scene, &mut |image| {
+        if image.is_relative() {
+            *image = folder.join(&*image);
+        }
+    });
     let notes = preset.scene.sanitize();
     Ok(Loaded { preset, notes })
 }
@@ -135,17 +141,32 @@ pub fn load(path: &Path) -> Result<Loaded, PresetError> {
 /// written relative to the file's folder, so a preset folder can be moved.
 pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
     let mut preset = preset.clone();
-    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source {
-        let dir = absolute(path.parent().unwrap_or(Path::new(".")));
-        if let Some(rel) = pathdiff::diff_paths(absolute(env), dir) {
-            *env = rel;
+    let dir = absolute(path.parent().unwrap_or(Path::new(".")));
+    let mut relative = |file: &mut PathBuf| {
+        if let Some(rel) = pathdiff::diff_paths(absolute(file), &dir) {
+            *file = rel;
         }
+    };
+    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source {
+        relative(env);
     }
+    for_each_image_path(&mut preset.scene, &mut relative);
     let config = ron::ser::PrettyConfig::new()
         .depth_limit(8)
         .struct_names(false)
         .indentor("    ".to_string());
     Ok(ron::ser::to_string_pretty(&preset, config)? + "\n")
+}
+
+/// Calls `f` on the path of every image texture in the scene.
+fn for_each_image_path(scene: &mut Scene, f: &mut dyn FnMut(&mut PathBuf)) {
+    for material in scene.materials_mut() {
+        material.visit_textures_mut(&mut |t| {
+            if let Some(image) = &mut t.image {
+                f(&mut image.path);
+            }
+        });
+    }
 }
 
 /// Saves atomically: a crash mid-save never destroys the previous file.

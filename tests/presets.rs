@@ -4,15 +4,16 @@
 //! which needs a GPU adapter and skips loudly without one (see
 //! `marbre::gpu::testing`).
 
-use marbre::commands::session::{accumulate, load_scene};
+use marbre::commands::session::{accumulate, load_scene, renderer_for};
 use marbre::gpu::pipelines::validate;
 use marbre::gpu::shader_source::{Program, assemble};
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::texture_codegen::generate;
-use marbre::gpu::{Feature, FeatureSet, Renderer};
+use marbre::gpu::{Feature, FeatureSet};
 use marbre::noise::{HashKind, NoiseKind, NoiseSettings};
 use marbre::preset::{self, Preset, PresetError};
 use marbre::scene::{EnvSource, Ground, Pattern, Scene, Sphere, Texture};
+use marbre::texture::ImageSet;
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
 
@@ -43,31 +44,43 @@ fn load(path: &Path) -> Preset {
     loaded.preset
 }
 
-/// The preset with its environment path made absolute and its `.` and `..`
-/// resolved (lexically: the folders a round trip passes through need not
-/// exist), so two spellings of the same file (`presets/../envmaps/x.exr`,
+/// The preset with its environment and image paths made absolute and their
+/// `.` and `..` resolved (lexically: the folders a round trip passes through
+/// need not exist), so two spellings of the same file (`presets/../envmaps/x.exr`,
 /// `/tmp/x/../../work/main/envmaps/x.exr`) compare equal.
 fn resolved(mut p: Preset) -> Preset {
     if let EnvSource::LatLong { path } = &mut p.scene.environment.source {
-        let mut out = PathBuf::new();
-        for c in std::path::absolute(&*path).unwrap().components() {
-            match c {
-                Component::CurDir => {}
-                Component::ParentDir => {
-                    out.pop();
-                }
-                c => out.push(c),
+        *path = existing_file(path);
+    }
+    for material in p.scene.materials_mut() {
+        material.visit_textures_mut(&mut |t| {
+            if let Some(image) = &mut t.image {
+                image.path = existing_file(&image.path);
             }
-        }
-        assert!(
-            out.is_file(),
-            "{} (from {}) does not exist",
-            out.display(),
-            path.display()
-        );
-        *path = out;
+        });
     }
     p
+}
+
+/// `path` made absolute with `.` and `..` resolved, checked to exist.
+fn existing_file(path: &std::path::Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in std::path::absolute(path).unwrap().components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    assert!(
+        out.is_file(),
+        "{} (from {}) does not exist",
+        out.display(),
+        path.display()
+    );
+    out
 }
 
 fn bad(name: &str) -> PathBuf {
@@ -228,7 +241,8 @@ fn to_text_writes_the_environment_path_relative_to_the_preset() {
 /// Every program assembles and validates with naga for `features`, the
 /// trace program with the texture code generated from `scene`.
 fn assert_validates(features: &FeatureSet, scene: &Scene, what: &str) {
-    let textures = generate(scene).unwrap();
+    let images = marbre::commands::session::load_images(scene, &mut Vec::new()).unwrap();
+    let textures = generate(scene, &images).unwrap();
     for program in [Program::Trace, Program::Display] {
         let source = assemble(program, features, &textures.wgsl)
             .unwrap_or_else(|e| panic!("{what}: {program:?} does not assemble: {e}"));
@@ -277,7 +291,7 @@ fn every_single_feature_set_validates() {
 }
 
 fn trace_source(scene: &Scene) -> String {
-    let textures = generate(scene).unwrap();
+    let textures = generate(scene, &ImageSet::empty()).unwrap();
     assemble(
         Program::Trace,
         &FeatureSet::for_scene(scene),
@@ -316,7 +330,9 @@ fn specialisation_removes_code() {
     let uber = assemble(
         Program::Trace,
         &FeatureSet::all(),
-        &generate(&Scene::default()).unwrap().wgsl,
+        &generate(&Scene::default(), &ImageSet::empty())
+            .unwrap()
+            .wgsl,
     )
     .unwrap();
     assert!(
@@ -467,7 +483,7 @@ fn every_shipped_preset_renders_finite_and_not_black() {
     for path in shipped_presets() {
         let loaded =
             load_scene(&path, None).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
-        let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size)
+        let mut renderer = renderer_for(&ctx, &loaded, size)
             .unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
         accumulate(&ctx, &mut renderer, spp, |_| {}).unwrap();
         assert!(renderer.accumulated_samples() >= spp);

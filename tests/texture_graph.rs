@@ -472,3 +472,86 @@ fn mapped_textures_render_the_cpu_reference() {
         })
     });
 }
+
+/// An image texture in a render: an 8×8 PNG of distinct colours, nearest
+/// filtered and mirrored twice across a polygon (through a mapping), lit as
+/// the polygon above. Every pixel lying in one texel shows that texel as the
+/// CPU samples the atlas (sRGB decoded to linear).
+#[test]
+fn image_texture_renders_the_cpu_reference() {
+    let Some(ctx) = gpu_or_skip("image_texture_renders_the_cpu_reference") else {
+        return;
+    };
+    use marbre::scene::{MappingSpace, SurfacePoint, TextureMapping};
+    use marbre::texture::{ImageFilter, ImageSource, ImageWrap, TextureTransform};
+    let dir = std::env::temp_dir().join(format!("marbre-image-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("colours.png");
+    let png = image::RgbImage::from_fn(8, 8, |x, y| {
+        image::Rgb([(x * 32 + 8) as u8, (y * 32 + 8) as u8, ((x + y) * 16) as u8])
+    });
+    png.save(&path).unwrap();
+    let mut diffuse = Texture::blend(
+        Pattern::Image {
+            filter: ImageFilter::Nearest,
+            wrap: ImageWrap::Mirror,
+        },
+        0.0,
+        0.0,
+    );
+    diffuse.image = Some(ImageSource {
+        path: path.clone(),
+        color_space: Default::default(),
+    });
+    diffuse.mapping = Some(TextureMapping {
+        space: MappingSpace::Object,
+        transform: TextureTransform {
+            scale: Vec3::new(0.5, 0.5, 1.0),
+            ..TextureTransform::default()
+        },
+    });
+    let polygon = Polygon {
+        vertices: vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ],
+        material: Material {
+            diffuse: diffuse.clone(),
+            ..lambert(0.5)
+        },
+        ..Polygon::default()
+    };
+    let mut scene = Scene {
+        polygons: vec![polygon.clone()],
+        camera: OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 3.0,
+            yaw_degrees: 0.0,
+            pitch_degrees: 0.0,
+            fov_degrees: 40.0,
+        },
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    let mut notes = Vec::new();
+    let images = marbre::commands::session::load_images(&scene, &mut notes).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    let (w, h) = (64, 64);
+    let mut renderer = marbre::gpu::Renderer::new(&ctx, &scene, None, (w, h)).unwrap();
+    renderer.set_images(&ctx, images.clone()).unwrap();
+    marbre::commands::session::accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
+    let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
+    let frame = polygon.frame().unwrap();
+    assert_pixels_match(&pixels, (w, h), 0.3, |at| {
+        let (o, d) = camera_ray(&scene, (w, h), at);
+        let p = o + (-o.z / d.z) * d;
+        let uv = marbre::texture::plane_uv(p, frame.origin, frame.u_axis, frame.v_axis);
+        let inside = p.x.abs() < 1.0 && p.y.abs() < 1.0;
+        inside.then(|| diffuse.eval_with(&SurfacePoint::new(p, uv), &images))
+    });
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -500,3 +500,73 @@ fn mappings_match_the_cpu() {
         |_| false,
     );
 }
+
+/// Image textures: the shipped uv grid and a small non-square image packed
+/// in one atlas, sampled with every filter and wrap at (u, v) over
+/// [-1.5, 1.5]² (every wrap region) and levels of detail over [−1, 10]
+/// (clamped at both ends). The GPU reads the same half floats with the same
+/// integer texel arithmetic, so only rounding of the weights may differ.
+/// Nearest sampling can pick the neighbouring texel where (u, v) lies on a
+/// texel edge to within rounding: those points are exempt.
+#[test]
+fn images_match_the_cpu() {
+    let Some(ctx) = gpu_or_skip("images_match_the_cpu") else {
+        return;
+    };
+    use marbre::texture::{ImageAtlas, ImageFilter, ImageLevel, ImageWrap, MipImage};
+    let grid = texture::load_image(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/images/uv_grid.png"),
+        texture::ColorSpace::Srgb,
+    )
+    .unwrap()
+    .image;
+    let stripes = MipImage::new(ImageLevel {
+        width: 8,
+        height: 2,
+        texels: (0..16)
+            .map(|k| [(k % 8) as f32 / 7.0, (k / 8) as f32, 0.5, 1.0])
+            .collect(),
+    });
+    let atlas = ImageAtlas::pack(&[&grid, &stripes], 8192).unwrap();
+    let pts: Vec<Vec3> = points(1.0)
+        .iter()
+        .map(|p| Vec3::new(1.5 * p.x, 1.5 * p.y, 4.5 + 5.5 * p.z))
+        .collect();
+    for entry in 0..2 {
+        let size = Vec2::new(
+            atlas.entries[entry].width as f32,
+            atlas.entries[entry].height as f32,
+        );
+        for filter in [
+            ImageFilter::Nearest,
+            ImageFilter::Bilinear,
+            ImageFilter::Trilinear,
+        ] {
+            for wrap in [ImageWrap::Repeat, ImageWrap::Clamp, ImageWrap::Mirror] {
+                let query = PatternQuery::Image {
+                    atlas: atlas.clone(),
+                    entry,
+                    filter,
+                    wrap,
+                };
+                let gpu = evaluate(&ctx, &query, &pts).unwrap();
+                assert_parity(
+                    &format!("image {entry} {filter:?} {wrap:?}"),
+                    &gpu,
+                    &pts,
+                    1e-5,
+                    |p| {
+                        atlas
+                            .sample(entry, Vec2::new(p.x, p.y), filter, wrap, p.z)
+                            .to_array()
+                    },
+                    |p| {
+                        filter == ImageFilter::Nearest
+                            && (off_integer(p.x * size.x) < 1e-3
+                                || off_integer((1.0 - p.y) * size.y) < 1e-3)
+                    },
+                );
+            }
+        }
+    }
+}

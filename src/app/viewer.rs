@@ -1,12 +1,13 @@
 //! One window's state: surface, renderer, egui, the scene being edited.
 
 use super::{ViewerOptions, camera_input, screenshots};
-use crate::commands::session::{load_scene, preset_or_default};
+use crate::commands::session::{load_images, load_scene, preset_or_default, renderer_for};
 use crate::envmap;
 use crate::gpu::{GpuContext, Renderer, Viewport, pass_timer::PassTimer, readback::read_texture};
 use crate::panel::{self, PanelAction, PanelState, Stats};
 use crate::preset::{self, Preset};
 use crate::scene::{EnvSource, OrbitCamera, Scene};
+use crate::texture::ImageSet;
 use anyhow::{Context as _, Result};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -78,12 +79,7 @@ impl Viewer {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&ctx.device, &config);
-        let renderer = Renderer::new(
-            &ctx,
-            &loaded.scene,
-            loaded.env.as_ref(),
-            (config.width, config.height),
-        )?;
+        let renderer = renderer_for(&ctx, &loaded, (config.width, config.height))?;
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
             egui_ctx.clone(),
@@ -178,7 +174,11 @@ impl Viewer {
     fn load_preset(&mut self, path: &Path) {
         match load_scene(path, None) {
             Ok(loaded) => {
-                if let Err(e) = self.apply_scene(loaded.scene.clone(), loaded.env.as_ref()) {
+                if let Err(e) = self.apply_scene(
+                    loaded.scene.clone(),
+                    loaded.env.as_ref(),
+                    Some(loaded.images.clone()),
+                ) {
                     self.panel.error(format!("{}: {e:#}", path.display()));
                     return;
                 }
@@ -207,7 +207,7 @@ impl Viewer {
                 scene.environment.source = EnvSource::LatLong {
                     path: path.to_owned(),
                 };
-                if let Err(e) = self.apply_scene(scene, Some(&l.image)) {
+                if let Err(e) = self.apply_scene(scene, Some(&l.image), None) {
                     self.panel.error(format!("{}: {e:#}", path.display()));
                     return;
                 }
@@ -221,12 +221,39 @@ impl Viewer {
         }
     }
 
-    /// Installs a whole new scene and environment; on failure nothing changes.
-    fn apply_scene(&mut self, scene: Scene, env: Option<&envmap::EnvImage>) -> Result<()> {
+    /// Installs a whole new scene and environment, and its images if given;
+    /// on failure nothing changes.
+    fn apply_scene(
+        &mut self,
+        scene: Scene,
+        env: Option<&envmap::EnvImage>,
+        images: Option<ImageSet>,
+    ) -> Result<()> {
         self.renderer.set_scene(&self.ctx, &scene)?;
+        if let Some(images) = images {
+            self.renderer.set_images(&self.ctx, images)?;
+        }
         self.renderer.set_environment(&self.ctx, env);
         self.scene = scene;
         Ok(())
+    }
+
+    /// Loads the images an edit added or changed (a new image node, a typed
+    /// path), reporting unreadable files; the renderer shows placeholders
+    /// for those.
+    fn reload_images_if_needed(&mut self) {
+        if self.scene.image_sources() == self.renderer.images().sources() {
+            return;
+        }
+        let mut notes = Vec::new();
+        let result = load_images(&self.scene, &mut notes)
+            .and_then(|images| self.renderer.set_images(&self.ctx, images));
+        for note in notes {
+            self.panel.error(note);
+        }
+        if let Err(e) = result {
+            self.panel.error(format!("{e:#}"));
+        }
     }
 
     fn save_preset(&mut self, path: &Path) {
@@ -368,6 +395,7 @@ impl Viewer {
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.scene().clone();
         }
+        self.reload_images_if_needed();
         if self.config.width == 0 || self.config.height == 0 {
             return Ok(true);
         }

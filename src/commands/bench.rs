@@ -1,6 +1,6 @@
 //! `marbre bench`: milliseconds per frame for every shipped preset.
 
-use super::session::load_scene;
+use super::session::{load_scene, renderer_for};
 use crate::gpu::{FeatureSet, GpuContext, Renderer};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -49,7 +49,7 @@ fn time_frames(ctx: &GpuContext, renderer: &mut Renderer, frames: u32) -> Result
 /// small frame: drivers like lavapipe compile the shader at the first draw.
 fn time_build(ctx: &GpuContext, loaded: &super::session::LoadedScene) -> Result<f64> {
     let start = Instant::now();
-    let mut renderer = Renderer::new(ctx, &loaded.scene, loaded.env.as_ref(), (64, 36))?;
+    let mut renderer = renderer_for(ctx, loaded, (64, 36))?;
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     renderer.trace(ctx, &mut encoder, None);
     ctx.queue.submit([encoder.finish()]);
@@ -90,7 +90,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut features = 0;
         let build = time_build(&ctx, &loaded)?;
         for &size in &args.sizes {
-            let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size)?;
+            let mut renderer = renderer_for(&ctx, &loaded, size)?;
             features = renderer.features().0.len();
             let ms = time_frames(&ctx, &mut renderer, args.frames)?;
             renderer.set_feature_override(&ctx, Some(FeatureSet::all()))?;

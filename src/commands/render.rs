@@ -1,7 +1,7 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
-use super::session::{accumulate, load_scene};
-use crate::gpu::{GpuContext, Renderer};
+use super::session::{accumulate, load_scene, renderer_for};
+use crate::gpu::GpuContext;
 use crate::image_io;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -50,7 +50,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("note: {note}");
     }
     let ctx = GpuContext::headless()?;
-    let mut renderer = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), args.size)?;
+    let mut renderer = renderer_for(&ctx, &loaded, args.size)?;
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));
     bar.set_style(
         indicatif::ProgressStyle::with_template(

@@ -5,16 +5,19 @@ use crate::envmap::{self, EnvImage};
 use crate::gpu::{GpuContext, Renderer};
 use crate::preset;
 use crate::scene::{EnvSource, Scene};
+use crate::texture::ImageSet;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
 /// The preset the viewer opens when none is named.
 pub const DEFAULT_PRESET: &str = "presets/default.ron";
 
-/// A preset's scene, with `--env` applied, and its loaded environment image.
+/// A preset's scene, with `--env` applied, and its loaded environment image
+/// and image textures.
 pub struct LoadedScene {
     pub scene: Scene,
     pub env: Option<EnvImage>,
+    pub images: ImageSet,
     /// Clamped values and sanitised pixels, for the user to see.
     pub notes: Vec<String>,
 }
@@ -36,7 +39,34 @@ pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<Loa
         }
         _ => None,
     };
-    Ok(LoadedScene { scene, env, notes })
+    let images = load_images(&scene, &mut notes)?;
+    Ok(LoadedScene {
+        scene,
+        env,
+        images,
+        notes,
+    })
+}
+
+/// The largest image atlas the renderer asks for: wgpu's default limit of
+/// `max_texture_dimension_2d`, which every adapter it runs on offers.
+pub const ATLAS_MAX_SIDE: u32 = 8192;
+
+/// The image textures of `scene`. An unreadable file becomes a placeholder
+/// with a note; only images too many to fit on the GPU are an error.
+pub fn load_images(scene: &Scene, notes: &mut Vec<String>) -> Result<ImageSet> {
+    Ok(ImageSet::load(
+        &scene.image_sources(),
+        ATLAS_MAX_SIDE,
+        notes,
+    )?)
+}
+
+/// A renderer for a loaded scene, with its environment and images.
+pub fn renderer_for(ctx: &GpuContext, loaded: &LoadedScene, size: (u32, u32)) -> Result<Renderer> {
+    let mut renderer = Renderer::new(ctx, &loaded.scene, loaded.env.as_ref(), size)?;
+    renderer.set_images(ctx, loaded.images.clone())?;
+    Ok(renderer)
 }
 
 /// `path`, or the default preset.

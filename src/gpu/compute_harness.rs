@@ -5,21 +5,26 @@
 
 use super::context::GpuContext;
 use super::features::FeatureSet;
-use super::pipelines::{checked, entry, permutation_table, shader_module, storage, uniform};
+use super::pipelines::{
+    checked, entry, float_texture, permutation_table, shader_module, storage, uniform, upload_atlas,
+};
 use super::readback::read_buffer;
 use super::shader_source::Program;
+use crate::texture::ImageAtlas;
 use anyhow::Result;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 /// Evaluates `program` (a harness) built with `features` at every point.
 /// `harness_uniform` is the raw bytes of the program's binding-0 uniform;
-/// binding 6 holds Perlin's permutation, as in the trace pass.
+/// binding 6 holds Perlin's permutation and binding 8 the image atlas (one
+/// black texel without one), as in the trace pass.
 pub fn run(
     ctx: &GpuContext,
     program: Program,
     features: &FeatureSet,
     harness_uniform: &[u8],
+    atlas: Option<&ImageAtlas>,
     points: &[Vec3],
 ) -> Result<Vec<[f32; 4]>> {
     if points.is_empty() {
@@ -34,6 +39,7 @@ pub fn run(
             entry(1, storage(true)),
             entry(2, storage(false)),
             entry(6, uniform()),
+            entry(8, float_texture(false)),
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -83,19 +89,27 @@ pub fn run(
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
+    let empty = ImageAtlas::pack(&[], 1)?;
+    let atlas_view = upload_atlas(ctx, atlas.unwrap_or(&empty));
+    let mut entries: Vec<wgpu::BindGroupEntry> = [
+        (0, &uniform_buffer),
+        (1, &input_buffer),
+        (2, &output_buffer),
+        (6, &perm_buffer),
+    ]
+    .map(|(binding, buffer)| wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    })
+    .into();
+    entries.push(wgpu::BindGroupEntry {
+        binding: 8,
+        resource: wgpu::BindingResource::TextureView(&atlas_view),
+    });
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("compute harness"),
         layout: &layout,
-        entries: &[
-            (0, &uniform_buffer),
-            (1, &input_buffer),
-            (2, &output_buffer),
-            (6, &perm_buffer),
-        ]
-        .map(|(binding, buffer)| wgpu::BindGroupEntry {
-            binding,
-            resource: buffer.as_entire_binding(),
-        }),
+        entries: &entries,
     });
     let mut encoder = device.create_command_encoder(&Default::default());
     {

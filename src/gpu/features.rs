@@ -26,6 +26,7 @@ pub enum Feature {
     PatternWaves,
     PatternRidged,
     PatternMix,
+    Image,
     Bump,
     Opacity,
     Emission,
@@ -37,7 +38,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 27] = [
+    pub const ALL: [Feature; 28] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -57,6 +58,7 @@ impl Feature {
         Feature::PatternWaves,
         Feature::PatternRidged,
         Feature::PatternMix,
+        Feature::Image,
         Feature::Bump,
         Feature::Opacity,
         Feature::Emission,
@@ -72,6 +74,7 @@ impl Feature {
         matches!(
             self,
             Feature::PatternChecker2d
+                | Feature::Image
                 | Feature::PatternBrick
                 | Feature::PatternTile
                 | Feature::PatternCutout
@@ -103,6 +106,7 @@ impl Feature {
             Feature::PatternWaves => "PATTERN_WAVES",
             Feature::PatternRidged => "PATTERN_RIDGED",
             Feature::PatternMix => "PATTERN_MIX",
+            Feature::Image => "IMAGE",
             Feature::Bump => "BUMP",
             Feature::Opacity => "OPACITY",
             Feature::Emission => "EMISSION",
@@ -144,6 +148,7 @@ impl FeatureSet {
             Feature::PatternTile,
             Feature::PatternCutout,
             Feature::PatternWaves,
+            Feature::Image,
             Feature::Bump,
         ];
         if uv_patterns.iter().any(|&f| self.contains(f)) {
@@ -235,6 +240,7 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
         Pattern::Waves { .. } => vec![Feature::PatternWaves],
         Pattern::Ridged { .. } => vec![Feature::PatternRidged],
         Pattern::Mix => vec![Feature::PatternMix],
+        Pattern::Image { .. } => vec![Feature::Image],
     };
     if let Some(n) = p.noise() {
         out.extend(noise_features(n));

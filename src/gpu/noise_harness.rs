@@ -75,6 +75,7 @@ pub fn evaluate(
         Program::NoiseHarness,
         &FeatureSet::for_noise(noise),
         bytemuck::bytes_of(&params),
+        None,
         points,
     )
 }

@@ -1,9 +1,12 @@
 //! Shader modules and pipelines, with validation errors caught instead of
 //! panicking, so a bad shader never takes the app down.
 
+use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::shader_source::{Program, assemble};
+use crate::texture::ImageAtlas;
 use anyhow::{Result, anyhow};
+use wgpu::util::DeviceExt;
 
 /// Assembles and validates a program with naga, then creates the module. A
 /// naga error names the file and line, which the wgpu panic would not.
@@ -133,4 +136,43 @@ pub fn float_texture(filterable: bool) -> wgpu::BindingType {
 pub fn permutation_table() -> Vec<u32> {
     let p = crate::noise::perlin::PERMUTATION;
     (0..512).map(|i| u32::from(p[i & 255])).collect()
+}
+
+/// The image atlas as an `Rgba16Float` texture (read with `textureLoad`).
+pub fn upload_atlas(ctx: &GpuContext, atlas: &ImageAtlas) -> wgpu::TextureView {
+    upload_rgba16f(
+        ctx,
+        "image atlas",
+        (atlas.width, atlas.height),
+        atlas.rgba16f_bytes(),
+    )
+}
+
+/// A sampled `Rgba16Float` texture holding `bytes` (row 0 first).
+pub fn upload_rgba16f(
+    ctx: &GpuContext,
+    label: &str,
+    (width, height): (u32, u32),
+    bytes: &[u8],
+) -> wgpu::TextureView {
+    let texture = ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytes,
+    );
+    texture.create_view(&Default::default())
 }

@@ -7,7 +7,7 @@ use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
-    uniform,
+    uniform, upload_atlas, upload_rgba16f,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
@@ -15,6 +15,7 @@ use super::shader_source::{Program, assemble};
 use super::texture_codegen;
 use crate::envmap::EnvImage;
 use crate::scene::{Scene, ToneMap};
+use crate::texture::ImageSet;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use std::collections::HashMap;
@@ -73,6 +74,9 @@ pub struct Renderer {
     trace_shader_bytes: usize,
     env_view: wgpu::TextureView,
     env_sampler: wgpu::Sampler,
+    /// The images the texture code reads, and their atlas on the GPU.
+    images: ImageSet,
+    image_atlas_view: wgpu::TextureView,
     accumulation: Accumulation,
     size: (u32, u32),
     render_scale: f32,
@@ -105,13 +109,15 @@ impl Renderer {
                 entry(5, float_texture(false)),
                 entry(6, uniform()),
                 entry(7, uniform()),
+                entry(8, float_texture(false)),
             ],
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
             entries: &[entry(0, uniform()), entry(1, float_texture(false))],
         });
-        let textures = texture_codegen::generate(scene)?;
+        let images = ImageSet::empty();
+        let textures = texture_codegen::generate(scene, &images)?;
         let (trace_pipeline, trace_shader_bytes) =
             Self::build_trace_pipeline(ctx, &trace_layout, &features, &textures.wgsl)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
@@ -153,6 +159,7 @@ impl Renderer {
             ..Default::default()
         });
         let env_view = upload_env(ctx, env);
+        let image_atlas_view = upload_atlas(ctx, images.atlas());
         let accumulation = create_accumulation(device, size);
         Ok(Self {
             scene: scene.clone(),
@@ -172,6 +179,8 @@ impl Renderer {
             trace_shader_bytes,
             env_view,
             env_sampler,
+            images,
+            image_atlas_view,
             accumulation,
             size,
             render_scale: 1.0,
@@ -243,7 +252,7 @@ impl Renderer {
         let textures = if self.scene.materials().eq(scene.materials()) {
             None
         } else {
-            Some(texture_codegen::generate(scene)?)
+            Some(texture_codegen::generate(scene, &self.images)?)
         };
         let code = textures.as_ref().map_or(&self.texture_code, |t| &t.wgsl);
         if features != self.features || *code != self.texture_code {
@@ -284,6 +293,36 @@ impl Renderer {
         self.feature_override = features;
         let scene = self.scene.clone();
         self.set_scene(ctx, &scene)
+    }
+
+    /// The images the texture code reads.
+    pub fn images(&self) -> &ImageSet {
+        &self.images
+    }
+
+    /// Replaces the images the scene's image textures read (loaded by
+    /// `ImageSet::load`): uploads their atlas and regenerates the texture
+    /// code, which holds where each image lies.
+    pub fn set_images(&mut self, ctx: &GpuContext, images: ImageSet) -> Result<()> {
+        let textures = texture_codegen::generate(&self.scene, &images)?;
+        if textures.wgsl != self.texture_code {
+            (self.trace_pipeline, self.trace_shader_bytes) = Self::build_trace_pipeline(
+                ctx,
+                &self.trace_layout,
+                &self.features,
+                &textures.wgsl,
+            )?;
+            self.texture_code = textures.wgsl;
+        }
+        ctx.queue.write_buffer(
+            &self.texture_param_buffer,
+            0,
+            bytemuck::cast_slice(&textures.params),
+        );
+        self.image_atlas_view = upload_atlas(ctx, images.atlas());
+        self.images = images;
+        self.reset_accumulation();
+        Ok(())
     }
 
     /// Replaces the environment image (None: a black 1×1 placeholder).
@@ -341,6 +380,10 @@ impl Renderer {
             ),
             bind(6, self.perm_buffer.as_entire_binding()),
             bind(7, self.texture_param_buffer.as_entire_binding()),
+            bind(
+                8,
+                wgpu::BindingResource::TextureView(&self.image_atlas_view),
+            ),
         ];
         entries.extend(self.geometry.entries());
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -569,24 +612,10 @@ fn upload_env(ctx: &GpuContext, env: Option<&EnvImage>) -> wgpu::TextureView {
         pixels: vec![[0.0, 0.0, 0.0, 1.0]],
     };
     let image = env.unwrap_or(&black);
-    let texture = ctx.device.create_texture_with_data(
-        &ctx.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("environment"),
-            size: wgpu::Extent3d {
-                width: image.width,
-                height: image.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
+    upload_rgba16f(
+        ctx,
+        "environment",
+        (image.width, image.height),
         bytemuck::cast_slice(&image.to_rgba16f()),
-    );
-    texture.create_view(&Default::default())
+    )
 }

@@ -301,7 +301,9 @@ mod tests {
 
     /// The element count of a uniform array global in the trace shader.
     fn wgsl_array_len(name: &str) -> u32 {
-        let generated = texture_codegen::generate(&Scene::default()).unwrap();
+        let generated =
+            texture_codegen::generate(&Scene::default(), &crate::texture::ImageSet::empty())
+                .unwrap();
         let source = crate::gpu::shader_source::assemble(
             crate::gpu::shader_source::Program::Trace,
             &crate::gpu::features::FeatureSet::all(),
@@ -339,7 +341,10 @@ mod tests {
         assert_eq!(wgsl_array_len("polygons") as usize, polygons(&scene).len());
         assert_eq!(
             wgsl_array_len("texture_params") as usize,
-            texture_codegen::generate(&scene).unwrap().params.len()
+            texture_codegen::generate(&scene, &crate::texture::ImageSet::empty())
+                .unwrap()
+                .params
+                .len()
         );
     }
 

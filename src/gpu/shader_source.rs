@@ -60,6 +60,10 @@ const SOURCES: &[(&str, &str)] = &[
         "texture_harness.wgsl",
         include_str!("../../shaders/texture_harness.wgsl"),
     ),
+    (
+        "texture_image.wgsl",
+        include_str!("../../shaders/texture_image.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,6 +107,11 @@ impl Program {
                     "scene.wgsl",
                     "texture_patterns.wgsl",
                     "texture_mapping.wgsl",
+                ]);
+                if features.contains(Feature::Image) {
+                    out.push("texture_image.wgsl");
+                }
+                out.extend([
                     "textures.wgsl",
                     "intersect.wgsl",
                     "random.wgsl",
@@ -126,6 +135,7 @@ impl Program {
                     "texture_patterns.wgsl",
                     "texture_shading.wgsl",
                     "texture_mapping.wgsl",
+                    "texture_image.wgsl",
                     "texture_harness.wgsl",
                 ]);
             }

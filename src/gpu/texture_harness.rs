@@ -8,7 +8,7 @@ use super::features::FeatureSet;
 use super::scene_gpu::NoiseParamsGpu;
 use super::shader_source::Program;
 use crate::noise::{FractalShape, NoiseSettings};
-use crate::texture::{MAX_RAMP_STOPS, RampStop};
+use crate::texture::{ImageAtlas, ImageFilter, ImageWrap, MAX_RAMP_STOPS, RampStop};
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
 use glam::{Affine3A, Vec2, Vec3};
@@ -96,6 +96,14 @@ pub enum PatternQuery {
     /// Result: the 3D texture point.
     Transform {
         to_texture: Affine3A,
+    },
+    /// Result: image `entry` of the atlas sampled at the point's (x, y) as
+    /// (u, v), with its z as the level of detail.
+    Image {
+        atlas: ImageAtlas,
+        entry: usize,
+        filter: ImageFilter,
+        wrap: ImageWrap,
     },
 }
 
@@ -243,6 +251,16 @@ impl PatternQuery {
                 u.b = v3(m.y_axis.into(), t.y);
                 u.c = v3(m.z_axis.into(), t.z);
             }
+            PatternQuery::Image {
+                atlas,
+                entry,
+                filter,
+                wrap,
+            } => {
+                u.mode = 16;
+                u.a = atlas.entries[*entry].params();
+                u.b = [filter.id() as f32, wrap.id() as f32, 0.0, 0.0];
+            }
         }
         Ok(u)
     }
@@ -267,6 +285,10 @@ pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Resu
         Program::TextureHarness,
         &FeatureSet::for_texture_library(&noise),
         bytemuck::bytes_of(&uniform),
+        match query {
+            PatternQuery::Image { atlas, .. } => Some(atlas),
+            _ => None,
+        },
         points,
     )
 }

@@ -6,9 +6,10 @@ use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::{
     Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
 };
-use crate::texture::{MAX_RAMP_STOPS, RampStop};
-use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, Ui};
+use crate::texture::{ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop};
+use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
+use std::path::PathBuf;
 
 /// Every property's texture, the bump, the emission strength and layers.
 pub fn material_ui(ui: &mut Ui, m: &mut Material) {
@@ -151,6 +152,9 @@ fn texture_ui(
             .default_open(depth == 1)
             .show(ui, |ui| {
                 pattern_ui(ui, &mut texture.pattern);
+                if matches!(texture.pattern, Pattern::Image { .. }) {
+                    image_source_ui(ui, &mut texture.image);
+                }
                 mapping_ui(ui, &mut texture.mapping);
                 if texture.pattern == Pattern::Mix {
                     let factor = texture
@@ -204,6 +208,36 @@ fn texture_ui(
                     ui.close();
                 }
             });
+    });
+}
+
+/// The image file of an image node, and how its codes decode. The path is
+/// applied on Enter or when the field loses focus (the viewer then loads
+/// it), not at every keystroke.
+fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
+    let source = image.get_or_insert_with(|| ImageSource {
+        path: PathBuf::new(),
+        color_space: ColorSpace::Srgb,
+    });
+    let id = ui.scope_id().with("image path");
+    let mut typed: String = ui
+        .ctx()
+        .data(|d| d.get_temp(id))
+        .unwrap_or_else(|| source.path.display().to_string());
+    let response = ui
+        .add(TextEdit::singleline(&mut typed).hint_text("images/picture.png"))
+        .on_hover_text("PNG, JPEG, HDR or EXR; relative to the preset file. Enter applies");
+    if response.lost_focus() {
+        source.path = PathBuf::from(typed.trim());
+        ui.ctx().data_mut(|d| d.remove::<String>(id));
+    } else {
+        ui.ctx().data_mut(|d| d.insert_temp(id, typed));
+    }
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut source.color_space, ColorSpace::Srgb, "sRGB colour")
+            .on_hover_text("8-bit colour images: decoded from sRGB to linear");
+        ui.selectable_value(&mut source.color_space, ColorSpace::Linear, "linear data")
+            .on_hover_text("Roughness, height and other data: codes taken as they are");
     });
 }
 
@@ -442,6 +476,33 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
             noise_ui(ui, noise)
         }
         Pattern::Mix => {}
+        Pattern::Image { filter, wrap } => {
+            ComboBox::new("filter", "filter")
+                .selected_text(format!("{filter:?}"))
+                .show_ui(ui, |ui| {
+                    for f in [
+                        ImageFilter::Nearest,
+                        ImageFilter::Bilinear,
+                        ImageFilter::Trilinear,
+                    ] {
+                        ui.selectable_value(filter, f, format!("{f:?}"));
+                    }
+                })
+                .response
+                .on_hover_text(
+                    "Nearest texel, bilinear between four, or trilinear between mip levels \
+                     chosen by the pixel's footprint",
+                );
+            ComboBox::new("wrap", "wrap")
+                .selected_text(format!("{wrap:?}"))
+                .show_ui(ui, |ui| {
+                    for w in [ImageWrap::Repeat, ImageWrap::Clamp, ImageWrap::Mirror] {
+                        ui.selectable_value(wrap, w, format!("{w:?}"));
+                    }
+                })
+                .response
+                .on_hover_text("What the image shows outside its unit square of (u, v)");
+        }
         Pattern::Marble {
             noise,
             stripe_frequency,

@@ -292,6 +292,19 @@ impl Material {
         out
     }
 
+    /// Calls `f` on every texture of the material, nested ones included.
+    pub fn visit_textures_mut(&mut self, f: &mut dyn FnMut(&mut Texture)) {
+        for property in Property::ALL {
+            self.texture_mut(property).visit_mut(f);
+        }
+        self.bump.visit_mut(f);
+        for layer in &mut self.layers {
+            for texture in layer.textures_mut() {
+                texture.visit_mut(f);
+            }
+        }
+    }
+
     /// Every pattern of every texture, nested ones included.
     pub fn patterns(&self) -> Vec<&Pattern> {
         self.all_textures()

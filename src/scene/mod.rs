@@ -113,6 +113,34 @@ impl Scene {
             .chain(self.ground.iter().map(|g| &g.material))
     }
 
+    /// Every material, mutably, in GPU order.
+    pub fn materials_mut(&mut self) -> impl Iterator<Item = &mut Material> {
+        self.spheres
+            .iter_mut()
+            .map(|s| &mut s.material)
+            .chain(self.cylinders.iter_mut().map(|c| &mut c.material))
+            .chain(self.polygons.iter_mut().map(|p| &mut p.material))
+            .chain(self.ground.iter_mut().map(|g| &mut g.material))
+    }
+
+    /// The image files the scene's image textures show, each once, in order
+    /// of appearance.
+    pub fn image_sources(&self) -> Vec<crate::texture::ImageSource> {
+        let mut out = Vec::new();
+        for material in self.materials() {
+            for texture in material.all_textures() {
+                texture.visit(&mut |t| {
+                    if let (Pattern::Image { .. }, Some(source)) = (&t.pattern, &t.image)
+                        && !out.contains(source)
+                    {
+                        out.push(source.clone());
+                    }
+                });
+            }
+        }
+        out
+    }
+
     /// Values no control can produce (a NaN radius, 40 octaves) are clamped
     /// into range; each clamp is reported so a preset author can see it.
     pub fn sanitize(&mut self) -> Vec<String> {

@@ -28,6 +28,14 @@ pub enum Pattern {
     Ridged { noise: NoiseSettings },
     /// `t` is the first channel of the texture's `factor` (Blender's Mix).
     Mix,
+    /// The texture's `image` at (u, v), filtered and wrapped so: the value
+    /// is the image's colour (or, with a ramp, its luminance mapped).
+    Image {
+        #[serde(default)]
+        filter: texture::ImageFilter,
+        #[serde(default)]
+        wrap: texture::ImageWrap,
+    },
     /// `t = 0.5 + 0.5 · sin(p.x · stripe_frequency + fbm(p))`.
     Marble {
         noise: NoiseSettings,
@@ -165,7 +173,7 @@ impl TextureMapping {
 }
 
 impl Pattern {
-    pub const NAMES: [&'static str; 14] = [
+    pub const NAMES: [&'static str; 15] = [
         "constant",
         "checker 3D",
         "fBm",
@@ -180,6 +188,7 @@ impl Pattern {
         "waves",
         "ridged",
         "mix",
+        "image",
     ];
 
     /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
@@ -199,6 +208,7 @@ impl Pattern {
             Pattern::Waves { .. } => 11,
             Pattern::Ridged { .. } => 12,
             Pattern::Mix => 13,
+            Pattern::Image { .. } => 14,
         }
     }
 
@@ -247,6 +257,10 @@ impl Pattern {
             },
             12 => Pattern::Ridged { noise },
             13 => Pattern::Mix,
+            14 => Pattern::Image {
+                filter: Default::default(),
+                wrap: Default::default(),
+            },
             _ => Pattern::Constant,
         }
     }
@@ -301,8 +315,9 @@ impl Pattern {
             Pattern::Checker { size } => (texture::checker_3d(p, Vec3::splat(size)), uv),
             Pattern::Fbm { .. } => ((0.5 + 0.5 * signal).clamp(0.0, 1.0), uv),
             Pattern::Turbulence { .. } | Pattern::Ridged { .. } => (signal.clamp(0.0, 1.0), uv),
-            // The texture tree takes t from the factor texture.
-            Pattern::Mix => (0.0, uv),
+            // The texture tree takes t from the factor texture, and the
+            // colour from the image.
+            Pattern::Mix | Pattern::Image { .. } => (0.0, uv),
             Pattern::Marble {
                 stripe_frequency, ..
             } => (0.5 + 0.5 * (p.x * stripe_frequency + signal).sin(), uv),

@@ -7,6 +7,7 @@
 use super::material::MAX_SIGNALS;
 use super::pattern::{Pattern, Signal, SurfacePoint, TextureMapping};
 use crate::texture;
+use crate::texture::{ImageSet, ImageSource};
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -14,23 +15,30 @@ use serde::{Deserialize, Serialize};
 /// (for mappings below, which start afresh from it), the current 3D point
 /// and (u, v), and the mapping they came through.
 #[derive(Debug, Clone, Copy)]
-struct Coordinates {
+struct Coordinates<'a> {
     surface: SurfacePoint,
     p: Vec3,
     uv: Vec2,
     mapping: Option<TextureMapping>,
+    /// The loaded images, if the caller has them.
+    images: Option<&'a ImageSet>,
 }
 
-impl Coordinates {
-    fn surface(point: &SurfacePoint) -> Self {
+impl<'a> Coordinates<'a> {
+    fn surface(point: &SurfacePoint, images: Option<&'a ImageSet>) -> Self {
         Self {
             surface: *point,
             p: point.object,
             uv: point.uv,
             mapping: None,
+            images,
         }
     }
 }
+
+/// What an image node shows when its image is not at hand (the CPU
+/// reference evaluated without an [`ImageSet`]).
+pub const IMAGE_UNAVAILABLE: Vec3 = Vec3::splat(0.5);
 
 /// One side of a blend: a scalar, a colour, or a whole nested texture.
 ///
@@ -105,7 +113,7 @@ impl<'de> Deserialize<'de> for Child {
 impl Child {
     /// The child's colour at a point (a scalar is grey).
     pub fn eval(&self, p: Vec3, uv: Vec2) -> Vec3 {
-        self.eval_in(&Coordinates::surface(&SurfacePoint::new(p, uv)))
+        self.eval_in(&Coordinates::surface(&SurfacePoint::new(p, uv), None))
     }
 
     fn eval_in(&self, at: &Coordinates) -> Vec3 {
@@ -237,6 +245,9 @@ pub struct Texture {
     /// The blend factor of [`Pattern::Mix`]: this texture's first channel.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub factor: Option<Box<Texture>>,
+    /// The file [`Pattern::Image`] shows.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub image: Option<ImageSource>,
     /// Set, this texture and its subtree read the surface's coordinates
     /// through it; unset, they read what the texture above them reads.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -275,6 +286,7 @@ impl Texture {
             a: a.into(),
             b: b.into(),
             factor: None,
+            image: None,
             mapping: None,
             ramp: Vec::new(),
             ops: Vec::new(),
@@ -297,6 +309,7 @@ impl Texture {
             && self.ops.is_empty()
             && self.factor.is_none()
             && self.mapping.is_none()
+            && self.image.is_none()
             && self.a == self.b;
         (plain && !matches!(self.a, Child::Texture(_))).then_some(&self.a)
     }
@@ -323,7 +336,14 @@ impl Texture {
     /// The colour at a surface point: the CPU reference of the shader code
     /// generated from this tree. A constant pattern never evaluates `b`.
     pub fn eval_at(&self, point: &SurfacePoint) -> Vec3 {
-        self.eval_in(&Coordinates::surface(point))
+        self.eval_in(&Coordinates::surface(point, None))
+    }
+
+    /// [`Texture::eval_at`] with the scene's images loaded (image nodes
+    /// otherwise show [`IMAGE_UNAVAILABLE`]). Images are sampled at their
+    /// finest level: the CPU reference has no pixel footprint.
+    pub fn eval_with(&self, point: &SurfacePoint, images: &ImageSet) -> Vec3 {
+        self.eval_in(&Coordinates::surface(point, Some(images)))
     }
 
     fn eval_in(&self, at: &Coordinates) -> Vec3 {
@@ -331,10 +351,10 @@ impl Texture {
         let at = match &self.mapping {
             Some(m) => {
                 mapped = Coordinates {
-                    surface: at.surface,
                     p: m.point(&at.surface),
                     uv: m.uv(&at.surface),
                     mapping: Some(*m),
+                    ..*at
                 };
                 &mapped
             }
@@ -346,6 +366,17 @@ impl Texture {
 
     /// The value before the `ops`.
     fn blended(&self, at: &Coordinates) -> Vec3 {
+        if let Pattern::Image { filter, wrap } = self.pattern {
+            let color = at
+                .images
+                .zip(self.image.as_ref())
+                .and_then(|(images, source)| images.sample(source, at.uv, filter, wrap, 0.0))
+                .map_or(IMAGE_UNAVAILABLE, |c| c.truncate());
+            if self.ramp.is_empty() {
+                return color;
+            }
+            return texture::ramp(&self.ramp, texture::luminance(color));
+        }
         let (t, child_uv) = match (&self.pattern, &self.factor) {
             (Pattern::Mix, Some(factor)) => (factor.eval_in(at).x.clamp(0.0, 1.0), at.uv),
             (Pattern::Mix, None) => (0.0, at.uv),
@@ -397,6 +428,27 @@ impl Texture {
             .into_iter()
             .filter_map(Child::texture)
             .chain(self.factor.as_deref())
+    }
+
+    /// Calls `f` on every texture of the tree, this one first.
+    pub fn visit(&self, f: &mut dyn FnMut(&Texture)) {
+        f(self);
+        for t in self.subtrees() {
+            t.visit(f);
+        }
+    }
+
+    /// Calls `f` on every texture of the tree, this one first.
+    pub fn visit_mut(&mut self, f: &mut dyn FnMut(&mut Texture)) {
+        f(self);
+        for child in [&mut self.a, &mut self.b] {
+            if let Child::Texture(t) = child {
+                t.visit_mut(f);
+            }
+        }
+        if let Some(factor) = &mut self.factor {
+            factor.visit_mut(f);
+        }
     }
 
     /// Whether any texture in the tree maps its blend factor through a ramp.

@@ -13,6 +13,12 @@ pub struct RampStop {
     pub color: Vec3,
 }
 
+/// Rec. 709 luminance, the weight a ramp gives an image's colour (twin of
+/// `luminance` in shaders/common.wgsl).
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 /// The colour at `t`: the first stop's colour before it, the last's after
 /// it, linear between neighbours. `stops` must be sorted by position (the
 /// scene's sanitiser sorts them); an empty ramp is black.
