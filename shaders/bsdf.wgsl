@@ -14,14 +14,16 @@ struct SurfacePoint {
     emission: vec3f,
 }
 
-fn surface_at(hit: Hit) -> SurfacePoint {
+// The surface at a hit reached by a ray cone `width` wide, along `d`.
+fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
     let p = hit.texture_point;
+    let fp = hit_footprint(hit, width, d);
 #if NOISE
-    let signals = material_signals(hit.material, p, hit.p);
+    let signals = material_signals(hit.material, p, hit.p, fp.p);
 #else
     let signals = vec4f(0.0);
 #endif
-    let textures = surface_textures(hit.material, p, hit.p, hit.uv, signals);
+    let textures = surface_textures(hit.material, p, hit.p, hit.uv, fp, signals);
     var s: SurfacePoint;
     // Math steps can leave [0, 1]: reflectances stay within it, so no
     // bounce ever adds energy.
@@ -33,7 +35,7 @@ fn surface_at(hit: Hit) -> SurfacePoint {
     s.opacity = clamp(textures.opacity, 0.0, 1.0);
     s.emission = max(textures.emission, vec3f(0.0));
 #if BUMP
-    s.n = bumped_shading_normal(hit, signals);
+    s.n = bumped_shading_normal(hit, fp, signals);
 #else
     s.n = hit.n;
 #endif

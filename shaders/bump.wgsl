@@ -8,23 +8,23 @@
 
 const BUMP_STEP: f32 = 1e-3;
 
-fn height_at(hit: Hit, signals: vec4f, du: f32, dv: f32) -> f32 {
+fn height_at(hit: Hit, fp: Footprint, signals: vec4f, du: f32, dv: f32) -> f32 {
     let offset = du * hit.dp_du + dv * hit.dp_dv;
     let p = hit.texture_point + offset;
     let pw = hit.p + offset;
     var offset_signals = signals;
 #if NOISE
     if BUMP_READS_NOISE {
-        offset_signals = material_signals(hit.material, p, pw);
+        offset_signals = material_signals(hit.material, p, pw, fp.p);
     }
 #endif
-    return surface_height(hit.material, p, pw, hit.uv + vec2f(du, dv), offset_signals);
+    return surface_height(hit.material, p, pw, hit.uv + vec2f(du, dv), fp, offset_signals);
 }
 
-fn bumped_shading_normal(hit: Hit, signals: vec4f) -> vec3f {
+fn bumped_shading_normal(hit: Hit, fp: Footprint, signals: vec4f) -> vec3f {
     let height = materials[hit.material].bump_height;
-    let dh_du = height_at(hit, signals, BUMP_STEP, 0.0) - height_at(hit, signals, -BUMP_STEP, 0.0);
-    let dh_dv = height_at(hit, signals, 0.0, BUMP_STEP) - height_at(hit, signals, 0.0, -BUMP_STEP);
+    let dh_du = height_at(hit, fp, signals, BUMP_STEP, 0.0) - height_at(hit, fp, signals, -BUMP_STEP, 0.0);
+    let dh_dv = height_at(hit, fp, signals, 0.0, BUMP_STEP) - height_at(hit, fp, signals, 0.0, -BUMP_STEP);
     let scale = height / (2.0 * BUMP_STEP);
     return bumped_normal(hit.n, hit.dp_du, hit.dp_dv, scale * dh_du, scale * dh_dv);
 }

@@ -15,8 +15,9 @@ struct NoiseParams {
     distortion: f32,
     // 1: the renderer takes the signal at world coordinates, 0: object ones.
     world: u32,
+    // How much the signal's mapping enlarges a footprint.
+    footprint_scale: f32,
     _pad0: f32,
-    _pad1: f32,
 }
 
 const MAX_OCTAVES: f32 = 16.0;
@@ -33,6 +34,21 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
     return 0.0;
 #endif
 }
+
+#if CLAMP_OCTAVES
+// The octaves a footprint `width` wide resolves; twin of
+// noise::footprint_octaves (pbrt's rule, any lacunarity).
+fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    if !(width > 0.0 && n.lacunarity > 1.0 && n.frequency > 0.0) {
+        return octaves;
+    }
+    let resolved = max((-1.0 - log2(n.frequency * width)) / log2(n.lacunarity), 0.0);
+    let whole = floor(resolved);
+    let x = clamp((resolved - whole - 0.3) / 0.4, 0.0, 1.0);
+    return min(whole + x * x * (3.0 - 2.0 * x), octaves);
+}
+#endif
 
 // Octave i's share of the sum, in one place for both kinds' loops: the last,
 // fractional octave fades in, and the shape applies.

@@ -9,8 +9,9 @@ struct Hit {
     // The primitive's 2D texture coordinates: lat-long on a sphere, world
     // (x, z) on the ground. Only computed where a 2D pattern reads them.
     uv: vec2f,
-#if BUMP
-    // ∂p/∂u and ∂p/∂v: how the surface moves with its (u, v), for bumps.
+#if TANGENTS
+    // ∂p/∂u and ∂p/∂v: how the surface moves with its (u, v), for bumps
+    // and footprints.
     dp_du: vec3f,
     dp_dv: vec3f,
 #endif
@@ -138,7 +139,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #if TEXTURE_UV
         hit.uv = sphere_uv(dir);
 #endif
-#if BUMP
+#if TANGENTS
         // Lat-long about +y: u turns around the axis (2π r per unit), v
         // climbs from pole to pole (π r per unit). Zero at the poles, where
         // bumped_normal keeps the plain normal.
@@ -164,7 +165,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #if TEXTURE_UV
                 hit.uv = cylinder_uv(local, c.height);
 #endif
-#if BUMP
+#if TANGENTS
                 hit.dp_du = TWO_PI * c.radius * vec3f(hit.n.z, 0.0, -hit.n.x);
                 hit.dp_dv = vec3f(0.0, c.height, 0.0);
 #endif
@@ -174,7 +175,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #if TEXTURE_UV
                 hit.uv = 0.5 + 0.5 * ring;
 #endif
-#if BUMP
+#if TANGENTS
                 hit.dp_du = vec3f(2.0 * c.radius, 0.0, 0.0);
                 hit.dp_dv = vec3f(0.0, 0.0, 2.0 * c.radius);
 #endif
@@ -197,7 +198,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #if TEXTURE_UV
             hit.uv = plane_uv(hit.p, poly.uv_origin, poly.uv_u, poly.uv_v);
 #endif
-#if BUMP
+#if TANGENTS
             hit.dp_du = poly.uv_u;
             hit.dp_dv = poly.uv_v;
 #endif
@@ -214,7 +215,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.n = vec3f(0.0, 1.0, 0.0);
             hit.texture_point = vec3f(hit.p.x, 0.0, hit.p.z);
             hit.uv = vec2f(hit.p.x, hit.p.z);
-#if BUMP
+#if TANGENTS
             hit.dp_du = vec3f(1.0, 0.0, 0.0);
             hit.dp_dv = vec3f(0.0, 0.0, 1.0);
 #endif

@@ -3,7 +3,8 @@
 
 struct Harness {
     noise: NoiseParams,
-    mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged
+    mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged,
+                          // 7 footprint octaves
     count: u32,
     param: f32,           // marble stripe frequency, or rotation in radians
     _pad: f32,
@@ -40,6 +41,9 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         }
         case 6u: {
             r.x = ridged(p, n);
+        }
+        case 7u: {
+            r.x = footprint_octaves(n, harness.param);
         }
         default: {
             r = vec4f(rotate_y(p, harness.param), 0.0);

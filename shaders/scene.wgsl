@@ -27,6 +27,8 @@ struct Frame {
     has_ground: u32,
     cylinder_count: u32,
     polygon_count: u32,
+    // The angle a pixel subtends at the camera: the spread of ray cones.
+    pixel_spread: f32,
 }
 
 const MAX_SIGNALS: u32 = 4u;

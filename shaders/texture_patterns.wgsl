@@ -29,9 +29,18 @@ fn checker_3d(p: vec3f, size: vec3f) -> f32 {
     let c = floor(p / size);
     return odd(c.x + c.y + c.z);
 }
+
+// The 3D checker box-filtered over p ± half_width: the XOR of three square
+// waves is odd with probability (1 - Π(1 - 2s)) / 2.
+fn filtered_checker_3d(p: vec3f, size: vec3f, half_width: f32) -> f32 {
+    let q = p / size;
+    let w = vec3f(half_width) / size;
+    let s = vec3f(odd_fraction(q.x, w.x), odd_fraction(q.y, w.y), odd_fraction(q.z, w.z));
+    return 0.5 * (1.0 - (1.0 - 2.0 * s.x) * (1.0 - 2.0 * s.y) * (1.0 - 2.0 * s.z));
+}
 #endif
 
-#if PATTERN_CHECKER_2D
+#if PATTERN_CHECKER_2D || PATTERN_CHECKER
 // How much of [0, x] lies in odd unit cells.
 fn odd_measure(x: f32) -> f32 {
     let half = floor(x * 0.5);
@@ -44,6 +53,9 @@ fn odd_fraction(x: f32, w: f32) -> f32 {
     }
     return (odd_measure(x + w) - odd_measure(x - w)) / (2.0 * w);
 }
+#endif
+
+#if PATTERN_CHECKER_2D
 
 // The checker box-filtered over uv ± half_width, in closed form.
 fn filtered_checker_2d(uv: vec2f, size: vec2f, phase: f32, half_width: vec2f) -> f32 {

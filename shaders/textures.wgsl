@@ -18,26 +18,67 @@ struct SurfaceTextures {
     emission: vec3f,
 }
 
+// How much of the surface a sample stands for: the ray cone's width on the
+// surface, in 3D units (`p`) and in (u, v) along each axis (`uv`). Zero
+// without the FOOTPRINT feature: textures are then point sampled.
+struct Footprint {
+    uv: vec2f,
+    p: f32,
+}
+
+// A cone `width` wide meeting the surface along `d` covers an ellipse: `w`
+// across the plane of incidence and `w / cos θ` along it. Its extent along
+// each tangent axis (∂p/∂u, ∂p/∂v), divided by how far the surface moves
+// per unit of u and of v, is the footprint in (u, v); the 3D footprint is
+// the long axis (pbrt's choice for noise: never too little blur).
+fn hit_footprint(hit: Hit, width: f32, d: vec3f) -> Footprint {
+#if FOOTPRINT
+    let cos_theta = max(abs(dot(d, hit.n)), 1e-4);
+    let along = d - dot(d, hit.n) * hit.n;
+    let along_len = length(along);
+    let m = select(vec3f(0.0), along / along_len, along_len > 0.0);
+    let stretch = 1.0 / (cos_theta * cos_theta) - 1.0;
+    let per_uv = vec2f(length(hit.dp_du), length(hit.dp_dv));
+    let e_u = dot(hit.dp_du, m) / max(per_uv.x, 1e-30);
+    let e_v = dot(hit.dp_dv, m) / max(per_uv.y, 1e-30);
+    let extent = width * sqrt(1.0 + vec2f(e_u * e_u, e_v * e_v) * stretch);
+    let uv = select(vec2f(0.0), extent / per_uv, per_uv > vec2f(0.0));
+    return Footprint(uv, width / cos_theta);
+#else
+    return Footprint(vec2f(0.0), 0.0);
+#endif
+}
+
 #if NOISE
 // The material's signals, ordered by kind on the CPU: gradient noise ones
 // first, then Perlin ones from `first_perlin` on. Each kind's loop holds only
 // its own noise, so a hit pays for Perlin octaves only where some lane reads
 // a Perlin signal.
-fn material_signals(material: u32, p: vec3f, pw: vec3f) -> vec4f {
+fn material_signals(material: u32, p: vec3f, pw: vec3f, width: f32) -> vec4f {
     var values = vec4f(0.0);
     let count = min(materials[material].signal_count, MAX_SIGNALS);
     let first_perlin = min(materials[material].first_perlin, count);
 #if NOISE_GRADIENT
     for (var k = 0u; k < first_perlin; k++) {
-        values[k] = fractal_sum_gradient(signal_point(material, k, p, pw), materials[material].signals[k]);
+        values[k] = fractal_sum_gradient(signal_point(material, k, p, pw), signal_params(material, k, width));
     }
 #endif
 #if NOISE_PERLIN
     for (var k = first_perlin; k < count; k++) {
-        values[k] = fractal_sum_perlin(signal_point(material, k, p, pw), materials[material].signals[k]);
+        values[k] = fractal_sum_perlin(signal_point(material, k, p, pw), signal_params(material, k, width));
     }
 #endif
     return values;
+}
+
+// Signal k's noise, its octaves clamped to what a footprint `width` wide
+// resolves (CLAMP_OCTAVES; twin of noise::footprint_octaves).
+fn signal_params(material: u32, k: u32, width: f32) -> NoiseParams {
+    var n = materials[material].signals[k];
+#if CLAMP_OCTAVES
+    n.octaves = footprint_octaves(n, width * n.footprint_scale);
+#endif
+    return n;
 }
 
 // Where signal k of a material is taken: its mapping of the object point p

@@ -84,9 +84,15 @@ fn trace_path(pixel: vec2f) -> vec3f {
     var bounces = 0u;
     // Surfaces passed straight through (where opacity < 1).
     var crossings = 0u;
+    // The ray cone's width where the current ray starts: it grows by the
+    // pixel's spread per unit of distance, bounce after bounce (no
+    // curvature term, so a mirror keeps it as the camera made it).
+    var cone_width = 0.0;
     if hit.t < NO_HIT && frame.max_bounces > 0u {
         loop {
-            let s = surface_at(hit);
+            let width = cone_width + frame.pixel_spread * hit.t;
+            cone_width = width;
+            let s = surface_at(hit, width, d);
             let wo = -d;
 #if OPACITY
             // Draws only where the surface has holes, so an opaque scene

@@ -127,6 +127,36 @@ fn domain_warped_sums_match_the_cpu() {
     }
 }
 
+/// The footprint rule for octaves agrees with the CPU for footprints from
+/// 1e-6 to 10 and lacunarities from 1 to 4 (the points carry neither; one
+/// evaluation per setting).
+#[test]
+fn footprint_octaves_match_the_cpu() {
+    let Some(ctx) = gpu_or_skip("footprint_octaves_match_the_cpu") else {
+        return;
+    };
+    for lacunarity in [1.0, 1.7, 2.0, 4.0] {
+        for k in 0..36 {
+            let width = 1e-6 * 10f32.powf(k as f32 / 5.0);
+            let mut s = settings(NoiseKind::Gradient, HashKind::Pcg);
+            s.fractal.lacunarity = lacunarity;
+            s.fractal.octaves = 9.5;
+            let gpu = evaluate_scalar(
+                &ctx,
+                &s,
+                Evaluate::FootprintOctaves { width },
+                &[Vec3::ZERO],
+            )
+            .unwrap()[0];
+            let cpu = noise::footprint_octaves(&s.fractal, width);
+            assert!(
+                (gpu - cpu).abs() < 1e-4,
+                "lacunarity {lacunarity}, width {width}: gpu {gpu}, cpu {cpu}"
+            );
+        }
+    }
+}
+
 /// GPU Perlin noise equals Perlin's f64 reference to 1e-4 for |p| ≤ 100.
 #[test]
 // Perlin's published point is x = 3.14, not π.

@@ -138,6 +138,25 @@ fn boards_match_the_cpu() {
         },
         |p| off_integer(p.y / size.y) < 1e-4,
     );
+
+    let (size3, w3) = (Vec3::new(0.5, 0.7, 0.3), 0.11);
+    let gpu = evaluate(
+        &ctx,
+        &PatternQuery::FilteredChecker3d {
+            size: size3,
+            half_width: w3,
+        },
+        &pts,
+    )
+    .unwrap();
+    assert_parity(
+        "filtered 3D checker",
+        &gpu,
+        &pts,
+        1e-4,
+        |p| [texture::filtered_checker_3d(p, size3, w3), 0.0, 0.0, 0.0],
+        |_| false,
+    );
 }
 
 #[test]

@@ -2,6 +2,7 @@
 
 use crate::noise::{HashKind, NoiseKind, NoiseSettings};
 use crate::scene::{EnvSource, Material, Pattern, Scene};
+use crate::texture::ImageFilter;
 use std::collections::BTreeSet;
 
 /// One piece of shader code that can be compiled out.
@@ -28,6 +29,8 @@ pub enum Feature {
     PatternMix,
     Image,
     Bump,
+    Footprint,
+    OctaveClamping,
     Opacity,
     Emission,
     NoiseWarp,
@@ -38,7 +41,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 28] = [
+    pub const ALL: [Feature; 30] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -60,6 +63,8 @@ impl Feature {
         Feature::PatternMix,
         Feature::Image,
         Feature::Bump,
+        Feature::Footprint,
+        Feature::OctaveClamping,
         Feature::Opacity,
         Feature::Emission,
         Feature::NoiseWarp,
@@ -108,6 +113,8 @@ impl Feature {
             Feature::PatternMix => "PATTERN_MIX",
             Feature::Image => "IMAGE",
             Feature::Bump => "BUMP",
+            Feature::Footprint => "FOOTPRINT",
+            Feature::OctaveClamping => "CLAMP_OCTAVES",
             Feature::Opacity => "OPACITY",
             Feature::Emission => "EMISSION",
             Feature::NoiseWarp => "NOISE_WARP",
@@ -154,6 +161,11 @@ impl FeatureSet {
         if uv_patterns.iter().any(|&f| self.contains(f)) {
             names.insert("TEXTURE_UV");
         }
+        // ∂p/∂u and ∂p/∂v: bump tilts the normal along them, footprints
+        // convert a cone's width into (u, v) with them.
+        if self.contains(Feature::Bump) || self.contains(Feature::Footprint) {
+            names.insert("TANGENTS");
+        }
         names
     }
 
@@ -181,8 +193,30 @@ impl FeatureSet {
                 set.insert(Feature::EnvMap);
             }
         }
-        for pattern in scene.materials().flat_map(|m| m.patterns()) {
+        let patterns: Vec<&Pattern> = scene.materials().flat_map(|m| m.patterns()).collect();
+        for pattern in &patterns {
             set.extend(pattern_features(pattern));
+        }
+        let render = &scene.render;
+        let filtered_checker = render.filter_checkers
+            && patterns
+                .iter()
+                .any(|p| matches!(p, Pattern::Checker { .. } | Pattern::Checker2d { .. }));
+        let clamped_noise = render.clamp_octaves && patterns.iter().any(|p| p.noise().is_some());
+        let mipmapped = patterns.iter().any(|p| {
+            matches!(
+                p,
+                Pattern::Image {
+                    filter: ImageFilter::Trilinear,
+                    ..
+                }
+            )
+        });
+        if filtered_checker || clamped_noise || mipmapped {
+            set.insert(Feature::Footprint);
+        }
+        if clamped_noise {
+            set.insert(Feature::OctaveClamping);
         }
         for (used, feature) in [
             (Material::has_bump as fn(&Material) -> bool, Feature::Bump),
@@ -199,6 +233,14 @@ impl FeatureSet {
     /// For the noise harness: exactly what evaluating `noise` needs.
     pub fn for_noise(noise: &NoiseSettings) -> Self {
         Self(noise_features(noise).into_iter().collect())
+    }
+
+    /// For the noise harness: [`FeatureSet::for_noise`] and the footprint
+    /// rule for octaves.
+    pub fn for_noise_harness(noise: &NoiseSettings) -> Self {
+        let mut set = Self::for_noise(noise);
+        set.0.insert(Feature::OctaveClamping);
+        set
     }
 
     /// For the texture harness: every pattern of the texture library, and
@@ -291,6 +333,8 @@ mod tests {
         }
     }
 
+    /// Without octave clamping a marble needs its pattern and its noise;
+    /// with it (the default), the footprint too.
     #[test]
     fn a_perlin_marble_needs_marble_and_perlin_only() {
         let mut scene = Scene::default();
@@ -306,6 +350,9 @@ mod tests {
             ..Default::default()
         };
         scene.spheres.push(sphere);
+        let set = FeatureSet::for_scene(&scene);
+        assert!(set.contains(Feature::Footprint) && set.contains(Feature::OctaveClamping));
+        scene.render.clamp_octaves = false;
         let set = FeatureSet::for_scene(&scene);
         assert_eq!(
             set.0,

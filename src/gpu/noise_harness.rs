@@ -19,6 +19,10 @@ pub enum Evaluate {
     Fbm,
     Turbulence,
     Ridged,
+    /// The octaves a footprint `width` wide keeps (x only).
+    FootprintOctaves {
+        width: f32,
+    },
     Marble {
         stripe_frequency: f32,
     },
@@ -40,6 +44,7 @@ impl Evaluate {
             Evaluate::EnvUv => (4, 0.0),
             Evaluate::RotateY { angle } => (5, angle),
             Evaluate::Ridged => (6, 0.0),
+            Evaluate::FootprintOctaves { width } => (7, width),
         }
     }
 }
@@ -73,7 +78,7 @@ pub fn evaluate(
     compute_harness::run(
         ctx,
         Program::NoiseHarness,
-        &FeatureSet::for_noise(noise),
+        &FeatureSet::for_noise_harness(noise),
         bytemuck::bytes_of(&params),
         None,
         points,

@@ -1,6 +1,7 @@
 //! A minimal conditional-compilation pass for WGSL, which has none.
 //!
-//! Lines `#if NAME`, `#if !NAME`, `#else` and `#endif` (nestable) keep or drop
+//! Lines `#if NAME`, `#if !NAME`, `#if A || B`, `#else` and `#endif`
+//! (nestable) keep or drop
 //! the lines between them according to the set of enabled names. This is how
 //! the shader is specialised per scene: code for a feature the scene does not
 //! use never reaches the compiler.
@@ -33,11 +34,13 @@ pub fn preprocess(
         let trimmed = line.trim();
         let parent_kept = stack.iter().all(|&(_, kept)| kept);
         if let Some(cond) = trimmed.strip_prefix("#if ") {
-            let cond = cond.trim();
-            let value = match cond.strip_prefix('!') {
-                Some(name) => !enabled.contains(name.trim()),
-                None => enabled.contains(cond),
-            };
+            let value = cond.split("||").any(|term| {
+                let term = term.trim();
+                match term.strip_prefix('!') {
+                    Some(name) => !enabled.contains(name.trim()),
+                    None => enabled.contains(term),
+                }
+            });
             stack.push((number, value));
         } else if trimmed == "#else" || trimmed == "#endif" {
             let Some(top) = stack.last_mut() else {
@@ -78,6 +81,14 @@ mod tests {
             .split_whitespace()
             .collect::<Vec<_>>()
             .join(" ")
+    }
+
+    #[test]
+    fn an_or_keeps_the_block_if_any_name_is_enabled() {
+        let src = "#if A || B\nx\n#endif\n#if !A || C\ny\n#endif";
+        assert_eq!(run(src, &["B"]), "x y");
+        assert_eq!(run(src, &["A"]), "x");
+        assert_eq!(run(src, &[]), "y");
     }
 
     #[test]

@@ -36,7 +36,9 @@ pub struct FrameUniform {
     pub has_ground: u32,
     pub cylinder_count: u32,
     pub polygon_count: u32,
-    pub _pad: [u32; 2],
+    /// The angle a pixel subtends at the camera: the spread of ray cones.
+    pub pixel_spread: f32,
+    pub _pad: u32,
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -55,7 +57,9 @@ pub struct NoiseParamsGpu {
     pub distortion: f32,
     /// 1: the signal's mapping reads world coordinates, 0: object ones.
     pub world: u32,
-    pub _pad: [f32; 2],
+    /// How much the signal's mapping enlarges a footprint.
+    pub footprint_scale: f32,
+    pub _pad: f32,
 }
 
 impl NoiseParamsGpu {
@@ -72,7 +76,8 @@ impl NoiseParamsGpu {
             shape: shape.id(),
             distortion: f.distortion,
             world: 0,
-            _pad: [0.0; 2],
+            footprint_scale: 1.0,
+            _pad: 0.0,
         }
     }
 }
@@ -152,6 +157,7 @@ pub fn material(m: &Material) -> MaterialGpu {
         out.signals[k] = NoiseParamsGpu::new(&signal.noise, signal.shape);
         let mapping = signal.mapping.unwrap_or_default();
         out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
+        out.signals[k].footprint_scale = mapping.footprint_scale()[2];
         out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&mapping.rows());
     }
     out
@@ -278,7 +284,8 @@ pub fn frame_uniform(
         has_ground: u32::from(scene.ground.is_some()),
         cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
         polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
-        _pad: [0; 2],
+        pixel_spread: 2.0 * cam.tan_half_fov / h,
+        _pad: 0,
     }
 }
 

@@ -43,6 +43,7 @@ pub struct GeneratedTextures {
 pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     let mut generator = Generator {
         images,
+        filter_checkers: scene.render.filter_checkers,
         code: String::new(),
         params: Vec::new(),
         next: 0,
@@ -67,7 +68,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
             generator.function(&name, &material.bump, &material_signals(material));
             writeln!(
                 heights,
-                "        case {index}u: {{\n            return {name}(p, pw, uv, signals).x;\n        }}"
+                "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals).x;\n        }}"
             )?;
         }
     }
@@ -81,7 +82,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     wgsl.push_str(&generator.code);
     write!(
         wgsl,
-        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
     )?;
     // Shadow rays read opacity alone; they evaluate the noise signals only
     // if some opacity texture reads one.
@@ -103,7 +104,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     };
     write!(
         wgsl,
-        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
+        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0);\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
     )?;
     let bump_reads_noise = scene
         .materials()
@@ -118,7 +119,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     // uber shader) builds for any scene.
     write!(
         wgsl,
-        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
+        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
     )?;
     let mut params = generator.params;
     params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
@@ -147,6 +148,8 @@ pub fn material_signals(material: &Material) -> Vec<Signal> {
 struct Site {
     p: String,
     uv: String,
+    /// A `Footprint`: the sample's extent around `p` and `uv`.
+    footprint: String,
     mapping: Option<TextureMapping>,
 }
 
@@ -160,6 +163,8 @@ struct MaterialCases {
 struct Generator<'a> {
     /// Where each image lies in the atlas (image nodes read it).
     images: &'a ImageSet,
+    /// Checkers are box-filtered over the footprint (`filter_checkers`).
+    filter_checkers: bool,
     code: String,
     params: Vec<[f32; 4]>,
     /// Numbers the local variables of the function being generated.
@@ -178,7 +183,7 @@ impl Generator<'_> {
             let name = format!("texture_{index}_layer{l}_mask");
             self.function(&name, &layer.mask, &signals);
             masks.push(format!(
-                "            let mask{l} = clamp({name}(p, pw, uv, signals).x, 0.0, 1.0);\n"
+                "            let mask{l} = clamp({name}(p, pw, uv, fp, signals).x, 0.0, 1.0);\n"
             ));
         }
         let mut cases = MaterialCases {
@@ -189,7 +194,8 @@ impl Generator<'_> {
             let value = property.name();
             let name = format!("texture_{index}_{value}");
             self.function(&name, material.texture(property), &signals);
-            let mut statements = format!("            var {value} = {name}(p, pw, uv, signals);\n");
+            let mut statements =
+                format!("            var {value} = {name}(p, pw, uv, fp, signals);\n");
             let mut masks_read = String::new();
             for (l, layer) in material.layers.iter().enumerate() {
                 if let Some(texture) = layer.texture(property) {
@@ -197,7 +203,7 @@ impl Generator<'_> {
                     self.function(&name, texture, &signals);
                     let _ = writeln!(
                         statements,
-                        "            {value} = mix({value}, {name}(p, pw, uv, signals), mask{l});"
+                        "            {value} = mix({value}, {name}(p, pw, uv, fp, signals), mask{l});"
                     );
                     masks_read.push_str(&masks[l]);
                 }
@@ -221,12 +227,13 @@ impl Generator<'_> {
         let site = Site {
             p: "p".into(),
             uv: "uv".into(),
+            footprint: "fp".into(),
             mapping: None,
         };
         let value = self.texture(texture, &site, signals, &mut body);
         let _ = write!(
             self.code,
-            "fn {name}(p: vec3f, pw: vec3f, uv: vec2f, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
+            "fn {name}(p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
         );
     }
 
@@ -286,8 +293,12 @@ impl Generator<'_> {
             Some(rect) => {
                 let rect = self.param(rect);
                 let modes = self.param([filter.id() as f32, wrap.id() as f32, 0.0, 0.0]);
+                // The level whose texels are as wide as the footprint.
+                let fp = &site.footprint;
+                let lod =
+                    format!("log2(max(max({fp}.uv.x * {rect}.z, {fp}.uv.y * {rect}.w), 1e-8))");
                 format!(
-                    "image_sample({rect}, {}, u32({modes}.x), u32({modes}.y), 0.0).xyz",
+                    "image_sample({rect}, {}, u32({modes}.x), u32({modes}.y), {lod}).xyz",
                     site.uv
                 )
             }
@@ -325,13 +336,16 @@ impl Generator<'_> {
                     MappingSpace::Object => "p",
                     MappingSpace::World => "pw",
                 };
+                let [su, sv, s3] = mapping.footprint_scale();
+                let scale = self.param([su, sv, s3, 0.0]);
                 let _ = writeln!(
                     body,
-                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;"
+                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z);"
                 );
                 mapped = Site {
                     p: format!("p{k}"),
                     uv: format!("uv{k}"),
+                    footprint: format!("fp{k}"),
                     mapping: Some(*mapping),
                 };
                 &mapped
@@ -380,7 +394,7 @@ impl Generator<'_> {
         if let Pattern::Image { filter, wrap } = texture.pattern {
             return self.image(texture, k, filter, wrap, site, body);
         }
-        let (p, uv) = (site.p.as_str(), site.uv.as_str());
+        let (p, uv, fp) = (site.p.as_str(), site.uv.as_str(), site.footprint.as_str());
         let signal = texture
             .pattern
             .signal()
@@ -391,11 +405,16 @@ impl Generator<'_> {
             .and_then(|s| signals.iter().position(|x| *x == s))
             .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
         let mut child_uv = uv.to_string();
+        let mut child_footprint = fp.to_string();
         let t = match texture.pattern {
             Pattern::Constant => "0.0".to_string(),
             Pattern::Checker { size } => {
                 let q = self.param([size, size, size, 0.0]);
-                format!("checker_3d({p}, {q}.xyz)")
+                if self.filter_checkers {
+                    format!("filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.p)")
+                } else {
+                    format!("checker_3d({p}, {q}.xyz)")
+                }
             }
             Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
             Pattern::Turbulence { .. } | Pattern::Ridged { .. } => {
@@ -419,7 +438,12 @@ impl Generator<'_> {
                 let q = self.param([size.x, size.y, phase, 0.0]);
                 let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
                 child_uv = format!("cell{k}.local");
-                format!("cell{k}.select")
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p)");
+                if self.filter_checkers {
+                    format!("filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv)")
+                } else {
+                    format!("cell{k}.select")
+                }
             }
             Pattern::Brick {
                 size,
@@ -429,6 +453,7 @@ impl Generator<'_> {
                 let q = self.param([size.x, size.y, mortar, row_offset]);
                 let _ = writeln!(body, "    let cell{k} = brick({uv}, {q}.xy, {q}.z, {q}.w);");
                 child_uv = format!("cell{k}.local");
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p)");
                 format!("cell{k}.select")
             }
             Pattern::Tile {
@@ -472,6 +497,7 @@ impl Generator<'_> {
         }
         let child_site = Site {
             uv: child_uv,
+            footprint: child_footprint,
             ..site.clone()
         };
         let a = self.child(&texture.a, &child_site, signals, body);

@@ -30,6 +30,10 @@ pub enum PatternQuery {
         phase: f32,
         half_width: Vec2,
     },
+    FilteredChecker3d {
+        size: Vec3,
+        half_width: f32,
+    },
     /// Result: (select, local u, local v).
     Brick {
         size: Vec2,
@@ -144,6 +148,10 @@ impl PatternQuery {
                 u.mode = 2;
                 u.a = v2(*size, *phase, 0.0);
                 u.b = v2(*half_width, 0.0, 0.0);
+            }
+            PatternQuery::FilteredChecker3d { size, half_width } => {
+                u.mode = 17;
+                u.a = v3(*size, *half_width);
             }
             PatternQuery::Brick {
                 size,

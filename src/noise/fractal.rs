@@ -123,6 +123,23 @@ pub fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: FractalShape) -> f32 {
     sum
 }
 
+/// How many octaves a pixel footprint `width` wide (in the noise's space)
+/// resolves, pbrt's rule generalised to any lacunarity L: octave i, of
+/// frequency f·Lⁱ, is kept while its period is more than two footprints
+/// (f·Lⁱ·width < 1/2), so n = (−1 − log2(f·width)) / log2(L); the last, partial
+/// octave fades in by smoothstep(0.3, 0.7) of its fraction. Never more than
+/// `octaves`; a zero width (no footprint) or L ≤ 1 keeps them all.
+pub fn footprint_octaves(f: &FractalParams, width: f32) -> f32 {
+    let octaves = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES);
+    if !(width > 0.0 && f.lacunarity > 1.0 && f.frequency > 0.0) {
+        return octaves;
+    }
+    let n = ((-1.0 - (f.frequency * width).log2()) / f.lacunarity.log2()).max(0.0);
+    let whole = n.floor();
+    let x = ((n - whole - 0.3) / 0.4).clamp(0.0, 1.0);
+    (whole + x * x * (3.0 - 2.0 * x)).min(octaves)
+}
+
 /// Fractional Brownian motion: a sum of octaves of signed noise.
 pub fn fbm(p: Vec3, s: &NoiseSettings) -> f32 {
     fractal_sum(p, s, FractalShape::Signed)
@@ -164,6 +181,34 @@ mod tests {
             let k = k as f32;
             Vec3::new(k * 0.37, k * 0.11 - 20.0, 3.0 - k * 0.053)
         })
+    }
+
+    /// The footprint rule: a footprint of half the first octave's period
+    /// keeps no octave, each halving of it one more, fading in between;
+    /// no footprint keeps them all.
+    #[test]
+    fn footprint_octaves_follow_the_nyquist_rule() {
+        let f = FractalParams {
+            octaves: 8.0,
+            frequency: 2.0,
+            lacunarity: 2.0,
+            ..FractalParams::default()
+        };
+        assert_eq!(footprint_octaves(&f, 0.0), 8.0);
+        assert_eq!(footprint_octaves(&f, 0.25), 0.0);
+        assert_eq!(footprint_octaves(&f, 0.125), 1.0);
+        assert_eq!(footprint_octaves(&f, 0.25 / 8.0), 3.0);
+        assert_eq!(footprint_octaves(&f, 1e-9), 8.0);
+        // Between whole counts, the partial octave fades in smoothly.
+        let mid = footprint_octaves(&f, 0.25 / 2f32.powf(2.5));
+        assert!((mid - 2.5).abs() < 1e-4, "{mid}");
+        let early = footprint_octaves(&f, 0.25 / 2f32.powf(2.2));
+        assert_eq!(early, 2.0);
+        let three = FractalParams {
+            lacunarity: 3.0,
+            ..f
+        };
+        assert!((footprint_octaves(&three, 0.25 / 9.0) - 2.0).abs() < 1e-4);
     }
 
     /// One octave of ridged noise is `(1 - |noise|)²`, in [0, 1], and

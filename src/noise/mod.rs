@@ -12,8 +12,8 @@ pub mod hash;
 pub mod perlin;
 
 pub use fractal::{
-    FractalParams, FractalShape, NoiseSettings, fbm, fractal_sum, marble, noise, ridged,
-    turbulence, warped,
+    FractalParams, FractalShape, NoiseSettings, fbm, footprint_octaves, fractal_sum, marble, noise,
+    ridged, turbulence, warped,
 };
 pub use gradient::gradient_noise;
 pub use hash::HashKind;

@@ -460,6 +460,12 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         "max bounces",
     ))
     .on_hover_text("1 is direct light only; each more adds one reflection");
+    ui.checkbox(&mut render.filter_checkers, "filter checkers")
+        .on_hover_text(
+            "Average checkerboards over each ray's footprint (closed form): no aliasing far away",
+        );
+    ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
+        .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
     if ui
         .button("Screenshot (F12)")
         .on_hover_text("Save the current image as a PNG")

@@ -159,6 +159,23 @@ impl TextureMapping {
             .truncate()
     }
 
+    /// How much the map enlarges a footprint: along u, along v (the map
+    /// of (u, v, 0)) and in 3D, each the longest image of a unit vector
+    /// among the axes (a bound that never under-filters a uniform scale).
+    pub fn footprint_scale(&self) -> [f32; 3] {
+        let l = self.transform.to_texture().matrix3;
+        let (x, y, z) = (
+            Vec3::from(l.x_axis),
+            Vec3::from(l.y_axis),
+            Vec3::from(l.z_axis),
+        );
+        [
+            x.truncate().length(),
+            y.truncate().length(),
+            x.length().max(y.length()).max(z.length()),
+        ]
+    }
+
     /// The three rows of the affine map, as the shader reads them:
     /// `p' = (dot(r0.xyz, p) + r0.w, …)`.
     pub fn rows(&self) -> [[f32; 4]; 3] {

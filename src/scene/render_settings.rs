@@ -41,6 +41,12 @@ pub struct RenderSettings {
     /// Path length: 1 is direct light only (point light and environment),
     /// each more bounce adds one more reflection.
     pub max_bounces: u32,
+    /// Checkerboards averaged over each ray's footprint in closed form,
+    /// rather than point sampled (which aliases far away).
+    pub filter_checkers: bool,
+    /// Fractal sums stop at the octaves the footprint resolves (pbrt's
+    /// rule), rather than summing detail finer than a pixel.
+    pub clamp_octaves: bool,
 }
 
 impl RenderSettings {
@@ -92,6 +98,8 @@ impl Default for RenderSettings {
             tone_map: ToneMap::Aces,
             interactive_scale: 0.5,
             max_bounces: 3,
+            filter_checkers: true,
+            clamp_octaves: true,
         }
     }
 }

@@ -26,7 +26,7 @@ pub use self::image::{
 };
 pub use brick::{TileSample, brick, brick_mortar_fraction, tile, tile_height};
 pub use bump::bumped_normal;
-pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d};
+pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d, filtered_checker_3d};
 pub use cutout::{cutout, cutout_area};
 pub use image_set::{ImageSet, ImageSource};
 pub use mapping::{TextureTransform, cylinder_uv, plane_uv, polygon_frame, sphere_uv, triangle_uv};

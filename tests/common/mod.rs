@@ -5,7 +5,7 @@
 use glam::{Vec2, Vec3};
 use marbre::commands::session::accumulate;
 use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{EnvSource, Ground, Material, Scene, Texture};
+use marbre::scene::{EnvSource, Ground, Material, RenderSettings, Scene, Texture};
 
 pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
     render_with(ctx, scene, size, spp, None)
@@ -49,6 +49,17 @@ pub fn lambert(albedo: f32) -> Material {
     }
 }
 
+/// Render settings whose textures are point sampled, as the CPU reference
+/// (`Texture::eval`) samples them: no footprint filtering of checkers, no
+/// clamping of octaves.
+pub fn point_sampled() -> RenderSettings {
+    RenderSettings {
+        filter_checkers: false,
+        clamp_octaves: false,
+        ..RenderSettings::default()
+    }
+}
+
 /// The camera ray through image point `at` (in pixels), as (origin, unit
 /// direction): the shader's `camera_ray`, on the CPU.
 pub fn camera_ray(scene: &Scene, (w, h): (u32, u32), at: Vec2) -> (Vec3, Vec3) {
@@ -80,6 +91,7 @@ pub fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
                 ..lambert(0.5)
             },
         }),
+        render: point_sampled(),
         ..Scene::default()
     };
     scene.environment.source = EnvSource::Constant {
