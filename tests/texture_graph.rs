@@ -668,3 +668,105 @@ fn footprint_filtering_brings_one_sample_near_the_supersampled_image() {
         }
     }
 }
+
+/// A structural edit builds its shader off the render thread: until the
+/// build is done the renderer keeps the old pipeline and draws the old
+/// scene; then it installs the new one. An edit the code generator refuses
+/// (more texture parameters than the renderer holds) leaves everything as
+/// it was and says why.
+#[test]
+fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
+    let Some(ctx) =
+        gpu_or_skip("structural_edits_build_in_the_background_and_keep_the_old_pipeline")
+    else {
+        return;
+    };
+    let red = Vec3::new(0.8, 0.1, 0.1);
+    let mut scene = textured_ground_in_white_light(Texture::color(red));
+    scene.camera = OrbitCamera {
+        target: Vec3::new(1.0, 0.0, 1.0),
+        distance: 2.0,
+        yaw_degrees: 0.0,
+        pitch_degrees: 89.0,
+        fov_degrees: 10.0,
+    };
+    let size = (16, 16);
+    let mut renderer = marbre::gpu::Renderer::new(&ctx, &scene, None, size).unwrap();
+    let before = renderer.features().clone();
+
+    let mut edited = scene.clone();
+    edited.ground.as_mut().unwrap().material.diffuse = Texture::blend(
+        Pattern::Checker2d {
+            size: Vec2::splat(1000.0),
+            phase: 0.0,
+        },
+        Vec3::new(0.1, 0.8, 0.1),
+        Vec3::new(0.1, 0.1, 0.8),
+    );
+    renderer.request_scene(&ctx, &edited).unwrap();
+    assert!(renderer.is_building());
+    // Meanwhile: the old pipeline, the old scene.
+    assert_eq!(renderer.features(), &before);
+    assert_eq!(renderer.scene(), &scene);
+    marbre::commands::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
+    let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
+    assert!((pixels[0][0] - red.x).abs() < 1e-3, "{:?}", pixels[0]);
+
+    let started = std::time::Instant::now();
+    let took = loop {
+        if let Some(result) = renderer.poll_build(&ctx) {
+            break result.unwrap();
+        }
+        assert!(started.elapsed().as_secs() < 60, "the build never finished");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    eprintln!("background shader build: {took:?}");
+    assert!(!renderer.is_building());
+    assert!(
+        renderer
+            .features()
+            .contains(marbre::gpu::Feature::PatternChecker2d)
+    );
+    assert_eq!(renderer.scene(), &edited);
+    let first_frame = std::time::Instant::now();
+    marbre::commands::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
+    eprintln!(
+        "first frame with the new pipeline: {:?}",
+        first_frame.elapsed()
+    );
+    let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
+    assert!((pixels[0][1] - 0.8).abs() < 1e-3, "{:?}", pixels[0]);
+
+    // Refused: 300 ramps of 8 stops need 2,400 parameter slots.
+    let mut huge = edited.clone();
+    let mut ramped = Texture::blend(
+        Pattern::Waves {
+            frequency: 1.0,
+            direction: Vec2::X,
+        },
+        0.0,
+        1.0,
+    );
+    ramped.ramp = (0..8)
+        .map(|i| marbre::texture::RampStop {
+            position: i as f32 / 7.0,
+            color: Vec3::splat(i as f32 / 7.0),
+        })
+        .collect();
+    let mut layers = Vec::new();
+    for i in 0..300 {
+        layers.push(Layer {
+            name: format!("layer {i}"),
+            mask: ramped.clone(),
+            ..Layer::default()
+        });
+    }
+    huge.ground.as_mut().unwrap().material.layers = layers;
+    let error = renderer.request_scene(&ctx, &huge).unwrap_err();
+    assert!(
+        format!("{error:#}").contains("parameter slots"),
+        "{error:#}"
+    );
+    assert!(!renderer.is_building());
+    assert_eq!(renderer.scene(), &edited);
+}

@@ -319,6 +319,8 @@ impl Viewer {
                 .map(|f| format!("{f:?}"))
                 .collect(),
             shader_bytes: self.renderer.trace_shader_bytes(),
+            building: self.renderer.is_building(),
+            last_build_ms: self.renderer.last_build().map(|d| d.as_secs_f32() * 1000.0),
             resolution: self.renderer.render_size(),
         }
     }
@@ -388,10 +390,18 @@ impl Viewer {
             self.scene.environment.source = self.renderer.scene().environment.source.clone();
             self.load_environment(&path);
         }
+        // Structural edits build their shader off this thread: the old one
+        // keeps rendering until the new one is ready.
         if self.scene != *self.renderer.scene()
-            && let Err(e) = self.renderer.set_scene(&self.ctx, &self.scene)
+            && let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene)
         {
             // Keep what is on screen; show why the edit was refused.
+            self.panel.error(format!("{e:#}"));
+            self.scene = self.renderer.scene().clone();
+        }
+        if let Some(Err(e)) = self.renderer.poll_build(&self.ctx) {
+            // The shader failed to build: the old one stays, and so does
+            // the scene it renders.
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.scene().clone();
         }

@@ -61,6 +61,34 @@ impl GpuContext {
         })
     }
 
+    /// A second device on the same adapter, with the same features and
+    /// limits: somewhere to compile shaders without holding up this
+    /// device's queue (see `gpu::pipeline_build`).
+    pub fn sibling(&self) -> Result<Self> {
+        let (device, queue) =
+            pollster::block_on(self.adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("marbre shader warm-up"),
+                required_features: self.device.features(),
+                required_limits: self.device.limits(),
+                ..Default::default()
+            }))
+            .context("the adapter refused a second device")?;
+        Ok(Self {
+            instance: self.instance.clone(),
+            adapter: self.adapter.clone(),
+            device,
+            queue,
+            timestamps: self.timestamps,
+        })
+    }
+
+    /// Whether the adapter is a CPU implementation (lavapipe, WARP), whose
+    /// shader compiler runs at the first draw rather than at pipeline
+    /// creation.
+    pub fn is_cpu(&self) -> bool {
+        self.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
     /// "name (backend)", as shown in the stats panel and benchmark tables.
     pub fn describe(&self) -> String {
         let info = self.adapter.get_info();

@@ -7,6 +7,7 @@ pub mod features;
 pub mod geometry_buffers;
 pub mod noise_harness;
 pub mod pass_timer;
+pub mod pipeline_build;
 pub mod pipelines;
 pub mod preprocess;
 pub mod readback;

@@ -5,6 +5,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
+use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
     uniform, upload_atlas, upload_rgba16f,
@@ -19,6 +20,8 @@ use crate::texture::ImageSet;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::Duration;
 use wgpu::util::DeviceExt;
 
 pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -51,8 +54,28 @@ struct Accumulation {
     latest: usize,
 }
 
+/// A scene waiting for its pipeline: what to write into the buffers once
+/// the pipeline is in place (the texture parameters if they changed).
+struct Target {
+    scene: Scene,
+    params: Option<Vec<[f32; 4]>>,
+}
+
+/// A pipeline build under way, with the key it is built for.
+struct PendingScene {
+    build: PipelineBuild,
+    features: FeatureSet,
+    code: String,
+    target: Target,
+}
+
 pub struct Renderer {
     scene: Scene,
+    /// A structural edit whose pipeline is being built.
+    pending: Option<PendingScene>,
+    /// The device that warms the shader cache for builds (CPU adapters).
+    warm_up: Option<Arc<GpuContext>>,
+    last_build: Option<Duration>,
     features: FeatureSet,
     /// When set, the shader is built with these features whatever the scene
     /// uses: `FeatureSet::all()` is the uber shader the benchmarks compare.
@@ -119,7 +142,7 @@ impl Renderer {
         let images = ImageSet::empty();
         let textures = texture_codegen::generate(scene, &images)?;
         let (trace_pipeline, trace_shader_bytes) =
-            Self::build_trace_pipeline(ctx, &trace_layout, &features, &textures.wgsl)?;
+            Self::build_trace_pipeline(&ctx.device, &trace_layout, &features, &textures.wgsl)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -163,6 +186,9 @@ impl Renderer {
         let accumulation = create_accumulation(device, size);
         Ok(Self {
             scene: scene.clone(),
+            pending: None,
+            warm_up: None,
+            last_build: None,
             features,
             feature_override: None,
             trace_layout,
@@ -191,16 +217,16 @@ impl Renderer {
 
     /// The trace pipeline, and the size of its WGSL.
     fn build_trace_pipeline(
-        ctx: &GpuContext,
+        device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         features: &FeatureSet,
         texture_code: &str,
     ) -> Result<(wgpu::RenderPipeline, usize)> {
         let source = assemble(Program::Trace, features, texture_code)?;
         let bytes = source.len();
-        let module = compile_wgsl(&ctx.device, Program::Trace, source)?;
+        let module = compile_wgsl(device, Program::Trace, source)?;
         let pipeline = fullscreen_pipeline(
-            &ctx.device,
+            device,
             "trace",
             &module,
             layout,
@@ -238,36 +264,149 @@ impl Renderer {
         (s(self.size.0), s(self.size.1))
     }
 
-    /// Applies an edited scene. Parameter edits only rewrite buffers; an edit
-    /// that changes the feature set or the texture trees' structure rebuilds
-    /// the trace pipeline. If that build fails, the previous pipeline and
-    /// scene stay and the error is returned for display.
+    /// Applies an edited scene and waits for any shader it needs: for
+    /// headless renders and tests. If the build fails, the previous pipeline
+    /// and scene stay and the error is returned.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        // Waiting here, the first draw may as well compile on this device:
+        // no warm-up.
+        self.start_scene(ctx, scene, false)?;
+        match self.pending.take() {
+            Some(mut pending) => {
+                let built = pending.build.wait()?;
+                self.install(ctx, built, &mut pending);
+                Ok(())
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Applies an edited scene without waiting: for the viewer. Parameter
+    /// edits only rewrite buffers and show at the next frame. An edit that
+    /// changes the feature set or the texture trees' structure starts a
+    /// pipeline build on a worker thread; until [`Renderer::poll_build`]
+    /// reports it done, the old pipeline keeps rendering the old scene (with
+    /// the new camera). A later edit of the same structure joins that build.
+    pub fn request_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        self.start_scene(ctx, scene, true)
+    }
+
+    /// [`Renderer::request_scene`], warming the driver's shader cache on a
+    /// second device first if `warm_up` (and the adapter compiles at draw).
+    fn start_scene(&mut self, ctx: &GpuContext, scene: &Scene, warm_up: bool) -> Result<()> {
         let features = self
             .feature_override
             .clone()
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
+        let target_scene = self
+            .pending
+            .as_ref()
+            .map_or(&self.scene, |p| &p.target.scene);
         // Camera and light edits (every frame of a drag) leave the textures
-        // alone: regenerate them only when a material changed.
-        let textures = if self.scene.materials().eq(scene.materials()) {
+        // alone: regenerate them only when a material or a render switch
+        // the texture code reads changed.
+        let textures_unchanged = target_scene.materials().eq(scene.materials())
+            && target_scene.render.filter_checkers == scene.render.filter_checkers;
+        let textures = if textures_unchanged {
             None
         } else {
             Some(texture_codegen::generate(scene, &self.images)?)
         };
-        let code = textures.as_ref().map_or(&self.texture_code, |t| &t.wgsl);
-        if features != self.features || *code != self.texture_code {
-            (self.trace_pipeline, self.trace_shader_bytes) =
-                Self::build_trace_pipeline(ctx, &self.trace_layout, &features, code)?;
-            self.features = features;
+        let target = Target {
+            scene: scene.clone(),
+            params: textures.as_ref().map(|t| t.params.clone()),
+        };
+        let code = match (&textures, &self.pending) {
+            (Some(t), _) => t.wgsl.clone(),
+            (None, Some(p)) => p.code.clone(),
+            (None, None) => self.texture_code.clone(),
+        };
+        if features == self.features && code == self.texture_code {
+            self.pending = None;
+            self.apply(ctx, target);
+            return Ok(());
         }
-        if let Some(textures) = textures {
-            ctx.queue.write_buffer(
-                &self.texture_param_buffer,
-                0,
-                bytemuck::cast_slice(&textures.params),
-            );
-            self.texture_code = textures.wgsl;
+        if let Some(pending) = &mut self.pending
+            && pending.features == features
+            && pending.code == code
+        {
+            // Keep the parameters of a regenerated tree, or those already
+            // waiting.
+            let params = target.params.or(pending.target.params.take());
+            pending.target = Target { params, ..target };
+            self.follow_camera(scene);
+            return Ok(());
         }
+        let warm_context = if warm_up {
+            self.warm_up_context(ctx)
+        } else {
+            None
+        };
+        let warm_up = warm_context.map(|warm| WarmUp {
+            ctx: warm,
+            scene: scene.clone(),
+            images: self.images.clone(),
+            features: self.feature_override.clone(),
+        });
+        let (device, layout) = (ctx.device.clone(), self.trace_layout.clone());
+        let (build_features, build_code) = (features.clone(), code.clone());
+        let build = PipelineBuild::start(warm_up, move || {
+            Self::build_trace_pipeline(&device, &layout, &build_features, &build_code)
+        });
+        self.pending = Some(PendingScene {
+            build,
+            features,
+            code,
+            target,
+        });
+        self.follow_camera(scene);
+        Ok(())
+    }
+
+    /// Whether a pipeline build is under way.
+    pub fn is_building(&self) -> bool {
+        self.pending.is_some()
+    }
+
+    /// Installs a finished build and its scene. Returns how long the build
+    /// took, or why it failed (the old pipeline and scene then stay); None
+    /// while nothing has finished.
+    pub fn poll_build(&mut self, ctx: &GpuContext) -> Option<Result<Duration>> {
+        let result = self.pending.as_ref()?.build.poll()?;
+        let mut pending = self.pending.take()?;
+        Some(result.map(|built| {
+            let took = built.took;
+            self.install(ctx, built, &mut pending);
+            took
+        }))
+    }
+
+    /// How long the last pipeline build took, from the edit to the new
+    /// pipeline (the Stats panel shows it).
+    pub fn last_build(&self) -> Option<Duration> {
+        self.last_build
+    }
+
+    fn install(&mut self, ctx: &GpuContext, built: BuiltPipeline, pending: &mut PendingScene) {
+        self.trace_pipeline = built.pipeline;
+        self.trace_shader_bytes = built.shader_bytes;
+        self.last_build = Some(built.took);
+        self.features = std::mem::take(&mut pending.features);
+        self.texture_code = std::mem::take(&mut pending.code);
+        let target = Target {
+            scene: std::mem::take(&mut pending.target.scene),
+            params: pending.target.params.take(),
+        };
+        self.apply(ctx, target);
+    }
+
+    /// Writes a scene whose pipeline is in place into the buffers.
+    fn apply(&mut self, ctx: &GpuContext, target: Target) {
+        if let Some(params) = &target.params {
+            ctx.queue
+                .write_buffer(&self.texture_param_buffer, 0, bytemuck::cast_slice(params));
+        }
+        let scene = &target.scene;
         self.geometry.write(&ctx.queue, scene);
         // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
@@ -279,8 +418,28 @@ impl Renderer {
         if traced_before != traced_now {
             self.reset_accumulation();
         }
-        self.scene = scene.clone();
-        Ok(())
+        self.scene = target.scene;
+    }
+
+    /// While a build is pending the old scene is drawn, but seen from the
+    /// new camera: orbiting stays live.
+    fn follow_camera(&mut self, scene: &Scene) {
+        if self.scene.camera != scene.camera {
+            self.scene.camera = scene.camera;
+            self.reset_accumulation();
+        }
+    }
+
+    /// The second device that warms the driver's shader cache, on CPU
+    /// adapters only (created at the first build; None if it cannot be).
+    fn warm_up_context(&mut self, ctx: &GpuContext) -> Option<Arc<GpuContext>> {
+        if !ctx.is_cpu() {
+            return None;
+        }
+        if self.warm_up.is_none() {
+            self.warm_up = ctx.sibling().ok().map(Arc::new);
+        }
+        self.warm_up.clone()
     }
 
     /// Builds the shader with `features` instead of the scene's own set
@@ -302,12 +461,17 @@ impl Renderer {
 
     /// Replaces the images the scene's image textures read (loaded by
     /// `ImageSet::load`): uploads their atlas and regenerates the texture
-    /// code, which holds where each image lies.
+    /// code, which holds where each image lies. A pending build is finished
+    /// first (its code assumed the old images).
     pub fn set_images(&mut self, ctx: &GpuContext, images: ImageSet) -> Result<()> {
+        if let Some(mut pending) = self.pending.take() {
+            let built = pending.build.wait()?;
+            self.install(ctx, built, &mut pending);
+        }
         let textures = texture_codegen::generate(&self.scene, &images)?;
         if textures.wgsl != self.texture_code {
             (self.trace_pipeline, self.trace_shader_bytes) = Self::build_trace_pipeline(
-                ctx,
+                &ctx.device,
                 &self.trace_layout,
                 &self.features,
                 &textures.wgsl,

@@ -96,6 +96,10 @@ pub struct Stats {
     /// Size of the trace shader's WGSL: what specialisation keeps it to.
     pub shader_bytes: usize,
     pub resolution: (u32, u32),
+    /// A new shader is being built (the old one renders meanwhile).
+    pub building: bool,
+    /// How long the last shader build took, from the edit to the pipeline.
+    pub last_build_ms: Option<f32>,
 }
 
 /// A button press the app must act on: these need files, the GPU or the
@@ -496,6 +500,14 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
         stats.shader_bytes as f32 / 1024.0
     ))
     .on_hover_text("The assembled trace module: the files its features need, plus the code generated from the texture trees");
+    if stats.building {
+        ui.label("building a new shader… (the old one renders meanwhile)");
+    } else if let Some(ms) = stats.last_build_ms {
+        ui.label(format!("last shader build: {ms:.0} ms"))
+            .on_hover_text(
+                "From the structural edit to the new pipeline, built off the render thread",
+            );
+    }
 }
 
 #[cfg(test)]
