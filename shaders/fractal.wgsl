@@ -35,7 +35,7 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 #endif
 }
 
-#if CLAMP_OCTAVES
+#if FOOTPRINT
 // The octaves a footprint `width` wide resolves; twin of
 // noise::footprint_octaves (pbrt's rule, any lacunarity).
 fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {

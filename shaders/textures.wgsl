@@ -18,6 +18,12 @@ struct SurfaceTextures {
     emission: vec3f,
 }
 
+// The render switches (Rust: gpu::renderer::RenderSwitches), as override
+// constants: toggling one makes a new pipeline from the same module, and the
+// driver folds the branch it does not take away.
+override filter_checkers: bool = true;
+override clamp_octaves: bool = true;
+
 // How much of the surface a sample stands for: the ray cone's width on the
 // surface, in 3D units (`p`) and in (u, v) along each axis (`uv`). Zero
 // without the FOOTPRINT feature: textures are then point sampled.
@@ -72,11 +78,13 @@ fn material_signals(material: u32, p: vec3f, pw: vec3f, width: f32) -> vec4f {
 }
 
 // Signal k's noise, its octaves clamped to what a footprint `width` wide
-// resolves (CLAMP_OCTAVES; twin of noise::footprint_octaves).
+// resolves if `clamp_octaves` (twin of noise::footprint_octaves).
 fn signal_params(material: u32, k: u32, width: f32) -> NoiseParams {
     var n = materials[material].signals[k];
-#if CLAMP_OCTAVES
-    n.octaves = footprint_octaves(n, width * n.footprint_scale);
+#if FOOTPRINT
+    if clamp_octaves {
+        n.octaves = footprint_octaves(n, width * n.footprint_scale);
+    }
 #endif
     return n;
 }

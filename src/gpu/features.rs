@@ -30,7 +30,6 @@ pub enum Feature {
     Image,
     Bump,
     Footprint,
-    OctaveClamping,
     Opacity,
     Emission,
     NoiseWarp,
@@ -41,7 +40,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 30] = [
+    pub const ALL: [Feature; 29] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -64,7 +63,6 @@ impl Feature {
         Feature::Image,
         Feature::Bump,
         Feature::Footprint,
-        Feature::OctaveClamping,
         Feature::Opacity,
         Feature::Emission,
         Feature::NoiseWarp,
@@ -114,7 +112,6 @@ impl Feature {
             Feature::Image => "IMAGE",
             Feature::Bump => "BUMP",
             Feature::Footprint => "FOOTPRINT",
-            Feature::OctaveClamping => "CLAMP_OCTAVES",
             Feature::Opacity => "OPACITY",
             Feature::Emission => "EMISSION",
             Feature::NoiseWarp => "NOISE_WARP",
@@ -197,26 +194,22 @@ impl FeatureSet {
         for pattern in &patterns {
             set.extend(pattern_features(pattern));
         }
-        let render = &scene.render;
-        let filtered_checker = render.filter_checkers
-            && patterns
-                .iter()
-                .any(|p| matches!(p, Pattern::Checker { .. } | Pattern::Checker2d { .. }));
-        let clamped_noise = render.clamp_octaves && patterns.iter().any(|p| p.noise().is_some());
-        let mipmapped = patterns.iter().any(|p| {
+        // The footprint serves checkers, noise and mipmapped images. Whether
+        // checkers are filtered and octaves clamped are override constants
+        // of the same module (`RenderSwitches`), so toggling them keeps it.
+        let footprint_users = patterns.iter().any(|p| {
             matches!(
                 p,
-                Pattern::Image {
-                    filter: ImageFilter::Trilinear,
-                    ..
-                }
-            )
+                Pattern::Checker { .. }
+                    | Pattern::Checker2d { .. }
+                    | Pattern::Image {
+                        filter: ImageFilter::Trilinear,
+                        ..
+                    }
+            ) || p.noise().is_some()
         });
-        if filtered_checker || clamped_noise || mipmapped {
+        if footprint_users {
             set.insert(Feature::Footprint);
-        }
-        if clamped_noise {
-            set.insert(Feature::OctaveClamping);
         }
         for (used, feature) in [
             (Material::has_bump as fn(&Material) -> bool, Feature::Bump),
@@ -239,7 +232,7 @@ impl FeatureSet {
     /// rule for octaves.
     pub fn for_noise_harness(noise: &NoiseSettings) -> Self {
         let mut set = Self::for_noise(noise);
-        set.0.insert(Feature::OctaveClamping);
+        set.0.insert(Feature::Footprint);
         set
     }
 
@@ -333,10 +326,10 @@ mod tests {
         }
     }
 
-    /// Without octave clamping a marble needs its pattern and its noise;
-    /// with it (the default), the footprint too.
+    /// A marble needs its pattern, its noise, and the footprint its octaves
+    /// are clamped by (on or off: an override constant).
     #[test]
-    fn a_perlin_marble_needs_marble_and_perlin_only() {
+    fn a_perlin_marble_needs_marble_perlin_and_the_footprint() {
         let mut scene = Scene::default();
         let mut sphere = Sphere::default();
         sphere.material.diffuse = Texture {
@@ -350,15 +343,17 @@ mod tests {
             ..Default::default()
         };
         scene.spheres.push(sphere);
-        let set = FeatureSet::for_scene(&scene);
-        assert!(set.contains(Feature::Footprint) && set.contains(Feature::OctaveClamping));
         scene.render.clamp_octaves = false;
         let set = FeatureSet::for_scene(&scene);
         assert_eq!(
             set.0,
-            [Feature::PatternMarble, Feature::NoisePerlin]
-                .into_iter()
-                .collect()
+            [
+                Feature::PatternMarble,
+                Feature::NoisePerlin,
+                Feature::Footprint
+            ]
+            .into_iter()
+            .collect()
         );
     }
 }

@@ -60,6 +60,8 @@ pub fn checked<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T)
     }
 }
 
+/// A pipeline drawing the full-screen triangle of `vs_fullscreen` with
+/// `fragment_entry`, its override constants set to `constants`.
 pub fn fullscreen_pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -67,6 +69,7 @@ pub fn fullscreen_pipeline(
     layout: &wgpu::BindGroupLayout,
     fragment_entry: &str,
     format: wgpu::TextureFormat,
+    constants: &[(&str, f64)],
 ) -> Result<wgpu::RenderPipeline> {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
@@ -89,7 +92,10 @@ pub fn fullscreen_pipeline(
             fragment: Some(wgpu::FragmentState {
                 module,
                 entry_point: Some(fragment_entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
                 targets: &[Some(format.into())],
             }),
             multiview_mask: None,

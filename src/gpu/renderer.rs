@@ -61,11 +61,44 @@ struct Target {
     params: Option<Vec<[f32; 4]>>,
 }
 
+/// What a trace pipeline is built from: two scenes with equal keys share
+/// one. The features and texture code make the module; the switches are
+/// its override constants.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct PipelineKey {
+    features: FeatureSet,
+    code: String,
+    switches: RenderSwitches,
+}
+
+/// The render settings the trace shader reads as override constants
+/// (declared in shaders/textures.wgsl).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct RenderSwitches {
+    filter_checkers: bool,
+    clamp_octaves: bool,
+}
+
+impl RenderSwitches {
+    fn of(scene: &Scene) -> Self {
+        Self {
+            filter_checkers: scene.render.filter_checkers,
+            clamp_octaves: scene.render.clamp_octaves,
+        }
+    }
+
+    fn constants(self) -> [(&'static str, f64); 2] {
+        [
+            ("filter_checkers", f64::from(u8::from(self.filter_checkers))),
+            ("clamp_octaves", f64::from(u8::from(self.clamp_octaves))),
+        ]
+    }
+}
+
 /// A pipeline build under way, with the key it is built for.
 struct PendingScene {
     build: PipelineBuild,
-    features: FeatureSet,
-    code: String,
+    key: PipelineKey,
     target: Target,
 }
 
@@ -76,7 +109,9 @@ pub struct Renderer {
     /// The device that warms the shader cache for builds (CPU adapters).
     warm_up: Option<Arc<GpuContext>>,
     last_build: Option<Duration>,
-    features: FeatureSet,
+    /// What the trace pipeline was built from: a scene whose key differs
+    /// needs a new pipeline.
+    key: PipelineKey,
     /// When set, the shader is built with these features whatever the scene
     /// uses: `FeatureSet::all()` is the uber shader the benchmarks compare.
     feature_override: Option<FeatureSet>,
@@ -90,9 +125,6 @@ pub struct Renderer {
     geometry: GeometryBuffers,
     perm_buffer: wgpu::Buffer,
     texture_param_buffer: wgpu::Buffer,
-    /// The generated texture code the trace pipeline was built with: a
-    /// scene whose code differs needs a new pipeline.
-    texture_code: String,
     /// Size of the trace module's WGSL, for the Stats panel.
     trace_shader_bytes: usize,
     env_view: wgpu::TextureView,
@@ -141,8 +173,13 @@ impl Renderer {
         });
         let images = ImageSet::empty();
         let textures = texture_codegen::generate(scene, &images)?;
+        let key = PipelineKey {
+            features,
+            code: textures.wgsl,
+            switches: RenderSwitches::of(scene),
+        };
         let (trace_pipeline, trace_shader_bytes) =
-            Self::build_trace_pipeline(&ctx.device, &trace_layout, &features, &textures.wgsl)?;
+            Self::build_trace_pipeline(&ctx.device, &trace_layout, &key)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -189,7 +226,7 @@ impl Renderer {
             pending: None,
             warm_up: None,
             last_build: None,
-            features,
+            key,
             feature_override: None,
             trace_layout,
             trace_pipeline,
@@ -201,7 +238,6 @@ impl Renderer {
             geometry,
             perm_buffer,
             texture_param_buffer,
-            texture_code: textures.wgsl,
             trace_shader_bytes,
             env_view,
             env_sampler,
@@ -219,10 +255,9 @@ impl Renderer {
     fn build_trace_pipeline(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
-        features: &FeatureSet,
-        texture_code: &str,
+        key: &PipelineKey,
     ) -> Result<(wgpu::RenderPipeline, usize)> {
-        let source = assemble(Program::Trace, features, texture_code)?;
+        let source = assemble(Program::Trace, &key.features, &key.code)?;
         let bytes = source.len();
         let module = compile_wgsl(device, Program::Trace, source)?;
         let pipeline = fullscreen_pipeline(
@@ -232,6 +267,7 @@ impl Renderer {
             layout,
             "fs_trace",
             ACCUMULATION_FORMAT,
+            &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
     }
@@ -242,7 +278,7 @@ impl Renderer {
     }
 
     pub fn features(&self) -> &FeatureSet {
-        &self.features
+        &self.key.features
     }
 
     pub fn scene(&self) -> &Scene {
@@ -303,11 +339,8 @@ impl Renderer {
             .as_ref()
             .map_or(&self.scene, |p| &p.target.scene);
         // Camera and light edits (every frame of a drag) leave the textures
-        // alone: regenerate them only when a material or a render switch
-        // the texture code reads changed.
-        let textures_unchanged = target_scene.materials().eq(scene.materials())
-            && target_scene.render.filter_checkers == scene.render.filter_checkers;
-        let textures = if textures_unchanged {
+        // alone: regenerate them only when a material changed.
+        let textures = if target_scene.materials().eq(scene.materials()) {
             None
         } else {
             Some(texture_codegen::generate(scene, &self.images)?)
@@ -318,17 +351,21 @@ impl Renderer {
         };
         let code = match (&textures, &self.pending) {
             (Some(t), _) => t.wgsl.clone(),
-            (None, Some(p)) => p.code.clone(),
-            (None, None) => self.texture_code.clone(),
+            (None, Some(p)) => p.key.code.clone(),
+            (None, None) => self.key.code.clone(),
         };
-        if features == self.features && code == self.texture_code {
+        let key = PipelineKey {
+            features,
+            code,
+            switches: RenderSwitches::of(scene),
+        };
+        if key == self.key {
             self.pending = None;
             self.apply(ctx, target);
             return Ok(());
         }
         if let Some(pending) = &mut self.pending
-            && pending.features == features
-            && pending.code == code
+            && pending.key == key
         {
             // Keep the parameters of a regenerated tree, or those already
             // waiting.
@@ -349,16 +386,11 @@ impl Renderer {
             features: self.feature_override.clone(),
         });
         let (device, layout) = (ctx.device.clone(), self.trace_layout.clone());
-        let (build_features, build_code) = (features.clone(), code.clone());
+        let build_key = key.clone();
         let build = PipelineBuild::start(warm_up, move || {
-            Self::build_trace_pipeline(&device, &layout, &build_features, &build_code)
+            Self::build_trace_pipeline(&device, &layout, &build_key)
         });
-        self.pending = Some(PendingScene {
-            build,
-            features,
-            code,
-            target,
-        });
+        self.pending = Some(PendingScene { build, key, target });
         self.follow_camera(scene);
         Ok(())
     }
@@ -391,8 +423,7 @@ impl Renderer {
         self.trace_pipeline = built.pipeline;
         self.trace_shader_bytes = built.shader_bytes;
         self.last_build = Some(built.took);
-        self.features = std::mem::take(&mut pending.features);
-        self.texture_code = std::mem::take(&mut pending.code);
+        self.key = std::mem::take(&mut pending.key);
         let target = Target {
             scene: std::mem::take(&mut pending.target.scene),
             params: pending.target.params.take(),
@@ -469,14 +500,14 @@ impl Renderer {
             self.install(ctx, built, &mut pending);
         }
         let textures = texture_codegen::generate(&self.scene, &images)?;
-        if textures.wgsl != self.texture_code {
-            (self.trace_pipeline, self.trace_shader_bytes) = Self::build_trace_pipeline(
-                &ctx.device,
-                &self.trace_layout,
-                &self.features,
-                &textures.wgsl,
-            )?;
-            self.texture_code = textures.wgsl;
+        if textures.wgsl != self.key.code {
+            let key = PipelineKey {
+                code: textures.wgsl,
+                ..self.key.clone()
+            };
+            (self.trace_pipeline, self.trace_shader_bytes) =
+                Self::build_trace_pipeline(&ctx.device, &self.trace_layout, &key)?;
+            self.key = key;
         }
         ctx.queue.write_buffer(
             &self.texture_param_buffer,
@@ -610,6 +641,7 @@ impl Renderer {
                 &self.display_layout,
                 "fs_display",
                 format,
+                &[],
             )?;
             self.display_pipelines.insert(format, p);
         }

@@ -43,7 +43,6 @@ pub struct GeneratedTextures {
 pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     let mut generator = Generator {
         images,
-        filter_checkers: scene.render.filter_checkers,
         code: String::new(),
         params: Vec::new(),
         next: 0,
@@ -163,8 +162,6 @@ struct MaterialCases {
 struct Generator<'a> {
     /// Where each image lies in the atlas (image nodes read it).
     images: &'a ImageSet,
-    /// Checkers are box-filtered over the footprint (`filter_checkers`).
-    filter_checkers: bool,
     code: String,
     params: Vec<[f32; 4]>,
     /// Numbers the local variables of the function being generated.
@@ -410,11 +407,9 @@ impl Generator<'_> {
             Pattern::Constant => "0.0".to_string(),
             Pattern::Checker { size } => {
                 let q = self.param([size, size, size, 0.0]);
-                if self.filter_checkers {
-                    format!("filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.p)")
-                } else {
-                    format!("checker_3d({p}, {q}.xyz)")
-                }
+                format!(
+                    "select(checker_3d({p}, {q}.xyz), filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.p), filter_checkers)"
+                )
             }
             Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
             Pattern::Turbulence { .. } | Pattern::Ridged { .. } => {
@@ -439,11 +434,9 @@ impl Generator<'_> {
                 let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
                 child_uv = format!("cell{k}.local");
                 child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p)");
-                if self.filter_checkers {
-                    format!("filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv)")
-                } else {
-                    format!("cell{k}.select")
-                }
+                format!(
+                    "select(cell{k}.select, filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv), filter_checkers)"
+                )
             }
             Pattern::Brick {
                 size,
@@ -654,6 +647,21 @@ mod tests {
             code.contains("opacity = mix(opacity, texture_0_layer0_opacity"),
             "{code}"
         );
+    }
+
+    /// The anti-aliasing switches are override constants: toggling them
+    /// changes neither the generated code nor the feature set, so the
+    /// module is the same and only the pipeline's constants differ.
+    #[test]
+    fn anti_aliasing_switches_leave_the_module_alone() {
+        let on = scene_with(nested());
+        let mut off = on.clone();
+        off.render.filter_checkers = false;
+        off.render.clamp_octaves = false;
+        assert_eq!(generate_plain(&on).unwrap(), generate_plain(&off).unwrap());
+        let features = crate::gpu::FeatureSet::for_scene;
+        assert_eq!(features(&on), features(&off));
+        assert!(generate_plain(&on).unwrap().wgsl.contains("filter_checkers)"));
     }
 
     #[test]
