@@ -58,13 +58,14 @@ fn transmittance(o: vec3f, d: vec3f, light: vec3f) -> f32 {
 }
 #endif
 
-#if EMISSION
-// With emitters, the loop runs one pass past the last bounce, to add the
-// emission of the surface the last bounce reached (as the environment is
-// added when it escapes).
-const EMISSION_PASS: u32 = 1u;
+#if EMISSION || OPACITY
+// With emitters or holes, the loop runs one pass past the last bounce: to
+// add the emission of the surface the last bounce reached (as the
+// environment is added when it escapes), and to let the path through that
+// surface where it has a hole (crossing is not bouncing).
+const FINAL_VERTEX_PASS: u32 = 1u;
 #else
-const EMISSION_PASS: u32 = 0u;
+const FINAL_VERTEX_PASS: u32 = 0u;
 #endif
 
 // SIMD lanes run every piece of code some lane needs, and lavapipe runs
@@ -108,6 +109,8 @@ fn trace_path(pixel: vec2f) -> vec3f {
             } else {
 #if EMISSION
                 radiance += throughput * s.emission;
+#endif
+#if EMISSION || OPACITY
                 if bounces >= frame.max_bounces {
                     alive = false;
                     break;
@@ -128,7 +131,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
             }
             hit = intersect_scene(origin, d);
             continuing {
-                break if bounces >= frame.max_bounces + EMISSION_PASS || hit.t >= NO_HIT || crossings >= MAX_CROSSINGS;
+                break if bounces >= frame.max_bounces + FINAL_VERTEX_PASS || hit.t >= NO_HIT || crossings >= MAX_CROSSINGS;
             }
         }
     }

@@ -406,18 +406,26 @@ fn accumulation_reduces_noise() {
 
 /// The uber shader (every feature compiled in) and the specialised one
 /// render the same image: specialisation removes code, never behaviour.
+/// The presets cover noise (gradient and Perlin), bump, opacity, images,
+/// cylinders and polygons.
 #[test]
 fn uber_and_specialised_shaders_agree() {
     let Some(ctx) = gpu_or_skip("uber_and_specialised_shaders_agree") else {
         return;
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    for preset in ["presets/default.ron", "presets/tiles.ron"] {
+    for preset in [
+        "presets/default.ron",
+        "presets/tiles.ron",
+        "presets/marble.ron",
+        "presets/cutouts.ron",
+        "presets/images.ron",
+    ] {
         let loaded = marbre::commands::session::load_scene(&root.join(preset), None).unwrap();
         let size = (48, 27);
         let mut specialised =
-            Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
-        let mut uber = Renderer::new(&ctx, &loaded.scene, loaded.env.as_ref(), size).unwrap();
+            marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
+        let mut uber = marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
         uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
             .unwrap();
         assert!(uber.features().0.len() > specialised.features().0.len());
