@@ -577,30 +577,8 @@ pub fn texel_for_direction(image: &EnvImage, d: Vec3, rotation_degrees: f32) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_dir::TempDir;
     use std::f32::consts::PI;
-
-    /// A fresh, empty directory for one test, removed on drop.
-    struct TempDir(PathBuf);
-
-    impl TempDir {
-        fn new(name: &str) -> TempDir {
-            let dir =
-                std::env::temp_dir().join(format!("marbre-envmap-{}-{name}", std::process::id()));
-            let _ = std::fs::remove_dir_all(&dir);
-            std::fs::create_dir_all(&dir).unwrap();
-            TempDir(dir)
-        }
-
-        fn path(&self, file: &str) -> PathBuf {
-            self.0.join(file)
-        }
-    }
-
-    impl Drop for TempDir {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
 
     /// A map shipped in `envmaps/`, else the shared copy; `None` if neither.
     fn shipped_map(name: &str) -> Option<PathBuf> {

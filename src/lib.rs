@@ -10,4 +10,6 @@ pub mod noise;
 pub mod panel;
 pub mod preset;
 pub mod scene;
+#[cfg(test)]
+mod test_dir;
 pub mod texture;

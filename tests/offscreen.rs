@@ -423,8 +423,7 @@ fn uber_and_specialised_shaders_agree() {
     ] {
         let loaded = marbre::commands::session::load_scene(&root.join(preset), None).unwrap();
         let size = (48, 27);
-        let mut specialised =
-            marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
+        let mut specialised = marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
         let mut uber = marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
         uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
             .unwrap();

@@ -661,7 +661,12 @@ mod tests {
         assert_eq!(generate_plain(&on).unwrap(), generate_plain(&off).unwrap());
         let features = crate::gpu::FeatureSet::for_scene;
         assert_eq!(features(&on), features(&off));
-        assert!(generate_plain(&on).unwrap().wgsl.contains("filter_checkers)"));
+        assert!(
+            generate_plain(&on)
+                .unwrap()
+                .wgsl
+                .contains("filter_checkers)")
+        );
     }
 
     #[test]
