@@ -94,27 +94,26 @@ fn intersect_cylinder(o: vec3f, d: vec3f, c: Cylinder) -> CylinderHit {
 #endif
 
 #if POLYGON
-// Distance along the ray to a convex polygon, or NO_HIT: the plane, then
-// the point on the inner side of every edge.
-fn intersect_polygon(o: vec3f, d: vec3f, poly: Polygon) -> f32 {
-    let denominator = dot(d, poly.normal);
-    if denominator == 0.0 {
-        return NO_HIT;
-    }
-    let t = dot(poly.vertices[0].xyz - o, poly.normal) / denominator;
-    if !(t > 0.0) {
-        return NO_HIT;
-    }
+// Distance along the ray to convex polygon `index`, or NO_HIT: the plane,
+// then the point on the inner side of every edge. Fields are read from the
+// uniform array in place (copying the struct and indexing the copy by a
+// loop counter made llvmpipe spill it: 5× the frame), and every edge is
+// tested without an early exit (the loop's trip count is the same for all
+// lanes).
+fn intersect_polygon(o: vec3f, d: vec3f, index: u32) -> f32 {
+    let normal = polygons[index].normal;
+    let denominator = dot(d, normal);
+    let t = dot(polygons[index].vertices[0].xyz - o, normal) / denominator;
     let p = o + t * d;
-    let n = min(poly.vertex_count, MAX_POLYGON_VERTICES);
+    let n = min(polygons[index].vertex_count, MAX_POLYGON_VERTICES);
+    var inside = denominator != 0.0 && t > 0.0;
+    var a = polygons[index].vertices[n - 1u].xyz;
     for (var i = 0u; i < n; i++) {
-        let a = poly.vertices[i].xyz;
-        let b = poly.vertices[(i + 1u) % n].xyz;
-        if dot(cross(b - a, p - a), poly.normal) < 0.0 {
-            return NO_HIT;
-        }
+        let b = polygons[index].vertices[i].xyz;
+        inside = inside && dot(cross(b - a, p - a), normal) >= 0.0;
+        a = b;
     }
-    return t;
+    return select(NO_HIT, t, inside);
 }
 #endif
 
@@ -186,21 +185,21 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #endif
 #if POLYGON
     for (var i = 0u; i < frame.polygon_count; i++) {
-        let t = intersect_polygon(o, d, polygons[i]);
+        let t = intersect_polygon(o, d, i);
         if t < hit.t {
-            let poly = polygons[i];
+            let normal = polygons[i].normal;
             hit.t = t;
             // On the plane exactly, whatever the rounding of t.
             let q = o + t * d;
-            hit.p = q - dot(q - poly.vertices[0].xyz, poly.normal) * poly.normal;
-            hit.n = poly.normal;
+            hit.p = q - dot(q - polygons[i].vertices[0].xyz, normal) * normal;
+            hit.n = normal;
             hit.texture_point = hit.p;
 #if TEXTURE_UV
-            hit.uv = plane_uv(hit.p, poly.uv_origin, poly.uv_u, poly.uv_v);
+            hit.uv = plane_uv(hit.p, polygons[i].uv_origin, polygons[i].uv_u, polygons[i].uv_v);
 #endif
 #if TANGENTS
-            hit.dp_du = poly.uv_u;
-            hit.dp_dv = poly.uv_v;
+            hit.dp_du = polygons[i].uv_u;
+            hit.dp_dv = polygons[i].uv_v;
 #endif
             hit.material = frame.sphere_count + frame.cylinder_count + i;
         }
@@ -245,7 +244,7 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
 #endif
 #if POLYGON
     for (var i = 0u; i < frame.polygon_count; i++) {
-        if intersect_polygon(o, d, polygons[i]) < t_max {
+        if intersect_polygon(o, d, i) < t_max {
             return true;
         }
     }

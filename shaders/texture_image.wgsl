@@ -40,16 +40,19 @@ fn image_level_origin(size: vec2i, k: i32) -> vec2i {
 }
 
 // Texel index `i` of a row or column of `n` texels, wrapped into [0, n - 1].
+// `n` is a power of two, so a positive modulo is a mask (two's complement
+// makes it right for negative `i` too): the same as the CPU's rem_euclid,
+// without the integer divisions llvmpipe does lane by lane.
 fn image_wrap(i: i32, n: i32, wrap: u32) -> i32 {
     if wrap == 1u {
         return clamp(i, 0, n - 1);
     }
     if wrap == 2u {
         let period = 2 * n;
-        let m = ((i % period) + period) % period;
+        let m = i & (period - 1);
         return select(m, period - 1 - m, m >= n);
     }
-    return ((i % n) + n) % n;
+    return i & (n - 1);
 }
 
 // Continuous texel coordinates of uv on a level of `size` texels (texel
@@ -85,7 +88,10 @@ fn image_bilinear(rect: vec4f, k: i32, uv: vec2f, wrap: u32) -> vec4f {
 }
 
 // The image described by `rect` at `uv`. Nearest and bilinear read level 0;
-// trilinear blends the two levels around `lod` (clamped to the chain).
+// trilinear blends the two levels around `lod` (clamped to the chain). The
+// generated texture code calls the filter's own function with the wrap as a
+// literal, so a shader holds only the filtering it uses (every branch costs
+// on SIMD); this switch serves the compute harness.
 fn image_sample(rect: vec4f, uv: vec2f, filter_mode: u32, wrap: u32, lod: f32) -> vec4f {
     if filter_mode == 0u {
         return image_nearest(rect, uv, wrap);
@@ -93,6 +99,10 @@ fn image_sample(rect: vec4f, uv: vec2f, filter_mode: u32, wrap: u32, lod: f32) -
     if filter_mode == 1u {
         return image_bilinear(rect, 0, uv, wrap);
     }
+    return image_trilinear(rect, uv, wrap, lod);
+}
+
+fn image_trilinear(rect: vec4f, uv: vec2f, wrap: u32, lod: f32) -> vec4f {
     let last = image_level_count(vec2i(rect.zw)) - 1;
     let l = clamp(lod, 0.0, f32(last));
     let base = floor(l);

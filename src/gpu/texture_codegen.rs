@@ -289,15 +289,20 @@ impl Generator<'_> {
         let color = match rect {
             Some(rect) => {
                 let rect = self.param(rect);
-                let modes = self.param([filter.id() as f32, wrap.id() as f32, 0.0, 0.0]);
-                // The level whose texels are as wide as the footprint.
-                let fp = &site.footprint;
-                let lod =
-                    format!("log2(max(max({fp}.uv.x * {rect}.z, {fp}.uv.y * {rect}.w), 1e-8))");
-                format!(
-                    "image_sample({rect}, {}, u32({modes}.x), u32({modes}.y), {lod}).xyz",
-                    site.uv
-                )
+                let (uv, wrap) = (&site.uv, wrap.id());
+                match filter {
+                    ImageFilter::Nearest => format!("image_nearest({rect}, {uv}, {wrap}u).xyz"),
+                    ImageFilter::Bilinear => {
+                        format!("image_bilinear({rect}, 0, {uv}, {wrap}u).xyz")
+                    }
+                    ImageFilter::Trilinear => {
+                        // The level whose texels are as wide as the footprint.
+                        let fp = &site.footprint;
+                        format!(
+                            "image_trilinear({rect}, {uv}, {wrap}u, log2(max(max({fp}.uv.x * {rect}.z, {fp}.uv.y * {rect}.w), 1e-8))).xyz"
+                        )
+                    }
+                }
             }
             None => {
                 let c = IMAGE_UNAVAILABLE;
