@@ -33,7 +33,7 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
     var r = vec4f(0.0);
     switch harness.mode {
         case 17u: {
-            r.x = filtered_checker_3d(p, a.xyz, a.w);
+            r.x = filtered_checker_3d(p, a.xyz, b.xyz);
         }
         case 16u: {
             r = image_sample(a, p.xy, u32(b.x), u32(b.y), p.z);

@@ -30,11 +30,11 @@ fn checker_3d(p: vec3f, size: vec3f) -> f32 {
     return odd(c.x + c.y + c.z);
 }
 
-// The 3D checker box-filtered over p ± half_width: the XOR of three square
-// waves is odd with probability (1 - Π(1 - 2s)) / 2.
-fn filtered_checker_3d(p: vec3f, size: vec3f, half_width: f32) -> f32 {
+// The 3D checker box-filtered over p ± half_width (per axis): the XOR of
+// three square waves is odd with probability (1 - Π(1 - 2s)) / 2.
+fn filtered_checker_3d(p: vec3f, size: vec3f, half_width: vec3f) -> f32 {
     let q = p / size;
-    let w = vec3f(half_width) / size;
+    let w = half_width / size;
     let s = vec3f(odd_fraction(q.x, w.x), odd_fraction(q.y, w.y), odd_fraction(q.z, w.z));
     return 0.5 * (1.0 - (1.0 - 2.0 * s.x) * (1.0 - 2.0 * s.y) * (1.0 - 2.0 * s.z));
 }

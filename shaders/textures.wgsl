@@ -24,34 +24,40 @@ struct SurfaceTextures {
 override filter_checkers: bool = true;
 override clamp_octaves: bool = true;
 
-// How much of the surface a sample stands for: the ray cone's width on the
-// surface, in 3D units (`p`) and in (u, v) along each axis (`uv`). Zero
-// without the FOOTPRINT feature: textures are then point sampled.
+// How much of the surface a sample stands for: the ray cone's footprint on
+// the surface, its extent in (u, v) along each axis (`uv`), along each 3D
+// axis (`axes`, for box filters) and its long axis (`p`, for noise: never
+// too little blur). Zero without the FOOTPRINT feature: textures are then
+// point sampled.
 struct Footprint {
     uv: vec2f,
     p: f32,
+    axes: vec3f,
 }
 
 // A cone `width` wide meeting the surface along `d` covers an ellipse: `w`
-// across the plane of incidence and `w / cos θ` along it. Its extent along
-// each tangent axis (∂p/∂u, ∂p/∂v), divided by how far the surface moves
-// per unit of u and of v, is the footprint in (u, v); the 3D footprint is
-// the long axis (pbrt's choice for noise: never too little blur).
+// across the plane of incidence and `w / cos θ` along it, in the tangent
+// plane. Its extent along a unit direction e is w·sqrt(e⊥² + (e·m)²/cos²θ)
+// with m the ellipse's long axis and e⊥ the part of e in the plane across
+// it. Along the tangents (∂p/∂u, ∂p/∂v), divided by how far the surface
+// moves per unit of u and of v, that is the footprint in (u, v).
 fn hit_footprint(hit: Hit, width: f32, d: vec3f) -> Footprint {
 #if FOOTPRINT
     let cos_theta = max(abs(dot(d, hit.n)), 1e-4);
     let along = d - dot(d, hit.n) * hit.n;
     let along_len = length(along);
     let m = select(vec3f(0.0), along / along_len, along_len > 0.0);
-    let stretch = 1.0 / (cos_theta * cos_theta) - 1.0;
+    let across = cross(hit.n, m);
     let per_uv = vec2f(length(hit.dp_du), length(hit.dp_dv));
-    let e_u = dot(hit.dp_du, m) / max(per_uv.x, 1e-30);
-    let e_v = dot(hit.dp_dv, m) / max(per_uv.y, 1e-30);
-    let extent = width * sqrt(1.0 + vec2f(e_u * e_u, e_v * e_v) * stretch);
-    let uv = select(vec2f(0.0), extent / per_uv, per_uv > vec2f(0.0));
-    return Footprint(uv, width / cos_theta);
+    let m_uv = vec2f(dot(hit.dp_du, m), dot(hit.dp_dv, m));
+    let a_uv = vec2f(dot(hit.dp_du, across), dot(hit.dp_dv, across));
+    let extent_uv = width * sqrt(a_uv * a_uv + m_uv * m_uv / (cos_theta * cos_theta));
+    let uv = select(vec2f(0.0), extent_uv / (per_uv * per_uv), per_uv > vec2f(0.0));
+    // The world axes' components along m and across it.
+    let axes = width * sqrt(across * across + m * m / (cos_theta * cos_theta));
+    return Footprint(uv, width / cos_theta, axes);
 #else
-    return Footprint(vec2f(0.0), 0.0);
+    return Footprint(vec2f(0.0), 0.0, vec3f(0.0));
 #endif
 }
 

@@ -578,7 +578,10 @@ fn rms_over_rows(a: &[[f32; 4]], b: &[[f32; 4]], w: u32, rows: std::ops::Range<u
 /// (256 jittered samples, point sampled) image than one point sample is:
 /// for a 2D checker and a 3D one (box-filtered in closed form) and for fBm
 /// (octaves clamped to the footprint). The same holds seen in a mirror,
-/// where the footprint is the cone's after the bounce.
+/// where the footprint is the cone's after the bounce. Measured on
+/// lavapipe (RMSE over the far rows, point → filtered): 2D checker 0.40 →
+/// 0.05, 3D checker 0.40 → 0.04, fBm 0.085 → 0.039; in the mirror 0.36 →
+/// 0.07, 0.36 → 0.07, 0.099 → 0.070.
 #[test]
 fn footprint_filtering_brings_one_sample_near_the_supersampled_image() {
     let Some(ctx) =
@@ -586,52 +589,16 @@ fn footprint_filtering_brings_one_sample_near_the_supersampled_image() {
     else {
         return;
     };
-    let checker_2d = Texture::blend(
-        Pattern::Checker2d {
-            size: Vec2::splat(0.25),
-            phase: 0.0,
-        },
-        Vec3::splat(0.1),
-        Vec3::splat(0.9),
-    );
-    let checker_3d = Texture::blend(
-        Pattern::Checker { size: 0.25 },
-        Vec3::splat(0.1),
-        Vec3::splat(0.9),
-    );
-    let noise = Texture::blend(
-        Pattern::Fbm {
-            noise: marbre::noise::NoiseSettings {
-                fractal: marbre::noise::FractalParams {
-                    octaves: 10.0,
-                    frequency: 2.0,
-                    amplitude: 1.2,
-                    ..Default::default()
-                },
-                ..Default::default()
-            },
-        },
-        Vec3::splat(0.1),
-        Vec3::splat(0.9),
-    );
     let (w, h) = (96, 48);
     // The fraction of the point-sampled error filtering must stay under:
     // a checker's edges filter exactly; noise keeps the jitter of the
     // octaves a pixel resolves.
-    for (name, texture, ratio) in [
-        ("2D checker", checker_2d, 0.3),
-        ("3D checker", checker_3d, 0.3),
-        ("fBm", noise, 0.8),
-    ] {
+    for ((name, texture), ratio) in marbre::commands::aa_scenes::textures()
+        .into_iter()
+        .zip([0.3, 0.3, 0.8])
+    {
         for mirrored in [false, true] {
-            let mut scene = textured_ground_in_white_light(texture.clone());
-            scene.camera = OrbitCamera {
-                target: Vec3::new(0.0, 0.5, 0.0),
-                distance: 3.0,
-                yaw_degrees: 0.0,
-                pitch_degrees: 8.0,
-                fov_degrees: 30.0,
-            };
+            let mut scene = marbre::commands::aa_scenes::grazing_ground(texture.clone());
             if mirrored {
                 // An upright mirror facing the camera: it shows the ground
                 // behind the camera, as far away and as grazing.

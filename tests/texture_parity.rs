@@ -139,7 +139,7 @@ fn boards_match_the_cpu() {
         |p| off_integer(p.y / size.y) < 1e-4,
     );
 
-    let (size3, w3) = (Vec3::new(0.5, 0.7, 0.3), 0.11);
+    let (size3, w3) = (Vec3::new(0.5, 0.7, 0.3), Vec3::new(0.11, 0.02, 0.3));
     let gpu = evaluate(
         &ctx,
         &PatternQuery::FilteredChecker3d {

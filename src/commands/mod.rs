@@ -1,5 +1,6 @@
 //! The headless commands: each is a thin layer over the library.
 
+pub mod aa_scenes;
 pub mod bench;
 pub mod noise;
 pub mod render;

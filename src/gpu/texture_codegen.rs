@@ -103,7 +103,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     };
     write!(
         wgsl,
-        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0);\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
+        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
     )?;
     let bump_reads_noise = scene
         .materials()
@@ -342,7 +342,7 @@ impl Generator<'_> {
                 let scale = self.param([su, sv, s3, 0.0]);
                 let _ = writeln!(
                     body,
-                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z);"
+                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z, fp.axes * {scale}.z);"
                 );
                 mapped = Site {
                     p: format!("p{k}"),
@@ -413,7 +413,7 @@ impl Generator<'_> {
             Pattern::Checker { size } => {
                 let q = self.param([size, size, size, 0.0]);
                 format!(
-                    "select(checker_3d({p}, {q}.xyz), filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.p), filter_checkers)"
+                    "select(checker_3d({p}, {q}.xyz), filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.axes), filter_checkers)"
                 )
             }
             Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
@@ -438,7 +438,7 @@ impl Generator<'_> {
                 let q = self.param([size.x, size.y, phase, 0.0]);
                 let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
                 child_uv = format!("cell{k}.local");
-                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p)");
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
                 format!(
                     "select(cell{k}.select, filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv), filter_checkers)"
                 )
@@ -451,7 +451,7 @@ impl Generator<'_> {
                 let q = self.param([size.x, size.y, mortar, row_offset]);
                 let _ = writeln!(body, "    let cell{k} = brick({uv}, {q}.xy, {q}.z, {q}.w);");
                 child_uv = format!("cell{k}.local");
-                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p)");
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
                 format!("cell{k}.select")
             }
             Pattern::Tile {

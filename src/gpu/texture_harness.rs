@@ -32,7 +32,7 @@ pub enum PatternQuery {
     },
     FilteredChecker3d {
         size: Vec3,
-        half_width: f32,
+        half_width: Vec3,
     },
     /// Result: (select, local u, local v).
     Brick {
@@ -151,7 +151,8 @@ impl PatternQuery {
             }
             PatternQuery::FilteredChecker3d { size, half_width } => {
                 u.mode = 17;
-                u.a = v3(*size, *half_width);
+                u.a = v3(*size, 0.0);
+                u.b = v3(*half_width, 0.0);
             }
             PatternQuery::Brick {
                 size,

@@ -67,13 +67,14 @@ pub fn filtered_checker_2d(uv: Vec2, size: Vec2, phase: f32, half_width: Vec2) -
     sx + sy - 2.0 * sx * sy
 }
 
-/// [`checker_3d`] averaged over the box `p ± half_width`, in closed form:
+/// [`checker_3d`] averaged over the box `p ± half_width` (per axis), in
+/// closed form:
 /// the board is the XOR of three square waves, and the XOR of independent
 /// bits that are odd with probabilities s is odd with probability
 /// (1 − Π(1 − 2s)) / 2 (for two axes, sx + sy − 2·sx·sy).
-pub fn filtered_checker_3d(p: Vec3, size: Vec3, half_width: f32) -> f32 {
+pub fn filtered_checker_3d(p: Vec3, size: Vec3, half_width: Vec3) -> f32 {
     let q = p / size;
-    let w = Vec3::splat(half_width) / size;
+    let w = half_width / size;
     let s = Vec3::new(
         odd_fraction(q.x, w.x),
         odd_fraction(q.y, w.y),
@@ -92,9 +93,9 @@ mod tests {
     fn filtered_3d_checker_equals_the_supersampled_box_integral() {
         let size = Vec3::new(0.5, 0.7, 0.3);
         for (p, w) in [
-            (Vec3::new(0.1, 0.2, 0.05), 0.2),
-            (Vec3::new(-1.3, 0.9, 2.2), 0.45),
-            (Vec3::new(3.0, -0.35, 0.6), 0.05),
+            (Vec3::new(0.1, 0.2, 0.05), Vec3::splat(0.2)),
+            (Vec3::new(-1.3, 0.9, 2.2), Vec3::new(0.45, 0.1, 0.3)),
+            (Vec3::new(3.0, -0.35, 0.6), Vec3::new(0.05, 0.0, 0.2)),
         ] {
             let n = 40;
             let mut sum = 0.0;
@@ -114,7 +115,10 @@ mod tests {
             );
         }
         let p = Vec3::new(0.3, 0.4, 0.1);
-        assert_eq!(filtered_checker_3d(p, size, 0.0), checker_3d(p, size));
+        assert_eq!(
+            filtered_checker_3d(p, size, Vec3::ZERO),
+            checker_3d(p, size)
+        );
     }
 
     #[test]
