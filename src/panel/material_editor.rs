@@ -170,7 +170,9 @@ fn texture_ui(
                     );
                 }
                 ramp_ui(ui, texture);
-                if texture.ramp.is_empty() {
+                // An image gives its own colour: it has no children.
+                let is_image = matches!(texture.pattern, Pattern::Image { .. });
+                if texture.ramp.is_empty() && !is_image {
                     if texture.pattern == Pattern::Constant {
                         child_ui(ui, "value", &mut texture.a, kind, depth);
                     } else {
