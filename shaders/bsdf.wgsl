@@ -98,6 +98,9 @@ struct BsdfSample {
     wi: vec3f,
     weight: vec3f,   // f·cos / pdf, or the mirror's 1
     valid: bool,
+    // The density of wi under the continuous lobes, (1 - mirror)·pdf, for
+    // multiple importance sampling; 0 when the mirror was chosen (a delta).
+    pdf: f32,
 }
 
 // One code path for both lobes, chosen by selects: the lobes differ only in
@@ -119,5 +122,6 @@ fn sample_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f) -> BsdfSample {
     out.wi = select(wi, reflect(-wo, n), mirror);
     out.weight = select(e.f_cos / e.pdf, vec3f(1.0), mirror);
     out.valid = mirror || e.pdf > 0.0;
+    out.pdf = select((1.0 - s.mirror) * e.pdf, 0.0, mirror);
     return out;
 }

@@ -29,6 +29,10 @@ struct Frame {
     polygon_count: u32,
     // The angle a pixel subtends at the camera: the spread of ray cones.
     pixel_spread: f32,
+    // Non-zero: sample the environment map by its luminance (MIS).
+    env_sampling: u32,
+    // Cells of the environment's sampling distribution (env_sampling.wgsl).
+    env_distribution_size: vec2u,
 }
 
 const MAX_SIGNALS: u32 = 4u;

@@ -22,11 +22,35 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     }
     let origin = offset_ray(hit.p, hit.n);
 #if OPACITY
-    let through = transmittance(origin, wi, frame.light_pos);
+    let through = transmittance(origin, wi, length(frame.light_pos - origin));
 #else
     let through = select(1.0, 0.0, occluded(origin, wi, length(frame.light_pos - origin)));
 #endif
     return through * (1.0 - s.mirror) * f_cos * frame.light_power / dist2;
+}
+#endif
+
+#if ENV_SAMPLING
+// Light from the environment map by sampling it (next-event estimation),
+// weighted against BSDF sampling's chance of the same direction by the
+// power heuristic; the escape at the next bounce takes the other weight.
+fn env_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
+    let sample = sample_env(rand(), rand());
+    if sample.pdf <= 0.0 || dot(sample.wi, hit.n) <= 0.0 {
+        return vec3f(0.0);
+    }
+    let e = eval_bsdf(s, s.n, wo, sample.wi);
+    if all(e.f_cos == vec3f(0.0)) {
+        return vec3f(0.0);
+    }
+    let origin = offset_ray(hit.p, hit.n);
+#if OPACITY
+    let through = transmittance(origin, sample.wi, NO_HIT);
+#else
+    let through = select(1.0, 0.0, occluded(origin, sample.wi, NO_HIT));
+#endif
+    let weight = power_heuristic(sample.pdf, (1.0 - s.mirror) * e.pdf);
+    return through * (1.0 - s.mirror) * e.f_cos * environment(sample.wi) * weight / sample.pdf;
 }
 #endif
 
@@ -35,18 +59,22 @@ fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
 const MAX_CROSSINGS: u32 = 16u;
 
 #if OPACITY
-// The fraction of light going from `o` along `d` that reaches `light`
-// through the surfaces in between: each lets `1 - opacity` through, like a
-// ray crossing it (no refraction, no tint).
-fn transmittance(o: vec3f, d: vec3f, light: vec3f) -> f32 {
+// The fraction of light going from `o` along `d` that reaches distance
+// `t_max` (NO_HIT: the environment) through the surfaces in between: each
+// lets `1 - opacity` through, like a ray crossing it (no refraction, no
+// tint). Distances are compared, never points far away, whose squared
+// lengths would overflow.
+fn transmittance(o: vec3f, d: vec3f, t_max: f32) -> f32 {
     var origin = o;
+    var remaining = t_max;
     var through = 1.0;
     var crossings = 0u;
     loop {
         let h = intersect_scene(origin, d);
-        if h.t >= length(light - origin) {
+        if h.t >= remaining {
             break;
         }
+        remaining -= h.t;
         through *= 1.0 - clamp(surface_opacity(h.material, h.texture_point, h.p, h.uv), 0.0, 1.0);
         origin = offset_ray(h.p, -h.n);
         crossings++;
@@ -89,6 +117,10 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // pixel's spread per unit of distance, bounce after bounce (no
     // curvature term, so a mirror keeps it as the camera made it).
     var cone_width = 0.0;
+    // The continuous density of the last bounce's direction (0 for the
+    // camera ray and mirror bounces): an escape weighs it against env
+    // sampling.
+    var last_bsdf_pdf = 0.0;
     if hit.t < NO_HIT && frame.max_bounces > 0u {
         loop {
             let width = cone_width + frame.pixel_spread * hit.t;
@@ -119,12 +151,18 @@ fn trace_path(pixel: vec2f) -> vec3f {
 #if POINT_LIGHT
                 radiance += throughput * point_light(hit, s, wo);
 #endif
+#if ENV_SAMPLING
+                if frame.env_sampling != 0u {
+                    radiance += throughput * env_light(hit, s, wo);
+                }
+#endif
                 let bs = sample_bsdf(s, s.n, wo);
                 if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
                     alive = false;
                     break;
                 }
                 throughput *= bs.weight;
+                last_bsdf_pdf = bs.pdf;
                 d = bs.wi;
                 origin = offset_ray(hit.p, hit.n);
                 bounces++;
@@ -140,7 +178,13 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // gets nothing more.
     let escaped = alive && hit.t >= NO_HIT && crossings < MAX_CROSSINGS;
     if escaped && (bounces > 0u || frame.background_visible != 0u) {
-        radiance += throughput * environment(d);
+        var weight = 1.0;
+#if ENV_SAMPLING
+        if frame.env_sampling != 0u && last_bsdf_pdf > 0.0 {
+            weight = power_heuristic(last_bsdf_pdf, env_pdf(d));
+        }
+#endif
+        radiance += throughput * environment(d) * weight;
     }
     return radiance;
 }

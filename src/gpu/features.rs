@@ -13,6 +13,7 @@ pub enum Feature {
     Polygon,
     PointLight,
     EnvMap,
+    EnvSampling,
     EnvConstant,
     PatternChecker,
     PatternFbm,
@@ -40,12 +41,13 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 29] = [
+    pub const ALL: [Feature; 30] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
         Feature::PointLight,
         Feature::EnvMap,
+        Feature::EnvSampling,
         Feature::EnvConstant,
         Feature::PatternChecker,
         Feature::PatternFbm,
@@ -95,6 +97,7 @@ impl Feature {
             Feature::Polygon => "POLYGON",
             Feature::PointLight => "POINT_LIGHT",
             Feature::EnvMap => "ENV_MAP",
+            Feature::EnvSampling => "ENV_SAMPLING",
             Feature::EnvConstant => "ENV_CONSTANT",
             Feature::PatternChecker => "PATTERN_CHECKER",
             Feature::PatternFbm => "PATTERN_FBM",
@@ -188,6 +191,9 @@ impl FeatureSet {
             }
             EnvSource::LatLong { .. } => {
                 set.insert(Feature::EnvMap);
+                if scene.render.env_importance {
+                    set.insert(Feature::EnvSampling);
+                }
             }
         }
         let patterns: Vec<&Pattern> = scene.materials().flat_map(|m| m.patterns()).collect();

@@ -8,12 +8,13 @@ use super::geometry_buffers::GeometryBuffers;
 use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
-    uniform, upload_atlas, upload_rgba16f,
+    storage, uniform, upload_atlas, upload_rgba16f,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
 use super::shader_source::{Program, assemble};
 use super::texture_codegen;
+use crate::env_sampling::EnvDistribution;
 use crate::envmap::EnvImage;
 use crate::scene::{Scene, ToneMap};
 use crate::texture::ImageSet;
@@ -129,6 +130,8 @@ pub struct Renderer {
     trace_shader_bytes: usize,
     env_view: wgpu::TextureView,
     env_sampler: wgpu::Sampler,
+    /// The environment's importance-sampling CDFs and their size in cells.
+    env_distribution: (wgpu::Buffer, [u32; 2]),
     /// The images the texture code reads, and their atlas on the GPU.
     images: ImageSet,
     image_atlas_view: wgpu::TextureView,
@@ -165,6 +168,7 @@ impl Renderer {
                 entry(6, uniform()),
                 entry(7, uniform()),
                 entry(8, float_texture(false)),
+                entry(11, storage(true)),
             ],
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -219,6 +223,7 @@ impl Renderer {
             ..Default::default()
         });
         let env_view = upload_env(ctx, env);
+        let env_distribution = upload_env_distribution(ctx, env);
         let image_atlas_view = upload_atlas(ctx, images.atlas());
         let accumulation = create_accumulation(device, size);
         Ok(Self {
@@ -241,6 +246,7 @@ impl Renderer {
             trace_shader_bytes,
             env_view,
             env_sampler,
+            env_distribution,
             images,
             image_atlas_view,
             accumulation,
@@ -523,6 +529,7 @@ impl Renderer {
     /// Replaces the environment image (None: a black 1×1 placeholder).
     pub fn set_environment(&mut self, ctx: &GpuContext, env: Option<&EnvImage>) {
         self.env_view = upload_env(ctx, env);
+        self.env_distribution = upload_env_distribution(ctx, env);
         self.reset_accumulation();
     }
 
@@ -559,8 +566,9 @@ impl Renderer {
             self.accumulated = 0;
         }
         let render_size = self.render_size();
-        let uniform: FrameUniform =
+        let mut uniform: FrameUniform =
             scene_gpu::frame_uniform(&self.scene, render_size, self.frame_index, self.accumulated);
+        uniform.env_distribution_size = self.env_distribution.1;
         ctx.queue
             .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
         let read = self.accumulation.latest;
@@ -579,6 +587,7 @@ impl Renderer {
                 8,
                 wgpu::BindingResource::TextureView(&self.image_atlas_view),
             ),
+            bind(11, self.env_distribution.0.as_entire_binding()),
         ];
         entries.extend(self.geometry.entries());
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -801,6 +810,21 @@ fn create_accumulation(device: &wgpu::Device, size: (u32, u32)) -> Accumulation 
 }
 
 /// Uploads an environment map as Rgba16Float (the sanitised values fit).
+/// The environment's importance-sampling CDFs (`env_sampling.wgsl`) and
+/// their size in cells; a 1×1 uniform distribution without a map.
+fn upload_env_distribution(ctx: &GpuContext, env: Option<&EnvImage>) -> (wgpu::Buffer, [u32; 2]) {
+    let black = crate::envmap::constant(1, 1, [0.0; 3]);
+    let distribution = EnvDistribution::new(env.unwrap_or(&black));
+    let buffer = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment distribution"),
+            contents: bytemuck::cast_slice(&distribution.gpu_data()),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+    (buffer, [distribution.width, distribution.height])
+}
+
 fn upload_env(ctx: &GpuContext, env: Option<&EnvImage>) -> wgpu::TextureView {
     let black = EnvImage {
         width: 1,

@@ -38,7 +38,11 @@ pub struct FrameUniform {
     pub polygon_count: u32,
     /// The angle a pixel subtends at the camera: the spread of ray cones.
     pub pixel_spread: f32,
-    pub _pad: u32,
+    /// Non-zero: sample the environment map by its luminance (MIS).
+    pub env_sampling: u32,
+    /// Cells of the environment's sampling distribution (width, height).
+    pub env_distribution_size: [u32; 2],
+    pub _pad: [u32; 2],
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -285,7 +289,12 @@ pub fn frame_uniform(
         cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
         polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
         pixel_spread: 2.0 * cam.tan_half_fov / h,
-        _pad: 0,
+        env_sampling: u32::from(
+            matches!(env.source, EnvSource::LatLong { .. }) && scene.render.env_importance,
+        ),
+        // Filled in by the renderer, which holds the distribution.
+        env_distribution_size: [0; 2],
+        _pad: [0; 2],
     }
 }
 
@@ -298,7 +307,7 @@ mod tests {
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 160);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 176);
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);

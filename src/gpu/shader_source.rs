@@ -64,6 +64,10 @@ const SOURCES: &[(&str, &str)] = &[
         "texture_image.wgsl",
         include_str!("../../shaders/texture_image.wgsl"),
     ),
+    (
+        "env_sampling.wgsl",
+        include_str!("../../shaders/env_sampling.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -117,9 +121,11 @@ impl Program {
                     "random.wgsl",
                     "bsdf.wgsl",
                     "env_lookup.wgsl",
-                    "fullscreen.wgsl",
-                    "trace.wgsl",
                 ]);
+                if features.contains(Feature::EnvSampling) {
+                    out.push("env_sampling.wgsl");
+                }
+                out.extend(["fullscreen.wgsl", "trace.wgsl"]);
                 if features.contains(Feature::Bump) {
                     out.extend(["texture_shading.wgsl", "bump.wgsl"]);
                 }

@@ -470,6 +470,11 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         );
     ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
         .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
+    ui.checkbox(&mut render.env_importance, "sample the environment map")
+        .on_hover_text(
+            "Also draw light directions from a lat-long map by its luminance, combined with \
+             BSDF sampling by MIS: a sun stops making fireflies",
+        );
     if ui
         .button("Screenshot (F12)")
         .on_hover_text("Save the current image as a PNG")

@@ -47,6 +47,11 @@ pub struct RenderSettings {
     /// Fractal sums stop at the octaves the footprint resolves (pbrt's
     /// rule), rather than summing detail finer than a pixel.
     pub clamp_octaves: bool,
+    /// A lat-long environment is also sampled in proportion to its
+    /// luminance at every bounce, combined with BSDF sampling by multiple
+    /// importance sampling (power heuristic); off, only BSDF sampling
+    /// finds it.
+    pub env_importance: bool,
 }
 
 impl RenderSettings {
@@ -100,6 +105,7 @@ impl Default for RenderSettings {
             max_bounces: 3,
             filter_checkers: true,
             clamp_octaves: true,
+            env_importance: true,
         }
     }
 }
