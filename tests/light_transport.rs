@@ -55,6 +55,20 @@ fn lat_long_scene(importance: bool) -> Scene {
     scene
 }
 
+/// A diffuse sphere on a diffuse ground under a map (background hidden),
+/// with environment importance sampling and without.
+fn sphere_on_ground_both_ways() -> (Scene, Scene) {
+    let mut with = lat_long_scene(true);
+    with.ground = Some(Ground {
+        height: 0.0,
+        material: lambert(0.5),
+    });
+    with.environment.background_visible = false;
+    let mut without = with.clone();
+    without.render.env_importance = false;
+    (with, without)
+}
+
 /// A white furnace through the importance-sampled path: a diffuse sphere of
 /// albedo ρ inside a lat-long map of constant radiance 1 reflects exactly ρ,
 /// whichever strategy finds the map, if the MIS weights of env sampling and
@@ -105,14 +119,7 @@ fn importance_sampling_is_unbiased_on_a_smooth_map() {
                 [0.2 + up + patch, 0.3 + up + 0.5 * patch, 0.5 + up, 1.0];
         }
     }
-    let mut with = lat_long_scene(true);
-    with.ground = Some(Ground {
-        height: 0.0,
-        material: lambert(0.5),
-    });
-    with.environment.background_visible = false;
-    let mut without = with.clone();
-    without.render.env_importance = false;
+    let (with, without) = sphere_on_ground_both_ways();
     let size = (24, 16);
     let mean = |p: &[[f32; 4]]| p.iter().map(|c| c[0] + c[1] + c[2]).sum::<f32>() / p.len() as f32;
     let m = mean(&render_env(&ctx, &with, &env, size, 1024));
@@ -136,14 +143,7 @@ fn importance_sampling_the_sky_lowers_the_error_at_equal_samples() {
     };
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("envmaps/sky.exr");
     let env = marbre::envmap::load(&path).unwrap().image;
-    let mut with = lat_long_scene(true);
-    with.ground = Some(Ground {
-        height: 0.0,
-        material: lambert(0.5),
-    });
-    with.environment.background_visible = false;
-    let mut without = with.clone();
-    without.render.env_importance = false;
+    let (with, without) = sphere_on_ground_both_ways();
     let size = (24, 16);
     let reference = render_env(&ctx, &with, &env, size, 1024);
     let rmse = |p: &[[f32; 4]]| {
