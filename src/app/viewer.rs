@@ -154,6 +154,20 @@ impl Viewer {
                     },
                 ..
             } if !consumed => self.screenshot_requested = true,
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        logical_key: Key::Character(text),
+                        state: ElementState::Pressed,
+                        ..
+                    },
+                ..
+            } if !consumed => {
+                // Keys 1–9 recall the preset's saved views.
+                if let Ok(digit @ 1..=9) = text.parse::<usize>() {
+                    self.scene.recall_view(digit - 1);
+                }
+            }
             WindowEvent::RedrawRequested => return self.redraw(),
             _ => {}
         }

@@ -135,7 +135,7 @@ pub fn draw(
                 point_light_ui(ui, &mut scene.point_light);
             });
             section(ui, "Camera", false, |ui| {
-                camera_ui(ui, &mut scene.camera, &mut actions);
+                camera_ui(ui, scene, &mut actions);
             });
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
@@ -399,7 +399,8 @@ fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {
     }
 }
 
-fn camera_ui(ui: &mut Ui, camera: &mut OrbitCamera, actions: &mut Vec<PanelAction>) {
+fn camera_ui(ui: &mut Ui, scene: &mut Scene, actions: &mut Vec<PanelAction>) {
+    let camera = &mut scene.camera;
     vec3_ui(
         ui,
         "target",
@@ -430,6 +431,53 @@ fn camera_ui(ui: &mut Ui, camera: &mut OrbitCamera, actions: &mut Vec<PanelActio
         actions.push(PanelAction::ResetCamera);
     }
     ui.weak("left drag: orbit · right/middle drag: pan · wheel: zoom");
+    views_ui(ui, scene);
+}
+
+/// The preset's saved views: recall (or keys 1–9), rename, delete, and
+/// save the current camera as a new one.
+fn views_ui(ui: &mut Ui, scene: &mut Scene) {
+    let mut recall = None;
+    let mut remove = None;
+    for (i, view) in scene.views.iter_mut().enumerate() {
+        ui.push_id(("view", i), |ui| {
+            ui.horizontal(|ui| {
+                let key = if i < 9 {
+                    format!("{}", i + 1)
+                } else {
+                    "·".to_owned()
+                };
+                if ui
+                    .button(key)
+                    .on_hover_text("Go to this view (the number key does it too)")
+                    .clicked()
+                {
+                    recall = Some(i);
+                }
+                ui.text_edit_singleline(&mut view.name);
+                if ui
+                    .small_button("✕")
+                    .on_hover_text("Delete this view")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+            });
+        });
+    }
+    if let Some(i) = recall {
+        scene.recall_view(i);
+    }
+    if let Some(i) = remove {
+        scene.views.remove(i);
+    }
+    if ui
+        .button("Save view")
+        .on_hover_text("Keep the current camera in the preset; keys 1–9 recall the first nine")
+        .clicked()
+    {
+        scene.save_view();
+    }
 }
 
 fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
@@ -586,7 +634,7 @@ mod tests {
                 material_ui(ui, &mut scene.ground.as_mut().unwrap().material);
                 environment_ui(ui, &mut scene.environment, &mut state, &mut actions);
                 point_light_ui(ui, &mut scene.point_light);
-                camera_ui(ui, &mut scene.camera, &mut actions);
+                camera_ui(ui, &mut scene, &mut actions);
             });
             assert_eq!(scene, before);
             assert!(actions.is_empty(), "{actions:?}");

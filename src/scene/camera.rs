@@ -29,6 +29,24 @@ impl Default for OrbitCamera {
     }
 }
 
+/// A named camera the preset keeps (the lab's saved orbiter): keys 1–9
+/// recall the first nine.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SavedView {
+    pub name: String,
+    pub camera: OrbitCamera,
+}
+
+impl Default for SavedView {
+    fn default() -> Self {
+        Self {
+            name: "view".into(),
+            camera: OrbitCamera::default(),
+        }
+    }
+}
+
 /// A camera frame: position and the orthonormal basis the shader needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraFrame {

@@ -13,7 +13,7 @@ pub mod primitives;
 pub mod render_settings;
 pub mod texture_tree;
 
-pub use camera::OrbitCamera;
+pub use camera::{OrbitCamera, SavedView};
 pub use environment::{EnvSource, Environment};
 pub use material::{Layer, Material, Property};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
@@ -90,6 +90,9 @@ pub const MAX_SPHERES: usize = 63;
 #[serde(default)]
 pub struct Scene {
     pub camera: OrbitCamera,
+    /// Named cameras to come back to; keys 1–9 recall the first nine.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub views: Vec<SavedView>,
     pub spheres: Vec<Sphere>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub cylinders: Vec<Cylinder>,
@@ -111,6 +114,26 @@ impl Scene {
             .chain(self.cylinders.iter().map(|c| &c.material))
             .chain(self.polygons.iter().map(|p| &p.material))
             .chain(self.ground.iter().map(|g| &g.material))
+    }
+
+    /// Moves the camera to saved view `index` (0-based); false if there is
+    /// none.
+    pub fn recall_view(&mut self, index: usize) -> bool {
+        match self.views.get(index) {
+            Some(view) => {
+                self.camera = view.camera;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Saves the current camera as a new view named after its number.
+    pub fn save_view(&mut self) {
+        self.views.push(SavedView {
+            name: format!("view {}", self.views.len() + 1),
+            camera: self.camera,
+        });
     }
 
     /// Every material, mutably, in GPU order.
@@ -175,6 +198,9 @@ impl Scene {
         }
         self.render.sanitize(&mut notes);
         self.camera.sanitize(&mut notes);
+        for view in &mut self.views {
+            view.camera.sanitize(&mut notes);
+        }
         notes
     }
 
@@ -228,6 +254,23 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Saving keeps the camera under the next number; recalling brings it
+    /// back after the camera moved; a missing view changes nothing.
+    #[test]
+    fn saved_views_come_back() {
+        let mut scene = Scene::default();
+        scene.save_view();
+        let saved = scene.camera;
+        scene.camera.orbit(40.0, 10.0);
+        scene.save_view();
+        assert_eq!(scene.views[1].name, "view 2");
+        assert!(scene.recall_view(0));
+        assert_eq!(scene.camera, saved);
+        let before = scene.camera;
+        assert!(!scene.recall_view(5));
+        assert_eq!(scene.camera, before);
+    }
 
     #[test]
     fn spheres_beyond_the_renderer_limit_are_dropped_with_a_note() {
