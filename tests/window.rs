@@ -5,6 +5,8 @@
 //!   window (UI included); its pixels must show a dark side panel with light
 //!   text in it (fonts render) and a rendered, non-flat image with the
 //!   preset's warm environment behind it.
+//! - `number_keys_recall_saved_views`: the key 3, then F12: the screenshot
+//!   shows the preset's third saved view.
 //! - `f12_writes_png_and_exr`: a real F12 key press (sent with `xdotool`)
 //!   writes `screenshots/marbre-<timestamp>.png` and `.exr` into the working
 //!   directory; both decode, have the same size and hold a sensible image
@@ -390,18 +392,19 @@ fn window_shows_panel_and_render() {
     );
 }
 
-#[test]
-fn f12_writes_png_and_exr() {
-    const TEST: &str = "f12_writes_png_and_exr";
-    let _serial = serial();
-    let dir = TempDir::new("f12");
-    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
-        return;
-    };
+/// Starts the viewer on `preset` in `dir/cwd`, gives its window the
+/// keyboard focus, presses `keys` and then F12 until the screenshots exist,
+/// and returns them with the still running viewer.
+fn screenshot_after_keys(
+    test: &str,
+    x: &Xvfb,
+    dir: &TempDir,
+    preset: &Path,
+    keys: &[&str],
+) -> ((PathBuf, PathBuf), Guard) {
     // Screenshots go to `screenshots/` in the working directory: a fresh one
     // here, so the preset must be named by its full path.
     let cwd = dir.subdir("cwd");
-    let preset = Path::new(REPO).join("presets/default.ron");
     let shots = cwd.join("screenshots");
     let start = Instant::now();
     // No frame limit: how many frames go by before the key press is read
@@ -409,27 +412,27 @@ fn f12_writes_png_and_exr() {
     // real one), so any fixed `--exit-after-frames` is either slow here or
     // racy there. The test stops the viewer itself once the files exist; a
     // clean exit is what `window_shows_panel_and_render` checks.
-    let mut child = spawn_marbre(&x, &dir, &cwd, &["--preset".into(), preset.into()]);
+    let mut child = spawn_marbre(x, dir, &cwd, &["--preset".into(), preset.into()]);
     // Fails if the viewer has exited (it never should here), or if the test
     // has been waiting for `what` for too long.
     let still_running = |child: &mut Guard, what: &str| {
         if let Some(status) = child.0.try_wait().unwrap() {
             panic!(
                 "marbre exited ({status}) while waiting for {what}; its log:\n{}",
-                marbre_log(&dir)
+                marbre_log(dir)
             );
         }
         assert!(
             start.elapsed() < CHILD_TIMEOUT,
             "no {what} after {CHILD_TIMEOUT:?}; marbre's log:\n{}",
-            marbre_log(&dir)
+            marbre_log(dir)
         );
     };
 
     // Wait for the window to be mapped (well before the first frame: the
     // device and pipelines are created after the window).
     let window = loop {
-        let out = xdotool(&x, &["search", "--onlyvisible", "--name", "^marbre$"]);
+        let out = xdotool(x, &["search", "--onlyvisible", "--name", "^marbre$"]);
         if let Some(id) = String::from_utf8_lossy(&out.stdout).lines().next() {
             break id.to_owned();
         }
@@ -437,20 +440,31 @@ fn f12_writes_png_and_exr() {
         std::thread::sleep(Duration::from_millis(50));
     };
     eprintln!(
-        "{TEST}: window {window} after {:.1} s",
+        "{test}: window {window} after {:.1} s",
         start.elapsed().as_secs_f64()
     );
 
     // There is no window manager: give the window the keyboard focus, then
-    // press F12 through XTEST (a real key event, not a synthetic XSendEvent
-    // one, which some toolkits ignore). X queues the event until the viewer
-    // reads it.
-    let focus = xdotool(&x, &["windowfocus", "--sync", &window]);
+    // press the keys through XTEST (real key events, not synthetic
+    // XSendEvent ones, which some toolkits ignore). X queues the events
+    // until the viewer reads them, in order.
+    let focus = xdotool(x, &["windowfocus", "--sync", &window]);
     assert!(
         focus.status.success(),
         "xdotool windowfocus: {}",
         String::from_utf8_lossy(&focus.stderr)
     );
+    let press = |key: &str| {
+        let out = xdotool(x, &["key", key]);
+        assert!(
+            out.status.success(),
+            "xdotool key {key}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    for key in keys {
+        press(key);
+    }
     let mut presses = 0;
     let pair = loop {
         if let Some(pair) = screenshot_pair(&shots) {
@@ -460,20 +474,28 @@ fn f12_writes_png_and_exr() {
         // The first press is handled after start-up and one frame; should a
         // press get lost, press again every 20 s rather than fail at once.
         if presses == 0 || start.elapsed().as_secs() / 20 >= presses {
-            let key = xdotool(&x, &["key", "F12"]);
-            assert!(
-                key.status.success(),
-                "xdotool key: {}",
-                String::from_utf8_lossy(&key.stderr)
-            );
+            press("F12");
             presses += 1;
         }
         std::thread::sleep(Duration::from_millis(100));
     };
     eprintln!(
-        "{TEST}: {presses} key press(es); screenshots after {:.1} s",
+        "{test}: {presses} F12 press(es); screenshots after {:.1} s",
         start.elapsed().as_secs_f64()
     );
+    (pair, child)
+}
+
+#[test]
+fn f12_writes_png_and_exr() {
+    const TEST: &str = "f12_writes_png_and_exr";
+    let _serial = serial();
+    let dir = TempDir::new("f12");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let preset = Path::new(REPO).join("presets/default.ron");
+    let (pair, mut child) = screenshot_after_keys(TEST, &x, &dir, &preset, &[]);
     // Saving must not have broken the viewer: it still runs a moment later.
     std::thread::sleep(Duration::from_secs(1));
     if let Some(status) = child.0.try_wait().unwrap() {
@@ -565,4 +587,32 @@ fn screenshot_pair(folder: &Path) -> Option<(PathBuf, PathBuf)> {
             (png, exr)
         })
         .find(|(_, exr)| exr.is_file())
+}
+
+/// Keys 1–9 recall the preset's saved views: in the default preset, view 3
+/// looks down at the pale checkerboard ground from 70°, so the top of the
+/// F12 screenshot is almost all light (measured: luma 0.68, 95 % light
+/// pixels), where the preset's own camera shows the darker evening sky and
+/// the spheres' tops there (luma 0.41, 45 % light).
+#[test]
+fn number_keys_recall_saved_views() {
+    const TEST: &str = "number_keys_recall_saved_views";
+    let _serial = serial();
+    let dir = TempDir::new("views");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let preset = Path::new(REPO).join("presets/default.ron");
+    let ((png_path, _), child) = screenshot_after_keys(TEST, &x, &dir, &preset, &["3"]);
+    drop(child);
+    let png = image::open(&png_path)
+        .unwrap_or_else(|e| panic!("{}: {e}", png_path.display()))
+        .to_rgba8();
+    let (w, _) = png.dimensions();
+    let top = region(&png, 0..w, 0..120);
+    eprintln!("{TEST}: top of the image {top:?}");
+    assert!(
+        top.mean_luma > 0.55 && top.light_fraction > 0.75,
+        "the top of the image is not the ground seen from above: {top:?}"
+    );
 }
