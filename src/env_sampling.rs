@@ -20,6 +20,7 @@
 //! (box-averaged from the map) so the GPU's binary searches stay short.
 
 use crate::envmap::{EnvImage, rotate_y};
+use crate::texture::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -47,7 +48,7 @@ impl EnvDistribution {
         for y in 0..image.height {
             for x in 0..image.width {
                 let p = image.texel(x, y);
-                let lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                let lum = luminance(Vec3::new(p[0], p[1], p[2]));
                 averaged[((y / factor) * width + x / factor) as usize] += f64::from(lum.max(0.0));
             }
         }

@@ -406,9 +406,8 @@ impl Viewer {
         }
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
-        if self.scene != *self.renderer.scene()
-            && let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene)
-        {
+        let edited = self.scene != *self.renderer.scene();
+        if edited && let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
             // Keep what is on screen; show why the edit was refused.
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.scene().clone();
@@ -419,7 +418,10 @@ impl Viewer {
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.scene().clone();
         }
-        self.reload_images_if_needed();
+        // Only an edit can add an image or change a path.
+        if edited {
+            self.reload_images_if_needed();
+        }
         if self.config.width == 0 || self.config.height == 0 {
             return Ok(true);
         }

@@ -809,12 +809,15 @@ fn create_accumulation(device: &wgpu::Device, size: (u32, u32)) -> Accumulation 
     }
 }
 
-/// Uploads an environment map as Rgba16Float (the sanitised values fit).
+/// What the renderer binds without an environment map: one black texel.
+fn no_env() -> EnvImage {
+    crate::envmap::constant(1, 1, [0.0; 3])
+}
+
 /// The environment's importance-sampling CDFs (`env_sampling.wgsl`) and
 /// their size in cells; a 1×1 uniform distribution without a map.
 fn upload_env_distribution(ctx: &GpuContext, env: Option<&EnvImage>) -> (wgpu::Buffer, [u32; 2]) {
-    let black = crate::envmap::constant(1, 1, [0.0; 3]);
-    let distribution = EnvDistribution::new(env.unwrap_or(&black));
+    let distribution = EnvDistribution::new(env.unwrap_or(&no_env()));
     let buffer = ctx
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -825,12 +828,9 @@ fn upload_env_distribution(ctx: &GpuContext, env: Option<&EnvImage>) -> (wgpu::B
     (buffer, [distribution.width, distribution.height])
 }
 
+/// Uploads an environment map as Rgba16Float (the sanitised values fit).
 fn upload_env(ctx: &GpuContext, env: Option<&EnvImage>) -> wgpu::TextureView {
-    let black = EnvImage {
-        width: 1,
-        height: 1,
-        pixels: vec![[0.0, 0.0, 0.0, 1.0]],
-    };
+    let black = no_env();
     let image = env.unwrap_or(&black);
     upload_rgba16f(
         ctx,
