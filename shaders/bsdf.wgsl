@@ -11,6 +11,8 @@ struct SurfacePoint {
     mirror: f32,
     // The chance that a ray meets the surface rather than passing through.
     opacity: f32,
+    // The colour of the light that passes through (where opacity < 1).
+    transmission: vec3f,
     emission: vec3f,
 }
 
@@ -33,6 +35,7 @@ fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
     s.alpha = max(r * r, 1e-3);
     s.mirror = clamp(textures.mirror, 0.0, 1.0);
     s.opacity = clamp(textures.opacity, 0.0, 1.0);
+    s.transmission = clamp(textures.transmission, vec3f(0.0), vec3f(1.0));
     s.emission = max(textures.emission, vec3f(0.0));
 #if BUMP
     s.n = bumped_shading_normal(hit, fp, signals);

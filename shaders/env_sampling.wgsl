@@ -75,10 +75,3 @@ fn env_pdf(d: vec3f) -> f32 {
     return select(0.0, env_pdf_texel_uv(t) / (2.0 * PI * PI * sin_theta), sin_theta > 0.0);
 }
 
-// The power heuristic (β = 2) weight of a strategy with density `a`
-// against one with density `b`.
-fn power_heuristic(a: f32, b: f32) -> f32 {
-    let a2 = a * a;
-    let b2 = b * b;
-    return select(0.0, a2 / (a2 + b2), a2 + b2 > 0.0);
-}

@@ -16,9 +16,21 @@ struct Hit {
     dp_dv: vec3f,
 #endif
     material: u32,
+    // Which primitive: its kind (SHAPE_*) and index among its kind.
+    shape: u32,
+    index: u32,
+    // Whether the ray arrived on the side the primitive faces (its
+    // outside, or a triangle's counter-clockwise side): emitters emit there.
+    front: bool,
 }
 
 const NO_HIT: f32 = 3.0e38;
+
+const SHAPE_SPHERE: u32 = 0u;
+const SHAPE_CYLINDER: u32 = 1u;
+const SHAPE_POLYGON: u32 = 2u;
+const SHAPE_GROUND: u32 = 3u;
+const SHAPE_TRIANGLE: u32 = 4u;
 
 // Smallest positive root of |o + t d - c| = r, d unit length, or NO_HIT.
 // Haines et al. (Ray Tracing Gems ch. 7): the discriminant is computed from
@@ -148,6 +160,8 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
         hit.dp_dv = select(vec3f(0.0), PI * s.radius * climb, ring > 0.0);
 #endif
         hit.material = index;
+        hit.shape = SHAPE_SPHERE;
+        hit.index = index;
     }
 #if CYLINDER
     for (var i = 0u; i < frame.cylinder_count; i++) {
@@ -180,6 +194,8 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
 #endif
             }
             hit.material = frame.sphere_count + i;
+            hit.shape = SHAPE_CYLINDER;
+            hit.index = i;
         }
     }
 #endif
@@ -202,6 +218,8 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.dp_dv = polygons[i].uv_v;
 #endif
             hit.material = frame.sphere_count + frame.cylinder_count + i;
+            hit.shape = SHAPE_POLYGON;
+            hit.index = i;
         }
     }
 #endif
@@ -219,10 +237,44 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.dp_dv = vec3f(0.0, 0.0, 1.0);
 #endif
             hit.material = frame.sphere_count + frame.cylinder_count + frame.polygon_count;
+            hit.shape = SHAPE_GROUND;
+            hit.index = 0u;
         }
     }
 #endif
-    if hit.t < NO_HIT && dot(hit.n, d) > 0.0 {
+#if MESH
+    let m = intersect_mesh(o, d, hit.t);
+    if m.t < hit.t {
+        let tri = mesh_triangles[m.triangle];
+        let a = mesh_attributes[m.triangle];
+        let e1 = tri.v1.xyz - tri.v0.xyz;
+        let e2 = tri.v2.xyz - tri.v0.xyz;
+        hit.t = m.t;
+        // From the barycentrics: on the triangle's plane whatever the
+        // rounding of t.
+        hit.p = tri.v0.xyz + m.b1 * e1 + m.b2 * e2;
+        hit.n = normalize(cross(e1, e2));
+        hit.texture_point = hit.p;
+        let b0 = 1.0 - m.b1 - m.b2;
+        hit.uv = b0 * a.uv01.xy + m.b1 * a.uv01.zw + m.b2 * a.uv2;
+#if TANGENTS
+        // Solve p = p0 + Δu ∂p/∂u + Δv ∂p/∂v over the two edges (pbrt);
+        // degenerate (u, v) get the edges themselves.
+        let du1 = a.uv01.zw - a.uv01.xy;
+        let du2 = a.uv2 - a.uv01.xy;
+        let det = du1.x * du2.y - du1.y * du2.x;
+        let ok = abs(det) > 1e-12;
+        let inv = select(0.0, 1.0 / det, ok);
+        hit.dp_du = select(e1, (du2.y * e1 - du1.y * e2) * inv, ok);
+        hit.dp_dv = select(e2, (du1.x * e2 - du2.x * e1) * inv, ok);
+#endif
+        hit.material = a.material;
+        hit.shape = SHAPE_TRIANGLE;
+        hit.index = m.triangle;
+    }
+#endif
+    hit.front = dot(hit.n, d) <= 0.0;
+    if hit.t < NO_HIT && !hit.front {
         hit.n = -hit.n;
     }
     return hit;
@@ -255,6 +307,11 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
         if t > 0.0 && t < t_max {
             return true;
         }
+    }
+#endif
+#if MESH
+    if mesh_occluded(o, d, t_max) {
+        return true;
     }
 #endif
     return false;

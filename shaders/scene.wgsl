@@ -33,6 +33,18 @@ struct Frame {
     env_sampling: u32,
     // Cells of the environment's sampling distribution (env_sampling.wgsl).
     env_distribution_size: vec2u,
+    // The light table (lights.wgsl): its length, how a light is chosen
+    // (0 uniformly, 1 by power) and the sum of its powers.
+    light_count: u32,
+    light_selection: u32,
+    light_total_power: f32,
+    // Light samples per shading point (the lab's N).
+    light_samples: u32,
+    // How light and BSDF samples combine (mis.wgsl).
+    strategy: u32,
+    // Russian roulette from this bounce on (0: never).
+    russian_roulette_from: u32,
+    triangle_count: u32,
 }
 
 const MAX_SIGNALS: u32 = 4u;
@@ -49,7 +61,9 @@ struct Material {
     first_perlin: u32,
     // Scene units of height for a bump value of 1.
     bump_height: f32,
-    _pad: f32,
+    // Mean emitted luminance: above 0, the material's spheres and triangles
+    // are in the light table (Rust: lights::emitted_luminance).
+    emitted_luminance: f32,
 }
 
 struct Sphere {
@@ -83,9 +97,9 @@ struct Polygon {
 // uniform buffer than from a storage buffer (measured: 14 % of the frame).
 const MAX_SPHERES: u32 = 63u;
 @group(0) @binding(1) var<uniform> spheres: array<Sphere, 63>;
-// The materials of the spheres, cylinders and polygons, then the ground's
-// (Rust: gpu::scene_gpu::MAX_MATERIALS).
-@group(0) @binding(2) var<uniform> materials: array<Material, 88>;
+// The materials of the spheres, cylinders and polygons, the ground's, then
+// the meshes' (Rust: scene::MAX_MATERIALS).
+@group(0) @binding(2) var<uniform> materials: array<Material, 160>;
 @group(0) @binding(9) var<uniform> cylinders: array<Cylinder, 8>;
 @group(0) @binding(10) var<uniform> polygons: array<Polygon, 16>;
 // The numbers of the scene's texture trees, read at constant indices by the
@@ -96,4 +110,35 @@ const MAX_SPHERES: u32 = 63u;
 // Every image of the scene with its mip levels (Rust: texture::ImageAtlas),
 // read with textureLoad and filtered by hand (texture_image.wgsl).
 @group(0) @binding(8) var image_atlas: texture_2d<f32>;
+#endif
+
+// One entry of the light table (Rust: lights::LightGpu).
+struct Light {
+    // 0 the point light, 1 a sphere, 2 a triangle.
+    kind: u32,
+    primitive: u32,
+    // Cumulative chance by power, up to and including this light.
+    cdf: f32,
+    power: f32,
+}
+
+#if POINT_LIGHT || AREA_LIGHT
+@group(0) @binding(15) var<storage, read> lights: array<Light>;
+#endif
+
+#if MESH
+// A triangle's texture coordinates (uv0 and uv1 packed, then uv2) and
+// material (Rust: gpu::mesh_buffers).
+struct TriangleAttributes {
+    uv01: vec4f,
+    uv2: vec2f,
+    material: u32,
+    _pad: u32,
+}
+
+// The meshes' triangles in BVH order (bvh.wgsl reads the nodes and the
+// vertices; the attributes are read once per hit).
+@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(13) var<storage, read> mesh_triangles: array<TriangleVerts>;
+@group(0) @binding(14) var<storage, read> mesh_attributes: array<TriangleAttributes>;
 #endif

@@ -15,6 +15,7 @@ struct SurfaceTextures {
     roughness: f32,
     mirror: f32,
     opacity: f32,
+    transmission: vec3f,
     emission: vec3f,
 }
 

@@ -11,63 +11,78 @@ fn camera_ray(pixel: vec2f) -> vec3f {
     return normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up);
 }
 
-#if POINT_LIGHT
-fn point_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
-    let to_light = frame.light_pos - hit.p;
-    let dist2 = dot(to_light, to_light);
-    let wi = to_light * inverseSqrt(dist2);
-    let f_cos = eval_bsdf(s, s.n, wo, wi).f_cos;
-    if all(f_cos == vec3f(0.0)) {
-        return vec3f(0.0);
-    }
+#if POINT_LIGHT || AREA_LIGHT
+// Direct light from the light table: `frame.light_samples` points, each on
+// a light chosen anew, their shadow rays through see-through surfaces,
+// each weighted against BSDF sampling's chance of the same direction.
+fn direct_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
+    let count = frame.light_samples;
     let origin = offset_ray(hit.p, hit.n);
-#if OPACITY
-    let through = transmittance(origin, wi, length(frame.light_pos - origin));
-#else
-    let through = select(1.0, 0.0, occluded(origin, wi, length(frame.light_pos - origin)));
-#endif
-    return through * (1.0 - s.mirror) * f_cos * frame.light_power / dist2;
+    var sum = vec3f(0.0);
+    for (var k = 0u; k < count; k++) {
+        let light = sample_light(hit.p);
+        if light.pdf > 0.0 && dot(light.wi, hit.n) > 0.0 {
+            let e = eval_bsdf(s, s.n, wo, light.wi);
+            var weight = 1.0;
+            if !light.delta {
+                weight = light_sample_weight(f32(count) * light.pdf, (1.0 - s.mirror) * e.pdf);
+            }
+            if weight > 0.0 && any(e.f_cos != vec3f(0.0)) {
+                // Stop short of the sampled point, which lies on the light.
+                let t_max = select(light.distance * (1.0 - 1e-4), light.distance, light.delta);
+                let through = visibility(origin, light.wi, t_max);
+                sum += through * e.f_cos * light.radiance * (weight / light.pdf);
+            }
+        }
+    }
+    return (1.0 - s.mirror) * sum / f32(count);
 }
 #endif
 
 #if ENV_SAMPLING
 // Light from the environment map by sampling it (next-event estimation),
-// weighted against BSDF sampling's chance of the same direction by the
-// power heuristic; the escape at the next bounce takes the other weight.
+// weighted against BSDF sampling's chance of the same direction; the
+// escape at the next bounce takes the other weight.
 fn env_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let sample = sample_env(rand(), rand());
     if sample.pdf <= 0.0 || dot(sample.wi, hit.n) <= 0.0 {
         return vec3f(0.0);
     }
     let e = eval_bsdf(s, s.n, wo, sample.wi);
-    if all(e.f_cos == vec3f(0.0)) {
+    let weight = light_sample_weight(sample.pdf, (1.0 - s.mirror) * e.pdf);
+    if weight <= 0.0 || all(e.f_cos == vec3f(0.0)) {
         return vec3f(0.0);
     }
-    let origin = offset_ray(hit.p, hit.n);
-#if OPACITY
-    let through = transmittance(origin, sample.wi, NO_HIT);
-#else
-    let through = select(1.0, 0.0, occluded(origin, sample.wi, NO_HIT));
-#endif
-    let weight = power_heuristic(sample.pdf, (1.0 - s.mirror) * e.pdf);
+    let through = visibility(offset_ray(hit.p, hit.n), sample.wi, NO_HIT);
     return through * (1.0 - s.mirror) * e.f_cos * environment(sample.wi) * weight / sample.pdf;
 }
 #endif
+
+// The fraction of light that goes from `o` along `d` to distance `t_max`
+// (NO_HIT: the environment), per channel.
+fn visibility(o: vec3f, d: vec3f, t_max: f32) -> vec3f {
+#if OPACITY
+    return transmittance(o, d, t_max);
+#else
+    return select(vec3f(1.0), vec3f(0.0), occluded(o, d, t_max));
+#endif
+}
 
 // The most surfaces a ray passes through (opacity < 1) before it counts as
 // stopped: a bound, so that a stack of holes always ends.
 const MAX_CROSSINGS: u32 = 16u;
 
 #if OPACITY
-// The fraction of light going from `o` along `d` that reaches distance
-// `t_max` (NO_HIT: the environment) through the surfaces in between: each
-// lets `1 - opacity` through, like a ray crossing it (no refraction, no
-// tint). Distances are compared, never points far away, whose squared
-// lengths would overflow.
-fn transmittance(o: vec3f, d: vec3f, t_max: f32) -> f32 {
+// The light going from `o` along `d` that reaches distance `t_max`
+// (NO_HIT: the environment) through the surfaces in between, per channel:
+// each lets `1 - opacity` through, tinted by its transmission colour, like
+// a ray crossing it (no refraction), so shadows take the colour of what
+// casts them. Distances are compared, never points far away, whose
+// squared lengths would overflow.
+fn transmittance(o: vec3f, d: vec3f, t_max: f32) -> vec3f {
     var origin = o;
     var remaining = t_max;
-    var through = 1.0;
+    var through = vec3f(1.0);
     var crossings = 0u;
     loop {
         let h = intersect_scene(origin, d);
@@ -75,14 +90,14 @@ fn transmittance(o: vec3f, d: vec3f, t_max: f32) -> f32 {
             break;
         }
         remaining -= h.t;
-        through *= 1.0 - clamp(surface_opacity(h.material, h.texture_point, h.p, h.uv), 0.0, 1.0);
+        through *= surface_transmittance(h.material, h.texture_point, h.p, h.uv);
         origin = offset_ray(h.p, -h.n);
         crossings++;
         continuing {
-            break if through <= 0.0 || crossings >= MAX_CROSSINGS;
+            break if all(through <= vec3f(0.0)) || crossings >= MAX_CROSSINGS;
         }
     }
-    return select(through, 0.0, crossings >= MAX_CROSSINGS);
+    return select(through, vec3f(0.0), crossings >= MAX_CROSSINGS);
 }
 #endif
 
@@ -118,9 +133,12 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // curvature term, so a mirror keeps it as the camera made it).
     var cone_width = 0.0;
     // The continuous density of the last bounce's direction (0 for the
-    // camera ray and mirror bounces): an escape weighs it against env
-    // sampling.
+    // camera ray and mirror bounces): an escape or an emitter reached
+    // weighs it against light sampling.
     var last_bsdf_pdf = 0.0;
+    // Where the path last scattered: light sampling's density for the
+    // emitter a bounce reaches is measured from there.
+    var scatter_point = frame.cam_pos;
     if hit.t < NO_HIT && frame.max_bounces > 0u {
         loop {
             let width = cone_width + frame.pixel_spread * hit.t;
@@ -136,11 +154,23 @@ fn trace_path(pixel: vec2f) -> vec3f {
 #endif
             var origin: vec3f;
             if crossing {
+                throughput *= s.transmission;
                 origin = offset_ray(hit.p, -hit.n);
                 crossings++;
             } else {
 #if EMISSION
-                radiance += throughput * s.emission;
+                // Triangles emit on their front side only; light sampling
+                // found this emitter too, unless the bounce that reached
+                // it was a delta.
+                let emits = hit.front || hit.shape != SHAPE_TRIANGLE;
+                var emission_weight = select(0.0, 1.0, emits);
+#if AREA_LIGHT
+                if emits && last_bsdf_pdf > 0.0 {
+                    let light_pdf = f32(frame.light_samples) * emitter_pdf(hit, scatter_point);
+                    emission_weight = bsdf_sample_weight(last_bsdf_pdf, light_pdf);
+                }
+#endif
+                radiance += throughput * s.emission * emission_weight;
 #endif
 #if EMISSION || OPACITY
                 if bounces >= frame.max_bounces {
@@ -148,11 +178,13 @@ fn trace_path(pixel: vec2f) -> vec3f {
                     break;
                 }
 #endif
-#if POINT_LIGHT
-                radiance += throughput * point_light(hit, s, wo);
+#if POINT_LIGHT || AREA_LIGHT
+                if frame.light_count > 0u {
+                    radiance += throughput * direct_light(hit, s, wo);
+                }
 #endif
 #if ENV_SAMPLING
-                if frame.env_sampling != 0u {
+                if frame.env_sampling != 0u && frame.strategy != STRATEGY_BSDF {
                     radiance += throughput * env_light(hit, s, wo);
                 }
 #endif
@@ -163,9 +195,21 @@ fn trace_path(pixel: vec2f) -> vec3f {
                 }
                 throughput *= bs.weight;
                 last_bsdf_pdf = bs.pdf;
+                scatter_point = hit.p;
                 d = bs.wi;
                 origin = offset_ray(hit.p, hit.n);
                 bounces++;
+                // Russian roulette: past a few bounces a path goes on with
+                // the chance of its throughput, and the survivors carry
+                // the lost ones' share (unbiased).
+                if frame.russian_roulette_from > 0u && bounces >= frame.russian_roulette_from {
+                    let survive = min(max(throughput.x, max(throughput.y, throughput.z)), 1.0);
+                    if rand() >= survive {
+                        alive = false;
+                        break;
+                    }
+                    throughput /= survive;
+                }
             }
             hit = intersect_scene(origin, d);
             continuing {
@@ -181,7 +225,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
         var weight = 1.0;
 #if ENV_SAMPLING
         if frame.env_sampling != 0u && last_bsdf_pdf > 0.0 {
-            weight = power_heuristic(last_bsdf_pdf, env_pdf(d));
+            weight = bsdf_sample_weight(last_bsdf_pdf, env_pdf(d));
         }
 #endif
         radiance += throughput * environment(d) * weight;

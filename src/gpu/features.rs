@@ -11,7 +11,9 @@ pub enum Feature {
     Ground,
     Cylinder,
     Polygon,
+    Mesh,
     PointLight,
+    AreaLight,
     EnvMap,
     EnvSampling,
     EnvConstant,
@@ -41,11 +43,12 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 30] = [
+    pub const ALL: [Feature; 31] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
         Feature::PointLight,
+        Feature::AreaLight,
         Feature::EnvMap,
         Feature::EnvSampling,
         Feature::EnvConstant,
@@ -95,7 +98,9 @@ impl Feature {
             Feature::Ground => "GROUND",
             Feature::Cylinder => "CYLINDER",
             Feature::Polygon => "POLYGON",
+            Feature::Mesh => "MESH",
             Feature::PointLight => "POINT_LIGHT",
+            Feature::AreaLight => "AREA_LIGHT",
             Feature::EnvMap => "ENV_MAP",
             Feature::EnvSampling => "ENV_SAMPLING",
             Feature::EnvConstant => "ENV_CONSTANT",
@@ -181,8 +186,14 @@ impl FeatureSet {
         if !scene.polygons.is_empty() {
             set.insert(Feature::Polygon);
         }
+        if scene.triangle_count() > 0 {
+            set.insert(Feature::Mesh);
+        }
         if scene.point_light.is_some() {
             set.insert(Feature::PointLight);
+        }
+        if has_area_lights(scene) {
+            set.insert(Feature::AreaLight);
         }
         match scene.environment.source {
             EnvSource::None => {}
@@ -251,6 +262,21 @@ impl FeatureSet {
             .extend(Feature::ALL.into_iter().filter(|f| f.reads_library()));
         set
     }
+}
+
+/// Whether an emissive sphere or triangle is in the scene: the light table
+/// then holds area lights (`lights::LightTable`).
+fn has_area_lights(scene: &Scene) -> bool {
+    let emits = |m: &Material| crate::lights::emitted_luminance(m) > 0.0;
+    scene.spheres.iter().any(|s| emits(&s.material))
+        || scene.meshes.iter().any(|mesh| {
+            let emissive: Vec<bool> = mesh.materials.iter().map(|m| emits(&m.material)).collect();
+            mesh.geometry
+                .0
+                .materials
+                .iter()
+                .any(|&m| emissive.get(m as usize).copied().unwrap_or(false))
+        })
 }
 
 fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {

@@ -5,6 +5,7 @@ pub mod compute_harness;
 pub mod context;
 pub mod features;
 pub mod geometry_buffers;
+pub mod mesh_buffers;
 pub mod noise_harness;
 pub mod pass_timer;
 pub mod pipeline_build;

@@ -5,6 +5,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
+use super::mesh_buffers::{MeshBuffers, MeshStats};
 use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
@@ -124,6 +125,8 @@ pub struct Renderer {
     frame_buffer: wgpu::Buffer,
     display_buffer: wgpu::Buffer,
     geometry: GeometryBuffers,
+    /// Triangles, their BVH and the light table.
+    meshes: MeshBuffers,
     perm_buffer: wgpu::Buffer,
     texture_param_buffer: wgpu::Buffer,
     /// Size of the trace module's WGSL, for the Stats panel.
@@ -169,6 +172,10 @@ impl Renderer {
                 entry(7, uniform()),
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
+                entry(MeshBuffers::BINDINGS[0], storage(true)),
+                entry(MeshBuffers::BINDINGS[1], storage(true)),
+                entry(MeshBuffers::BINDINGS[2], storage(true)),
+                entry(MeshBuffers::BINDINGS[3], storage(true)),
             ],
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -203,6 +210,7 @@ impl Renderer {
             wgpu::BufferUsages::UNIFORM,
         );
         let geometry = GeometryBuffers::new(device, scene);
+        let meshes = MeshBuffers::new(device, scene);
         let perm_buffer = buffer(
             "permutation",
             bytemuck::cast_slice(&permutation_table()),
@@ -241,6 +249,7 @@ impl Renderer {
             frame_buffer,
             display_buffer,
             geometry,
+            meshes,
             perm_buffer,
             texture_param_buffer,
             trace_shader_bytes,
@@ -276,6 +285,16 @@ impl Renderer {
             &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
+    }
+
+    /// Triangles, BVH nodes, lights and the last BVH build time.
+    pub fn mesh_stats(&self) -> MeshStats {
+        self.meshes.stats()
+    }
+
+    /// Notes on emitters left out of the light table.
+    pub fn light_notes(&self) -> &[String] {
+        &self.meshes.table().notes
     }
 
     /// Size of the trace shader's assembled WGSL.
@@ -445,6 +464,7 @@ impl Renderer {
         }
         let scene = &target.scene;
         self.geometry.write(&ctx.queue, scene);
+        self.meshes.update(&ctx.device, scene);
         // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
         let mut traced_now = scene.clone();
@@ -569,6 +589,10 @@ impl Renderer {
         let mut uniform: FrameUniform =
             scene_gpu::frame_uniform(&self.scene, render_size, self.frame_index, self.accumulated);
         uniform.env_distribution_size = self.env_distribution.1;
+        let table = self.meshes.table();
+        uniform.light_count = table.lights.len() as u32;
+        uniform.light_total_power = table.total_power;
+        uniform.triangle_count = self.meshes.stats().triangles as u32;
         ctx.queue
             .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
         let read = self.accumulation.latest;
@@ -590,6 +614,7 @@ impl Renderer {
             bind(11, self.env_distribution.0.as_entire_binding()),
         ];
         entries.extend(self.geometry.entries());
+        entries.extend(self.meshes.entries());
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("trace"),
             layout: &self.trace_layout,

@@ -1,11 +1,12 @@
 //! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
 
 use super::texture_codegen;
+use crate::lights::LightSelection;
 use crate::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use crate::scene::material::MAX_SIGNALS;
 use crate::scene::primitives::MAX_POLYGON_VERTICES;
 use crate::scene::{
-    EnvSource, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,
+    EnvSource, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,
 };
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -42,7 +43,17 @@ pub struct FrameUniform {
     pub env_sampling: u32,
     /// Cells of the environment's sampling distribution (width, height).
     pub env_distribution_size: [u32; 2],
-    pub _pad: [u32; 2],
+    /// The light table's length, how it is sampled (0 uniform, 1 by power)
+    /// and its total power.
+    pub light_count: u32,
+    pub light_selection: u32,
+    pub light_total_power: f32,
+    pub light_samples: u32,
+    /// `scene::Strategy::id`.
+    pub strategy: u32,
+    pub russian_roulette_from: u32,
+    pub triangle_count: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -96,7 +107,10 @@ pub struct MaterialGpu {
     /// Signals before this index are gradient noise, from it on Perlin.
     pub first_perlin: u32,
     pub bump_height: f32,
-    pub _pad: f32,
+    /// The mean emitted luminance ([`crate::lights::emitted_luminance`]):
+    /// above 0, the spheres and triangles of this material are lights, and
+    /// an emitter hit by a BSDF ray finds its light-sampling density from it.
+    pub emitted_luminance: f32,
 }
 
 /// `Cylinder` of `shaders/scene.wgsl`.
@@ -155,6 +169,7 @@ pub fn material(m: &Material) -> MaterialGpu {
             .position(|s| s.noise.kind == NoiseKind::Perlin)
             .unwrap_or(signals.len()) as u32,
         bump_height: m.bump_height,
+        emitted_luminance: crate::lights::emitted_luminance(m),
         ..Default::default()
     };
     for (k, signal) in signals.iter().enumerate() {
@@ -175,9 +190,9 @@ pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
     out
 }
 
-/// Entries of the `materials` uniform array: every primitive's, and the
-/// ground's.
-pub const MAX_MATERIALS: usize = MAX_SPHERES + MAX_CYLINDERS + MAX_POLYGONS + 1;
+/// Entries of the `materials` uniform array: every primitive's, the
+/// ground's and the meshes'.
+pub use crate::scene::MAX_MATERIALS;
 
 /// Cylinders, padded to the uniform array's length.
 pub fn cylinders(scene: &Scene) -> Vec<CylinderGpu> {
@@ -278,7 +293,12 @@ pub fn frame_uniform(
         ground_height: scene.ground.as_ref().map_or(0.0, |g| g.height),
         sphere_count: scene.spheres.len().min(MAX_SPHERES) as u32,
         samples_per_frame: scene.render.samples_per_frame.max(1),
-        max_bounces: scene.render.max_bounces.max(1),
+        // The direct integrator is a path of one bounce: what it reaches
+        // adds only its emission or the environment.
+        max_bounces: match scene.render.transport.integrator {
+            Integrator::Direct => 1,
+            Integrator::Path => scene.render.max_bounces.max(1),
+        },
         render_size: [w, h],
         env_kind: match env.source {
             EnvSource::None => 0,
@@ -292,9 +312,20 @@ pub fn frame_uniform(
         env_sampling: u32::from(
             matches!(env.source, EnvSource::LatLong { .. }) && scene.render.env_importance,
         ),
-        // Filled in by the renderer, which holds the distribution.
+        // Filled in by the renderer, which holds the distribution and the
+        // light table.
         env_distribution_size: [0; 2],
-        _pad: [0; 2],
+        light_count: 0,
+        light_selection: match scene.render.transport.light_selection {
+            LightSelection::Uniform => 0,
+            LightSelection::Power => 1,
+        },
+        light_total_power: 0.0,
+        light_samples: scene.render.transport.light_samples.max(1),
+        strategy: scene.render.transport.strategy.id(),
+        russian_roulette_from: scene.render.transport.russian_roulette_from,
+        triangle_count: 0,
+        _pad: [0; 3],
     }
 }
 
@@ -307,7 +338,7 @@ mod tests {
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 176);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 208);
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);

@@ -68,6 +68,8 @@ const SOURCES: &[(&str, &str)] = &[
         "env_sampling.wgsl",
         include_str!("../../shaders/env_sampling.wgsl"),
     ),
+    ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
+    ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,7 +123,11 @@ impl Program {
                     "random.wgsl",
                     "bsdf.wgsl",
                     "env_lookup.wgsl",
+                    "mis.wgsl",
                 ]);
+                if features.contains(Feature::PointLight) || features.contains(Feature::AreaLight) {
+                    out.push("lights.wgsl");
+                }
                 if features.contains(Feature::EnvSampling) {
                     out.push("env_sampling.wgsl");
                 }

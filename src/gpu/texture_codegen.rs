@@ -48,7 +48,8 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
         next: 0,
     };
     let mut dispatch = String::new();
-    let mut opacities = String::new();
+    let mut transmittances = String::new();
+    let mut emissions = String::new();
     let mut heights = String::new();
     for (index, material) in scene.materials().enumerate() {
         let cases = generator.material(index, material);
@@ -58,9 +59,14 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
             cases.textures
         )?;
         writeln!(
-            opacities,
+            transmittances,
             "        case {index}u: {{\n{}        }}",
-            cases.opacity
+            cases.transmittance
+        )?;
+        writeln!(
+            emissions,
+            "        case {index}u: {{\n{}        }}",
+            cases.emission
         )?;
         if material.has_bump() {
             let name = format!("texture_{index}_bump");
@@ -81,29 +87,40 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     wgsl.push_str(&generator.code);
     write!(
         wgsl,
-        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(1.0), vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
     )?;
-    // Shadow rays read opacity alone; they evaluate the noise signals only
-    // if some opacity texture reads one.
-    let opacity_reads_noise = scene.materials().any(|m| {
-        std::iter::once(&m.opacity)
-            .chain(
-                m.layers
-                    .iter()
-                    .flat_map(|l| [Some(&l.mask), l.opacity.as_ref()])
-                    .flatten(),
-            )
-            .flat_map(Texture::patterns)
-            .any(|p| p.signal().is_some())
-    });
-    let signals = if opacity_reads_noise {
-        "material_signals(material, p, pw)"
-    } else {
-        "vec4f(0.0)"
+    // Shadow rays read opacity and transmission alone, light samples
+    // emission alone; each evaluates the noise signals only if one of its
+    // textures reads one.
+    let signals_for = |properties: &[Property]| {
+        let reads_noise = scene.materials().any(|m| {
+            properties.iter().any(|&property| {
+                std::iter::once(m.texture(property))
+                    .chain(
+                        m.layers
+                            .iter()
+                            .flat_map(|l| [Some(&l.mask), l.texture(property)])
+                            .flatten(),
+                    )
+                    .flat_map(Texture::patterns)
+                    .any(|p| p.signal().is_some())
+            })
+        });
+        if reads_noise {
+            "material_signals(material, p, pw)"
+        } else {
+            "vec4f(0.0)"
+        }
     };
+    let signals = signals_for(&[Property::Opacity, Property::Transmission]);
     write!(
         wgsl,
-        "\n// A material's opacity alone, for shadow rays.\nfn surface_opacity(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> f32 {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{opacities}        default: {{}}\n    }}\n    return 1.0;\n}}\n"
+        "\n// The fraction of light a material lets straight through, per channel:\n// (1 - opacity) tinted by the transmission colour, for shadow rays.\nfn surface_transmittance(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> vec3f {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{transmittances}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
+    )?;
+    let signals = signals_for(&[Property::Emission]);
+    write!(
+        wgsl,
+        "\n// A material's emitted radiance alone, for points sampled on lights.\nfn surface_emission(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> vec3f {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{emissions}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
     )?;
     let bump_reads_noise = scene
         .materials()
@@ -156,7 +173,10 @@ struct Site {
 /// two dispatch functions.
 struct MaterialCases {
     textures: String,
-    opacity: String,
+    /// The statements of `surface_transmittance`.
+    transmittance: String,
+    /// The statements of `surface_emission`.
+    emission: String,
 }
 
 struct Generator<'a> {
@@ -185,15 +205,20 @@ impl Generator<'_> {
         }
         let mut cases = MaterialCases {
             textures: masks.concat(),
-            opacity: String::new(),
+            transmittance: String::new(),
+            emission: String::new(),
         };
+        let strength = self.param([material.emission_strength, 0.0, 0.0, 0.0]);
+        // The layer masks the transmittance reads (each declared once).
+        let mut transmittance_masks = std::collections::BTreeSet::new();
+        let mut transmittance = String::new();
         for property in Property::ALL {
             let value = property.name();
             let name = format!("texture_{index}_{value}");
             self.function(&name, material.texture(property), &signals);
             let mut statements =
                 format!("            var {value} = {name}(p, pw, uv, fp, signals);\n");
-            let mut masks_read = String::new();
+            let mut masks_read = Vec::new();
             for (l, layer) in material.layers.iter().enumerate() {
                 if let Some(texture) = layer.texture(property) {
                     let name = format!("texture_{index}_layer{l}_{value}");
@@ -202,18 +227,34 @@ impl Generator<'_> {
                         statements,
                         "            {value} = mix({value}, {name}(p, pw, uv, fp, signals), mask{l});"
                     );
-                    masks_read.push_str(&masks[l]);
+                    masks_read.push(l);
                 }
             }
             cases.textures.push_str(&statements);
-            if property == Property::Opacity {
-                cases.opacity = format!("{masks_read}{statements}            return opacity.x;\n");
+            match property {
+                Property::Opacity | Property::Transmission => {
+                    transmittance_masks.extend(masks_read);
+                    transmittance.push_str(&statements);
+                }
+                Property::Emission => {
+                    let masks_read: String =
+                        masks_read.iter().map(|&l| masks[l].as_str()).collect();
+                    cases.emission = format!(
+                        "{masks_read}{statements}            return emission * {strength}.x;\n"
+                    );
+                }
+                _ => {}
             }
         }
-        let strength = self.param([material.emission_strength, 0.0, 0.0, 0.0]);
+        cases.transmittance = transmittance_masks
+            .iter()
+            .map(|&l| masks[l].as_str())
+            .collect::<String>()
+            + &transmittance
+            + "            return (1.0 - clamp(opacity.x, 0.0, 1.0)) * clamp(transmission, vec3f(0.0), vec3f(1.0));\n";
         let _ = writeln!(
             cases.textures,
-            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, emission * {strength}.x);"
+            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, transmission, emission * {strength}.x);"
         );
         cases
     }
@@ -622,9 +663,10 @@ mod tests {
     }
 
     /// Shadow rays evaluate the noise signals only when an opacity texture
-    /// reads one; layers' opacity bindings count.
+    /// reads one; layers' opacity bindings count. A layer that sets both
+    /// opacity and transmission declares its mask once.
     #[test]
-    fn surface_opacity_reads_noise_only_when_opacity_does() {
+    fn surface_transmittance_reads_noise_only_when_opacity_does() {
         let mut scene = scene_with(nested());
         scene.spheres[0].material.diffuse = Texture::blend(
             Pattern::Fbm {
@@ -634,7 +676,7 @@ mod tests {
             1.0,
         );
         let code = generate_plain(&scene).unwrap().wgsl;
-        assert!(code.contains("fn surface_opacity"), "{code}");
+        assert!(code.contains("fn surface_transmittance"), "{code}");
         assert!(!code.contains("let signals = material_signals"), "{code}");
         scene.spheres[0].material.layers.push(crate::scene::Layer {
             opacity: Some(Texture::blend(
@@ -644,10 +686,14 @@ mod tests {
                 0.0,
                 1.0,
             )),
+            transmission: Some(Texture::color(Vec3::X)),
             ..Default::default()
         });
         let code = generate_plain(&scene).unwrap().wgsl;
         assert!(code.contains("let signals = material_signals"), "{code}");
+        let transmittance = &code[code.find("fn surface_transmittance").unwrap()..];
+        let transmittance = &transmittance[..transmittance.find("\n}\n").unwrap()];
+        assert_eq!(transmittance.matches("let mask0").count(), 1, "{code}");
         assert!(
             code.contains("opacity = mix(opacity, texture_0_layer0_opacity"),
             "{code}"

@@ -54,6 +54,9 @@ fn property_ui_info(property: Property) -> (ValueKind, &'static str) {
         Property::Opacity => {
             "1 is solid; below, rays and shadows pass straight through (a cutout's holes)"
         }
+        Property::Transmission => {
+            "Colour of the light passing through where opacity < 1: tints the view through and the shadow"
+        }
         Property::Emission => "Light the surface gives off (times the strength below)",
     };
     (kind, hint)

@@ -19,17 +19,19 @@ pub enum Property {
     Roughness,
     Mirror,
     Opacity,
+    Transmission,
     Emission,
 }
 
 impl Property {
     /// In the order the generated shader returns them (`SurfaceTextures`).
-    pub const ALL: [Property; 6] = [
+    pub const ALL: [Property; 7] = [
         Property::Diffuse,
         Property::Specular,
         Property::Roughness,
         Property::Mirror,
         Property::Opacity,
+        Property::Transmission,
         Property::Emission,
     ];
 
@@ -40,6 +42,7 @@ impl Property {
             Property::Roughness => "roughness",
             Property::Mirror => "mirror",
             Property::Opacity => "opacity",
+            Property::Transmission => "transmission",
             Property::Emission => "emission",
         }
     }
@@ -48,7 +51,7 @@ impl Property {
     pub fn is_color(self) -> bool {
         matches!(
             self,
-            Property::Diffuse | Property::Specular | Property::Emission
+            Property::Diffuse | Property::Specular | Property::Transmission | Property::Emission
         )
     }
 }
@@ -74,6 +77,11 @@ pub struct Material {
     /// `1 - opacity` (a cutout's holes), and shadows thin accordingly.
     #[serde(with = "property_serde")]
     pub opacity: Texture,
+    /// The colour of the light that passes through where opacity < 1 (MTL's
+    /// `Tf`, N3D's transmission coefficients): white keeps it unchanged, a
+    /// colour tints what is seen through the surface and its shadow.
+    #[serde(with = "property_serde")]
+    pub transmission: Texture,
     /// Emitted radiance is this colour times `emission_strength`.
     #[serde(with = "property_serde")]
     pub emission: Texture,
@@ -97,6 +105,7 @@ impl Default for Material {
             roughness: Texture::scalar(0.4),
             mirror: Texture::scalar(0.0),
             opacity: Texture::scalar(1.0),
+            transmission: Texture::color(Vec3::ONE),
             emission: Texture::color(Vec3::ZERO),
             emission_strength: 1.0,
             bump: Texture::scalar(0.0),
@@ -145,6 +154,11 @@ pub struct Layer {
         with = "optional_property_serde",
         skip_serializing_if = "Option::is_none"
     )]
+    pub transmission: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub emission: Option<Texture>,
 }
 
@@ -158,6 +172,7 @@ impl Default for Layer {
             roughness: None,
             mirror: None,
             opacity: None,
+            transmission: None,
             emission: None,
         }
     }
@@ -176,6 +191,7 @@ impl Layer {
             Property::Roughness => &mut self.roughness,
             Property::Mirror => &mut self.mirror,
             Property::Opacity => &mut self.opacity,
+            Property::Transmission => &mut self.transmission,
             Property::Emission => &mut self.emission,
         }
     }
@@ -187,6 +203,7 @@ impl Layer {
             Property::Roughness => &self.roughness,
             Property::Mirror => &self.mirror,
             Property::Opacity => &self.opacity,
+            Property::Transmission => &self.transmission,
             Property::Emission => &self.emission,
         }
     }
@@ -201,6 +218,7 @@ impl Layer {
                 &mut self.roughness,
                 &mut self.mirror,
                 &mut self.opacity,
+                &mut self.transmission,
                 &mut self.emission,
             ]
             .into_iter()
@@ -219,6 +237,7 @@ impl Material {
             Property::Roughness => &self.roughness,
             Property::Mirror => &self.mirror,
             Property::Opacity => &self.opacity,
+            Property::Transmission => &self.transmission,
             Property::Emission => &self.emission,
         }
     }
@@ -230,6 +249,7 @@ impl Material {
             Property::Roughness => &mut self.roughness,
             Property::Mirror => &mut self.mirror,
             Property::Opacity => &mut self.opacity,
+            Property::Transmission => &mut self.transmission,
             Property::Emission => &mut self.emission,
         }
     }
@@ -320,6 +340,7 @@ impl Material {
             (format!("{what} roughness"), &mut self.roughness),
             (format!("{what} mirror"), &mut self.mirror),
             (format!("{what} opacity"), &mut self.opacity),
+            (format!("{what} transmission"), &mut self.transmission),
             (format!("{what} emission"), &mut self.emission),
             (format!("{what} bump"), &mut self.bump),
         ];

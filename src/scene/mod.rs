@@ -8,18 +8,22 @@
 pub mod camera;
 pub mod environment;
 pub mod material;
+pub mod mesh;
 pub mod pattern;
 pub mod primitives;
 pub mod render_settings;
 pub mod texture_tree;
+pub mod transport;
 
 pub use camera::{OrbitCamera, SavedView};
 pub use environment::{EnvSource, Environment};
 pub use material::{Layer, Material, Property};
+pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
 pub use render_settings::{RenderSettings, ToneMap};
 pub use texture_tree::{Child, MathOp, Texture};
+pub use transport::{Integrator, Strategy, TransportSettings};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -86,6 +90,11 @@ impl Default for PointLight {
 /// storage-buffer reads on lavapipe.
 pub const MAX_SPHERES: usize = 63;
 
+/// The most materials a scene holds: every primitive's, the ground's and the
+/// meshes' (a uniform array in `shaders/scene.wgsl`, within the 64 KiB a
+/// uniform binding may hold).
+pub const MAX_MATERIALS: usize = 160;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default)]
 pub struct Scene {
@@ -99,6 +108,9 @@ pub struct Scene {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub polygons: Vec<Polygon>,
     pub ground: Option<Ground>,
+    /// Triangle meshes read from OBJ/MTL files.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub meshes: Vec<Mesh>,
     pub point_light: Option<PointLight>,
     pub environment: Environment,
     pub render: RenderSettings,
@@ -106,7 +118,7 @@ pub struct Scene {
 
 impl Scene {
     /// Every material in GPU order: the spheres', the cylinders', the
-    /// polygons', then the ground's.
+    /// polygons', the ground's, then each mesh's.
     pub fn materials(&self) -> impl Iterator<Item = &Material> {
         self.spheres
             .iter()
@@ -114,6 +126,32 @@ impl Scene {
             .chain(self.cylinders.iter().map(|c| &c.material))
             .chain(self.polygons.iter().map(|p| &p.material))
             .chain(self.ground.iter().map(|g| &g.material))
+            .chain(
+                self.meshes
+                    .iter()
+                    .flat_map(|m| m.materials.iter().map(|m| &m.material)),
+            )
+    }
+
+    /// The index (in [`Scene::materials`]) of each mesh's first material.
+    pub fn mesh_material_bases(&self) -> Vec<u32> {
+        let mut next = (self.spheres.len()
+            + self.cylinders.len()
+            + self.polygons.len()
+            + usize::from(self.ground.is_some())) as u32;
+        self.meshes
+            .iter()
+            .map(|m| {
+                let base = next;
+                next += m.materials.len() as u32;
+                base
+            })
+            .collect()
+    }
+
+    /// Triangles of every mesh, in the world.
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.geometry.0.len()).sum()
     }
 
     /// Moves the camera to saved view `index` (0-based); false if there is
@@ -144,6 +182,11 @@ impl Scene {
             .chain(self.cylinders.iter_mut().map(|c| &mut c.material))
             .chain(self.polygons.iter_mut().map(|p| &mut p.material))
             .chain(self.ground.iter_mut().map(|g| &mut g.material))
+            .chain(
+                self.meshes
+                    .iter_mut()
+                    .flat_map(|m| m.materials.iter_mut().map(|m| &mut m.material)),
+            )
     }
 
     /// The image files the scene's image textures show, each once, in order
@@ -196,6 +239,7 @@ impl Scene {
             }
             g.material.sanitize("ground", &mut notes);
         }
+        self.sanitize_meshes(&mut notes);
         self.render.sanitize(&mut notes);
         self.camera.sanitize(&mut notes);
         for view in &mut self.views {
@@ -225,6 +269,43 @@ impl Scene {
             }
             c.material
                 .sanitize(&format!("cylinder `{}`", c.name), notes);
+        }
+    }
+
+    /// Mesh placements stay invertible and finite; materials beyond the
+    /// renderer's limit are dropped (their triangles then show the last kept
+    /// one).
+    fn sanitize_meshes(&mut self, notes: &mut Vec<String>) {
+        let fixed = self.spheres.len()
+            + self.cylinders.len()
+            + self.polygons.len()
+            + usize::from(self.ground.is_some());
+        let mut room = MAX_MATERIALS.saturating_sub(fixed);
+        for mesh in &mut self.meshes {
+            let p = &mut mesh.placement;
+            if !(p.scale.is_finite() && p.scale > 0.0) {
+                notes.push(format!("mesh `{}`: scale {} set to 1", mesh.name, p.scale));
+                p.scale = 1.0;
+            }
+            if !p.translate.is_finite() || !p.rotate_y_degrees.is_finite() {
+                notes.push(format!("mesh `{}`: non-finite placement reset", mesh.name));
+                *p = MeshPlacement::default();
+            }
+            if mesh.materials.len() > room {
+                notes.push(format!(
+                    "mesh `{}`: {} materials, only {room} fit (the renderer holds {MAX_MATERIALS})",
+                    mesh.name,
+                    mesh.materials.len()
+                ));
+                mesh.materials.truncate(room);
+            }
+            room -= mesh.materials.len();
+            for m in &mut mesh.materials {
+                m.material.sanitize(
+                    &format!("mesh `{}` material `{}`", mesh.name, m.name),
+                    notes,
+                );
+            }
         }
     }
 

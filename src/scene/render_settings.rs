@@ -52,11 +52,12 @@ pub struct RenderSettings {
     /// importance sampling (power heuristic); off, only BSDF sampling
     /// finds it.
     pub env_importance: bool,
+    pub transport: super::transport::TransportSettings,
 }
 
 impl RenderSettings {
     pub const MAX_SAMPLES_PER_FRAME: u32 = 64;
-    pub const MAX_BOUNCES: u32 = 8;
+    pub const MAX_BOUNCES: u32 = 16;
 
     pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
         let d = Self::default();
@@ -91,6 +92,7 @@ impl RenderSettings {
             ));
             self.interactive_scale = d.interactive_scale;
         }
+        self.transport.sanitize(notes);
     }
 }
 
@@ -106,6 +108,7 @@ impl Default for RenderSettings {
             filter_checkers: true,
             clamp_octaves: true,
             env_importance: true,
+            transport: Default::default(),
         }
     }
 }

@@ -1,0 +1,223 @@
+//! The storage buffers of the scene's triangles and lights: the BVH nodes,
+//! the triangles' vertices and attributes in BVH order (bindings 12–14 of
+//! `shaders/scene.wgsl`), and the light table (binding 15), which names
+//! emissive triangles by their place in that order.
+//!
+//! The BVH is rebuilt only when the geometry or its placement changes; the
+//! light table at every edit, since an emission edit changes the powers.
+
+use crate::lights::{EmitterTriangle, LightGpu, LightTable};
+use crate::scene::{MeshPlacement, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use std::time::{Duration, Instant};
+use wgpu::util::DeviceExt;
+
+/// `TriangleVerts` of `shaders/bvh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct TriangleVertsGpu {
+    pub v: [[f32; 4]; 3],
+}
+
+/// `TriangleAttributes` of `shaders/scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct TriangleAttributesGpu {
+    pub uv01: [f32; 4],
+    pub uv2: [f32; 2],
+    pub material: u32,
+    pub _pad: u32,
+}
+
+/// What the BVH was built from: the same key, the same BVH.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct GeometryKey {
+    meshes: Vec<(usize, MeshPlacement, u32)>,
+}
+
+impl GeometryKey {
+    fn of(scene: &Scene) -> Self {
+        let bases = scene.mesh_material_bases();
+        Self {
+            meshes: scene
+                .meshes
+                .iter()
+                .zip(bases)
+                .map(|(m, base)| {
+                    (
+                        std::sync::Arc::as_ptr(&m.geometry.0) as usize,
+                        m.placement,
+                        base,
+                    )
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Counts for the Stats panel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct MeshStats {
+    pub triangles: usize,
+    pub bvh_nodes: usize,
+    pub bvh_build: Duration,
+    pub lights: usize,
+}
+
+pub struct MeshBuffers {
+    key: GeometryKey,
+    nodes: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    attributes: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    /// The triangles in BVH order, as the light table reads them.
+    emitters: Vec<EmitterTriangle>,
+    table: LightTable,
+    stats: MeshStats,
+}
+
+fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    // A binding may not be empty: an empty list is one zeroed element.
+    let zeros = [0u8; 64];
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: if contents.is_empty() {
+            &zeros
+        } else {
+            contents
+        },
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+impl MeshBuffers {
+    pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
+        let mut out = Self {
+            key: GeometryKey::default(),
+            nodes: storage_buffer(device, "bvh nodes", &[]),
+            triangles: storage_buffer(device, "mesh triangles", &[]),
+            attributes: storage_buffer(device, "mesh attributes", &[]),
+            lights: storage_buffer(device, "lights", &[]),
+            emitters: Vec::new(),
+            table: LightTable::default(),
+            stats: MeshStats::default(),
+        };
+        out.rebuild_geometry(device, scene);
+        out.rebuild_lights(device, scene);
+        out
+    }
+
+    /// Brings the buffers up to `scene`: the BVH if its geometry moved, the
+    /// light table always.
+    pub fn update(&mut self, device: &wgpu::Device, scene: &Scene) {
+        if GeometryKey::of(scene) != self.key {
+            self.rebuild_geometry(device, scene);
+        }
+        self.rebuild_lights(device, scene);
+    }
+
+    fn rebuild_geometry(&mut self, device: &wgpu::Device, scene: &Scene) {
+        self.key = GeometryKey::of(scene);
+        let bases = scene.mesh_material_bases();
+        let mut positions: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
+        let mut attributes = Vec::with_capacity(scene.triangle_count());
+        for (mesh, base) in scene.meshes.iter().zip(bases) {
+            positions.extend(mesh.world_positions());
+            let g = &mesh.geometry.0;
+            for (uv, &m) in g.uvs.iter().zip(&g.materials) {
+                attributes.push(TriangleAttributesGpu {
+                    uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
+                    uv2: [uv[2].x, uv[2].y],
+                    material: base + m.min(mesh.materials.len().saturating_sub(1) as u32),
+                    _pad: 0,
+                });
+            }
+        }
+        let start = Instant::now();
+        let (nodes, order) = build_bvh(&positions);
+        let took = start.elapsed();
+        let ordered: Vec<usize> = order.iter().map(|&i| i as usize).collect();
+        let verts: Vec<TriangleVertsGpu> = ordered
+            .iter()
+            .map(|&i| TriangleVertsGpu {
+                v: positions[i].map(|p| p.extend(0.0).to_array()),
+            })
+            .collect();
+        let attributes: Vec<TriangleAttributesGpu> =
+            ordered.iter().map(|&i| attributes[i]).collect();
+        self.emitters = ordered
+            .iter()
+            .zip(&attributes)
+            .map(|(&i, a)| EmitterTriangle {
+                vertices: positions[i],
+                material: a.material,
+            })
+            .collect();
+        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&nodes));
+        self.triangles = storage_buffer(device, "mesh triangles", bytemuck::cast_slice(&verts));
+        self.attributes =
+            storage_buffer(device, "mesh attributes", bytemuck::cast_slice(&attributes));
+        self.stats.triangles = verts.len();
+        self.stats.bvh_nodes = nodes.len();
+        self.stats.bvh_build = took;
+    }
+
+    fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {
+        let table = LightTable::build(scene, &self.emitters);
+        if table != self.table {
+            let entries: Vec<LightGpu> = table.lights.clone();
+            self.lights = storage_buffer(device, "lights", bytemuck::cast_slice(&entries));
+            self.stats.lights = table.lights.len();
+            self.table = table;
+        }
+    }
+
+    pub fn table(&self) -> &LightTable {
+        &self.table
+    }
+
+    pub fn stats(&self) -> MeshStats {
+        self.stats
+    }
+
+    /// The trace bind group's entries (bindings 12 to 15).
+    pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
+        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }
+        }
+        [
+            entry(12, &self.nodes),
+            entry(13, &self.triangles),
+            entry(14, &self.attributes),
+            entry(15, &self.lights),
+        ]
+    }
+
+    /// The bindings [`MeshBuffers::entries`] fills.
+    pub const BINDINGS: [u32; 4] = [12, 13, 14, 15];
+}
+
+/// One leaf holding every triangle (replaced by the SAH build).
+fn build_bvh(positions: &[[Vec3; 3]]) -> (Vec<[u32; 8]>, Vec<u32>) {
+    let (lo, hi) = positions
+        .iter()
+        .flatten()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let node = [
+        lo.x.to_bits(),
+        lo.y.to_bits(),
+        lo.z.to_bits(),
+        0,
+        hi.x.to_bits(),
+        hi.y.to_bits(),
+        hi.z.to_bits(),
+        positions.len() as u32,
+    ];
+    (vec![node], (0..positions.len() as u32).collect())
+}

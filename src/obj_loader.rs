@@ -1,0 +1,330 @@
+//! OBJ/MTL files into triangle meshes and materials, through `tobj`.
+//!
+//! MTL keys map onto the material model as the lab reads them: `Kd`
+//! diffuse, `Ks` specular, `Ns` roughness (see [`roughness_from_ns`]),
+//! `Ke` emission, `d` or `Tr` opacity, `Tf` transmission (`Kd` when a
+//! see-through material has none, so it tints by its colour), `map_Kd` and
+//! `map_Ks` image textures, `map_bump`/`bump` a bump height image. Texture
+//! paths are relative to the .mtl file; a missing one keeps the magenta
+//! placeholder of image textures and a note naming it.
+
+use crate::scene::mesh::{Geometry, MeshMaterial, TriangleMesh};
+use crate::scene::{Material, Pattern, Scene, Texture};
+use crate::texture::{ColorSpace, ImageSource};
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    #[error("{path}: cannot read the OBJ file: {cause}")]
+    Read {
+        path: PathBuf,
+        cause: std::io::Error,
+    },
+    #[error("{path}: not a valid OBJ file: {cause}")]
+    Parse {
+        path: PathBuf,
+        cause: tobj::LoadError,
+    },
+    #[error("{path}: no triangle left to draw ({reason})")]
+    Empty { path: PathBuf, reason: String },
+}
+
+/// An OBJ file's triangles (in the file's coordinates) and materials.
+#[derive(Debug, Clone, Default)]
+pub struct LoadedObj {
+    pub triangles: TriangleMesh,
+    pub materials: Vec<MeshMaterial>,
+    /// What was skipped or replaced, each naming the file.
+    pub notes: Vec<String>,
+}
+
+/// The material of faces the OBJ gives none, or whose MTL is unreadable.
+const DEFAULT_MATERIAL: &str = "(default)";
+
+pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
+    // tobj reports a missing file as a bare "open file failed"; a read here
+    // first gives the OS's reason.
+    std::fs::metadata(path).map_err(|cause| ObjError::Read {
+        path: path.to_owned(),
+        cause,
+    })?;
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj(path, &options).map_err(|cause| ObjError::Parse {
+        path: path.to_owned(),
+        cause,
+    })?;
+    let mut notes = Vec::new();
+    let mtl_folder = path.parent().unwrap_or(Path::new("."));
+    let mtl = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            notes.push(format!(
+                "{}: its material library could not be read ({e}); grey is used instead",
+                path.display()
+            ));
+            Vec::new()
+        }
+    };
+    let mut out = LoadedObj::default();
+    for m in &mtl {
+        let (material, material_notes) = convert_material(m, mtl_folder);
+        notes.extend(
+            material_notes
+                .into_iter()
+                .map(|n| format!("{}: material `{}`: {n}", path.display(), m.name)),
+        );
+        out.materials.push(MeshMaterial {
+            name: m.name.clone(),
+            from_file: Some(material.clone()),
+            material,
+        });
+    }
+    let mut default_index = None;
+    let mut non_finite = 0usize;
+    let mut degenerate = 0usize;
+    for model in &models {
+        let mesh = &model.mesh;
+        let material = match mesh.material_id.filter(|&i| i < out.materials.len()) {
+            Some(i) => i as u32,
+            None => *default_index.get_or_insert_with(|| {
+                out.materials.push(MeshMaterial {
+                    name: DEFAULT_MATERIAL.into(),
+                    from_file: Some(Material::default()),
+                    material: Material::default(),
+                });
+                (out.materials.len() - 1) as u32
+            }),
+        };
+        let position = |i: u32| {
+            let i = i as usize * 3;
+            Vec3::new(
+                mesh.positions[i],
+                mesh.positions[i + 1],
+                mesh.positions[i + 2],
+            )
+        };
+        let uv = |i: u32| {
+            let i = i as usize * 2;
+            if mesh.texcoords.len() >= i + 2 {
+                Vec2::new(mesh.texcoords[i], mesh.texcoords[i + 1])
+            } else {
+                Vec2::ZERO
+            }
+        };
+        for face in mesh.indices.chunks_exact(3) {
+            let v = [position(face[0]), position(face[1]), position(face[2])];
+            if !v.iter().all(|p| p.is_finite()) {
+                non_finite += 1;
+                continue;
+            }
+            if (v[1] - v[0]).cross(v[2] - v[0]).length_squared() == 0.0 {
+                degenerate += 1;
+            }
+            out.triangles.positions.push(v);
+            out.triangles
+                .uvs
+                .push([uv(face[0]), uv(face[1]), uv(face[2])]);
+            out.triangles.materials.push(material);
+        }
+    }
+    if non_finite > 0 {
+        notes.push(format!(
+            "{}: {non_finite} triangles with a NaN or infinite vertex were dropped",
+            path.display()
+        ));
+    }
+    if degenerate > 0 {
+        notes.push(format!(
+            "{}: {degenerate} triangles have zero area (kept: rays never hit them, and they give no light)",
+            path.display()
+        ));
+    }
+    if out.triangles.is_empty() {
+        return Err(ObjError::Empty {
+            path: path.to_owned(),
+            reason: if non_finite > 0 {
+                "every triangle has a non-finite vertex".into()
+            } else {
+                "the file has no faces".into()
+            },
+        });
+    }
+    out.notes = notes;
+    Ok(out)
+}
+
+/// GGX roughness from a Phong exponent: the Beckmann match α = √(2/(Ns+2))
+/// (Walter et al. 2007), read as GGX α, with roughness = √α.
+pub fn roughness_from_ns(ns: f32) -> f32 {
+    let alpha = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
+    alpha.sqrt().clamp(0.0, 1.0)
+}
+
+fn rgb(c: Option<[f32; 3]>) -> Option<Vec3> {
+    c.map(Vec3::from_array).filter(|v| v.is_finite())
+}
+
+/// An image texture of `file` (relative to the MTL's folder), scaled by
+/// the grey level of `tint` (a colour tint has no node; its mean stands in).
+fn image_texture(
+    file: &str,
+    folder: &Path,
+    color_space: ColorSpace,
+    tint: Vec3,
+    notes: &mut Vec<String>,
+) -> Texture {
+    let (file, _) = strip_options(file);
+    let path = folder.join(file);
+    if !path.exists() {
+        notes.push(format!(
+            "texture {} not found: shown as the magenta placeholder",
+            path.display()
+        ));
+    }
+    let mut t = Texture::blend(
+        Pattern::Image {
+            filter: Default::default(),
+            wrap: Default::default(),
+        },
+        0.0,
+        1.0,
+    );
+    t.image = Some(ImageSource { path, color_space });
+    let scale = tint.element_sum() / 3.0;
+    if tint.max_element() - tint.min_element() > 1e-3 {
+        notes.push(format!(
+            "colour {tint} times its texture: only its mean {scale:.3} is applied"
+        ));
+    }
+    if scale != 1.0 {
+        t.ops.push(crate::scene::MathOp::Scale(scale));
+    }
+    t
+}
+
+/// MTL texture statements may carry options before the file name
+/// (`-bm 0.5 bumps.png`): the file name, and `-bm`'s value if any.
+fn strip_options(statement: &str) -> (&str, Option<f32>) {
+    let words: Vec<&str> = statement.split_whitespace().collect();
+    let mut bump_multiplier = None;
+    let mut i = 0;
+    while i < words.len() && words[i].starts_with('-') && i + 1 < words.len() {
+        if words[i] == "-bm" {
+            bump_multiplier = words[i + 1].parse().ok();
+        }
+        // Every MTL option takes one value except -o/-s/-t (three) and
+        // -mm (two); only the common ones matter here.
+        i += match words[i] {
+            "-o" | "-s" | "-t" => 4,
+            "-mm" => 3,
+            _ => 2,
+        };
+    }
+    let file = words.get(i..).map_or("", |rest| {
+        let start = rest.first().map_or(statement.len(), |first| {
+            statement.find(first).unwrap_or(statement.len())
+        });
+        statement[start..].trim()
+    });
+    (file, bump_multiplier)
+}
+
+/// One MTL material as a marbre material, and notes on what was replaced.
+pub fn convert_material(m: &tobj::Material, folder: &Path) -> (Material, Vec<String>) {
+    let mut notes = Vec::new();
+    let kd = rgb(m.diffuse).unwrap_or(Vec3::splat(0.8));
+    let ks = rgb(m.specular).unwrap_or(Vec3::ZERO);
+    let ke = rgb(m.emissive).unwrap_or(Vec3::ZERO);
+    let params: HashMap<&str, &str> = m
+        .unknown_param
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.as_str()))
+        .collect();
+    let opacity = m
+        .dissolve
+        .or_else(|| {
+            params
+                .get("Tr")
+                .and_then(|t| t.parse::<f32>().ok())
+                .map(|tr| 1.0 - tr)
+        })
+        .filter(|d| d.is_finite())
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    let transmission = params
+        .get("Tf")
+        .and_then(|t| {
+            let v: Vec<f32> = t
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            match v.as_slice() {
+                [g] => Some(Vec3::splat(*g)),
+                [r, g, b, ..] => Some(Vec3::new(*r, *g, *b)),
+                _ => None,
+            }
+        })
+        .unwrap_or(if opacity < 1.0 { kd } else { Vec3::ONE });
+    let mut material = Material {
+        diffuse: Texture::color(kd.clamp(Vec3::ZERO, Vec3::ONE)),
+        specular: Texture::color(ks.clamp(Vec3::ZERO, Vec3::ONE)),
+        roughness: Texture::scalar(m.shininess.map_or(1.0, roughness_from_ns)),
+        mirror: Texture::scalar(0.0),
+        opacity: Texture::scalar(opacity),
+        transmission: Texture::color(transmission.clamp(Vec3::ZERO, Vec3::ONE)),
+        emission: Texture::color(ke.max(Vec3::ZERO)),
+        emission_strength: 1.0,
+        ..Material::default()
+    };
+    if let Some(file) = &m.diffuse_texture {
+        material.diffuse = image_texture(file, folder, ColorSpace::Srgb, kd, &mut notes);
+    }
+    if let Some(file) = &m.specular_texture {
+        material.specular = image_texture(file, folder, ColorSpace::Srgb, ks, &mut notes);
+    }
+    if let Some(statement) = &m.normal_texture {
+        let (_, multiplier) = strip_options(statement);
+        material.bump = image_texture(statement, folder, ColorSpace::Linear, Vec3::ONE, &mut notes);
+        // Heights in [0, 1] over a hundredth of a unit: a visible relief on
+        // objects a few units across, as most OBJ scenes are.
+        material.bump_height = 0.01 * multiplier.unwrap_or(1.0);
+    }
+    (material, notes)
+}
+
+/// Reads every mesh's OBJ file into the scene: its triangles and its
+/// materials, with the preset's overrides kept (matched by name). A
+/// preset override naming no MTL material is kept too, with a note.
+pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), ObjError> {
+    for mesh in &mut scene.meshes {
+        let loaded = load(&mesh.obj)?;
+        notes.extend(loaded.notes);
+        let overrides = std::mem::take(&mut mesh.materials);
+        let mut materials = loaded.materials;
+        for o in overrides {
+            match materials.iter_mut().find(|m| m.name == o.name) {
+                Some(m) => m.material = o.material,
+                None => {
+                    notes.push(format!(
+                        "mesh `{}`: the preset's material `{}` is not in {}",
+                        mesh.name,
+                        o.name,
+                        mesh.obj.display()
+                    ));
+                    materials.push(o);
+                }
+            }
+        }
+        mesh.materials = materials;
+        mesh.geometry = Geometry(Arc::new(loaded.triangles));
+    }
+    Ok(())
+}
