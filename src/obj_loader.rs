@@ -328,3 +328,210 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), Obj
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Mesh, Property};
+    use crate::test_dir::TempDir;
+
+    const CORNELL: &str = "presets/scenes/cornell-box/CornellBox-Original.obj";
+
+    /// The Cornell box: every quad in two triangles, its eight materials
+    /// with the MTL's values, the light emitting Ke.
+    #[test]
+    fn the_cornell_box_loads_with_its_materials() {
+        let obj = load(Path::new(CORNELL)).unwrap();
+        assert!(obj.notes.is_empty(), "{:?}", obj.notes);
+        assert_eq!(obj.materials.len(), 8);
+        // 5 walls + 1 light + 2 boxes of 5 visible quads... count from the file.
+        let quads = std::fs::read_to_string(CORNELL)
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count();
+        assert_eq!(obj.triangles.len(), 2 * quads);
+        let light = obj.materials.iter().find(|m| m.name == "light").unwrap();
+        let at = crate::scene::SurfacePoint::new(Vec3::ZERO, Vec2::ZERO);
+        assert_eq!(
+            light.material.value_at(Property::Emission, &at),
+            Vec3::new(17.0, 12.0, 4.0)
+        );
+        let left = obj.materials.iter().find(|m| m.name == "leftWall").unwrap();
+        assert_eq!(
+            left.material.value_at(Property::Diffuse, &at),
+            Vec3::new(0.63, 0.065, 0.05)
+        );
+        assert!(!left.is_override());
+    }
+
+    fn write(dir: &TempDir, name: &str, text: &str) -> PathBuf {
+        let path = dir.path(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    const QUAD: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+
+    /// d, Tr, Tf, Ns and the texture maps, with paths relative to the MTL.
+    #[test]
+    fn mtl_keys_map_onto_the_material() {
+        let dir = TempDir::new("obj-keys");
+        write(
+            &dir,
+            "m.mtl",
+            "newmtl glass\nKd 0.2 0.4 0.8\nd 0.25\nNs 100\nKs 0.5 0.5 0.5\n\
+             newmtl film\nKd 1 1 1\nTr 0.75\nTf 1 0 0\n\
+             newmtl pictured\nKd 1 1 1\nmap_Kd pic.png\nmap_bump -bm 2 bumps.png\n",
+        );
+        let obj = write(
+            &dir,
+            "m.obj",
+            &format!(
+                "mtllib m.mtl\n{QUAD}usemtl glass\nf 1/1 2/2 3/3\nusemtl film\nf 1/1 3/3 4/4\nusemtl pictured\nf 1/1 2/2 4/4\n"
+            ),
+        );
+        let loaded = load(&obj).unwrap();
+        let at = crate::scene::SurfacePoint::new(Vec3::ZERO, Vec2::ZERO);
+        let get = |name: &str, p: Property| {
+            loaded
+                .materials
+                .iter()
+                .find(|m| m.name == name)
+                .unwrap()
+                .material
+                .value_at(p, &at)
+        };
+        assert_eq!(get("glass", Property::Opacity).x, 0.25);
+        // Without Tf, a see-through material tints by its diffuse colour.
+        assert_eq!(
+            get("glass", Property::Transmission),
+            Vec3::new(0.2, 0.4, 0.8)
+        );
+        assert!((get("glass", Property::Roughness).x - roughness_from_ns(100.0)).abs() < 1e-6);
+        assert_eq!(get("film", Property::Opacity).x, 0.25);
+        assert_eq!(get("film", Property::Transmission), Vec3::X);
+        let pictured = &loaded.materials[2].material;
+        assert_eq!(
+            pictured.diffuse.image.as_ref().unwrap().path,
+            dir.path("pic.png")
+        );
+        assert_eq!(
+            pictured.bump.image.as_ref().unwrap().path,
+            dir.path("bumps.png")
+        );
+        assert!((pictured.bump_height - 0.02).abs() < 1e-6);
+        // Both textures are missing: each named in a note.
+        for file in ["pic.png", "bumps.png"] {
+            assert!(
+                loaded
+                    .notes
+                    .iter()
+                    .any(|n| n.contains(file) && n.contains("not found")),
+                "{:?}",
+                loaded.notes
+            );
+        }
+        assert_eq!(loaded.triangles.uvs[0], [Vec2::ZERO, Vec2::X, Vec2::ONE]);
+    }
+
+    /// Smoother surfaces have higher Phong exponents: roughness falls with
+    /// Ns, from 1 (Ns = 0) towards 0.
+    #[test]
+    fn roughness_falls_as_the_phong_exponent_grows() {
+        assert_eq!(roughness_from_ns(0.0), 1.0);
+        let values: Vec<f32> = [1.0, 10.0, 100.0, 1000.0].map(roughness_from_ns).to_vec();
+        assert!(values.windows(2).all(|w| w[1] < w[0]), "{values:?}");
+        assert!(values[3] < 0.3);
+    }
+
+    /// Broken files: a clear error naming the file and the cause.
+    #[test]
+    fn broken_obj_files_give_errors_naming_them() {
+        let dir = TempDir::new("obj-broken");
+        let missing = dir.path("missing.obj");
+        let e = load(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("missing.obj") && e.contains("cannot read"),
+            "{e}"
+        );
+        let out_of_range = write(&dir, "range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n");
+        let e = load(&out_of_range).unwrap_err().to_string();
+        assert!(
+            e.contains("range.obj") && e.contains("out of bounds"),
+            "{e}"
+        );
+        let garbage = write(&dir, "garbage.obj", "v 0 zero 0\nf 1 1 1\n");
+        let e = load(&garbage).unwrap_err().to_string();
+        assert!(e.contains("garbage.obj"), "{e}");
+        let no_faces = write(&dir, "empty.obj", "v 0 0 0\n");
+        let e = load(&no_faces).unwrap_err().to_string();
+        assert!(e.contains("empty.obj") && e.contains("no faces"), "{e}");
+    }
+
+    /// NaN vertices are rejected with a note, the rest still renders; a
+    /// missing MTL file gives grey and a note naming it.
+    #[test]
+    fn nan_vertices_and_a_missing_library_are_reported() {
+        let dir = TempDir::new("obj-nan");
+        let obj = write(
+            &dir,
+            "nan.obj",
+            &format!("mtllib nowhere.mtl\n{QUAD}v nan 0 0\nf 1 2 3\nf 1 3 5\n"),
+        );
+        let loaded = load(&obj).unwrap();
+        assert_eq!(loaded.triangles.len(), 1);
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("NaN") && n.contains("nan.obj")),
+            "{:?}",
+            loaded.notes
+        );
+        assert!(
+            loaded.notes.iter().any(|n| n.contains("material library")),
+            "{:?}",
+            loaded.notes
+        );
+        assert_eq!(loaded.materials[0].name, DEFAULT_MATERIAL);
+    }
+
+    /// A preset's edited material survives loading the file again, and only
+    /// edited materials are written back.
+    #[test]
+    fn preset_overrides_win_and_only_they_are_saved() {
+        let mut marble = Material::default();
+        marble.roughness = Texture::scalar(0.123);
+        let mut scene = Scene {
+            meshes: vec![Mesh {
+                name: "box".into(),
+                obj: CORNELL.into(),
+                materials: vec![MeshMaterial {
+                    name: "leftWall".into(),
+                    material: marble.clone(),
+                    from_file: None,
+                }],
+                ..Mesh::default()
+            }],
+            ..Scene::default()
+        };
+        let mut notes = Vec::new();
+        load_meshes(&mut scene, &mut notes).unwrap();
+        let mesh = &scene.meshes[0];
+        assert_eq!(mesh.materials.len(), 8);
+        let left = mesh
+            .materials
+            .iter()
+            .find(|m| m.name == "leftWall")
+            .unwrap();
+        assert_eq!(left.material, marble);
+        let text = ron::to_string(mesh).unwrap();
+        assert_eq!(text.matches("name:").count(), 2, "{text}");
+        assert!(
+            text.contains("leftWall") && !text.contains("rightWall"),
+            "{text}"
+        );
+        assert_eq!(scene.triangle_count(), mesh.geometry.0.len());
+    }
+}

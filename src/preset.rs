@@ -110,6 +110,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
             *image = folder.join(&*image);
         }
     });
+    for mesh in &mut preset.scene.meshes {
+        if mesh.obj.is_relative() {
+            mesh.obj = folder.join(&mesh.obj);
+        }
+    }
     let notes = preset.scene.sanitize();
     Ok(Loaded { preset, notes })
 }
@@ -151,6 +156,9 @@ pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
         relative(env);
     }
     for_each_image_path(&mut preset.scene, &mut relative);
+    for mesh in &mut preset.scene.meshes {
+        relative(&mut mesh.obj);
+    }
     let config = ron::ser::PrettyConfig::new()
         .depth_limit(8)
         .struct_names(false)

@@ -318,6 +318,7 @@ impl Viewer {
     fn stats(&self) -> Stats {
         let gpu_ms = self.timer.as_ref().and_then(PassTimer::last_ms);
         let info = self.ctx.adapter.get_info();
+        let mesh = self.renderer.mesh_stats();
         Stats {
             fps: self.fps,
             ms_per_frame: gpu_ms.unwrap_or(self.ms_per_frame),
@@ -336,6 +337,10 @@ impl Viewer {
             building: self.renderer.is_building(),
             last_build_ms: self.renderer.last_build().map(|d| d.as_secs_f32() * 1000.0),
             resolution: self.renderer.render_size(),
+            lights: mesh.lights,
+            triangles: mesh.triangles,
+            bvh_nodes: mesh.bvh_nodes,
+            bvh_build_ms: mesh.bvh_build.as_secs_f32() * 1000.0,
         }
     }
 

@@ -39,6 +39,10 @@ pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<Loa
         }
         _ => None,
     };
+    crate::obj_loader::load_meshes(&mut scene, &mut notes)?;
+    // The meshes' materials arrive with their files: clamp them as the
+    // preset's own were.
+    notes.extend(scene.sanitize());
     let images = load_images(&scene, &mut notes)?;
     Ok(LoadedScene {
         scene,

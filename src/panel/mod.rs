@@ -8,6 +8,7 @@
 //! colours are written back only on a change.
 
 mod material_editor;
+mod transport;
 
 use crate::scene::{
     EnvSource, Environment, OrbitCamera, PointLight, RenderSettings, Scene, ToneMap,
@@ -100,6 +101,11 @@ pub struct Stats {
     pub building: bool,
     /// How long the last shader build took, from the edit to the pipeline.
     pub last_build_ms: Option<f32>,
+    /// Entries of the light table (point, sphere and triangle lights).
+    pub lights: usize,
+    pub triangles: usize,
+    pub bvh_nodes: usize,
+    pub bvh_build_ms: f32,
 }
 
 /// A button press the app must act on: these need files, the GPU or the
@@ -136,6 +142,9 @@ pub fn draw(
             });
             section(ui, "Camera", false, |ui| {
                 camera_ui(ui, scene, &mut actions);
+            });
+            section(ui, "Light transport", true, |ui| {
+                transport::transport_ui(ui, &mut scene.render);
             });
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
@@ -506,23 +515,12 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         "resolution while dragging",
     ))
     .on_hover_text("Resolution scale while the camera moves, to keep the view responsive");
-    ui.add(slider(
-        &mut render.max_bounces,
-        1..=RenderSettings::MAX_BOUNCES,
-        "max bounces",
-    ))
-    .on_hover_text("1 is direct light only; each more adds one reflection");
     ui.checkbox(&mut render.filter_checkers, "filter checkers")
         .on_hover_text(
             "Average checkerboards over each ray's footprint (closed form): no aliasing far away",
         );
     ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
         .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
-    ui.checkbox(&mut render.env_importance, "sample the environment map")
-        .on_hover_text(
-            "Also draw light directions from a lat-long map by its luminance, combined with \
-             BSDF sampling by MIS: a sun stops making fireflies",
-        );
     if ui
         .button("Screenshot (F12)")
         .on_hover_text("Save the current image as a PNG")
@@ -534,6 +532,16 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
 
 fn stats_ui(ui: &mut Ui, stats: &Stats) {
     ui.label(format!("{:.1} fps", stats.fps));
+    ui.label(format!("{} lights", stats.lights)).on_hover_text(
+        "Entries of the light table: the point light, emissive spheres and triangles",
+    );
+    if stats.triangles > 0 {
+        ui.label(format!(
+            "{} triangles, {} BVH nodes (built in {:.1} ms)",
+            stats.triangles, stats.bvh_nodes, stats.bvh_build_ms
+        ))
+        .on_hover_text("The meshes' triangles and their bounding volume hierarchy (binned SAH)");
+    }
     let clock = if stats.ms_is_gpu { "GPU" } else { "CPU" };
     ui.label(format!("{:.2} ms/frame ({clock})", stats.ms_per_frame))
         .on_hover_text("GPU: timestamp queries around the passes; CPU: wall time per frame");

@@ -1,0 +1,73 @@
+//! The Light transport section: integrator, bounces, how lights are chosen
+//! and how strategies combine. Every control is a uniform of the shader, so
+//! a change restarts accumulation without a shader build.
+
+use super::slider;
+use crate::lights::LightSelection;
+use crate::scene::{Integrator, RenderSettings, Strategy, TransportSettings};
+use egui::{ComboBox, Ui};
+
+pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
+    let t = &mut render.transport;
+    ui.horizontal(|ui| {
+        ui.label("integrator");
+        ui.selectable_value(&mut t.integrator, Integrator::Direct, "direct")
+            .on_hover_text(
+                "Camera rays and shadow rays only (the lab's first exercises): no indirect light",
+            );
+        ui.selectable_value(&mut t.integrator, Integrator::Path, "path tracing")
+            .on_hover_text("Paths of up to `max bounces` reflections: indirect light too");
+    });
+    if t.integrator == Integrator::Path {
+        ui.add(slider(
+            &mut render.max_bounces,
+            1..=RenderSettings::MAX_BOUNCES,
+            "max bounces",
+        ))
+        .on_hover_text("1 is direct light only; each more adds one reflection");
+        ui.add(slider(
+            &mut t.russian_roulette_from,
+            0..=16,
+            "Russian roulette from",
+        ))
+        .on_hover_text(
+            "From this bounce on, a path goes on with the chance of its throughput and the \
+                 survivors are weighted up (unbiased, cheaper); 0 never ends paths early",
+        );
+    }
+    ui.add(slider(
+        &mut t.light_samples,
+        1..=TransportSettings::MAX_LIGHT_SAMPLES,
+        "light samples",
+    ))
+    .on_hover_text("Points sampled on the lights at each shading point (the lab's N)");
+    ComboBox::new("light selection", "light selection")
+        .selected_text(t.light_selection.label())
+        .show_ui(ui, |ui| {
+            for s in LightSelection::ALL {
+                ui.selectable_value(&mut t.light_selection, s, s.label());
+            }
+        })
+        .response
+        .on_hover_text(
+            "How each light sample picks its light: every light (triangle, sphere, point) \
+             equally, or in proportion to its power",
+        );
+    ComboBox::new("strategy", "direct light")
+        .selected_text(t.strategy.label())
+        .show_ui(ui, |ui| {
+            for s in Strategy::ALL {
+                ui.selectable_value(&mut t.strategy, s, s.label());
+            }
+        })
+        .response
+        .on_hover_text(
+            "Sample the lights, follow the BSDF, or both weighted by multiple importance \
+             sampling (balance or power heuristic); the environment map follows the same rule",
+        );
+    ui.checkbox(&mut render.env_importance, "sample the environment map")
+        .on_hover_text(
+            "Also draw light directions from a lat-long map by its luminance, combined with \
+             BSDF sampling by MIS: a sun stops making fireflies",
+        );
+}
