@@ -501,8 +501,10 @@ mod tests {
     /// edited materials are written back.
     #[test]
     fn preset_overrides_win_and_only_they_are_saved() {
-        let mut marble = Material::default();
-        marble.roughness = Texture::scalar(0.123);
+        let marble = Material {
+            roughness: Texture::scalar(0.123),
+            ..Material::default()
+        };
         let mut scene = Scene {
             meshes: vec![Mesh {
                 name: "box".into(),
