@@ -307,6 +307,45 @@ fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
             material_ui(ui, &mut ground.material)
         });
     }
+    for (i, mesh) in scene.meshes.iter_mut().enumerate() {
+        object(ui, ("mesh", i), format!("mesh “{}”", mesh.name), &mut |ui| {
+            mesh_ui(ui, mesh)
+        });
+    }
+}
+
+/// A mesh's placement and each of its MTL materials, editable like any
+/// other (a Cornell box wall can be marble); "reset" goes back to the file.
+fn mesh_ui(ui: &mut Ui, mesh: &mut crate::scene::Mesh) {
+    ui.label(format!(
+        "{} triangles from {}",
+        mesh.geometry.0.len(),
+        mesh.obj.display()
+    ));
+    let p = &mut mesh.placement;
+    vec3_ui(ui, "translate", &mut p.translate, 0.01, "Moves the mesh");
+    ui.add(slider(&mut p.rotate_y_degrees, -180.0..=180.0, "turn").suffix("°"))
+        .on_hover_text("Turns the mesh about the vertical axis (rebuilds the BVH)");
+    ui.add(slider(&mut p.scale, 0.01..=100.0, "scale").logarithmic(true))
+        .on_hover_text("Scales the mesh about its file's origin (rebuilds the BVH)");
+    for (k, m) in mesh.materials.iter_mut().enumerate() {
+        ui.push_id(("mesh material", k), |ui| {
+            CollapsingHeader::new(format!("material “{}”", m.name))
+                .id_salt("mesh material")
+                .show(ui, |ui| {
+                    if let Some(original) = &m.from_file
+                        && m.material != *original
+                        && ui
+                            .small_button("reset to the MTL file")
+                            .on_hover_text("Forget the edits: the file's values come back")
+                            .clicked()
+                    {
+                        m.material = original.clone();
+                    }
+                    material_ui(ui, &mut m.material);
+                });
+        });
+    }
 }
 
 fn environment_ui(
