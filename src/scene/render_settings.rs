@@ -121,3 +121,32 @@ impl Default for RenderSettings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_exposure_reads_off_from_old_presets_and_on_when_set() {
+        let old: RenderSettings = ron::from_str("(exposure: 1.5, tone_map: Reinhard)").unwrap();
+        assert!(!old.auto_exposure);
+        assert_eq!(old.exposure, 1.5);
+        let auto: RenderSettings = ron::from_str("(auto_exposure: true, exposure: -1.0)").unwrap();
+        assert!(auto.auto_exposure);
+        assert_eq!(auto.exposure, -1.0);
+    }
+
+    #[test]
+    fn exposure_compensation_is_clamped_with_a_note() {
+        let mut render = RenderSettings {
+            auto_exposure: true,
+            exposure: 35.0,
+            ..RenderSettings::default()
+        };
+        let mut notes = Vec::new();
+        render.sanitize(&mut notes);
+        assert_eq!(render.exposure, 20.0);
+        assert!(render.auto_exposure);
+        assert_eq!(notes, ["render: exposure compensation 35 clamped"]);
+    }
+}
