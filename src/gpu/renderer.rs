@@ -468,12 +468,12 @@ impl Renderer {
         }
         let scene = &target.scene;
         self.geometry.write(&ctx.queue, scene);
-        // Display-only edits (exposure, auto exposure, tone map) keep the
-        // samples.
+        // Display-only edits (exposure, tone map) keep the samples.
         let mut traced_before = self.scene.clone();
         let mut traced_now = scene.clone();
         traced_before.render.exposure = 0.0;
         traced_now.render.exposure = 0.0;
+        // So does auto exposure: it meters the samples, it does not trace.
         traced_before.render.auto_exposure = false;
         traced_now.render.auto_exposure = false;
         traced_before.render.tone_map = ToneMap::default();
