@@ -2,17 +2,28 @@
 // from the accumulation target onto the window or an offscreen image.
 
 struct Display {
+    // 2^exposure: the manual exposure, or with auto exposure the
+    // compensation applied on top of the metered scale.
     exposure_scale: f32,
     tone_map: u32,          // 0 ACES, 1 Reinhard, 2 clamp
     encode_srgb: u32,       // 1 when the target format does not encode
-    _pad: u32,
+    auto_exposure: u32,     // 1: also scale by `metered.scale`
     // Maps a target pixel to an accumulation texel: texel = (pixel - origin) * scale.
     origin: vec2f,
     scale: vec2f,
 }
 
+// What the auto-exposure pass wrote (auto_exposure.wgsl; same layout).
+struct Metered {
+    log_average: f32,
+    stops: f32,
+    scale: f32,
+    count: u32,
+}
+
 @group(0) @binding(0) var<uniform> display: Display;
 @group(0) @binding(1) var radiance: texture_2d<f32>;
+@group(0) @binding(2) var<uniform> metered: Metered;
 
 // Narkowicz's fit of the ACES filmic curve.
 fn aces(x: vec3f) -> vec3f {
@@ -43,7 +54,8 @@ fn tone_map(c: vec3f) -> vec3f {
 fn fs_display(@builtin(position) position: vec4f) -> @location(0) vec4f {
     let size = vec2i(textureDimensions(radiance));
     let texel = clamp(vec2i(floor((position.xy - display.origin) * display.scale)), vec2i(0), size - 1);
-    let c = max(textureLoad(radiance, texel, 0).rgb * display.exposure_scale, vec3f(0.0));
+    let scale = display.exposure_scale * select(1.0, metered.scale, display.auto_exposure != 0u);
+    let c = max(textureLoad(radiance, texel, 0).rgb * scale, vec3f(0.0));
     var mapped = tone_map(c);
     if display.encode_srgb != 0u {
         mapped = srgb_encode(mapped);

@@ -1,7 +1,8 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
 use super::session::{accumulate, load_scene, renderer_for};
-use crate::gpu::GpuContext;
+use crate::gpu::auto_exposure;
+use crate::gpu::{GpuContext, Renderer};
 use crate::image_io;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -24,6 +25,11 @@ pub struct RenderArgs {
     /// Output: .png (tone-mapped, sRGB) or .exr (linear radiance, float).
     #[arg(short = 'o', long)]
     pub output: PathBuf,
+    /// Expose the PNG automatically (log-average luminance to middle grey),
+    /// the preset's exposure becoming a compensation; as the viewer's
+    /// "auto exposure". EXR output stays unscaled radiance.
+    #[arg(long)]
+    pub auto_exposure: bool,
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -45,7 +51,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == 0 {
         bail!("--spp must be at least 1");
     }
-    let loaded = load_scene(&args.preset, args.env.as_deref())?;
+    let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
+    if args.auto_exposure {
+        loaded.scene.render.auto_exposure = true;
+    }
     for note in &loaded.notes {
         eprintln!("note: {note}");
     }
@@ -63,6 +72,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bar.set_position(u64::from(n))
     })?;
     bar.finish();
+    // EXR output is the radiance, unscaled: only a PNG is exposed.
+    if loaded.scene.render.auto_exposure && matches!(format, image_io::ImageFormat::Png) {
+        report_auto_exposure(&ctx, &mut renderer)?;
+    }
     match format {
         image_io::ImageFormat::Png => {
             let image = renderer.read_display(&ctx)?;
@@ -75,5 +88,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     .with_context(|| format!("saving {}", args.output.display()))?;
     eprintln!("wrote {}", args.output.display());
+    Ok(())
+}
+
+/// Prints the exposure the PNG gets: the GPU's metering (what the display
+/// pass applies) and the CPU twin's log-average over the whole image.
+fn report_auto_exposure(ctx: &GpuContext, renderer: &mut Renderer) -> Result<()> {
+    let metered = renderer.metering(ctx)?;
+    let (_, _, pixels) = renderer.read_radiance(ctx)?;
+    let compensation = renderer.scene().render.exposure;
+    eprintln!(
+        "auto exposure: {:+.2} stops{} (log-average luminance {:.4} over {} metered texels; \
+         {:.4} over the whole image)",
+        metered.stops,
+        if compensation == 0.0 {
+            String::new()
+        } else {
+            format!(", {compensation:+.2} stops of compensation on top")
+        },
+        metered.log_average,
+        metered.count,
+        auto_exposure::log_average_luminance(&pixels),
+    );
     Ok(())
 }

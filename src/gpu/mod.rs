@@ -1,6 +1,8 @@
 //! Everything that talks to wgpu: device creation, shader assembly and
-//! specialisation, the progressive renderer, and the noise compute harness.
+//! specialisation, the progressive renderer, auto exposure, and the noise
+//! compute harness.
 
+pub mod auto_exposure;
 pub mod compute_harness;
 pub mod context;
 pub mod features;

@@ -2,6 +2,7 @@
 //! target, display pass onto any colour target. It owns every GPU resource
 //! derived from the scene and rebuilds only what an edit invalidates.
 
+use super::auto_exposure::{AutoExposure, Metered};
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
@@ -34,9 +35,18 @@ struct DisplayUniform {
     exposure_scale: f32,
     tone_map: u32,
     encode_srgb: u32,
-    _pad: u32,
+    auto_exposure: u32,
     origin: [f32; 2],
     scale: [f32; 2],
+}
+
+/// The accumulation an auto-exposure metering read: the frame that wrote
+/// it, the targets' size and the traced region.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct MeteredFrom {
+    frame_index: u32,
+    size: (u32, u32),
+    render_size: (u32, u32),
 }
 
 /// Where the image goes in a target: a rectangle in target pixels.
@@ -124,6 +134,12 @@ pub struct Renderer {
     display_module: wgpu::ShaderModule,
     frame_buffer: wgpu::Buffer,
     display_buffer: wgpu::Buffer,
+    /// Meters the accumulation for auto exposure; the display pass reads
+    /// its result buffer.
+    auto_exposure: AutoExposure,
+    /// What the auto-exposure result was metered from: the display of one
+    /// frame on two targets meters once.
+    metered_from: Option<MeteredFrom>,
     geometry: GeometryBuffers,
     /// Triangles, their BVH and the light table.
     meshes: MeshBuffers,
@@ -180,7 +196,11 @@ impl Renderer {
         });
         let display_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
-            entries: &[entry(0, uniform()), entry(1, float_texture(false))],
+            entries: &[
+                entry(0, uniform()),
+                entry(1, float_texture(false)),
+                entry(2, uniform()),
+            ],
         });
         let images = ImageSet::empty();
         let textures = texture_codegen::generate(scene, &images)?;
@@ -192,6 +212,7 @@ impl Renderer {
         let (trace_pipeline, trace_shader_bytes) =
             Self::build_trace_pipeline(&ctx.device, &trace_layout, &key)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
+        let auto_exposure = AutoExposure::new(device)?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -248,6 +269,8 @@ impl Renderer {
             display_module,
             frame_buffer,
             display_buffer,
+            auto_exposure,
+            metered_from: None,
             geometry,
             meshes,
             perm_buffer,
@@ -470,6 +493,9 @@ impl Renderer {
         let mut traced_now = scene.clone();
         traced_before.render.exposure = 0.0;
         traced_now.render.exposure = 0.0;
+        // So does auto exposure: it meters the samples, it does not trace.
+        traced_before.render.auto_exposure = false;
+        traced_now.render.auto_exposure = false;
         traced_before.render.tone_map = ToneMap::default();
         traced_now.render.tone_map = ToneMap::default();
         if traced_before != traced_now {
@@ -656,8 +682,30 @@ impl Renderer {
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
+    /// Records the auto-exposure metering of the latest mean, unless the
+    /// result already comes from it.
+    fn meter(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        let render_size = self.render_size();
+        let from = MeteredFrom {
+            frame_index: self.frame_index,
+            size: self.size,
+            render_size,
+        };
+        if self.metered_from != Some(from) {
+            self.auto_exposure.record(
+                ctx,
+                encoder,
+                &self.accumulation.views[self.accumulation.latest],
+                render_size,
+            );
+            self.metered_from = Some(from);
+        }
+    }
+
     /// Records the display pass: exposure and tone mapping of the latest mean
     /// into `viewport` of `target`. The rest of the target is left as is.
+    /// With auto exposure the mean is metered first (a compute pass in the
+    /// same encoder, its result read on the GPU).
     pub fn display(
         &mut self,
         ctx: &GpuContext,
@@ -679,6 +727,10 @@ impl Renderer {
             )?;
             self.display_pipelines.insert(format, p);
         }
+        let auto_exposure = self.scene.render.auto_exposure;
+        if auto_exposure {
+            self.meter(ctx, encoder);
+        }
         let render_size = self.render_size();
         let uniform = DisplayUniform {
             exposure_scale: self.scene.render.exposure.exp2(),
@@ -688,7 +740,7 @@ impl Renderer {
                 ToneMap::Clamp => 2,
             },
             encode_srgb: u32::from(!format.is_srgb()),
-            _pad: 0,
+            auto_exposure: u32::from(auto_exposure),
             origin: [viewport.x, viewport.y],
             scale: [
                 render_size.0 as f32 / viewport.width.max(1.0),
@@ -708,6 +760,7 @@ impl Renderer {
                         &self.accumulation.views[self.accumulation.latest],
                     ),
                 ),
+                bind(2, self.auto_exposure.result().as_entire_binding()),
             ],
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -756,6 +809,16 @@ impl Renderer {
             out.extend_from_slice(&all[start..start + rw as usize]);
         }
         Ok((rw, rh, out))
+    }
+
+    /// Meters the latest mean for auto exposure and reads the result back,
+    /// waiting for the GPU (whether or not auto exposure is on): for tests
+    /// and reports. The display pass reads the same result on the GPU.
+    pub fn metering(&mut self, ctx: &GpuContext) -> Result<Metered> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.meter(ctx, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        self.auto_exposure.read(ctx)
     }
 
     /// The displayed (tone-mapped, sRGB) image at the trace resolution.

@@ -40,6 +40,10 @@ const SOURCES: &[(&str, &str)] = &[
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     (
+        "auto_exposure.wgsl",
+        include_str!("../../shaders/auto_exposure.wgsl"),
+    ),
+    (
         "noise_harness.wgsl",
         include_str!("../../shaders/noise_harness.wgsl"),
     ),
@@ -78,6 +82,8 @@ pub enum Program {
     Trace,
     /// Exposure and tone mapping to the screen or an image.
     Display,
+    /// The compute pass that meters the image's log-average luminance.
+    AutoExposure,
     /// The compute pass that evaluates noise at given points.
     NoiseHarness,
     /// The compute pass that evaluates the texture library's patterns.
@@ -85,9 +91,10 @@ pub enum Program {
 }
 
 impl Program {
-    pub const ALL: [Program; 4] = [
+    pub const ALL: [Program; 5] = [
         Program::Trace,
         Program::Display,
+        Program::AutoExposure,
         Program::NoiseHarness,
         Program::TextureHarness,
     ];
@@ -137,6 +144,7 @@ impl Program {
                 }
             }
             Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
+            Program::AutoExposure => out.push("auto_exposure.wgsl"),
             Program::NoiseHarness => {
                 noise(&mut out);
                 out.push("noise_harness.wgsl");

@@ -537,8 +537,24 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
     .on_hover_text("Jittered samples per pixel each frame: smoother, slower frames");
     ui.checkbox(&mut render.accumulate, "accumulate")
         .on_hover_text("Average frames while nothing changes; off shows each frame alone");
-    ui.add(slider(&mut render.exposure, -10.0..=10.0, "exposure").suffix(" stops"))
-        .on_hover_text("Scales the radiance by 2^exposure before tone mapping");
+    ui.checkbox(&mut render.auto_exposure, "auto exposure")
+        .on_hover_text(
+            "Meter the image every frame and expose its log-average luminance to middle grey \
+             (Reinhard's key, 0.18); off, the exposure slider alone sets it",
+        );
+    let (label, hint) = if render.auto_exposure {
+        (
+            "compensation",
+            "Stops added to the automatic exposure: + brighter, − darker than middle grey",
+        )
+    } else {
+        (
+            "exposure",
+            "Scales the radiance by 2^exposure before tone mapping",
+        )
+    };
+    ui.add(slider(&mut render.exposure, -10.0..=10.0, label).suffix(" stops"))
+        .on_hover_text(hint);
     ComboBox::new("tone map", "tone map")
         .selected_text(render.tone_map.label())
         .show_ui(ui, |ui| {

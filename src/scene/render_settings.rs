@@ -32,8 +32,14 @@ pub struct RenderSettings {
     pub samples_per_frame: u32,
     /// Average frames while nothing changes; off shows each frame alone.
     pub accumulate: bool,
-    /// Exposure in stops: the radiance is scaled by 2^exposure.
+    /// Exposure in stops: the radiance is scaled by 2^exposure. With
+    /// `auto_exposure` it is a compensation added to the automatic value.
     pub exposure: f32,
+    /// Expose by Reinhard's key: the image's log-average luminance is
+    /// brought to middle grey (0.18), `exposure` stops on top; metered on
+    /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
+    /// sets it: the manual override.
+    pub auto_exposure: bool,
     pub tone_map: ToneMap,
     /// Resolution scale used while the camera is being dragged, so the view
     /// stays responsive; full resolution comes back when the mouse is still.
@@ -78,7 +84,12 @@ impl RenderSettings {
             self.max_bounces = b;
         }
         if !self.exposure.is_finite() || self.exposure.abs() > 20.0 {
-            notes.push(format!("render: exposure {} clamped", self.exposure));
+            let what = if self.auto_exposure {
+                "exposure compensation"
+            } else {
+                "exposure"
+            };
+            notes.push(format!("render: {what} {} clamped", self.exposure));
             self.exposure = if self.exposure.is_finite() {
                 self.exposure.clamp(-20.0, 20.0)
             } else {
@@ -102,6 +113,7 @@ impl Default for RenderSettings {
             samples_per_frame: 1,
             accumulate: true,
             exposure: 0.0,
+            auto_exposure: false,
             tone_map: ToneMap::Aces,
             interactive_scale: 0.5,
             max_bounces: 3,
@@ -110,5 +122,34 @@ impl Default for RenderSettings {
             env_importance: true,
             transport: Default::default(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_exposure_reads_off_from_old_presets_and_on_when_set() {
+        let old: RenderSettings = ron::from_str("(exposure: 1.5, tone_map: Reinhard)").unwrap();
+        assert!(!old.auto_exposure);
+        assert_eq!(old.exposure, 1.5);
+        let auto: RenderSettings = ron::from_str("(auto_exposure: true, exposure: -1.0)").unwrap();
+        assert!(auto.auto_exposure);
+        assert_eq!(auto.exposure, -1.0);
+    }
+
+    #[test]
+    fn exposure_compensation_is_clamped_with_a_note() {
+        let mut render = RenderSettings {
+            auto_exposure: true,
+            exposure: 35.0,
+            ..RenderSettings::default()
+        };
+        let mut notes = Vec::new();
+        render.sanitize(&mut notes);
+        assert_eq!(render.exposure, 20.0);
+        assert!(render.auto_exposure);
+        assert_eq!(notes, ["render: exposure compensation 35 clamped"]);
     }
 }
