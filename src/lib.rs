@@ -3,6 +3,7 @@
 pub mod app;
 pub mod atomic_write;
 pub mod commands;
+pub mod cubemap;
 pub mod env_sampling;
 pub mod envmap;
 pub mod gpu;

@@ -1,7 +1,7 @@
 //! Preset files: a [`Scene`] in RON, versioned, with precise errors.
 
 use crate::atomic_write::write_atomic;
-use crate::scene::{EnvSource, Scene};
+use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -100,10 +100,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     }
     preset.format_version = FORMAT_VERSION;
     let folder = path.parent().unwrap_or(Path::new("."));
-    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source
-        && env.is_relative()
-    {
-        *env = folder.join(&*env);
+    for env in preset.scene.environment.source.paths_mut() {
+        if env.is_relative() {
+            *env = folder.join(&*env);
+        }
     }
     for_each_image_path(&mut preset.scene, &mut |image| {
         if image.is_relative() {
@@ -152,7 +152,7 @@ pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
             *file = rel;
         }
     };
-    if let EnvSource::LatLong { path: env } = &mut preset.scene.environment.source {
+    for env in preset.scene.environment.source.paths_mut() {
         relative(env);
     }
     for_each_image_path(&mut preset.scene, &mut relative);
@@ -207,6 +207,7 @@ fn absolute(p: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::EnvSource;
 
     #[test]
     fn round_trips_the_default_scene() {

@@ -2,6 +2,7 @@
 
 use super::{ViewerOptions, camera_input, screenshots};
 use crate::commands::session::{load_images, load_scene, preset_or_default, renderer_for};
+use crate::cubemap;
 use crate::envmap;
 use crate::gpu::{GpuContext, Renderer, Viewport, pass_timer::PassTimer, readback::read_texture};
 use crate::panel::{self, PanelAction, PanelState, Stats};
@@ -215,22 +216,37 @@ impl Viewer {
     }
 
     fn load_environment(&mut self, path: &Path) {
-        match envmap::load(path) {
-            Ok(l) => {
+        self.load_environment_source(EnvSource::LatLong {
+            path: path.to_owned(),
+        });
+    }
+
+    /// Loads a lat-long or cube map (a cube resampled to lat-long) and
+    /// installs it with `source`; on failure the scene stays as it was.
+    fn load_environment_source(&mut self, source: EnvSource) {
+        let what = source
+            .paths()
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
+        match cubemap::load_source(&source) {
+            Ok(Some(l)) => {
                 let mut scene = self.scene.clone();
-                scene.environment.source = EnvSource::LatLong {
-                    path: path.to_owned(),
-                };
+                scene.environment.source = source;
                 if let Err(e) = self.apply_scene(scene, Some(&l.image), None) {
-                    self.panel.error(format!("{}: {e:#}", path.display()));
+                    self.panel.error(format!("{what}: {e:#}"));
                     return;
                 }
-                self.panel.env_path = path.display().to_string();
-                self.panel.info(format!("environment {}", path.display()));
+                if let EnvSource::LatLong { path } = &self.scene.environment.source {
+                    self.panel.env_path = path.display().to_string();
+                }
+                self.panel.info(format!("environment {what}"));
                 for note in l.notes {
                     self.panel.info(note);
                 }
             }
+            Ok(None) => {}
             Err(e) => self.panel.error(format!("{e:#}")),
         }
     }
@@ -401,13 +417,16 @@ impl Viewer {
         image_rect: egui::Rect,
         dragging: bool,
     ) -> Result<bool> {
-        // A lat-long path chosen in the panel needs its image loaded first.
-        if let EnvSource::LatLong { path } = &self.scene.environment.source
+        // A map (lat-long or cube) chosen in the panel needs its image
+        // loaded first.
+        if self.scene.environment.source.is_map()
             && self.scene.environment.source != self.renderer.scene().environment.source
         {
-            let path = path.clone();
-            self.scene.environment.source = self.renderer.scene().environment.source.clone();
-            self.load_environment(&path);
+            let source = std::mem::replace(
+                &mut self.scene.environment.source,
+                self.renderer.scene().environment.source.clone(),
+            );
+            self.load_environment_source(source);
         }
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.

@@ -1,7 +1,8 @@
 //! Loading a preset and its environment into a ready renderer: shared by the
 //! viewer, `render` and `bench`, so they all see the same scene.
 
-use crate::envmap::{self, EnvImage};
+use crate::cubemap;
+use crate::envmap::EnvImage;
 use crate::gpu::{GpuContext, Renderer};
 use crate::preset;
 use crate::scene::{EnvSource, Scene};
@@ -31,14 +32,11 @@ pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<Loa
             path: env.to_owned(),
         };
     }
-    let env = match &scene.environment.source {
-        EnvSource::LatLong { path } => {
-            let l = envmap::load(path)?;
-            notes.extend(l.notes);
-            Some(l.image)
-        }
-        _ => None,
-    };
+    // A cube map arrives resampled to lat-long (`cubemap::load_source`).
+    let env = cubemap::load_source(&scene.environment.source)?.map(|l| {
+        notes.extend(l.notes);
+        l.image
+    });
     crate::obj_loader::load_meshes(&mut scene, &mut notes)?;
     // The meshes' materials arrive with their files: clamp them as the
     // preset's own were.

@@ -200,7 +200,9 @@ impl FeatureSet {
             EnvSource::Constant { .. } => {
                 set.insert(Feature::EnvConstant);
             }
-            EnvSource::LatLong { .. } => {
+            EnvSource::LatLong { .. }
+            | EnvSource::CubeFaces { .. }
+            | EnvSource::CubeCross { .. } => {
                 set.insert(Feature::EnvMap);
                 if scene.render.env_importance {
                     set.insert(Feature::EnvSampling);

@@ -303,15 +303,16 @@ pub fn frame_uniform(
         env_kind: match env.source {
             EnvSource::None => 0,
             EnvSource::Constant { .. } => 1,
-            EnvSource::LatLong { .. } => 2,
+            // A cube map reaches the GPU resampled to lat-long.
+            EnvSource::LatLong { .. }
+            | EnvSource::CubeFaces { .. }
+            | EnvSource::CubeCross { .. } => 2,
         },
         has_ground: u32::from(scene.ground.is_some()),
         cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
         polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
         pixel_spread: 2.0 * cam.tan_half_fov / h,
-        env_sampling: u32::from(
-            matches!(env.source, EnvSource::LatLong { .. }) && scene.render.env_importance,
-        ),
+        env_sampling: u32::from(env.source.is_map() && scene.render.env_importance),
         // Filled in by the renderer, which holds the distribution and the
         // light table.
         env_distribution_size: [0; 2],

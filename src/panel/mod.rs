@@ -30,7 +30,13 @@ const SHOWN_MESSAGES: usize = 5;
 const KEPT_MESSAGES: usize = 100;
 
 /// The environment sources in the order of the source dropdown.
-const ENV_SOURCE_NAMES: [&str; 3] = ["none", "constant", "lat-long map"];
+const ENV_SOURCE_NAMES: [&str; 5] = [
+    "none",
+    "constant",
+    "lat-long map",
+    "cube (6 faces)",
+    "cube (cross)",
+];
 
 /// A line of feedback for the user (a preset loaded, a file that failed).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -51,6 +57,17 @@ pub struct PanelState {
     /// The constant environment radiance last seen, so that switching the
     /// source away from constant and back does not lose the colour.
     last_radiance: Vec3,
+    /// The cube face paths being typed (+x, -x, +y, -y, +z, -z) and the
+    /// cross path; their Load buttons use them.
+    cube_faces: [String; 6],
+    cube_cross: String,
+    /// The cube source last seen in the scene: when the scene's source
+    /// changes (a preset loaded), the path fields above take its paths.
+    cube_seen: Option<EnvSource>,
+    /// A cube entry picked in the source dropdown before its paths were
+    /// typed (true: six faces, false: cross): the panel shows its fields
+    /// while the scene keeps its source until Load.
+    cube_pending: Option<bool>,
 }
 
 impl PanelState {
@@ -60,6 +77,10 @@ impl PanelState {
             env_path,
             messages: Vec::new(),
             last_radiance: Vec3::ONE,
+            cube_faces: Default::default(),
+            cube_cross: String::new(),
+            cube_seen: None,
+            cube_pending: None,
         }
     }
 
@@ -355,7 +376,27 @@ fn environment_ui(
     actions: &mut Vec<PanelAction>,
 ) {
     env_source_ui(ui, &mut env.source, state);
-    match &mut env.source {
+    if let Some(faces) = state.cube_pending {
+        cube_source_ui(ui, &mut env.source, state, faces);
+    } else {
+        source_fields_ui(ui, &mut env.source, state, actions);
+    }
+    ui.add(slider(&mut env.rotation_degrees, -180.0..=180.0, "rotation").suffix("°"))
+        .on_hover_text("Turns the environment about the vertical axis");
+    ui.add(slider(&mut env.intensity, 0.01..=100.0, "intensity").logarithmic(true))
+        .on_hover_text("Multiplies the environment's radiance");
+    ui.checkbox(&mut env.background_visible, "background visible")
+        .on_hover_text("Show the environment behind the scene; it lights the scene either way");
+}
+
+/// The controls of the scene's current source.
+fn source_fields_ui(
+    ui: &mut Ui,
+    source: &mut EnvSource,
+    state: &mut PanelState,
+    actions: &mut Vec<PanelAction>,
+) {
+    match source {
         EnvSource::None => {}
         EnvSource::Constant { radiance } => {
             labelled_color(ui, radiance, "colour").on_hover_text(
@@ -381,13 +422,75 @@ fn environment_ui(
             });
             ui.weak("or drop a file on the window");
         }
+        EnvSource::CubeFaces { .. } => cube_source_ui(ui, source, state, true),
+        EnvSource::CubeCross { .. } => cube_source_ui(ui, source, state, false),
     }
-    ui.add(slider(&mut env.rotation_degrees, -180.0..=180.0, "rotation").suffix("°"))
-        .on_hover_text("Turns the environment about the vertical axis");
-    ui.add(slider(&mut env.intensity, 0.01..=100.0, "intensity").logarithmic(true))
-        .on_hover_text("Multiplies the environment's radiance");
-    ui.checkbox(&mut env.background_visible, "background visible")
-        .on_hover_text("Show the environment behind the scene; it lights the scene either way");
+}
+
+/// The path fields of a cube map (six faces, or a cross) and a Load button
+/// that puts them in the scene: typing alone does not load half a path.
+fn cube_source_ui(ui: &mut Ui, source: &mut EnvSource, state: &mut PanelState, is_faces: bool) {
+    let is_cube = matches!(
+        source,
+        EnvSource::CubeFaces { .. } | EnvSource::CubeCross { .. }
+    );
+    if is_cube && state.cube_seen.as_ref() != Some(source) {
+        match source {
+            EnvSource::CubeFaces { faces } => {
+                state.cube_faces = faces.each_ref().map(|p| p.display().to_string());
+            }
+            EnvSource::CubeCross { path } => state.cube_cross = path.display().to_string(),
+            _ => {}
+        }
+        state.cube_seen = Some(source.clone());
+    }
+    if is_cube {
+        for path in source.paths() {
+            ui.label(format!("current: {}", path.display()))
+                .on_hover_text("A file the scene uses; relative to the preset file");
+        }
+    }
+    let ready = if is_faces {
+        let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
+        let hints = ["px.exr", "nx.exr", "py.exr", "ny.exr", "pz.exr", "nz.exr"];
+        for ((name, hint), path) in names.iter().zip(hints).zip(&mut state.cube_faces) {
+            ui.horizontal(|ui| {
+                ui.label(*name);
+                ui.add(TextEdit::singleline(path).hint_text(hint))
+                    .on_hover_text(
+                        "A square face (.exr, .hdr, .png or .jpg), OpenGL orientation; \
+                         all six the same size",
+                    );
+            });
+        }
+        state.cube_faces.iter().all(|p| !p.trim().is_empty())
+    } else {
+        ui.add(TextEdit::singleline(&mut state.cube_cross).hint_text("cross.exr"))
+            .on_hover_text(
+                "One image of 4x3 square faces: +y above +z; -x, +z, +x, -z across; -y below",
+            );
+        !state.cube_cross.trim().is_empty()
+    };
+    if ui
+        .add_enabled(ready, egui::Button::new("Load"))
+        .on_hover_text("Load the cube map at these paths (resampled to lat-long)")
+        .clicked()
+    {
+        *source = cube_source_from(state, is_faces);
+    }
+}
+
+/// A cube source with the paths typed in the panel.
+fn cube_source_from(state: &PanelState, faces: bool) -> EnvSource {
+    if faces {
+        EnvSource::CubeFaces {
+            faces: state.cube_faces.each_ref().map(|p| PathBuf::from(p.trim())),
+        }
+    } else {
+        EnvSource::CubeCross {
+            path: PathBuf::from(state.cube_cross.trim()),
+        }
+    }
 }
 
 /// The source dropdown. Switching to constant restores the last colour;
@@ -400,24 +503,55 @@ fn env_source_ui(ui: &mut Ui, source: &mut EnvSource, state: &mut PanelState) {
             1
         }
         EnvSource::LatLong { .. } => 2,
+        EnvSource::CubeFaces { .. } => 3,
+        EnvSource::CubeCross { .. } => 4,
     };
-    let mut index = current;
+    // A cube entry waiting for its paths shows as picked.
+    let shown = match state.cube_pending {
+        Some(faces) if current == if faces { 3 } else { 4 } => {
+            state.cube_pending = None;
+            current
+        }
+        Some(true) => 3,
+        Some(false) => 4,
+        None => current,
+    };
+    let mut index = shown;
     ComboBox::new("env source", "source")
         .show_index(ui, &mut index, ENV_SOURCE_NAMES.len(), |i| {
             ENV_SOURCE_NAMES[i]
         })
         .on_hover_text("What rays that leave the scene see");
-    if index != current {
-        *source = match index {
-            1 => EnvSource::Constant {
-                radiance: state.last_radiance,
-            },
-            2 => EnvSource::LatLong {
-                path: PathBuf::from(state.env_path.trim()),
-            },
-            _ => EnvSource::None,
-        };
+    if index == shown {
+        return;
     }
+    state.cube_pending = None;
+    if index == current {
+        return;
+    }
+    let cube_typed = |faces: bool| {
+        if faces {
+            state.cube_faces.iter().all(|p| !p.trim().is_empty())
+        } else {
+            !state.cube_cross.trim().is_empty()
+        }
+    };
+    if (index == 3 || index == 4) && !cube_typed(index == 3) {
+        // Nothing to load yet: show the fields, keep the scene's source.
+        state.cube_pending = Some(index == 3);
+        return;
+    }
+    *source = match index {
+        1 => EnvSource::Constant {
+            radiance: state.last_radiance,
+        },
+        2 => EnvSource::LatLong {
+            path: PathBuf::from(state.env_path.trim()),
+        },
+        3 => cube_source_from(state, true),
+        4 => cube_source_from(state, false),
+        _ => EnvSource::None,
+    };
 }
 
 fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {
@@ -686,6 +820,13 @@ mod tests {
             EnvSource::LatLong {
                 path: "sky.exr".into(),
             },
+            EnvSource::CubeFaces {
+                faces: ["px.exr", "nx.exr", "py.exr", "ny.exr", "pz.exr", "nz.exr"]
+                    .map(PathBuf::from),
+            },
+            EnvSource::CubeCross {
+                path: "cross.exr".into(),
+            },
         ] {
             scene.environment.source = source;
             let before = scene.clone();
@@ -702,6 +843,37 @@ mod tests {
             assert_eq!(scene, before);
             assert!(actions.is_empty(), "{actions:?}");
         }
+    }
+
+    /// The cube path fields take the scene's cube paths (a preset loaded),
+    /// and a cube entry picked before its paths are typed shows its fields
+    /// without touching the scene.
+    #[test]
+    fn cube_fields_follow_the_scene_and_a_pending_cube_leaves_it_alone() {
+        let mut env = Environment {
+            source: EnvSource::CubeCross {
+                path: "maps/cross.exr".into(),
+            },
+            ..Environment::default()
+        };
+        let mut state = PanelState::new(String::new(), String::new());
+        let mut actions = Vec::new();
+        frame(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+        assert_eq!(state.cube_cross, "maps/cross.exr");
+
+        env.source = EnvSource::LatLong {
+            path: "sky.exr".into(),
+        };
+        let before = env.clone();
+        state.cube_pending = Some(true);
+        frame(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+        assert_eq!(env, before);
+        assert_eq!(state.cube_pending, Some(true));
+        assert!(actions.is_empty(), "{actions:?}");
+        // Once the scene holds a six-face cube, nothing is pending.
+        env.source = cube_source_from(&state, true);
+        frame(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+        assert_eq!(state.cube_pending, None);
     }
 
     #[test]
