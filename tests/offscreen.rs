@@ -143,11 +143,30 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
             fov_degrees: 60.0,
         };
         scene.render.max_bounces = bounces;
-        let pixels = render_with(&ctx, &scene, (16, 16), 2, features);
+        // Russian roulette would add variance (not bias): off here.
+        scene.render.transport.russian_roulette_from = 0;
+        let pixels = render_with(&ctx, &scene, (16, 16), 2, features.clone());
         let series: f32 = (0..bounces).map(|k| albedo.powi(k as i32)).sum();
         let expected = albedo / std::f32::consts::PI * intensity / (radius * radius) * series;
         for p in &pixels {
             assert_channels_near(*p, expected, 1e-3, &format!("{bounces} bounces"));
+        }
+        // With Russian roulette from the first bounce, paths end at random
+        // and survivors are weighted up: the mean stays the same.
+        if bounces == 4 {
+            scene.render.transport.russian_roulette_from = 1;
+            let pixels = render_with(&ctx, &scene, (16, 16), 256, features);
+            let mean = pixels.iter().map(|p| p[0]).sum::<f32>() / pixels.len() as f32;
+            assert!(
+                (mean - expected).abs() < 0.01 * expected,
+                "Russian roulette: mean {mean}, expected {expected}"
+            );
+            assert!(
+                pixels
+                    .iter()
+                    .any(|p| (p[0] - expected).abs() > 1e-3 * expected),
+                "Russian roulette ended no path"
+            );
         }
     }
 }

@@ -329,9 +329,12 @@ fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
         });
     }
     for (i, mesh) in scene.meshes.iter_mut().enumerate() {
-        object(ui, ("mesh", i), format!("mesh “{}”", mesh.name), &mut |ui| {
-            mesh_ui(ui, mesh)
-        });
+        object(
+            ui,
+            ("mesh", i),
+            format!("mesh “{}”", mesh.name),
+            &mut |ui| mesh_ui(ui, mesh),
+        );
     }
 }
 
