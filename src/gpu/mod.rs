@@ -1,6 +1,7 @@
 //! Everything that talks to wgpu: device creation, shader assembly and
 //! specialisation, the progressive renderer, and the noise compute harness.
 
+pub mod bvh_harness;
 pub mod compute_harness;
 pub mod context;
 pub mod features;

@@ -68,6 +68,11 @@ const SOURCES: &[(&str, &str)] = &[
         "env_sampling.wgsl",
         include_str!("../../shaders/env_sampling.wgsl"),
     ),
+    ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
+    (
+        "bvh_harness.wgsl",
+        include_str!("../../shaders/bvh_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,14 +85,17 @@ pub enum Program {
     NoiseHarness,
     /// The compute pass that evaluates the texture library's patterns.
     TextureHarness,
+    /// The compute pass that sends rays through a triangle mesh's BVH.
+    BvhHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 4] = [
+    pub const ALL: [Program; 5] = [
         Program::Trace,
         Program::Display,
         Program::NoiseHarness,
         Program::TextureHarness,
+        Program::BvhHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -145,6 +153,7 @@ impl Program {
                     "texture_harness.wgsl",
                 ]);
             }
+            Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
         }
         out
     }
