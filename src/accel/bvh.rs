@@ -29,9 +29,10 @@
 //! whose depth plus the levels a balanced split would still need reaches the
 //! bound splits at its median instead, which halves it exactly.
 //!
-//! Triangles with a NaN or infinite coordinate get the empty box: they land
-//! in some leaf (the permutation still covers every triangle) but widen no
-//! box, so traversal never reaches them because of them.
+//! Triangles with a NaN or infinite coordinate get the empty box. Where
+//! there are some among finite ones, the root's right child holds them all,
+//! in leaves whose boxes are empty: the permutation still covers every
+//! triangle, but no ray reaches them and no box grows because of them.
 
 use super::aabb::Aabb;
 use bytemuck::{Pod, Zeroable};
@@ -160,11 +161,18 @@ impl Bvh {
                 index: i as u32,
             })
             .collect();
-        let mut nodes = Vec::with_capacity(2 * prims.len().max(1));
-        if prims.is_empty() {
-            nodes.push(BvhNode::EMPTY);
-        } else {
-            nodes.push(BvhNode::zeroed());
+        let mut nodes = Vec::with_capacity(2 * prims.len().max(1) + 2);
+        nodes.push(BvhNode::EMPTY);
+        // Non-finite triangles go to a subtree of their own under the root,
+        // whose empty boxes no ray enters: they are never tested.
+        let finite = partition(&mut prims, |p| !p.bounds.is_empty());
+        if finite > 0 && finite < prims.len() {
+            nodes.extend([BvhNode::zeroed(); 2]);
+            let (good, bad) = prims.split_at_mut(finite);
+            build_node(&mut nodes, 1, good, 0, 1, max_depth);
+            build_node(&mut nodes, 2, bad, finite, 1, max_depth);
+            nodes[0] = BvhNode::new(&nodes[1].bounds(), 1, 0);
+        } else if !prims.is_empty() {
             build_node(&mut nodes, 0, &mut prims, 0, 0, max_depth);
         }
         let build_time = start.elapsed();
