@@ -20,7 +20,12 @@
 // Shaped for lanes in lock step (llvmpipe runs every branch under a mask):
 // nodes and triangles are read from the storage arrays in place, the ray's
 // constants are computed once, and bool operators are the non-short-circuit
-// `&`, `|`, so the tests are straight-line code.
+// `&`, `|`, so the tests are straight-line code. On lavapipe (Mesa 22.3) the
+// reads bound the speed, not the arithmetic: a storage read whose index
+// differs between lanes becomes a loop over the 8 lanes, one scalar load per
+// component and lane, each inserted into the vector through memory. A step
+// down the tree reads 14 components (two child boxes, then the next node's
+// a and count), a triangle 9.
 
 struct BvhNode {
     min: vec3f,
@@ -157,6 +162,13 @@ fn mesh_box_entry(r: MeshRay, index: u32, t_far: f32) -> f32 {
 
 // The closest hit with t in (0, t_max) (t_max above NO_HIT counts as
 // NO_HIT), or t = NO_HIT and triangle = NO_TRIANGLE.
+//
+// "While-while" (Aila and Laine, "Understanding the Efficiency of Ray
+// Traversal on GPUs", 2009): an inner loop walks interior nodes until the
+// lane holds a leaf, then the leaf's triangles are tested. Lanes in lock
+// step wait for each other at the end of each inner loop, so they test
+// triangles together rather than each iteration paying, under a mask, for
+// both a node step and a leaf.
 fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
     var hit = MeshHit(NO_HIT, NO_TRIANGLE, 0.0, 0.0);
     let r = mesh_ray(o, d);
@@ -168,10 +180,9 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
     var sp = 0u;
     var node = 0u;
     loop {
-        let a = bvh_nodes[node].a;
-        let count = bvh_nodes[node].count;
-        var next = NO_TRIANGLE;
-        if count == 0u {
+        var a = bvh_nodes[node].a;
+        var count = bvh_nodes[node].count;
+        while count == 0u {
             let tl = mesh_box_entry(r, a, t_far);
             let tr = mesh_box_entry(r, a + 1u, t_far);
             // Near child first; the other waits on the stack. A missed
@@ -181,30 +192,37 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
                 stack[sp] = select(a + 1u, a, right_first);
                 sp += 1u;
             }
-            next = select(NO_TRIANGLE, select(a, a + 1u, right_first), min(tl, tr) < BOX_MISS);
-        } else {
-            for (var i = a; i < a + count; i++) {
-                let h = mesh_triangle(r, i, t_far);
-                if h.x < t_far {
-                    t_far = h.x;
-                    hit = MeshHit(h.x, i, h.y, h.z);
+            if min(tl, tr) < BOX_MISS {
+                node = select(a, a + 1u, right_first);
+            } else {
+                if sp == 0u {
+                    return hit;
                 }
+                sp -= 1u;
+                node = stack[sp];
+            }
+            a = bvh_nodes[node].a;
+            count = bvh_nodes[node].count;
+        }
+        for (var i = a; i < a + count; i++) {
+            let h = mesh_triangle(r, i, t_far);
+            if h.x < t_far {
+                t_far = h.x;
+                hit = MeshHit(h.x, i, h.y, h.z);
             }
         }
-        if next == NO_TRIANGLE {
-            if sp == 0u {
-                break;
-            }
-            sp -= 1u;
-            next = stack[sp];
+        if sp == 0u {
+            return hit;
         }
-        node = next;
+        sp -= 1u;
+        node = stack[sp];
     }
     return hit;
 }
 
-// Whether any triangle is hit with t in (0, t_max): for shadow rays. Stops
-// at the first hit and does not order the children.
+// Whether any triangle is hit with t in (0, t_max): for shadow rays. The
+// same walk, stopping at the first hit. Near children first too: in a
+// closed mesh the near side is where a hit is likeliest.
 fn mesh_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
     let r = mesh_ray(o, d);
     let t_far = min(t_max, NO_HIT);
@@ -215,32 +233,38 @@ fn mesh_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
     var sp = 0u;
     var node = 0u;
     loop {
-        let a = bvh_nodes[node].a;
-        let count = bvh_nodes[node].count;
-        var next = NO_TRIANGLE;
-        if count == 0u {
-            let hit_l = mesh_box_entry(r, a, t_far) < BOX_MISS;
-            let hit_r = mesh_box_entry(r, a + 1u, t_far) < BOX_MISS;
-            if hit_l & hit_r {
-                stack[sp] = a + 1u;
+        var a = bvh_nodes[node].a;
+        var count = bvh_nodes[node].count;
+        while count == 0u {
+            let tl = mesh_box_entry(r, a, t_far);
+            let tr = mesh_box_entry(r, a + 1u, t_far);
+            let right_first = tr < tl;
+            if max(tl, tr) < BOX_MISS {
+                stack[sp] = select(a + 1u, a, right_first);
                 sp += 1u;
             }
-            next = select(select(NO_TRIANGLE, a + 1u, hit_r), a, hit_l);
-        } else {
-            for (var i = a; i < a + count; i++) {
-                if mesh_triangle(r, i, t_far).x < t_far {
-                    return true;
+            if min(tl, tr) < BOX_MISS {
+                node = select(a, a + 1u, right_first);
+            } else {
+                if sp == 0u {
+                    return false;
                 }
+                sp -= 1u;
+                node = stack[sp];
+            }
+            a = bvh_nodes[node].a;
+            count = bvh_nodes[node].count;
+        }
+        for (var i = a; i < a + count; i++) {
+            if mesh_triangle(r, i, t_far).x < t_far {
+                return true;
             }
         }
-        if next == NO_TRIANGLE {
-            if sp == 0u {
-                break;
-            }
-            sp -= 1u;
-            next = stack[sp];
+        if sp == 0u {
+            return false;
         }
-        node = next;
+        sp -= 1u;
+        node = stack[sp];
     }
     return false;
 }

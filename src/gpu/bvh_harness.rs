@@ -158,17 +158,17 @@ impl BvhHarness {
             .collect())
     }
 
-    /// Wall-clock time of one dispatch of all `rays`, waited for, as the
-    /// median of `repeats` after one untimed warm-up (which compiles the
-    /// shader on drivers that do so at the first dispatch). Uploads and
-    /// readback are outside the timing.
+    /// Wall-clock times of `repeats` dispatches of all `rays`, each waited
+    /// for, sorted, after one untimed warm-up (which compiles the shader on
+    /// drivers that do so at the first dispatch). Uploads and readback are
+    /// outside the timing.
     pub fn time(
         &self,
         ctx: &GpuContext,
         rays: &[Ray],
         query: Query,
         repeats: u32,
-    ) -> Result<Duration> {
+    ) -> Result<Vec<Duration>> {
         ensure!(!rays.is_empty(), "no rays to time");
         let batch = self.batch(ctx, rays)?;
         let dispatch = || -> Result<()> {
@@ -186,7 +186,7 @@ impl BvhHarness {
             times.push(start.elapsed());
         }
         times.sort();
-        Ok(times[times.len() / 2])
+        Ok(times)
     }
 
     fn run(&self, ctx: &GpuContext, rays: &[Ray], query: Query) -> Result<Vec<[u32; 4]>> {
