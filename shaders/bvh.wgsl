@@ -53,7 +53,7 @@ struct MeshHit {
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const BVH_STACK_SIZE: u32 = 64u;
-// A direction component below 2^-40 of the largest counts as zero: that
+// A direction component at most 2^-40 of the largest counts as zero: that
 // axis does not cull (conservative), and 1/d stays finite, since WGSL lets
 // compilers assume there are no infinities or NaNs (no 0 * inf).
 const SLAB_PARALLEL: f32 = 9.094947e-13;
@@ -101,7 +101,7 @@ fn mesh_ray(o: vec3f, d: vec3f) -> MeshRay {
     r.o = o;
     r.shear = mat3x3f(mesh_unit(kx) - sx * ez, mesh_unit(ky) - sy * ez, sz * ez);
     let largest = max(max(a.x, a.y), a.z);
-    let parallel = a < vec3f(SLAB_PARALLEL * largest);
+    let parallel = a <= vec3f(SLAB_PARALLEL * largest);
     r.inv = select(1.0 / select(d, vec3f(1.0), parallel), vec3f(0.0), parallel);
     r.pad = select(vec3f(0.0), vec3f(SLAB_PAD), parallel);
     r.negative = d < vec3f(0.0);

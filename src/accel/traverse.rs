@@ -18,12 +18,15 @@ pub struct MeshHit {
     pub b2: f32,
 }
 
-/// A direction component smaller than this times the largest one counts as
+/// A direction component at most this times the largest one counts as
 /// zero for the slab test, which then does not cull along that axis at all
 /// (`SLAB_PARALLEL` in bvh.wgsl). Keeps 1/d finite and bounded (|1/d| ≤
 /// 2^40 / max|d|), so no 0·∞ = NaN or ∞ ever appears, which WGSL does not
 /// promise to handle; not culling is conservative, so no hit is lost.
 pub const SLAB_PARALLEL: f32 = 1.0 / (1u64 << 40) as f32;
+// The empty box's corners times the largest 1/d of a unit direction stay
+// finite (and far from overflow) in the slab test.
+const _: () = assert!(super::bvh::EMPTY_BOX_EXTENT / SLAB_PARALLEL < 1e36);
 /// Added to either side of a parallel axis's slab interval.
 const SLAB_PAD: f32 = 1.0e30;
 /// The exit distance is stretched by this before it is compared with the
@@ -48,7 +51,7 @@ pub struct SlabRay {
 impl SlabRay {
     pub fn new(origin: Vec3, direction: Vec3) -> Self {
         let largest = direction.abs().max_element();
-        let parallel = direction.abs().cmplt(Vec3::splat(SLAB_PARALLEL * largest));
+        let parallel = direction.abs().cmple(Vec3::splat(SLAB_PARALLEL * largest));
         SlabRay {
             origin,
             inv: Vec3::select(parallel, Vec3::ZERO, direction.recip()),

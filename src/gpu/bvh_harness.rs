@@ -319,4 +319,29 @@ mod tests {
         assert_eq!(size("HarnessRay"), std::mem::size_of::<GpuRay>());
         assert_eq!(size("BvhHarness"), std::mem::size_of::<HarnessUniform>());
     }
+
+    /// The shader's constants are the CPU traversal's.
+    #[test]
+    fn the_wgsl_constants_match_the_cpu() {
+        use crate::accel::bvh::MAX_DEPTH;
+        use crate::accel::traverse::{SLAB_INFLATE, SLAB_PARALLEL};
+        use naga::{Expression, Literal};
+        let source = assemble(Program::BvhHarness, &FeatureSet::default(), "").unwrap();
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let constant = |name: &str| {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))
+                .unwrap();
+            match module.global_expressions[c.init] {
+                Expression::Literal(l) => l,
+                ref e => panic!("{name}: {e:?}"),
+            }
+        };
+        assert_eq!(constant("SLAB_INFLATE"), Literal::F32(SLAB_INFLATE));
+        assert_eq!(constant("SLAB_PARALLEL"), Literal::F32(SLAB_PARALLEL));
+        assert_eq!(constant("BVH_STACK_SIZE"), Literal::U32(MAX_DEPTH as u32));
+        assert_eq!(constant("NO_TRIANGLE"), Literal::U32(NO_TRIANGLE));
+    }
 }
