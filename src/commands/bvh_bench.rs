@@ -179,12 +179,13 @@ pub fn run(args: &BvhBenchArgs) -> Result<()> {
         let hit_count = hits.iter().filter(|h| h.is_some()).count();
         let closest = measure(&ctx, &harness, &rays, Query::Closest, args.repeats)?;
         let occluded = measure(&ctx, &harness, &rays, Query::Occluded, args.repeats)?;
-        // The CPU on one thread, on a sample, for scale.
-        let sample = &rays[..rays.len().min(100_000)];
+        // The CPU on one thread, on every k-th ray, for scale.
+        let stride = rays.len().div_ceil(100_000);
+        let sample: Vec<(usize, &Ray)> = rays.iter().enumerate().step_by(stride).collect();
         let start = Instant::now();
         let cpu_hits = sample
             .iter()
-            .filter(|r| {
+            .filter(|(_, r)| {
                 bvh.intersect(&ordered, r.origin, r.direction, r.t_max)
                     .is_some()
             })
@@ -198,7 +199,7 @@ pub fn run(args: &BvhBenchArgs) -> Result<()> {
             sample.len(),
             rate(sample.len(), cpu),
         );
-        let gpu_sample_hits = hits[..sample.len()].iter().filter(|h| h.is_some()).count();
+        let gpu_sample_hits = sample.iter().filter(|(i, _)| hits[*i].is_some()).count();
         if gpu_sample_hits != cpu_hits {
             println!(
                 "  warning: of the CPU's sample the GPU hit {gpu_sample_hits}, the CPU {cpu_hits}"
