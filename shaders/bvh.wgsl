@@ -14,8 +14,10 @@
 // node with count == 0 is interior, its children bvh_nodes[a] and
 // bvh_nodes[a + 1]. The root is bvh_nodes[0]; its box is tested first, and
 // the mesh of no triangles is one node whose box (inverted, min > max)
-// rejects every ray. Leaves are at most 63 deep, so BVH_STACK_SIZE entries
-// always suffice (accel::bvh::MAX_DEPTH).
+// rejects every ray. A root of count 0 and a 0 (that node, or a zeroed
+// placeholder buffer, whose "children" would be itself) is never walked.
+// Leaves are at most 63 deep, so BVH_STACK_SIZE entries always suffice
+// (accel::bvh::MAX_DEPTH).
 //
 // Shaped for lanes in lock step (llvmpipe runs every branch under a mask):
 // nodes and triangles are read from the storage arrays in place, the ray's
@@ -146,6 +148,13 @@ fn mesh_triangle(r: MeshRay, index: u32, t_max: f32) -> vec3f {
     return select(vec3f(NO_HIT, 0.0, 0.0), vec3f(t, v * inv_det, w * inv_det), hit);
 }
 
+// Whether the ray may meet anything at all: a non-zero direction, a root
+// that is not the empty hierarchy (count 0, a 0), and the root's box.
+fn mesh_worth_walking(r: MeshRay, d: vec3f, t_far: f32) -> bool {
+    let empty = bvh_nodes[0].count == 0u & bvh_nodes[0].a == 0u;
+    return !(empty | all(d == vec3f(0.0))) & mesh_box_entry(r, 0u, t_far) < BOX_MISS;
+}
+
 // Where the ray enters node `index`'s box (clamped to 0), or BOX_MISS when
 // it does not before t_far. Near and far planes are picked by the
 // direction's sign, not by min/max of the two distances, so an inverted
@@ -173,7 +182,7 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
     var hit = MeshHit(NO_HIT, NO_TRIANGLE, 0.0, 0.0);
     let r = mesh_ray(o, d);
     var t_far = min(t_max, NO_HIT);
-    if mesh_box_entry(r, 0u, t_far) == BOX_MISS | all(d == vec3f(0.0)) {
+    if !mesh_worth_walking(r, d, t_far) {
         return hit;
     }
     var stack: array<u32, BVH_STACK_SIZE>;
@@ -226,7 +235,7 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
 fn mesh_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
     let r = mesh_ray(o, d);
     let t_far = min(t_max, NO_HIT);
-    if mesh_box_entry(r, 0u, t_far) == BOX_MISS | all(d == vec3f(0.0)) {
+    if !mesh_worth_walking(r, d, t_far) {
         return false;
     }
     var stack: array<u32, BVH_STACK_SIZE>;

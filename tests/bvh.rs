@@ -307,6 +307,21 @@ fn degenerate_meshes_build_and_answer() {
     let empty = Mesh::new(Vec::new());
     assert_eq!(empty.bvh.nodes, vec![BvhNode::EMPTY]);
     assert!(rays.iter().all(|r| empty.cpu(r).is_none()));
+    // A zeroed node (a point box at the origin, its own child) neither.
+    let zeroed = Bvh {
+        nodes: vec![BvhNode {
+            min: [0.0; 3],
+            a: 0,
+            max: [0.0; 3],
+            count: 0,
+        }],
+        permutation: Vec::new(),
+        stats: Default::default(),
+    };
+    for r in &rays {
+        assert!(zeroed.intersect(&[], r.origin, -r.origin, T_MAX).is_none());
+        assert!(!zeroed.occluded(&[], r.origin, -r.origin, T_MAX));
+    }
     // One triangle, and many identical ones: as brute force.
     let big = [
         Vec3::new(-2.0, -1.0, 0.0),
@@ -663,15 +678,26 @@ fn gpu_traversal_of_degenerate_meshes() {
         });
     }
     let empty = Mesh::new(Vec::new());
-    let harness = empty.harness(&ctx);
-    assert!(
-        harness
-            .closest(&ctx, &rays)
-            .unwrap()
-            .iter()
-            .all(Option::is_none)
-    );
-    assert!(!harness.occluded(&ctx, &rays).unwrap().iter().any(|&o| o));
+    // Also a zeroed node, as a placeholder buffer holds: a point box at the
+    // origin whose children would be itself. Rays through the origin too.
+    let zeroed = [BvhNode {
+        min: [0.0; 3],
+        a: 0,
+        max: [0.0; 3],
+        count: 0,
+    }];
+    let mut through_origin = rays.clone();
+    through_origin.extend(rays.iter().map(|r| Ray {
+        direction: -r.origin,
+        ..*r
+    }));
+    for nodes in [&empty.bvh.nodes[..], &zeroed] {
+        let harness = BvhHarness::new(&ctx, nodes, &[]).unwrap();
+        let hits = harness.closest(&ctx, &through_origin).unwrap();
+        assert!(hits.iter().all(Option::is_none));
+        let occluded = harness.occluded(&ctx, &through_origin).unwrap();
+        assert!(!occluded.iter().any(|&o| o));
+    }
     let big = [
         Vec3::new(-2.0, -1.0, 0.0),
         Vec3::new(2.0, -1.0, 0.3),

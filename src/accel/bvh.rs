@@ -14,7 +14,10 @@
 //! The one exception is the hierarchy of no triangles: a single node with
 //! `count == 0`, `a == 0` and the empty box ([`BvhNode::EMPTY`]). Traversal
 //! tests the root's box before anything else and the empty box rejects
-//! every ray, so that node's "children" are never read.
+//! every ray, so that node's "children" are never read; both traversals
+//! also stop at a root of `count == 0` and `a == 0` outright, so a zeroed
+//! placeholder buffer (a point box whose children would be itself) cannot
+//! send them round in circles.
 //!
 //! # Build
 //!

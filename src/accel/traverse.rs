@@ -133,7 +133,9 @@ impl Bvh {
         };
         let slab = SlabRay::new(origin, direction);
         let mut t_far = t_max;
-        if slab.entry(&self.nodes[0], t_far).is_none() {
+        // The empty hierarchy (or a zeroed node) would be its own child.
+        let root = &self.nodes[0];
+        if (root.count == 0 && root.a == 0) || slab.entry(root, t_far).is_none() {
             return;
         }
         let mut stack = [0u32; MAX_DEPTH];
