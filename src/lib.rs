@@ -1,5 +1,6 @@
 //! marbre: an interactive ray tracer for procedural textures.
 
+pub mod accel;
 pub mod app;
 pub mod atomic_write;
 pub mod commands;

@@ -3,7 +3,7 @@
 //! tests rely on them.
 
 use clap::{Args, Parser, Subcommand};
-use marbre::commands::{bench, noise, render};
+use marbre::commands::{bench, bvh_bench, noise, render};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -44,6 +44,8 @@ enum Command {
     Noise(noise::NoiseArgs),
     /// Time every shipped preset at several resolutions.
     Bench(bench::BenchArgs),
+    /// Build the BVH of a heavy generated mesh and time its GPU traversal.
+    BenchBvh(bvh_bench::BvhBenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Noise(args)) => noise::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::BenchBvh(args)) => bvh_bench::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {
             preset: cli.viewer.preset,
             env: cli.viewer.env,

@@ -280,8 +280,10 @@ pub fn convert_material(m: &tobj::Material, folder: &Path) -> (Material, Vec<Str
         mirror: Texture::scalar(0.0),
         opacity: Texture::scalar(opacity),
         transmission: Texture::color(transmission.clamp(Vec3::ZERO, Vec3::ONE)),
-        emission: Texture::color(ke.max(Vec3::ZERO)),
-        emission_strength: 1.0,
+        // Colours stay within [0, 1] (the panel's colour editor): the
+        // emission's brightness goes into its strength.
+        emission: Texture::color(ke.max(Vec3::ZERO) / ke.max_element().max(1.0)),
+        emission_strength: ke.max_element().max(1.0),
         ..Material::default()
     };
     if let Some(file) = &m.diffuse_texture {

@@ -2,6 +2,7 @@
 
 pub mod aa_scenes;
 pub mod bench;
+pub mod bvh_bench;
 pub mod noise;
 pub mod render;
 pub mod session;

@@ -43,10 +43,11 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 31] = [
+    pub const ALL: [Feature; 32] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
+        Feature::Mesh,
         Feature::PointLight,
         Feature::AreaLight,
         Feature::EnvMap,

@@ -6,19 +6,13 @@
 //! The BVH is rebuilt only when the geometry or its placement changes; the
 //! light table at every edit, since an emission edit changes the powers.
 
+use crate::accel::{Bvh, TriangleVerts};
 use crate::lights::{EmitterTriangle, LightGpu, LightTable};
 use crate::scene::{MeshPlacement, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use wgpu::util::DeviceExt;
-
-/// `TriangleVerts` of `shaders/bvh.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct TriangleVertsGpu {
-    pub v: [[f32; 4]; 3],
-}
 
 /// `TriangleAttributes` of `shaders/scene.wgsl`.
 #[repr(C)]
@@ -134,33 +128,25 @@ impl MeshBuffers {
                 });
             }
         }
-        let start = Instant::now();
-        let (nodes, order) = build_bvh(&positions);
-        let took = start.elapsed();
-        let ordered: Vec<usize> = order.iter().map(|&i| i as usize).collect();
-        let verts: Vec<TriangleVertsGpu> = ordered
-            .iter()
-            .map(|&i| TriangleVertsGpu {
-                v: positions[i].map(|p| p.extend(0.0).to_array()),
-            })
-            .collect();
-        let attributes: Vec<TriangleAttributesGpu> =
-            ordered.iter().map(|&i| attributes[i]).collect();
-        self.emitters = ordered
+        let bvh = Bvh::build(&positions);
+        let positions = bvh.reorder(&positions);
+        let attributes = bvh.reorder(&attributes);
+        let verts: Vec<TriangleVerts> = positions.iter().map(TriangleVerts::new).collect();
+        self.emitters = positions
             .iter()
             .zip(&attributes)
-            .map(|(&i, a)| EmitterTriangle {
-                vertices: positions[i],
+            .map(|(&vertices, a)| EmitterTriangle {
+                vertices,
                 material: a.material,
             })
             .collect();
-        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&nodes));
+        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&bvh.nodes));
         self.triangles = storage_buffer(device, "mesh triangles", bytemuck::cast_slice(&verts));
         self.attributes =
             storage_buffer(device, "mesh attributes", bytemuck::cast_slice(&attributes));
         self.stats.triangles = verts.len();
-        self.stats.bvh_nodes = nodes.len();
-        self.stats.bvh_build = took;
+        self.stats.bvh_nodes = bvh.nodes.len();
+        self.stats.bvh_build = bvh.stats.build_time;
     }
 
     fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {
@@ -199,25 +185,4 @@ impl MeshBuffers {
 
     /// The bindings [`MeshBuffers::entries`] fills.
     pub const BINDINGS: [u32; 4] = [12, 13, 14, 15];
-}
-
-/// One leaf holding every triangle (replaced by the SAH build).
-fn build_bvh(positions: &[[Vec3; 3]]) -> (Vec<[u32; 8]>, Vec<u32>) {
-    let (lo, hi) = positions
-        .iter()
-        .flatten()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    let node = [
-        lo.x.to_bits(),
-        lo.y.to_bits(),
-        lo.z.to_bits(),
-        0,
-        hi.x.to_bits(),
-        hi.y.to_bits(),
-        hi.z.to_bits(),
-        positions.len() as u32,
-    ];
-    (vec![node], (0..positions.len() as u32).collect())
 }

@@ -3,6 +3,7 @@
 //! compute harness.
 
 pub mod auto_exposure;
+pub mod bvh_harness;
 pub mod compute_harness;
 pub mod context;
 pub mod features;

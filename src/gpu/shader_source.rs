@@ -74,6 +74,11 @@ const SOURCES: &[(&str, &str)] = &[
     ),
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
+    (
+        "bvh_harness.wgsl",
+        include_str!("../../shaders/bvh_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,15 +93,18 @@ pub enum Program {
     NoiseHarness,
     /// The compute pass that evaluates the texture library's patterns.
     TextureHarness,
+    /// The compute pass that sends rays through a triangle mesh's BVH.
+    BvhHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 5] = [
+    pub const ALL: [Program; 6] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
         Program::NoiseHarness,
         Program::TextureHarness,
+        Program::BvhHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -124,8 +132,11 @@ impl Program {
                 if features.contains(Feature::Image) {
                     out.push("texture_image.wgsl");
                 }
+                out.push("textures.wgsl");
+                if features.contains(Feature::Mesh) {
+                    out.push("bvh.wgsl");
+                }
                 out.extend([
-                    "textures.wgsl",
                     "intersect.wgsl",
                     "random.wgsl",
                     "bsdf.wgsl",
@@ -159,6 +170,7 @@ impl Program {
                     "texture_harness.wgsl",
                 ]);
             }
+            Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
         }
         out
     }
