@@ -59,6 +59,9 @@ fn resolved(mut p: Preset) -> Preset {
             }
         });
     }
+    for mesh in &mut p.scene.meshes {
+        mesh.obj = existing_file(&mesh.obj);
+    }
     p
 }
 
@@ -133,8 +136,8 @@ fn every_shipped_preset_loads_without_notes() {
             path.display()
         );
         assert!(
-            !p.scene.spheres.is_empty(),
-            "{}: no spheres",
+            !p.scene.spheres.is_empty() || !p.scene.meshes.is_empty(),
+            "{}: neither spheres nor meshes",
             path.display()
         );
         // The environment map it names exists (load_scene would fail otherwise).
