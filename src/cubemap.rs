@@ -377,11 +377,7 @@ impl CubeMap {
         let at = |i: usize, j: usize| texels[j * side + i];
         let (a, b) = (at(x0, y0), at(x0 + 1, y0));
         let (c, e) = (at(x0, y0 + 1), at(x0 + 1, y0 + 1));
-        std::array::from_fn(|k| {
-            let top = a[k] + (b[k] - a[k]) * fx;
-            let bottom = c[k] + (e[k] - c[k]) * fx;
-            top + (bottom - top) * fy
-        })
+        bilinear([a, b, c, e], fx, fy)
     }
 
     /// Resamples a lat-long map into a cube of `size` × `size` faces: each
@@ -581,6 +577,16 @@ pub fn load_source(source: &EnvSource) -> Result<Option<EnvLoad>, CubeMapError> 
     Ok(Some(EnvLoad { image, notes }))
 }
 
+/// The bilinear blend of four texels (top left, top right, bottom left,
+/// bottom right) at fractions `fx` across and `fy` down.
+pub fn bilinear([a, b, c, e]: [[f32; 3]; 4], fx: f32, fy: f32) -> [f32; 3] {
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * fx;
+        let bottom = c[k] + (e[k] - c[k]) * fx;
+        top + (bottom - top) * fy
+    })
+}
+
 /// The lat-long image's bilinear value towards `d` (any length), as the GPU
 /// reads it: texel uv `(u, 1 - v)`, repeating in u, clamped in v.
 fn latlong_bilinear(image: &EnvImage, d: Vec3) -> [f32; 3] {
@@ -599,11 +605,7 @@ fn latlong_bilinear(image: &EnvImage, d: Vec3) -> [f32; 3] {
         at(x0, y0 + 1),
         at(x0 + 1, y0 + 1),
     );
-    std::array::from_fn(|k| {
-        let top = a[k] + (b[k] - a[k]) * fx;
-        let bottom = c[k] + (e[k] - c[k]) * fx;
-        top + (bottom - top) * fy
-    })
+    bilinear([a, b, c, e].map(|t| [t[0], t[1], t[2]]), fx, fy)
 }
 
 /// The mean of `f` at the four points (0.25 | 0.75, 0.25 | 0.75) of a unit

@@ -312,11 +312,7 @@ fn naive_clamped_sample(cube: &CubeMap, d: Vec3) -> [f32; 3] {
         at(x0, y0 + 1),
         at(x0 + 1, y0 + 1),
     );
-    std::array::from_fn(|k| {
-        let top = a[k] + (b[k] - a[k]) * fx;
-        let bottom = c[k] + (e[k] - c[k]) * fx;
-        top + (bottom - top) * fy
-    })
+    cubemap::bilinear([a, b, c, e], fx, fy)
 }
 
 /// Faces of distinct constant colours, each with a smooth gradient.

@@ -236,6 +236,22 @@ fn every_selection_rule_and_strategy_agrees_in_mean() {
     }
 }
 
+/// The RMSE of direct light sampling at 16 spp, choosing lights uniformly
+/// and by power, against a 2048-spp reference. The reference combines
+/// strategies, so its samples are not the ones measured (the same seeds
+/// would correlate them).
+fn selection_errors(ctx: &GpuContext, mut scene: Scene, size: (u32, u32)) -> (f64, f64) {
+    scene.render.transport.integrator = Integrator::Direct;
+    scene.render.transport.strategy = Strategy::MisBalance;
+    let reference = render_spp(ctx, &scene, size, 2048);
+    scene.render.transport.strategy = Strategy::Light;
+    let mut error = |selection| {
+        scene.render.transport.light_selection = selection;
+        rmse(&render_spp(ctx, &scene, size, 16), &reference)
+    };
+    (error(LightSelection::Uniform), error(LightSelection::Power))
+}
+
 /// Two sphere lights of equal power, one small and bright, one large and
 /// dim, and many dim spheres: choosing lights by power puts the samples
 /// where the light is, so at equal samples it has the lower error.
@@ -265,21 +281,7 @@ fn choosing_lights_by_power_beats_uniform_choice() {
             ..Sphere::default()
         });
     }
-    scene.render.transport.integrator = Integrator::Direct;
-    scene.render.transport.strategy = Strategy::Light;
-    let size = (32, 24);
-    // The reference combines strategies, so its samples are not the ones
-    // measured (the same seeds would correlate them).
-    let mut reference_scene = scene.clone();
-    reference_scene.render.transport.strategy = Strategy::MisBalance;
-    let reference = render_spp(&ctx, &reference_scene, size, 2048);
-    let mut errors = Vec::new();
-    for selection in LightSelection::ALL {
-        scene.render.transport.light_selection = selection;
-        let pixels = render_spp(&ctx, &scene, size, 16);
-        errors.push(rmse(&pixels, &reference));
-    }
-    let (uniform, power) = (errors[0], errors[1]);
+    let (uniform, power) = selection_errors(&ctx, scene, (32, 24));
     assert!(
         power < 0.8 * uniform,
         "RMSE by power {power}, uniform {uniform}"
@@ -521,22 +523,10 @@ fn on_two_panels_choosing_by_power_beats_uniform() {
         return;
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut scene =
-        marbre::commands::session::load_scene(&root.join("presets/two_panels.ron"), None)
-            .unwrap()
-            .scene;
-    scene.render.transport.integrator = Integrator::Direct;
-    scene.render.transport.strategy = Strategy::Light;
-    let size = (40, 30);
-    let mut reference_scene = scene.clone();
-    reference_scene.render.transport.strategy = Strategy::MisBalance;
-    let reference = render_spp(&ctx, &reference_scene, size, 2048);
-    let mut errors = Vec::new();
-    for selection in LightSelection::ALL {
-        scene.render.transport.light_selection = selection;
-        errors.push(rmse(&render_spp(&ctx, &scene, size, 16), &reference));
-    }
-    let (uniform, power) = (errors[0], errors[1]);
+    let scene = marbre::commands::session::load_scene(&root.join("presets/two_panels.ron"), None)
+        .unwrap()
+        .scene;
+    let (uniform, power) = selection_errors(&ctx, scene, (40, 30));
     eprintln!("two-panels, 16 spp: RMSE uniform {uniform:.5}, by power {power:.5}");
     assert!(
         power < 0.7 * uniform,

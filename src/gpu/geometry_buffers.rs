@@ -62,12 +62,7 @@ impl GeometryBuffers {
     /// The trace bind group's entries for these buffers (bindings 1, 2, 9
     /// and 10 of `shaders/scene.wgsl`).
     pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
+        use super::pipelines::buffer_entry as entry;
         [
             entry(1, &self.spheres),
             entry(2, &self.materials),

@@ -169,12 +169,7 @@ impl MeshBuffers {
 
     /// The trace bind group's entries (bindings 12 to 15).
     pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
+        use super::pipelines::buffer_entry as entry;
         [
             entry(12, &self.nodes),
             entry(13, &self.triangles),
