@@ -12,6 +12,7 @@ pub mod image_io;
 pub mod lights;
 pub mod noise;
 pub mod obj_loader;
+pub mod obj_syntax;
 pub mod panel;
 pub mod preset;
 pub mod scene;

@@ -8,6 +8,7 @@
 //! paths are relative to the .mtl file; a missing one keeps the magenta
 //! placeholder of image textures and a note naming it.
 
+use crate::obj_syntax;
 use crate::scene::mesh::{Geometry, MeshMaterial, TriangleMesh};
 use crate::scene::{Material, Pattern, Scene, Texture};
 use crate::texture::{ColorSpace, ImageSource};
@@ -23,11 +24,19 @@ pub enum ObjError {
         path: PathBuf,
         cause: std::io::Error,
     },
+    #[error("{path}:{line}: not a valid OBJ statement: `{statement}`")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        statement: String,
+    },
     #[error("{path}: not a valid OBJ file: {cause}")]
     Parse {
         path: PathBuf,
         cause: tobj::LoadError,
     },
+    #[error("{path}: the OBJ reader failed on this file (a malformed statement it does not check)")]
+    Crashed { path: PathBuf },
     #[error("{path}: no triangle left to draw ({reason})")]
     Empty { path: PathBuf, reason: String },
 }
@@ -45,31 +54,68 @@ pub struct LoadedObj {
 const DEFAULT_MATERIAL: &str = "(default)";
 
 pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
-    // tobj reports a missing file as a bare "open file failed"; a read here
-    // first gives the OS's reason.
-    std::fs::metadata(path).map_err(|cause| ObjError::Read {
+    let bytes = std::fs::read(path).map_err(|cause| ObjError::Read {
         path: path.to_owned(),
         cause,
     })?;
+    let text = String::from_utf8_lossy(&bytes);
+    // tobj says what is wrong but not where, and panics on some malformed
+    // statements: the syntax check runs first and names the line.
+    if let Some((line, statement)) = obj_syntax::first_bad_obj_line(&text) {
+        return Err(ObjError::Syntax {
+            path: path.to_owned(),
+            line,
+            statement,
+        });
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|cause| ObjError::Parse {
+    let mtl_folder = path.parent().unwrap_or(Path::new("."));
+    // Why the library failed, where tobj's error alone would not say.
+    let library_problem = std::cell::RefCell::new(None);
+    let load_library = |name: &Path| {
+        let mtl = mtl_folder.join(name);
+        let text = match std::fs::read(&mtl) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) => {
+                *library_problem.borrow_mut() = Some(format!(
+                    "its material library {} cannot be read: {e}",
+                    mtl.display()
+                ));
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
+        if let Some((line, statement)) = obj_syntax::first_bad_mtl_line(&text) {
+            *library_problem.borrow_mut() = Some(format!(
+                "its material library {}:{line} cannot be read: `{statement}`",
+                mtl.display()
+            ));
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl_buf(&mut text.as_bytes())
+    };
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &options, load_library)
+    }))
+    .map_err(|_| ObjError::Crashed {
+        path: path.to_owned(),
+    })?;
+    let (models, materials) = parsed.map_err(|cause| ObjError::Parse {
         path: path.to_owned(),
         cause,
     })?;
     let mut notes = Vec::new();
-    let mtl_folder = path.parent().unwrap_or(Path::new("."));
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
-            notes.push(format!(
-                "{}: its material library could not be read ({e}); grey is used instead",
-                path.display()
-            ));
+            let why = library_problem
+                .into_inner()
+                .unwrap_or_else(|| format!("its material library cannot be read ({e})"));
+            notes.push(format!("{}: {why}; grey is used instead", path.display()));
             Vec::new()
         }
     };
@@ -459,13 +505,17 @@ mod tests {
         );
         let out_of_range = write(&dir, "range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n");
         let e = load(&out_of_range).unwrap_err().to_string();
-        assert!(
-            e.contains("range.obj") && e.contains("out of bounds"),
-            "{e}"
-        );
-        let garbage = write(&dir, "garbage.obj", "v 0 zero 0\nf 1 1 1\n");
+        assert!(e.contains("range.obj:3") && e.contains("`f 1 2 9`"), "{e}");
+        let garbage = write(&dir, "garbage.obj", "v 0 0 0\nv 0 zero 0\nf 1 1 1\n");
         let e = load(&garbage).unwrap_err().to_string();
-        assert!(e.contains("garbage.obj"), "{e}");
+        assert!(e.contains("garbage.obj:2"), "{e}");
+        // Truncated mid-statement: the face lost its last corners.
+        let cornell = std::fs::read_to_string(CORNELL).unwrap();
+        let cut = cornell.rfind("\nf ").unwrap() + 6;
+        let truncated = write(&dir, "truncated.obj", &cornell[..cut]);
+        let e = load(&truncated).unwrap_err().to_string();
+        let last_line = cornell[..cut].lines().count();
+        assert!(e.contains(&format!("truncated.obj:{last_line}:")), "{e}");
         let no_faces = write(&dir, "empty.obj", "v 0 0 0\n");
         let e = load(&no_faces).unwrap_err().to_string();
         assert!(e.contains("empty.obj") && e.contains("no faces"), "{e}");
@@ -492,7 +542,26 @@ mod tests {
             loaded.notes
         );
         assert!(
-            loaded.notes.iter().any(|n| n.contains("material library")),
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("nowhere.mtl") && n.contains("cannot be read")),
+            "{:?}",
+            loaded.notes
+        );
+        // A broken library: its file and line are named, grey is used.
+        write(&dir, "broken.mtl", "newmtl a\nKd 1 1\n");
+        let obj = write(
+            &dir,
+            "b.obj",
+            &format!("mtllib broken.mtl\n{QUAD}usemtl a\nf 1 2 3\n"),
+        );
+        let loaded = load(&obj).unwrap();
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("broken.mtl:2") && n.contains("`Kd 1 1`")),
             "{:?}",
             loaded.notes
         );
