@@ -3,7 +3,7 @@
 //! tests rely on them.
 
 use clap::{Args, Parser, Subcommand};
-use marbre::commands::{bench, bvh_bench, noise, render};
+use marbre::commands::{bench, bvh_bench, convergence_bench, noise, render};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,6 +46,9 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Build the BVH of a heavy generated mesh and time its GPU traversal.
     BenchBvh(bvh_bench::BvhBenchArgs),
+    /// Time and error at increasing samples per pixel against a cached
+    /// high-spp reference (default: the Cornell box at 512x512).
+    BenchConvergence(convergence_bench::ConvergenceBenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Some(Command::Noise(args)) => noise::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),
+        Some(Command::BenchConvergence(args)) => convergence_bench::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {
             preset: cli.viewer.preset,
             env: cli.viewer.env,

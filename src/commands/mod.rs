@@ -3,6 +3,7 @@
 pub mod aa_scenes;
 pub mod bench;
 pub mod bvh_bench;
+pub mod convergence_bench;
 pub mod noise;
 pub mod render;
 pub mod session;

@@ -179,6 +179,15 @@ impl Program {
 /// The WGSL text of `program` specialised for `features`. The trace program
 /// also takes the scene's generated texture code
 /// ([`super::texture_codegen::generate`]); the others ignore it.
+/// A hash of every WGSL source: results cached on disk (benchmark
+/// references) are keyed by it, so a shader change invalidates them.
+pub fn sources_fingerprint() -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    SOURCES.hash(&mut hasher);
+    hasher.finish()
+}
+
 pub fn assemble(
     program: Program,
     features: &FeatureSet,

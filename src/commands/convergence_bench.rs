@@ -1,0 +1,136 @@
+//! `marbre bench-convergence`: what accuracy costs in time on one preset.
+//! It renders a high-spp reference (cached on disk), then the preset at
+//! increasing samples per pixel, and reports samples per second and the
+//! time to reach each error, so renderers and settings can be compared at
+//! equal error rather than equal samples.
+
+use super::render::parse_size;
+use super::session::{accumulate, load_scene, renderer_for};
+use crate::gpu::GpuContext;
+use crate::image_io;
+use anyhow::{Context, Result};
+use clap::Args;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct ConvergenceBenchArgs {
+    /// The preset to measure.
+    #[arg(long, default_value = "presets/cornell.ron")]
+    pub preset: PathBuf,
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Samples per pixel of the reference.
+    #[arg(long, default_value_t = 4096)]
+    pub reference_spp: u32,
+    /// Sample counts measured, each a fresh render.
+    #[arg(long, value_delimiter = ',', default_value = "1,4,16,64,256")]
+    pub spp: Vec<u32>,
+    /// Where references are kept between runs.
+    #[arg(long, default_value = "target/marbre-references")]
+    pub cache: PathBuf,
+}
+
+/// Root-mean-square error over every pixel and colour channel.
+pub fn rmse(image: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
+    let sum: f64 = image
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (0..3).map(|c| f64::from(a[c] - b[c]).powi(2)).sum::<f64>())
+        .sum();
+    (sum / (3 * image.len().max(1)) as f64).sqrt()
+}
+
+/// The reference's file: keyed by the preset's text, its meshes' files,
+/// the size, the sample count and this build, so a change to any of them
+/// renders a new one.
+fn reference_path(args: &ConvergenceBenchArgs) -> Result<PathBuf> {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    std::fs::read(&args.preset)
+        .with_context(|| format!("reading {}", args.preset.display()))?
+        .hash(&mut hasher);
+    (args.size, args.reference_spp, env!("CARGO_PKG_VERSION")).hash(&mut hasher);
+    crate::gpu::shader_source::sources_fingerprint().hash(&mut hasher);
+    Ok(args
+        .cache
+        .join(format!("reference-{:016x}.exr", hasher.finish())))
+}
+
+fn render(
+    ctx: &GpuContext,
+    preset: &Path,
+    size: (u32, u32),
+    spp: u32,
+) -> Result<(Vec<[f32; 4]>, f64)> {
+    let loaded = load_scene(preset, None)?;
+    let mut renderer = renderer_for(ctx, &loaded, size)?;
+    // One warm-up frame compiles the shader; it is not timed.
+    accumulate(ctx, &mut renderer, 1, |_| {})?;
+    renderer.reset_accumulation();
+    let start = Instant::now();
+    accumulate(ctx, &mut renderer, spp, |_| {})?;
+    let seconds = start.elapsed().as_secs_f64();
+    let (_, _, pixels) = renderer.read_radiance(ctx)?;
+    Ok((pixels, seconds))
+}
+
+pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
+    let ctx = GpuContext::headless()?;
+    let info = ctx.adapter.get_info();
+    let (w, h) = args.size;
+    println!("adapter: {} ({:?})", info.name, info.backend);
+    println!(
+        "{}: {w}x{h}, reference {} spp",
+        args.preset.display(),
+        args.reference_spp
+    );
+    let cached = reference_path(args)?;
+    // A cached reference of the wrong size (a hash collision) is re-rendered.
+    let cached_pixels = crate::envmap::load(&cached)
+        .ok()
+        .filter(|l| (l.image.width, l.image.height) == args.size)
+        .map(|l| l.image.pixels);
+    let reference = match cached_pixels {
+        Some(pixels) => {
+            println!("reference: {} (cached)", cached.display());
+            pixels
+        }
+        None => {
+            let (pixels, seconds) = render(&ctx, &args.preset, args.size, args.reference_spp)?;
+            std::fs::create_dir_all(&args.cache)?;
+            image_io::save_exr(w, h, &pixels, &cached)?;
+            println!(
+                "reference: rendered in {seconds:.1} s, saved to {}",
+                cached.display()
+            );
+            pixels
+        }
+    };
+    println!("| spp | seconds | samples/s | RMSE | RMSE × √seconds |");
+    println!("|---|---|---|---|---|");
+    let mut points = Vec::new();
+    for &spp in &args.spp {
+        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp)?;
+        let error = rmse(&pixels, &reference);
+        let samples = f64::from(w * h) * f64::from(spp) / seconds;
+        println!(
+            "| {spp} | {seconds:.2} | {:.3} M | {error:.5} | {:.5} |",
+            samples / 1e6,
+            error * seconds.sqrt()
+        );
+        points.push((seconds, error));
+    }
+    // Monte Carlo error falls as 1/√time: RMSE·√t is the constant that
+    // predicts the time to any error, t(E) = (RMSE·√t / E)².
+    if let Some(&(seconds, error)) = points.last() {
+        let efficiency = error * seconds.sqrt();
+        for target in [0.05, 0.02, 0.01] {
+            println!(
+                "time to RMSE {target}: {:.1} s (from the last row)",
+                (efficiency / target).powi(2)
+            );
+        }
+    }
+    Ok(())
+}
