@@ -81,9 +81,18 @@ fn sample_light(x: vec3f) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
     out.delta = false;
+#if AREA_LIGHT
     let index = choose_light(rand());
     let pmf = light_pmf(index);
     let light = lights[index];
+#else
+    // The point light is the only light: no table to read. The choice's
+    // random number is still drawn, so the sequence matches a shader that
+    // reads the table.
+    _ = rand();
+    let pmf = 1.0;
+    let light = Light(0u, 0u, 1.0, 1.0);
+#endif
     let u1 = rand();
     let u2 = rand();
 #if POINT_LIGHT
