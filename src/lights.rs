@@ -286,15 +286,14 @@ mod tests {
                 material: 0,
             })
             .collect();
+        // Material 0, the sphere's, is the triangles' too.
         let scene = Scene {
             spheres: vec![Sphere {
-                material: emitter(0.0),
+                material: emitter(2.0),
                 ..Sphere::default()
             }],
             ..Scene::default()
         };
-        let mut scene = scene;
-        scene.spheres[0].material = emitter(2.0);
         let table = LightTable::build(&scene, &triangles);
         assert_eq!(table.lights.len(), 6);
         for selection in LightSelection::ALL {
