@@ -4,7 +4,8 @@
 //! emissive triangles by their place in that order.
 //!
 //! The BVH is rebuilt only when the geometry or its placement changes; the
-//! light table at every edit, since an emission edit changes the powers.
+//! light table when the geometry, a material, a sphere's size or the point
+//! light changes (an emission edit changes the powers).
 
 use crate::accel::{Bvh, TriangleVerts};
 use crate::lights::{EmitterTriangle, LightGpu, LightTable};
@@ -68,7 +69,29 @@ pub struct MeshBuffers {
     /// The triangles in BVH order, as the light table reads them.
     emitters: Vec<EmitterTriangle>,
     table: LightTable,
+    /// What the light table was built from (with the geometry): a camera
+    /// move or a texture edit away from emitters leaves it as it is,
+    /// without walking a million triangles again.
+    light_key: Option<LightKey>,
     stats: MeshStats,
+}
+
+/// Everything besides the triangles that the light table reads.
+#[derive(Debug, Clone, PartialEq)]
+struct LightKey {
+    point_light: Option<crate::scene::PointLight>,
+    sphere_radii: Vec<f32>,
+    materials: Vec<crate::scene::Material>,
+}
+
+impl LightKey {
+    fn of(scene: &Scene) -> Self {
+        Self {
+            point_light: scene.point_light.clone(),
+            sphere_radii: scene.spheres.iter().map(|s| s.radius).collect(),
+            materials: scene.materials().cloned().collect(),
+        }
+    }
 }
 
 fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
@@ -95,6 +118,7 @@ impl MeshBuffers {
             lights: storage_buffer(device, "lights", &[]),
             emitters: Vec::new(),
             table: LightTable::default(),
+            light_key: None,
             stats: MeshStats::default(),
         };
         out.rebuild_geometry(device, scene);
@@ -103,10 +127,11 @@ impl MeshBuffers {
     }
 
     /// Brings the buffers up to `scene`: the BVH if its geometry moved, the
-    /// light table always.
+    /// light table if the geometry or anything else it reads changed.
     pub fn update(&mut self, device: &wgpu::Device, scene: &Scene) {
         if GeometryKey::of(scene) != self.key {
             self.rebuild_geometry(device, scene);
+            self.light_key = None;
         }
         self.rebuild_lights(device, scene);
     }
@@ -150,6 +175,11 @@ impl MeshBuffers {
     }
 
     fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {
+        let key = LightKey::of(scene);
+        if self.light_key.as_ref() == Some(&key) {
+            return;
+        }
+        self.light_key = Some(key);
         let table = LightTable::build(scene, &self.emitters);
         if table != self.table {
             let entries: Vec<LightGpu> = table.lights.clone();
