@@ -1,23 +1,14 @@
 // Auto exposure (Reinhard et al. 2002, "Photographic tone reproduction"):
 // the log-average luminance L_avg = exp(mean(log(DELTA + L))) of the
 // accumulated radiance, and the exposure that maps it to the middle grey
-// KEY. One workgroup meters a grid of at most GRID × GRID texels spread over
-// the traced region and reduces it in workgroup memory; the result stays in
-// a buffer the display pass reads (`Metered` in tonemap.wgsl mirrors it).
+// KEY. One workgroup meters a grid of texels (metering_grid.wgsl) and
+// reduces it in workgroup memory; the result stays in a buffer the display
+// pass reads (`Metered` in tonemap.wgsl mirrors it).
 // CPU twin: src/gpu/auto_exposure.rs.
 
-const GRID: u32 = 256u;
-const WORKGROUP: u32 = 256u;
 const DELTA: f32 = 1e-4;
 const KEY: f32 = 0.18;
 const MAX_STOPS: f32 = 20.0;
-
-struct Metering {
-    // The traced region of the accumulation texture, in texels.
-    region: vec2u,
-    // Texels metered along each axis: min(region, GRID).
-    grid: vec2u,
-}
 
 struct Metered {
     log_average: f32,
@@ -26,19 +17,12 @@ struct Metered {
     count: u32,
 }
 
-@group(0) @binding(0) var<uniform> metering: Metering;
+@group(0) @binding(0) var<uniform> metering: MeteringGrid;
 @group(0) @binding(1) var radiance: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read_write> metered: Metered;
 
 var<workgroup> sums: array<f32, WORKGROUP>;
 var<workgroup> counts: array<u32, WORKGROUP>;
-
-// The texel under the centre of grid cell `i` of `grid` cells spanning
-// `size` texels: floor((i + 0.5) * size / grid), in integers. With
-// grid == size it is i: every texel.
-fn grid_texel(i: u32, grid: u32, size: u32) -> u32 {
-    return ((2u * i + 1u) * size) / (2u * grid);
-}
 
 @compute @workgroup_size(256)
 fn cs_meter(@builtin(local_invocation_index) t: u32) {
@@ -47,12 +31,7 @@ fn cs_meter(@builtin(local_invocation_index) t: u32) {
     var sum = 0.0;
     var count = 0u;
     for (var k = t; k < n; k += WORKGROUP) {
-        let cell = vec2u(k % grid.x, k / grid.x);
-        let texel = vec2u(
-            grid_texel(cell.x, grid.x, metering.region.x),
-            grid_texel(cell.y, grid.y, metering.region.y),
-        );
-        let c = textureLoad(radiance, texel, 0).rgb;
+        let c = textureLoad(radiance, grid_cell_texel(k, metering), 0).rgb;
         // NaN, ±Inf and negative texels (and a luminance that overflows) are
         // left out rather than poisoning the mean.
         let l = luminance(c);

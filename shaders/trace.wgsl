@@ -1,8 +1,18 @@
 // The per-frame trace pass: a full-screen triangle whose fragment shader
 // traces `samples_per_frame` jittered paths per pixel and folds them into the
-// running mean held in the accumulation target.
+// running mean held in the accumulation target, and folds the spread of the
+// frames' means into the second-moment target (what the error meter,
+// shaders/error_meter.wgsl, estimates the image's error from).
 
 @group(0) @binding(5) var previous: texture_2d<f32>;
+@group(0) @binding(16) var previous_spread: texture_2d<f32>;
+
+// What one frame leaves per pixel: the running mean of every sample so far,
+// and the running weighted second moment about it (Welford's update).
+struct Accumulated {
+    @location(0) mean: vec4f,
+    @location(1) spread: vec4f,
+}
 
 fn camera_ray(pixel: vec2f) -> vec3f {
     let ndc = vec2f(pixel.x / frame.render_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.render_size.y * 2.0);
@@ -234,7 +244,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
 }
 
 @fragment
-fn fs_trace(@builtin(position) position: vec4f) -> @location(0) vec4f {
+fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
     let pixel = vec2u(position.xy);
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);
@@ -247,10 +257,21 @@ fn fs_trace(@builtin(position) position: vec4f) -> @location(0) vec4f {
             sum += l;
         }
     }
-    let mean = sum / f32(spp);
+    let x = sum / f32(spp);
     let n = f32(frame.accumulated);
-    let prev = textureLoad(previous, pixel, 0).xyz;
+    // The first frame ignores what the targets held before (a resize or a
+    // reset leaves stale texels, which must not leak in, even as NaN * 0).
+    let first = frame.accumulated == 0u;
+    let prev = select(textureLoad(previous, pixel, 0).xyz, vec3f(0.0), first);
+    let prev_spread = select(textureLoad(previous_spread, pixel, 0).xyz, vec3f(0.0), first);
     // A running mean: its rounding error does not grow with the frame count.
-    let blended = prev + (mean - prev) * (f32(spp) / (n + f32(spp)));
-    return vec4f(blended, 1.0);
+    let w = f32(spp) / (n + f32(spp));
+    let mean = prev + (x - prev) * w;
+    // Weighted Welford (West 1979), kept divided by the weight like the
+    // mean: spread = Σ spp_i (x_i - mean)² / Σ spp_i over the frames' means
+    // x_i. With F frames of equal spp, E[spread] = (F - 1)/F · σ²/spp, so the
+    // variance of the pixel's mean is estimated by spread / (F - 1)
+    // (gpu::error_meter).
+    let spread = prev_spread + ((x - prev) * (x - mean) - prev_spread) * w;
+    return Accumulated(vec4f(mean, 1.0), vec4f(spread, 1.0));
 }

@@ -7,8 +7,9 @@ use common::*;
 use glam::Vec3;
 use marbre::commands::session::accumulate;
 use marbre::gpu::auto_exposure::{
-    AutoExposure, DELTA, KEY, exposure_stops, grid_pixels, log_average_luminance, meter,
+    AutoExposure, DELTA, KEY, exposure_stops, log_average_luminance, meter,
 };
+use marbre::gpu::metering_grid::grid_pixels;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere, ToneMap};
@@ -206,6 +207,7 @@ fn metering_skips_non_finite_and_negative_texels() {
             &mut encoder,
             &texture.create_view(&Default::default()),
             region,
+            None,
         );
         ctx.queue.submit([encoder.finish()]);
         metering.read(&ctx).unwrap()

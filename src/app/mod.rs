@@ -6,6 +6,8 @@
 //! changes) → trace pass → display pass → egui pass → present.
 
 mod camera_input;
+mod convergence;
+mod feature_costs;
 mod screenshots;
 mod viewer;
 

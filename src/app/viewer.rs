@@ -1,11 +1,15 @@
 //! One window's state: surface, renderer, egui, the scene being edited.
 
+use super::convergence::Convergence;
+use super::feature_costs::FeatureCosts;
 use super::{ViewerOptions, camera_input, screenshots};
 use crate::commands::session::{load_images, load_scene, preset_or_default, renderer_for};
 use crate::cubemap;
 use crate::envmap;
-use crate::gpu::{GpuContext, Renderer, Viewport, pass_timer::PassTimer, readback::read_texture};
-use crate::panel::{self, PanelAction, PanelState, Stats};
+use crate::gpu::pass_timer::{Pass, PassTimer};
+use crate::gpu::readback::read_texture;
+use crate::gpu::{DisplayTarget, FeatureSet, GpuContext, Renderer, Viewport};
+use crate::panel::{self, PanelAction, PanelState, QualityStats, Stats};
 use crate::preset::{self, Preset};
 use crate::scene::{EnvSource, OrbitCamera, Scene};
 use crate::texture::ImageSet;
@@ -26,8 +30,12 @@ pub struct Viewer {
     config: wgpu::SurfaceConfiguration,
     ctx: GpuContext,
     renderer: Renderer,
-    /// GPU time of the trace pass, where the adapter has timestamp queries.
+    /// GPU time of each pass, where the adapter has timestamp queries.
     timer: Option<PassTimer>,
+    /// The error estimates since the last change, for the Quality panel.
+    convergence: Convergence,
+    /// Trace times with shader features compiled out, for the Quality panel.
+    feature_costs: FeatureCosts,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
@@ -104,6 +112,8 @@ impl Viewer {
         let preset_camera = loaded.scene.camera;
         Ok(Self {
             timer,
+            convergence: Convergence::default(),
+            feature_costs: FeatureCosts::default(),
             window,
             surface,
             config,
@@ -327,12 +337,53 @@ impl Viewer {
                 PanelAction::LoadEnvironment(p) => self.load_environment(&p),
                 PanelAction::Screenshot => self.screenshot_requested = true,
                 PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
+                PanelAction::ToggleFeature(feature) => self.toggle_feature(feature),
             }
         }
     }
 
+    /// Compiles `feature` out of the shader (or back in) to time the scene
+    /// without it; a set that cannot be built is refused with the reason.
+    fn toggle_feature(&mut self, feature: crate::gpu::Feature) {
+        self.feature_costs.toggle(feature);
+        let request = self
+            .renderer
+            .request_feature_override(&self.ctx, self.feature_costs.override_set());
+        if let Err(e) = request {
+            self.feature_costs.toggle(feature);
+            self.panel
+                .error(format!("cannot compile {feature:?} out: {e:#}"));
+        }
+    }
+
+    fn quality_stats(&self) -> QualityStats {
+        let scene_features: Vec<_> = FeatureSet::for_scene(&self.scene).0.into_iter().collect();
+        QualityStats {
+            points: self.convergence.points().to_vec(),
+            latest: self.convergence.latest(),
+            paused_at_target: self.paused_at_target(),
+            passes: self.timer.as_ref().map_or_else(Vec::new, |t| {
+                Pass::ALL.iter().map(|&p| (p.label(), t.ms(p))).collect()
+            }),
+            without_ms: scene_features
+                .iter()
+                .map(|&f| self.feature_costs.without(f))
+                .collect(),
+            scene_features,
+            disabled: self.feature_costs.disabled().clone(),
+            with_all_ms: self.feature_costs.with_all(),
+        }
+    }
+
+    /// Whether tracing rests: the user asked to stop at the target error,
+    /// and the estimate of the current image is there.
+    fn paused_at_target(&self) -> bool {
+        let controls = &self.panel.quality;
+        controls.stop_at_target && self.convergence.reached(controls.target_error)
+    }
+
     fn stats(&self) -> Stats {
-        let gpu_ms = self.timer.as_ref().and_then(PassTimer::last_ms);
+        let gpu_ms = self.timer.as_ref().and_then(|t| t.ms(Pass::Trace));
         let info = self.ctx.adapter.get_info();
         let mesh = self.renderer.mesh_stats();
         Stats {
@@ -357,6 +408,7 @@ impl Viewer {
             triangles: mesh.triangles,
             bvh_nodes: mesh.bvh_nodes,
             bvh_build_ms: mesh.bvh_build.as_secs_f32() * 1000.0,
+            quality: self.quality_stats(),
         }
     }
 
@@ -428,6 +480,14 @@ impl Viewer {
             );
             self.load_environment_source(source);
         }
+        // A structural edit that changes the scene's features ends any
+        // feature-cost experiment: the new shader is specialised again.
+        if self
+            .feature_costs
+            .follow_scene(&FeatureSet::for_scene(&self.scene))
+        {
+            self.renderer.forget_feature_override();
+        }
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
         let edited = self.scene != *self.renderer.scene();
@@ -483,11 +543,22 @@ impl Viewer {
         } else {
             None
         };
+        self.convergence.observe(
+            self.renderer.accumulation_generation(),
+            self.renderer.poll_error(),
+        );
+        if let Some(t) = &mut self.timer {
+            t.begin_frame();
+            if !self.scene.render.auto_exposure {
+                t.forget(Pass::AutoExposure);
+            }
+        }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        let writes = self.timer.as_mut().and_then(PassTimer::begin_frame);
-        self.renderer.trace(&self.ctx, &mut encoder, writes);
-        if let Some(t) = &self.timer {
-            t.resolve(&mut encoder);
+        if !self.paused_at_target() {
+            self.renderer
+                .trace(&self.ctx, &mut encoder, self.timer.as_ref());
+            self.renderer
+                .meter_error(&self.ctx, &mut encoder, self.timer.as_ref());
         }
         let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
         let screen = egui_wgpu::ScreenDescriptor {
@@ -511,14 +582,14 @@ impl Viewer {
             .chain(capture.as_ref().map(|(_, v)| v))
             .collect();
         for view in views {
-            self.renderer.display(
-                &self.ctx,
-                &mut encoder,
+            let target = DisplayTarget {
                 view,
-                self.config.format,
+                format: self.config.format,
                 viewport,
-                background,
-            )?;
+                load: background,
+            };
+            self.renderer
+                .display(&self.ctx, &mut encoder, &target, self.timer.as_ref())?;
             let mut pass = encoder
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("egui"),
@@ -531,10 +602,14 @@ impl Viewer {
                             store: wgpu::StoreOp::Store,
                         },
                     })],
+                    timestamp_writes: self.timer.as_ref().and_then(|t| t.render_pass(Pass::Ui)),
                     ..Default::default()
                 })
                 .forget_lifetime();
             self.egui_renderer.render(&mut pass, &paint_jobs, &screen);
+        }
+        if let Some(t) = &mut self.timer {
+            t.resolve(&mut encoder);
         }
         self.ctx
             .queue
@@ -542,8 +617,18 @@ impl Viewer {
         if let Some(t) = &mut self.timer {
             t.after_submit();
         }
+        self.renderer.after_submit();
+        self.record_feature_cost();
         self.ctx.queue.present(frame);
         self.frames += 1;
+        let controls = &self.panel.quality;
+        if controls.screenshot_at_target
+            && self
+                .convergence
+                .take_screenshot_moment(controls.target_error)
+        {
+            self.screenshot_requested = true;
+        }
         if self.screenshot_requested {
             self.screenshot_requested = false;
             self.take_screenshot();
@@ -553,6 +638,21 @@ impl Viewer {
             self.save_window_capture(&texture, &path)?;
         }
         Ok(!is_last)
+    }
+
+    /// Feeds the trace pass's time (GPU, or the whole frame's on the CPU
+    /// clock without timestamps) to the feature-cost measurement.
+    fn record_feature_cost(&mut self) {
+        if self.paused_at_target() {
+            return;
+        }
+        let trace_ms = match &mut self.timer {
+            Some(t) => t.take_fresh(Pass::Trace),
+            None => Some(self.last_frame.elapsed().as_secs_f32() * 1000.0),
+        };
+        if let Some(ms) = trace_ms {
+            self.feature_costs.record(self.renderer.features(), ms);
+        }
     }
 
     /// An offscreen twin of the swapchain image, so the final frame (UI

@@ -2,11 +2,13 @@
 
 use super::session::{accumulate, load_scene, renderer_for};
 use crate::gpu::auto_exposure;
+use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::{GpuContext, Renderer};
 use crate::image_io;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -16,9 +18,15 @@ pub struct RenderArgs {
     /// Environment map to use instead of the preset's.
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
+    /// Samples per pixel (default 64); with --target-error, the most it
+    /// may take (default 16384).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Stop as soon as the estimated relative error (√relMSE, from the
+    /// spread of each pixel's frames, as the viewer's Quality panel shows
+    /// it) is at or below this, e.g. 0.01 for 1 %.
+    #[arg(long)]
+    pub target_error: Option<f64>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -46,10 +54,24 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
+/// Samples per pixel without --target-error, and the cap with it.
+const DEFAULT_SPP: u32 = 64;
+const DEFAULT_MAX_SPP: u32 = 16384;
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     let format = image_io::ImageFormat::from_path(&args.output)?;
-    if args.spp == 0 {
+    let spp = args.spp.unwrap_or(if args.target_error.is_some() {
+        DEFAULT_MAX_SPP
+    } else {
+        DEFAULT_SPP
+    });
+    if spp == 0 {
         bail!("--spp must be at least 1");
+    }
+    if let Some(target) = args.target_error
+        && !(target.is_finite() && target > 0.0)
+    {
+        bail!("--target-error must be a positive number, like 0.01 for 1 %");
     }
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
     if args.auto_exposure {
@@ -60,7 +82,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let ctx = GpuContext::headless()?;
     let mut renderer = renderer_for(&ctx, &loaded, args.size)?;
-    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
+    let bar = indicatif::ProgressBar::new(u64::from(spp));
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})",
@@ -68,9 +90,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .expect("a valid template"),
     );
     bar.set_message(ctx.describe());
-    accumulate(&ctx, &mut renderer, args.spp, |n| {
-        bar.set_position(u64::from(n))
-    })?;
+    match args.target_error {
+        None => accumulate(&ctx, &mut renderer, spp, |n| bar.set_position(u64::from(n)))?,
+        Some(target) => {
+            let reached = accumulate_to_error(&ctx, &mut renderer, target, spp, &bar)?;
+            bar.finish();
+            report_error(&renderer, target, reached);
+        }
+    }
     bar.finish();
     // EXR output is the radiance, unscaled: only a PNG is exposed.
     if loaded.scene.render.auto_exposure && matches!(format, image_io::ImageFormat::Png) {
@@ -89,6 +116,66 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     .with_context(|| format!("saving {}", args.output.display()))?;
     eprintln!("wrote {}", args.output.display());
     Ok(())
+}
+
+/// How often the error is measured while rendering to a target: each
+/// measurement waits for the GPU, so not after every frame of a fast one.
+const ERROR_CHECK_INTERVAL: Duration = Duration::from_millis(250);
+
+/// Traces until the estimated relative error is at most `target`, or
+/// `max_spp` samples per pixel; returns the last estimate.
+fn accumulate_to_error(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: f64,
+    max_spp: u32,
+    bar: &indicatif::ProgressBar,
+) -> Result<Option<ErrorEstimate>> {
+    let mut last_check: Option<Instant> = None;
+    while renderer.accumulated_samples() < max_spp {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        // Waiting for each frame keeps the GPU no further ahead than the
+        // check: a target reached is not overshot by a queue of frames.
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .context("waiting for the GPU")?;
+        bar.set_position(u64::from(renderer.accumulated_samples()));
+        if last_check.is_some_and(|t| t.elapsed() < ERROR_CHECK_INTERVAL) {
+            continue;
+        }
+        last_check = Some(Instant::now());
+        if let Some(e) = renderer.estimate_error(ctx)? {
+            bar.set_message(format!("error {:.2} %", 100.0 * e.relative));
+            if e.relative <= target {
+                return Ok(Some(e));
+            }
+        }
+    }
+    // The cap: measure the final image.
+    renderer.estimate_error(ctx)
+}
+
+/// Says where the error ended, against the target.
+fn report_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstimate>) {
+    let spp = renderer.accumulated_samples();
+    let seconds = renderer.accumulation_time().as_secs_f64();
+    match estimate {
+        Some(e) if e.relative <= target => eprintln!(
+            "target reached: estimated relative error {:.3} % (RMSE {:.5}) at {spp} spp in {seconds:.1} s",
+            100.0 * e.relative,
+            e.rmse
+        ),
+        Some(e) => eprintln!(
+            "target not reached: estimated relative error {:.3} % (RMSE {:.5}) at the cap of {spp} spp \
+             ({seconds:.1} s); raise --spp, about {:.0} s more would do",
+            100.0 * e.relative,
+            e.rmse,
+            e.seconds_to(target)
+        ),
+        None => eprintln!("no error estimate: it needs two frames (--spp {spp} is too few)"),
+    }
 }
 
 /// Prints the exposure the PNG gets: the GPU's metering (what the display

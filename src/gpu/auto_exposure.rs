@@ -4,13 +4,14 @@
 //! log2(key / L_avg) that brings it to middle grey.
 //!
 //! [`AutoExposure`] meters the accumulation target on the GPU
-//! (`shaders/auto_exposure.wgsl`): one workgroup reads a grid of at most
-//! [`GRID`] × [`GRID`] texels spread over the traced region and reduces it,
+//! (`shaders/auto_exposure.wgsl`): one workgroup reads a grid of texels
+//! spread over the traced region ([`super::metering_grid`]) and reduces it,
 //! and the result stays in a buffer that the display pass binds, so the
 //! frame never waits for a readback. The free functions are its CPU twin.
 
 use super::context::GpuContext;
 use super::features::FeatureSet;
+use super::metering_grid::MeteringGrid;
 use super::pipelines::{checked, entry, float_texture, shader_module, storage, uniform};
 use super::readback::read_buffer;
 use super::shader_source::Program;
@@ -22,8 +23,6 @@ use wgpu::util::DeviceExt;
 pub const KEY: f32 = 0.18;
 /// Added to every luminance before the log, so black does not give -∞.
 pub const DELTA: f32 = 1e-4;
-/// At most this many texels are metered along each axis.
-pub const GRID: u32 = 256;
 /// The automatic exposure is clamped to ±this many stops.
 pub const MAX_STOPS: f32 = 20.0;
 
@@ -111,39 +110,6 @@ pub fn log_average_luminance(pixels: &[[f32; 4]]) -> f32 {
     meter(pixels).log_average
 }
 
-/// How many texels the GPU meters along each axis of a `region`.
-pub fn grid_size(region: (u32, u32)) -> (u32, u32) {
-    (region.0.clamp(1, GRID), region.1.clamp(1, GRID))
-}
-
-/// The texel under the centre of cell `i` of `grid` cells spanning `size`
-/// texels (`grid_texel` in the shader).
-fn grid_texel(i: u32, grid: u32, size: u32) -> u32 {
-    ((2 * i + 1) * size) / (2 * grid)
-}
-
-/// The pixels of a `size` image (row-major) that the GPU meters: all of them
-/// up to [`GRID`] per axis, a centred strided grid beyond.
-pub fn grid_pixels(pixels: &[[f32; 4]], size: (u32, u32)) -> Vec<[f32; 4]> {
-    let (gw, gh) = grid_size(size);
-    let mut out = Vec::with_capacity((gw * gh) as usize);
-    for gy in 0..gh {
-        let y = grid_texel(gy, gh, size.1);
-        for gx in 0..gw {
-            let x = grid_texel(gx, gw, size.0);
-            out.push(pixels[(y * size.0 + x) as usize]);
-        }
-    }
-    out
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct MeteringUniform {
-    region: [u32; 2],
-    grid: [u32; 2],
-}
-
 /// The metering pass and the buffer it leaves its [`Metered`] in.
 pub struct AutoExposure {
     pipeline: wgpu::ComputePipeline,
@@ -180,7 +146,7 @@ impl AutoExposure {
         })?;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("metering"),
-            size: std::mem::size_of::<MeteringUniform>() as u64,
+            size: std::mem::size_of::<MeteringGrid>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -208,13 +174,9 @@ impl AutoExposure {
         encoder: &mut wgpu::CommandEncoder,
         radiance: &wgpu::TextureView,
         region: (u32, u32),
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let region = (region.0.max(1), region.1.max(1));
-        let (gw, gh) = grid_size(region);
-        let uniform = MeteringUniform {
-            region: [region.0, region.1],
-            grid: [gw, gh],
-        };
+        let uniform = MeteringGrid::over(region);
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&uniform));
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -237,7 +199,7 @@ impl AutoExposure {
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("auto exposure"),
-            timestamp_writes: None,
+            timestamp_writes,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
@@ -349,26 +311,6 @@ mod tests {
         assert!((meter(&[grey(4.0 * KEY - DELTA); 3]).stops + 2.0).abs() < 1e-5);
     }
 
-    #[test]
-    fn the_grid_is_every_pixel_up_to_its_size_and_strided_beyond() {
-        let pixels: Vec<[f32; 4]> = (0..200 * 3).map(|i| grey(i as f32)).collect();
-        assert_eq!(grid_pixels(&pixels, (200, 3)), pixels);
-        let (w, h) = (1000, 300);
-        let pixels: Vec<[f32; 4]> = (0..w * h)
-            .map(|i| [(i % w) as f32, (i / w) as f32, 0.0, 0.0])
-            .collect();
-        let grid = grid_pixels(&pixels, (w, h));
-        assert_eq!(grid.len(), (GRID * GRID) as usize);
-        let xs: Vec<f32> = grid[..GRID as usize].iter().map(|p| p[0]).collect();
-        // Centred cells: the first and last texels sit half a cell in.
-        assert_eq!(xs[0], 1.0);
-        assert_eq!(xs[GRID as usize - 1], 998.0);
-        assert!(xs.windows(2).all(|p| p[1] > p[0]));
-        let ys: Vec<f32> = grid.iter().step_by(GRID as usize).map(|p| p[1]).collect();
-        assert_eq!((ys[0], ys[GRID as usize - 1]), (0.0, 299.0));
-        assert!(ys.windows(2).all(|p| p[1] > p[0]));
-    }
-
     /// The display pass reads the metering pass's output through its own
     /// declaration of `Metered`: the two must agree, field for field.
     #[test]
@@ -392,7 +334,6 @@ mod tests {
     fn the_shader_constants_are_the_cpu_twins() {
         let source = include_str!("../../shaders/auto_exposure.wgsl");
         for line in [
-            format!("const GRID: u32 = {GRID}u;"),
             format!("const DELTA: f32 = {DELTA:e};"),
             format!("const KEY: f32 = {KEY};"),
             format!("const MAX_STOPS: f32 = {MAX_STOPS:.1};"),

@@ -2,13 +2,17 @@
 //! specialisation, the progressive renderer, auto exposure, and the noise
 //! compute harness.
 
+pub mod accumulation;
+pub mod async_readback;
 pub mod auto_exposure;
 pub mod bvh_harness;
 pub mod compute_harness;
 pub mod context;
+pub mod error_meter;
 pub mod features;
 pub mod geometry_buffers;
 pub mod mesh_buffers;
+pub mod metering_grid;
 pub mod noise_harness;
 pub mod pass_timer;
 pub mod pipeline_build;
@@ -24,4 +28,4 @@ pub mod texture_harness;
 
 pub use context::GpuContext;
 pub use features::{Feature, FeatureSet};
-pub use renderer::{Renderer, Viewport};
+pub use renderer::{DisplayTarget, Renderer, Viewport};

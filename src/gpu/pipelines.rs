@@ -68,7 +68,7 @@ pub fn fullscreen_pipeline(
     module: &wgpu::ShaderModule,
     layout: &wgpu::BindGroupLayout,
     fragment_entry: &str,
-    format: wgpu::TextureFormat,
+    formats: &[wgpu::TextureFormat],
     constants: &[(&str, f64)],
 ) -> Result<wgpu::RenderPipeline> {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -96,7 +96,7 @@ pub fn fullscreen_pipeline(
                     constants,
                     ..Default::default()
                 },
-                targets: &[Some(format.into())],
+                targets: &formats.iter().map(|&f| Some(f.into())).collect::<Vec<_>>(),
             }),
             multiview_mask: None,
             cache: None,

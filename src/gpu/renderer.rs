@@ -2,15 +2,18 @@
 //! target, display pass onto any colour target. It owns every GPU resource
 //! derived from the scene and rebuilds only what an edit invalidates.
 
+use super::accumulation::{ACCUMULATION_FORMAT, Accumulation};
 use super::auto_exposure::{AutoExposure, Metered};
 use super::context::GpuContext;
+use super::error_meter::{self, ErrorEstimate, ErrorMeter};
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
 use super::mesh_buffers::{MeshBuffers, MeshStats};
+use super::pass_timer::{Pass, PassTimer};
 use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
-    storage, uniform, upload_atlas, upload_rgba16f,
+    storage, uniform, upload_atlas, upload_rgba16f, validate,
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
@@ -26,8 +29,6 @@ use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Duration;
 use wgpu::util::DeviceExt;
-
-pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -58,12 +59,14 @@ pub struct Viewport {
     pub height: f32,
 }
 
-struct Accumulation {
-    /// Ping-pong pair: each frame reads one and writes the other.
-    views: [wgpu::TextureView; 2],
-    textures: [wgpu::Texture; 2],
-    /// Index of the texture holding the latest mean.
-    latest: usize,
+/// Where [`Renderer::display`] draws: a view of a colour target, its
+/// format, the rectangle the image goes in, and what the rest starts as.
+#[derive(Clone, Copy)]
+pub struct DisplayTarget<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub format: wgpu::TextureFormat,
+    pub viewport: Viewport,
+    pub load: wgpu::LoadOp<wgpu::Color>,
 }
 
 /// A scene waiting for its pipeline: what to write into the buffers once
@@ -155,9 +158,10 @@ pub struct Renderer {
     images: ImageSet,
     image_atlas_view: wgpu::TextureView,
     accumulation: Accumulation,
+    /// Estimates the accumulated image's error from its spread.
+    error_meter: ErrorMeter,
     size: (u32, u32),
     render_scale: f32,
-    accumulated: u32,
     frame_index: u32,
 }
 
@@ -188,6 +192,7 @@ impl Renderer {
                 entry(7, uniform()),
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
+                entry(16, float_texture(false)),
                 entry(MeshBuffers::BINDINGS[0], storage(true)),
                 entry(MeshBuffers::BINDINGS[1], storage(true)),
                 entry(MeshBuffers::BINDINGS[2], storage(true)),
@@ -254,7 +259,8 @@ impl Renderer {
         let env_view = upload_env(ctx, env);
         let env_distribution = upload_env_distribution(ctx, env);
         let image_atlas_view = upload_atlas(ctx, images.atlas());
-        let accumulation = create_accumulation(device, size);
+        let accumulation = Accumulation::new(device, size);
+        let error_meter = ErrorMeter::new(device)?;
         Ok(Self {
             scene: scene.clone(),
             pending: None,
@@ -282,9 +288,9 @@ impl Renderer {
             images,
             image_atlas_view,
             accumulation,
+            error_meter,
             size,
             render_scale: 1.0,
-            accumulated: 0,
             frame_index: 0,
         })
     }
@@ -304,7 +310,7 @@ impl Renderer {
             &module,
             layout,
             "fs_trace",
-            ACCUMULATION_FORMAT,
+            &[ACCUMULATION_FORMAT; 2],
             &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
@@ -335,7 +341,17 @@ impl Renderer {
 
     /// Samples per pixel averaged so far.
     pub fn accumulated_samples(&self) -> u32 {
-        self.accumulated
+        self.accumulation.samples()
+    }
+
+    /// Frames averaged so far (the error estimate needs two).
+    pub fn accumulated_frames(&self) -> u32 {
+        self.accumulation.frames()
+    }
+
+    /// Time since the first frame of the current accumulation.
+    pub fn accumulation_time(&self) -> Duration {
+        self.accumulation.elapsed()
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -537,6 +553,41 @@ impl Renderer {
         self.set_scene(ctx, &scene)
     }
 
+    /// Builds the shader with `features` instead of the scene's own set,
+    /// without waiting (the viewer's feature-cost toggles). The set is
+    /// checked first: a feature the texture code calls cannot be left out,
+    /// and the error says so while the current shader stays.
+    pub fn request_feature_override(
+        &mut self,
+        ctx: &GpuContext,
+        features: Option<FeatureSet>,
+    ) -> Result<()> {
+        let code = self
+            .pending
+            .as_ref()
+            .map_or(&self.key.code, |p| &p.key.code);
+        if let Some(set) = &features {
+            let source = assemble(Program::Trace, set, code)?;
+            validate(&source).map_err(|e| {
+                anyhow::anyhow!("this scene's shader cannot be built with those features: {e}")
+            })?;
+        }
+        self.feature_override = features;
+        let scene = self
+            .pending
+            .as_ref()
+            .map_or(&self.scene, |p| &p.target.scene)
+            .clone();
+        self.start_scene(ctx, &scene, true)
+    }
+
+    /// Goes back to specialising per scene at the next scene request,
+    /// without building anything now (the caller is about to request a
+    /// scene whose features changed).
+    pub fn forget_feature_override(&mut self) {
+        self.feature_override = None;
+    }
+
     /// The images the texture code reads.
     pub fn images(&self) -> &ImageSet {
         &self.images
@@ -583,7 +634,7 @@ impl Renderer {
         let size = (size.0.max(1), size.1.max(1));
         if size != self.size {
             self.size = size;
-            self.accumulation = create_accumulation(&ctx.device, size);
+            self.accumulation = Accumulation::new(&ctx.device, size);
             self.reset_accumulation();
         }
     }
@@ -598,7 +649,7 @@ impl Renderer {
     }
 
     pub fn reset_accumulation(&mut self) {
-        self.accumulated = 0;
+        self.accumulation.reset();
     }
 
     /// Records one trace pass: `samples_per_frame` more samples per pixel.
@@ -606,14 +657,18 @@ impl Renderer {
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        timer: Option<&PassTimer>,
     ) {
         if !self.scene.render.accumulate {
-            self.accumulated = 0;
+            self.accumulation.reset();
         }
         let render_size = self.render_size();
-        let mut uniform: FrameUniform =
-            scene_gpu::frame_uniform(&self.scene, render_size, self.frame_index, self.accumulated);
+        let mut uniform: FrameUniform = scene_gpu::frame_uniform(
+            &self.scene,
+            render_size,
+            self.frame_index,
+            self.accumulation.samples(),
+        );
         uniform.env_distribution_size = self.env_distribution.1;
         let table = self.meshes.table();
         uniform.light_count = table.lights.len() as u32;
@@ -621,16 +676,13 @@ impl Renderer {
         uniform.triangle_count = self.meshes.stats().triangles as u32;
         ctx.queue
             .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
-        let read = self.accumulation.latest;
-        let write = 1 - read;
+        let (previous_mean, previous_spread) = self.accumulation.latest_views();
         let mut entries = vec![
             bind(0, self.frame_buffer.as_entire_binding()),
             bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
             bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
-            bind(
-                5,
-                wgpu::BindingResource::TextureView(&self.accumulation.views[read]),
-            ),
+            bind(5, wgpu::BindingResource::TextureView(previous_mean)),
+            bind(16, wgpu::BindingResource::TextureView(previous_spread)),
             bind(6, self.perm_buffer.as_entire_binding()),
             bind(7, self.texture_param_buffer.as_entire_binding()),
             bind(
@@ -649,17 +701,9 @@ impl Renderer {
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("trace"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.accumulation.views[write],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &self.accumulation.attachments(),
                 depth_stencil_attachment: None,
-                timestamp_writes,
+                timestamp_writes: timer.and_then(|t| t.render_pass(Pass::Trace)),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -675,16 +719,19 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
-        self.accumulation.latest = write;
-        self.accumulated = self
-            .accumulated
-            .saturating_add(self.scene.render.samples_per_frame.max(1));
+        self.accumulation
+            .advance(self.scene.render.samples_per_frame.max(1));
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
     /// Records the auto-exposure metering of the latest mean, unless the
     /// result already comes from it.
-    fn meter(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+    fn meter(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<&PassTimer>,
+    ) {
         let render_size = self.render_size();
         let from = MeteredFrom {
             frame_index: self.frame_index,
@@ -695,8 +742,9 @@ impl Renderer {
             self.auto_exposure.record(
                 ctx,
                 encoder,
-                &self.accumulation.views[self.accumulation.latest],
+                self.accumulation.latest_views().0,
                 render_size,
+                timer.and_then(|t| t.compute_pass(Pass::AutoExposure)),
             );
             self.metered_from = Some(from);
         }
@@ -710,11 +758,15 @@ impl Renderer {
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        format: wgpu::TextureFormat,
-        viewport: Viewport,
-        load: wgpu::LoadOp<wgpu::Color>,
+        target: &DisplayTarget<'_>,
+        timer: Option<&PassTimer>,
     ) -> Result<()> {
+        let DisplayTarget {
+            view: target,
+            format,
+            viewport,
+            load,
+        } = *target;
         if !self.display_pipelines.contains_key(&format) {
             let p = fullscreen_pipeline(
                 &ctx.device,
@@ -722,14 +774,14 @@ impl Renderer {
                 &self.display_module,
                 &self.display_layout,
                 "fs_display",
-                format,
+                &[format],
                 &[],
             )?;
             self.display_pipelines.insert(format, p);
         }
         let auto_exposure = self.scene.render.auto_exposure;
         if auto_exposure {
-            self.meter(ctx, encoder);
+            self.meter(ctx, encoder, timer);
         }
         let render_size = self.render_size();
         let uniform = DisplayUniform {
@@ -756,9 +808,7 @@ impl Renderer {
                 bind(0, self.display_buffer.as_entire_binding()),
                 bind(
                     1,
-                    wgpu::BindingResource::TextureView(
-                        &self.accumulation.views[self.accumulation.latest],
-                    ),
+                    wgpu::BindingResource::TextureView(self.accumulation.latest_views().0),
                 ),
                 bind(2, self.auto_exposure.result().as_entire_binding()),
             ],
@@ -775,7 +825,7 @@ impl Renderer {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: None,
+            timestamp_writes: timer.and_then(|t| t.render_pass(Pass::Display)),
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -795,12 +845,22 @@ impl Renderer {
 
     /// The linear radiance of the traced region (the running mean), RGBA f32.
     pub fn read_radiance(&self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
-        let bytes = read_texture(
-            &ctx.device,
-            &ctx.queue,
-            &self.accumulation.textures[self.accumulation.latest],
-            16,
-        )?;
+        self.read_accumulated(ctx, self.accumulation.latest_mean_texture())
+    }
+
+    /// The spread of the frames' means about the mean, per pixel, as the
+    /// trace pass keeps it (see [`super::error_meter`]).
+    pub fn read_spread(&self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+        self.read_accumulated(ctx, self.accumulation.latest_spread_texture())
+    }
+
+    /// The traced region of one of the accumulation targets.
+    fn read_accumulated(
+        &self,
+        ctx: &GpuContext,
+        texture: &wgpu::Texture,
+    ) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+        let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
         let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         let (rw, rh) = self.render_size();
         let mut out = Vec::with_capacity((rw * rh) as usize);
@@ -816,9 +876,61 @@ impl Renderer {
     /// and reports. The display pass reads the same result on the GPU.
     pub fn metering(&mut self, ctx: &GpuContext) -> Result<Metered> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.meter(ctx, &mut encoder);
+        self.meter(ctx, &mut encoder, None);
         ctx.queue.submit([encoder.finish()]);
         self.auto_exposure.read(ctx)
+    }
+
+    /// Records the error meter on the latest frame (skip it before the
+    /// second frame: one frame has no spread). The viewer calls it every
+    /// frame, then [`Self::after_submit`], then collects with
+    /// [`Self::poll_error`].
+    pub fn meter_error(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<&PassTimer>,
+    ) {
+        if self.accumulation.frames() >= 2 {
+            self.error_meter
+                .record(ctx, encoder, &self.accumulated(), timer);
+        }
+    }
+
+    /// What the error meter reads.
+    fn accumulated(&self) -> error_meter::Accumulated<'_> {
+        let (mean, spread) = self.accumulation.latest_views();
+        error_meter::Accumulated {
+            mean,
+            spread,
+            region: self.render_size(),
+            frames: self.accumulation.frames(),
+            samples: self.accumulation.samples(),
+            seconds: self.accumulation.elapsed().as_secs_f32(),
+            generation: self.accumulation.generation(),
+        }
+    }
+
+    /// Which accumulation the image holds: it changes at every reset.
+    pub fn accumulation_generation(&self) -> u32 {
+        self.accumulation.generation()
+    }
+
+    /// Starts the readbacks recorded in the encoder just submitted.
+    pub fn after_submit(&self) {
+        self.error_meter.after_submit();
+    }
+
+    /// The error estimate of a finished readback, once, a frame or two
+    /// after it was recorded: it says which frame it measured.
+    pub fn poll_error(&self) -> Option<ErrorEstimate> {
+        self.error_meter.poll()
+    }
+
+    /// Meters the error of the latest frame and waits for it: for headless
+    /// renders and tests. `None` before two frames.
+    pub fn estimate_error(&self, ctx: &GpuContext) -> Result<Option<ErrorEstimate>> {
+        self.error_meter.measure(ctx, &self.accumulated())
     }
 
     /// The displayed (tone-mapped, sRGB) image at the trace resolution.
@@ -841,20 +953,18 @@ impl Renderer {
         });
         let view = target.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let viewport = Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: w as f32,
-            height: h as f32,
-        };
-        self.display(
-            ctx,
-            &mut encoder,
-            &view,
+        let display_target = DisplayTarget {
+            view: &view,
             format,
-            viewport,
-            wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-        )?;
+            viewport: Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: w as f32,
+                height: h as f32,
+            },
+            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        };
+        self.display(ctx, &mut encoder, &display_target, None)?;
         ctx.queue.submit([encoder.finish()]);
         let bytes = read_texture(&ctx.device, &ctx.queue, &target, 4)?;
         image::RgbaImage::from_raw(w, h, bytes)
@@ -864,37 +974,6 @@ impl Renderer {
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource }
-}
-
-fn create_accumulation(device: &wgpu::Device, size: (u32, u32)) -> Accumulation {
-    let make = |i: usize| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&format!("accumulation {i}")),
-            size: wgpu::Extent3d {
-                width: size.0.max(1),
-                height: size.1.max(1),
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: ACCUMULATION_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
-    };
-    let textures = [make(0), make(1)];
-    let views = [
-        textures[0].create_view(&Default::default()),
-        textures[1].create_view(&Default::default()),
-    ];
-    Accumulation {
-        views,
-        textures,
-        latest: 0,
-    }
 }
 
 /// What the renderer binds without an environment map: one black texel.

@@ -40,8 +40,16 @@ const SOURCES: &[(&str, &str)] = &[
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     (
+        "metering_grid.wgsl",
+        include_str!("../../shaders/metering_grid.wgsl"),
+    ),
+    (
         "auto_exposure.wgsl",
         include_str!("../../shaders/auto_exposure.wgsl"),
+    ),
+    (
+        "error_meter.wgsl",
+        include_str!("../../shaders/error_meter.wgsl"),
     ),
     (
         "noise_harness.wgsl",
@@ -89,6 +97,8 @@ pub enum Program {
     Display,
     /// The compute pass that meters the image's log-average luminance.
     AutoExposure,
+    /// The compute pass that estimates the image's error from its spread.
+    ErrorMeter,
     /// The compute pass that evaluates noise at given points.
     NoiseHarness,
     /// The compute pass that evaluates the texture library's patterns.
@@ -98,10 +108,11 @@ pub enum Program {
 }
 
 impl Program {
-    pub const ALL: [Program; 6] = [
+    pub const ALL: [Program; 7] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
+        Program::ErrorMeter,
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
@@ -155,7 +166,8 @@ impl Program {
                 }
             }
             Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
-            Program::AutoExposure => out.push("auto_exposure.wgsl"),
+            Program::AutoExposure => out.extend(["metering_grid.wgsl", "auto_exposure.wgsl"]),
+            Program::ErrorMeter => out.extend(["metering_grid.wgsl", "error_meter.wgsl"]),
             Program::NoiseHarness => {
                 noise(&mut out);
                 out.push("noise_harness.wgsl");

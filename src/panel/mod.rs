@@ -8,6 +8,7 @@
 //! colours are written back only on a change.
 
 mod material_editor;
+mod quality;
 mod transport;
 
 use crate::scene::{
@@ -20,6 +21,7 @@ use egui::{
 };
 use glam::Vec3;
 use material_editor::material_ui;
+pub use quality::{QualityControls, QualityStats};
 use std::ops::RangeInclusive;
 use std::path::PathBuf;
 
@@ -68,6 +70,8 @@ pub struct PanelState {
     /// typed (true: six faces, false: cross): the panel shows its fields
     /// while the scene keeps its source until Load.
     cube_pending: Option<bool>,
+    /// The target error and what to do on reaching it.
+    pub quality: QualityControls,
 }
 
 impl PanelState {
@@ -81,6 +85,7 @@ impl PanelState {
             cube_cross: String::new(),
             cube_seen: None,
             cube_pending: None,
+            quality: QualityControls::default(),
         }
     }
 
@@ -127,6 +132,7 @@ pub struct Stats {
     pub triangles: usize,
     pub bvh_nodes: usize,
     pub bvh_build_ms: f32,
+    pub quality: QualityStats,
 }
 
 /// A button press the app must act on: these need files, the GPU or the
@@ -140,6 +146,9 @@ pub enum PanelAction {
     LoadEnvironment(PathBuf),
     Screenshot,
     ResetCamera,
+    /// Compile a shader feature out (or back in), to time the scene
+    /// without it.
+    ToggleFeature(crate::gpu::Feature),
 }
 
 /// Draws the whole panel contents into `ui` and returns the buttons pressed.
@@ -169,6 +178,9 @@ pub fn draw(
             });
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
+            });
+            section(ui, "Quality", true, |ui| {
+                quality::quality_ui(ui, &mut state.quality, &stats.quality, &mut actions);
             });
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));
         });

@@ -1,0 +1,151 @@
+//! The targets the trace pass accumulates into, and how much they hold.
+//!
+//! Two images per pixel, each ping-ponged (a frame reads the latest pair and
+//! writes the other): the running mean of every sample, which is the image,
+//! and the running spread of the frames' means about it, from which
+//! [`super::error_meter`] estimates the image's error. Both are running
+//! averages rather than sums, so their rounding error does not grow with
+//! the frame count.
+
+use std::time::{Duration, Instant};
+
+/// The format of both targets: linear radiance needs floats, and the
+/// running mean needs more than half precision to keep averaging.
+pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// One ping-ponged image: two textures, one read while the other is written.
+struct PingPong {
+    textures: [wgpu::Texture; 2],
+    views: [wgpu::TextureView; 2],
+}
+
+impl PingPong {
+    fn new(device: &wgpu::Device, label: &str, size: (u32, u32)) -> Self {
+        let make = |i: usize| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(&format!("{label} {i}")),
+                size: wgpu::Extent3d {
+                    width: size.0.max(1),
+                    height: size.1.max(1),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ACCUMULATION_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let textures = [make(0), make(1)];
+        let views = [
+            textures[0].create_view(&Default::default()),
+            textures[1].create_view(&Default::default()),
+        ];
+        Self { textures, views }
+    }
+}
+
+pub struct Accumulation {
+    mean: PingPong,
+    spread: PingPong,
+    /// Index of the pair holding the latest frame.
+    latest: usize,
+    samples: u32,
+    frames: u32,
+    /// When the current accumulation started (its first frame).
+    started: Instant,
+    /// Counts resets: tells measurements of one accumulation from the next.
+    generation: u32,
+}
+
+impl Accumulation {
+    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        Self {
+            mean: PingPong::new(device, "accumulated mean", size),
+            spread: PingPong::new(device, "accumulated spread", size),
+            latest: 0,
+            samples: 0,
+            frames: 0,
+            started: Instant::now(),
+            generation: 0,
+        }
+    }
+
+    /// Starts over: the next frame ignores what the targets hold.
+    pub fn reset(&mut self) {
+        if self.frames > 0 {
+            self.generation = self.generation.wrapping_add(1);
+        }
+        self.samples = 0;
+        self.frames = 0;
+    }
+
+    pub fn generation(&self) -> u32 {
+        self.generation
+    }
+
+    /// Samples per pixel averaged so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Frames averaged so far.
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// Time since the first frame of this accumulation.
+    pub fn elapsed(&self) -> Duration {
+        if self.frames == 0 {
+            Duration::ZERO
+        } else {
+            self.started.elapsed()
+        }
+    }
+
+    /// The latest mean and spread, which the next frame reads.
+    pub fn latest_views(&self) -> (&wgpu::TextureView, &wgpu::TextureView) {
+        (
+            &self.mean.views[self.latest],
+            &self.spread.views[self.latest],
+        )
+    }
+
+    pub fn latest_mean_texture(&self) -> &wgpu::Texture {
+        &self.mean.textures[self.latest]
+    }
+
+    pub fn latest_spread_texture(&self) -> &wgpu::Texture {
+        &self.spread.textures[self.latest]
+    }
+
+    /// The colour attachments a frame writes: mean, then spread (the trace
+    /// shader's locations 0 and 1).
+    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 2] {
+        let write = 1 - self.latest;
+        [&self.mean.views[write], &self.spread.views[write]].map(|view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+    }
+
+    /// Records that a frame of `samples` samples per pixel was written.
+    pub fn advance(&mut self, samples: u32) {
+        if self.frames == 0 {
+            self.started = Instant::now();
+        }
+        self.latest = 1 - self.latest;
+        self.samples = self.samples.saturating_add(samples);
+        self.frames = self.frames.saturating_add(1);
+    }
+}
