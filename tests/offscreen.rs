@@ -462,3 +462,54 @@ fn uber_and_specialised_shaders_agree() {
         }
     }
 }
+
+/// The Quality strip's feature-cost toggles: compiling the ground out of
+/// the default preset builds (and the image loses the ground), while a
+/// pattern its texture code calls cannot be compiled out; the refusal
+/// names the reason and leaves the shader as it was.
+#[test]
+fn a_feature_can_be_compiled_out_unless_the_texture_code_needs_it() {
+    use marbre::commands::session::{load_scene, renderer_for};
+    use marbre::gpu::{Feature, FeatureSet};
+    let Some(ctx) = gpu_or_skip("a_feature_can_be_compiled_out_unless_the_texture_code_needs_it")
+    else {
+        return;
+    };
+    let loaded = load_scene(std::path::Path::new("presets/default.ron"), None).unwrap();
+    let size = (32, 24);
+    let mut renderer = renderer_for(&ctx, &loaded, size).unwrap();
+    let scene_features = FeatureSet::for_scene(&loaded.scene);
+    let without = |f: Feature| {
+        let mut set = scene_features.clone();
+        assert!(set.0.remove(&f), "the default preset uses {f:?}");
+        set
+    };
+    let refused = renderer
+        .request_feature_override(&ctx, Some(without(Feature::PatternChecker)))
+        .expect_err("the ground's checker is called by the texture code");
+    assert!(
+        format!("{refused:#}").contains("cannot be built with those features"),
+        "{refused:#}"
+    );
+    assert!(!renderer.is_building());
+    assert_eq!(*renderer.features(), scene_features);
+
+    accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
+    let with_ground = renderer.read_radiance(&ctx).unwrap().2;
+    renderer
+        .request_feature_override(&ctx, Some(without(Feature::Ground)))
+        .unwrap();
+    while renderer.is_building() {
+        if let Some(result) = renderer.poll_build(&ctx) {
+            result.unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(*renderer.features(), without(Feature::Ground));
+    renderer.reset_accumulation();
+    accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
+    let without_ground = renderer.read_radiance(&ctx).unwrap().2;
+    // The bottom row looked at the ground; it now sees the environment.
+    let bottom = |image: &[[f32; 4]]| image[image.len() - size.0 as usize..].to_vec();
+    assert_ne!(bottom(&with_ground), bottom(&without_ground));
+}

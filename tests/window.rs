@@ -343,11 +343,16 @@ fn window_shows_panel_and_render() {
 
     // The side panel is 380 px wide; its right 300 px are panel and nothing else.
     let panel = region(&img, w - 300..w, 0..h);
-    // The left 700 px are rendered image and nothing else.
-    let render = region(&img, 0..700, 0..h);
+    // The left 700 px above the Quality strip (its top 500 rows) are
+    // rendered image and nothing else.
+    let render = region(&img, 0..700, 0..500);
+    // The Quality strip: the bottom 160 rows under the image.
+    let quality = region(&img, 0..880, h - 160..h);
     // The top 40 rows of the render show the environment above the horizon.
     let sky = region(&img, 0..700, 0..40);
-    eprintln!("{TEST}: panel  {panel:?}\n{TEST}: render {render:?}\n{TEST}: sky    {sky:?}");
+    eprintln!(
+        "{TEST}: panel  {panel:?}\n{TEST}: render {render:?}\n{TEST}: sky    {sky:?}\n{TEST}: quality {quality:?}"
+    );
 
     // Measured with lavapipe (Mesa 22.3, 10 frames; the render is seeded, so
     // every run gives the same numbers): panel mean luma 0.133 with 2.8 % of
@@ -377,6 +382,23 @@ fn window_shows_panel_and_render() {
     assert!(
         render.std_luma > 0.05,
         "the rendered image is flat: {render:?}"
+    );
+    // The Quality strip is panel too (dark, with text and a plot), not the
+    // render showing through; and the viewer's closing line says what it
+    // showed: an error estimate (ten frames give several) and the passes'
+    // GPU times.
+    assert!(
+        quality.mean_luma < 0.25 && quality.light_fraction > 0.01,
+        "no Quality strip under the image: {quality:?}"
+    );
+    let log = marbre_log(&dir);
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("quality: "))
+        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    assert!(
+        line.contains("estimated error 0.") && line.contains("relative"),
+        "no error estimate after 10 frames: {line}"
     );
     // The default preset's background is sunset.exr, a warm, bright plaza
     // (measured: luma 0.44, red 0.52 over blue 0.37). A missing environment

@@ -23,6 +23,9 @@ use winit::window::Window;
 
 /// Width of the side panel, in points, when the window opens.
 const PANEL_WIDTH: f32 = 380.0;
+/// Height of the Quality strip under the image, in points, when the window
+/// opens.
+const QUALITY_HEIGHT: f32 = 190.0;
 
 pub struct Viewer {
     window: Arc<Window>,
@@ -429,6 +432,12 @@ impl Viewer {
                         actions = panel::draw(ui, scene, panel_state, &stats);
                     });
                 });
+            egui::Panel::bottom("marbre-quality")
+                .resizable(true)
+                .default_size(QUALITY_HEIGHT)
+                .show(ui, |ui| {
+                    actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                });
             image_rect = ui.available_rect_before_wrap();
             let response = ui.allocate_rect(image_rect, egui::Sense::click_and_drag());
             dragging = camera_input::apply(ui, &response, &mut scene.camera);
@@ -543,6 +552,12 @@ impl Viewer {
         } else {
             None
         };
+        // Runs the callbacks of finished readbacks (they otherwise wait for
+        // the next submit), so the timer and the error meter are free to
+        // measure this frame, both of them.
+        if let Err(e) = self.ctx.device.poll(wgpu::PollType::Poll) {
+            log::warn!("polling the device: {e}");
+        }
         self.convergence.observe(
             self.renderer.accumulation_generation(),
             self.renderer.poll_error(),
@@ -637,7 +652,30 @@ impl Viewer {
         {
             self.save_window_capture(&texture, &path)?;
         }
+        if is_last {
+            self.report_quality();
+        }
         Ok(!is_last)
+    }
+
+    /// One line on stderr when a scripted run (`--exit-after-frames`) ends:
+    /// what the Quality strip showed, for scripts and tests.
+    fn report_quality(&self) {
+        let spp = self.renderer.accumulated_samples();
+        let error = self
+            .convergence
+            .latest()
+            .map_or("none yet".to_owned(), |e| {
+                format!(
+                    "{:.4} relative (RMSE {:.5}) at {} spp",
+                    e.relative, e.rmse, e.samples
+                )
+            });
+        let trace = match self.timer.as_ref().and_then(|t| t.ms(Pass::Trace)) {
+            Some(ms) => format!("{ms:.1} ms per frame (GPU timestamps)"),
+            None => "not timed (no timestamp queries)".to_owned(),
+        };
+        eprintln!("quality: {spp} spp accumulated; estimated error {error}; trace pass {trace}");
     }
 
     /// Feeds the trace pass's time (GPU, or the whole frame's on the CPU

@@ -179,11 +179,18 @@ pub fn draw(
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
             });
-            section(ui, "Quality", true, |ui| {
-                quality::quality_ui(ui, &mut state.quality, &stats.quality, &mut actions);
-            });
+
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));
         });
+    actions
+}
+
+/// Draws the Quality strip (under the image, so that convergence and cost
+/// stay in view while the side panel scrolls) and returns the buttons
+/// pressed.
+pub fn draw_quality(ui: &mut Ui, state: &mut PanelState, stats: &Stats) -> Vec<PanelAction> {
+    let mut actions = Vec::new();
+    quality::quality_ui(ui, &mut state.quality, &stats.quality, &mut actions);
     actions
 }
 

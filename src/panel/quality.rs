@@ -53,17 +53,21 @@ pub struct QualityStats {
     pub without_ms: Vec<Option<f32>>,
 }
 
+/// Three columns: convergence and its plot, the time of each pass, the
+/// cost of each feature.
 pub fn quality_ui(
     ui: &mut Ui,
     controls: &mut QualityControls,
     stats: &QualityStats,
     actions: &mut Vec<PanelAction>,
 ) {
-    convergence_ui(ui, controls, stats);
-    ui.separator();
-    passes_ui(ui, stats);
-    ui.separator();
-    feature_costs_ui(ui, stats, actions);
+    ui.columns(3, |columns| {
+        convergence_ui(&mut columns[0], controls, stats);
+        passes_ui(&mut columns[1], stats);
+        egui::ScrollArea::vertical()
+            .id_salt("feature costs")
+            .show(&mut columns[2], |ui| feature_costs_ui(ui, stats, actions));
+    });
 }
 
 fn convergence_ui(ui: &mut Ui, controls: &mut QualityControls, stats: &QualityStats) {
@@ -133,15 +137,16 @@ fn error_plot(ui: &mut Ui, target: f64, points: &[[f64; 2]]) {
         .map(|p| [p[0].log10(), p[1].log10()])
         .collect();
     let power_of_ten = |mark: egui_plot::GridMark, _: &std::ops::RangeInclusive<f64>| {
-        format!("{:.3}", 10f64.powf(mark.value))
+        axis_value(10f64.powf(mark.value))
     };
     Plot::new("error against time")
-        .height(160.0)
+        .height(ui.available_height().max(80.0))
         .x_axis_label("seconds (log)")
         .y_axis_label("relative error (log)")
         .x_axis_formatter(power_of_ten)
         .y_axis_formatter(power_of_ten)
         .allow_scroll(false)
+        .legend(egui_plot::Legend::default())
         .show(ui, |plot| {
             if let (Some(first), Some(last)) = (log.first(), log.last()) {
                 let slope = [first[0], last[0]].map(|x| [x, last[1] - 0.5 * (x - last[0])]);
@@ -150,6 +155,18 @@ fn error_plot(ui: &mut Ui, target: f64, points: &[[f64; 2]]) {
             plot.line(Line::new("estimate", PlotPoints::from(log)));
             plot.hline(HLine::new("target", target.log10()));
         });
+}
+
+/// A tick label of a log axis: as few digits as its size needs.
+fn axis_value(v: f64) -> String {
+    if v >= 10.0 {
+        format!("{v:.0}")
+    } else if v >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        let digits = (-v.log10()).ceil() as usize + 1;
+        format!("{v:.digits$}")
+    }
 }
 
 fn human_seconds(s: f64) -> String {
