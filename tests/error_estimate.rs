@@ -4,13 +4,11 @@
 
 mod common;
 
-use common::lambert;
-use glam::Vec3;
+use common::spheres_in_constant_light;
 use marbre::commands::session::{LoadedScene, accumulate, load_scene, renderer_for};
 use marbre::gpu::error_meter::{self, REL_EPSILON};
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{EnvSource, Ground, OrbitCamera, Scene, Sphere};
 use std::path::Path;
 
 const SIZE: (u32, u32) = (48, 32);
@@ -28,38 +26,6 @@ fn rendered(ctx: &GpuContext, samples_per_frame: u32, spp: u32) -> Renderer {
     let mut renderer = renderer_for(ctx, &default_preset(samples_per_frame), SIZE).unwrap();
     accumulate(ctx, &mut renderer, spp, |_| {}).unwrap();
     renderer
-}
-
-/// Diffuse spheres on a ground under a constant sky, three bounces: noise
-/// without fireflies, so the error falls smoothly as 1/√samples.
-fn spheres_under_a_constant_sky() -> Scene {
-    let mut scene = Scene {
-        ground: Some(Ground {
-            height: -1.0,
-            material: lambert(0.5),
-        }),
-        ..Scene::default()
-    };
-    for (x, albedo) in [(-1.1, 0.8), (1.1, 0.3)] {
-        scene.spheres.push(Sphere {
-            name: format!("albedo {albedo}"),
-            center: Vec3::new(x, 0.0, 0.0),
-            radius: 1.0,
-            material: lambert(albedo),
-        });
-    }
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::ONE,
-    };
-    scene.camera = OrbitCamera {
-        target: Vec3::ZERO,
-        distance: 7.0,
-        yaw_degrees: 0.0,
-        pitch_degrees: 15.0,
-        fov_degrees: 45.0,
-    };
-    scene.render.samples_per_frame = 2;
-    scene
 }
 
 /// RMSE and √relMSE of `image` against `reference`, over every channel.
@@ -123,8 +89,10 @@ fn the_gpu_meter_matches_its_cpu_twin_and_falls_as_one_over_frames() {
     };
     let mut rmse_at = Vec::new();
     for spp in [32, 128] {
-        let mut renderer =
-            Renderer::new(&ctx, &spheres_under_a_constant_sky(), None, SIZE).unwrap();
+        // Diffuse spheres under a constant sky: noise without fireflies.
+        let mut scene = spheres_in_constant_light(1.0);
+        scene.render.samples_per_frame = 2;
+        let mut renderer = Renderer::new(&ctx, &scene, None, SIZE).unwrap();
         accumulate(&ctx, &mut renderer, spp, |_| {}).unwrap();
         let gpu = renderer.estimate_error(&ctx).unwrap().expect("two frames");
         let (w, h, mean) = renderer.read_radiance(&ctx).unwrap();

@@ -12,39 +12,8 @@ use marbre::gpu::auto_exposure::{
 use marbre::gpu::metering_grid::grid_pixels;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere, ToneMap};
+use marbre::scene::{PointLight, Scene, ToneMap};
 use wgpu::util::DeviceExt;
-
-/// Two diffuse spheres on a grey ground under a constant environment of
-/// `radiance`: every pixel's radiance is proportional to it.
-fn spheres_in_constant_light(radiance: f32) -> Scene {
-    let mut scene = Scene {
-        ground: Some(Ground {
-            height: -1.0,
-            material: lambert(0.3),
-        }),
-        ..Scene::default()
-    };
-    for (x, albedo) in [(-1.1, 0.8), (1.1, 0.1)] {
-        scene.spheres.push(Sphere {
-            name: format!("albedo {albedo}"),
-            center: Vec3::new(x, 0.0, 0.0),
-            radius: 1.0,
-            material: lambert(albedo),
-        });
-    }
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::splat(radiance),
-    };
-    scene.camera = OrbitCamera {
-        target: Vec3::ZERO,
-        distance: 7.0,
-        yaw_degrees: 0.0,
-        pitch_degrees: 15.0,
-        fov_degrees: 45.0,
-    };
-    scene
-}
 
 /// `scene` traced at `spp` from a fresh renderer (so two scenes see the same
 /// random numbers).

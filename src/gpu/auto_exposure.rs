@@ -12,7 +12,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::metering_grid::MeteringGrid;
-use super::pipelines::{checked, entry, float_texture, shader_module, storage, uniform};
+use super::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
 use super::readback::read_buffer;
 use super::shader_source::Program;
 use anyhow::Result;
@@ -120,30 +120,17 @@ pub struct AutoExposure {
 
 impl AutoExposure {
     pub fn new(device: &wgpu::Device) -> Result<Self> {
-        let module = shader_module(device, Program::AutoExposure, &FeatureSet::default(), "")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("auto exposure"),
-            entries: &[
+        let (pipeline, layout) = compute_pipeline(
+            device,
+            Program::AutoExposure,
+            &FeatureSet::default(),
+            &[
                 entry(0, uniform()),
                 entry(1, float_texture(false)),
                 entry(2, storage(false)),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("auto exposure"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = checked(device, "auto exposure pipeline", || {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("auto exposure"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("cs_meter"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+            "cs_meter",
+        )?;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("metering"),
             size: std::mem::size_of::<MeteringGrid>() as u64,

@@ -6,7 +6,7 @@
 use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::pipelines::{
-    checked, entry, float_texture, permutation_table, shader_module, storage, uniform, upload_atlas,
+    compute_pipeline, entry, float_texture, permutation_table, storage, uniform, upload_atlas,
 };
 use super::readback::read_buffer;
 use super::shader_source::Program;
@@ -31,32 +31,19 @@ pub fn run(
         return Ok(Vec::new());
     }
     let device = &ctx.device;
-    let module = shader_module(device, program, features, "")?;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("compute harness"),
-        entries: &[
+    let (pipeline, layout) = compute_pipeline(
+        device,
+        program,
+        features,
+        &[
             entry(0, uniform()),
             entry(1, storage(true)),
             entry(2, storage(false)),
             entry(6, uniform()),
             entry(8, float_texture(false)),
         ],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("compute harness"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let pipeline = checked(device, "compute harness pipeline", || {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("compute harness"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("cs_evaluate"),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    })?;
+        "cs_evaluate",
+    )?;
     let init = |label: &str, contents: &[u8], usage| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),

@@ -21,7 +21,7 @@ use super::context::GpuContext;
 use super::features::FeatureSet;
 use super::metering_grid::{MeteringGrid, grid_pixels};
 use super::pass_timer::{Pass, PassTimer};
-use super::pipelines::{checked, entry, float_texture, shader_module, storage, uniform};
+use super::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
 use super::readback::read_buffer;
 use super::shader_source::Program;
 use anyhow::Result;
@@ -163,31 +163,18 @@ pub struct Accumulated<'a> {
 
 impl ErrorMeter {
     pub fn new(device: &wgpu::Device) -> Result<Self> {
-        let module = shader_module(device, Program::ErrorMeter, &FeatureSet::default(), "")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("error meter"),
-            entries: &[
+        let (pipeline, layout) = compute_pipeline(
+            device,
+            Program::ErrorMeter,
+            &FeatureSet::default(),
+            &[
                 entry(0, uniform()),
                 entry(1, float_texture(false)),
                 entry(2, float_texture(false)),
                 entry(3, storage(false)),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("error meter"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = checked(device, "error meter pipeline", || {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("error meter"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("cs_error"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+            "cs_error",
+        )?;
         let buffer = |label, size, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),

@@ -20,6 +20,39 @@ pub fn shader_module(
     compile_wgsl(device, program, source)
 }
 
+/// A compute pipeline running `entry_point` of `program` (built with
+/// `features`), with one bind group of `entries`; and that group's layout.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    program: Program,
+    features: &FeatureSet,
+    entries: &[wgpu::BindGroupLayoutEntry],
+    entry_point: &str,
+) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
+    let module = shader_module(device, program, features, "")?;
+    let label = format!("{program:?}");
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(&label),
+        entries,
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = checked(device, &format!("{label} pipeline"), || {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&label),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry_point),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })?;
+    Ok((pipeline, layout))
+}
+
 /// Validates assembled WGSL with naga, then creates the module.
 pub fn compile_wgsl(
     device: &wgpu::Device,

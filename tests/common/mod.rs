@@ -5,7 +5,9 @@
 use glam::{Vec2, Vec3};
 use marbre::commands::session::accumulate;
 use marbre::gpu::{GpuContext, Renderer};
-use marbre::scene::{EnvSource, Ground, Material, RenderSettings, Scene, Texture};
+use marbre::scene::{
+    EnvSource, Ground, Material, OrbitCamera, RenderSettings, Scene, Sphere, Texture,
+};
 
 pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
     render_with(ctx, scene, size, spp, None)
@@ -157,4 +159,35 @@ pub fn assert_ground_matches(
         let p = ground_point(scene, size, at);
         Some(reference(p, Vec2::new(p.x, p.z)))
     });
+}
+
+/// Two diffuse spheres on a grey ground under a constant environment of
+/// `radiance`: every pixel's radiance is proportional to it.
+pub fn spheres_in_constant_light(radiance: f32) -> Scene {
+    let mut scene = Scene {
+        ground: Some(Ground {
+            height: -1.0,
+            material: lambert(0.3),
+        }),
+        ..Scene::default()
+    };
+    for (x, albedo) in [(-1.1, 0.8), (1.1, 0.1)] {
+        scene.spheres.push(Sphere {
+            name: format!("albedo {albedo}"),
+            center: Vec3::new(x, 0.0, 0.0),
+            radius: 1.0,
+            material: lambert(albedo),
+        });
+    }
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::splat(radiance),
+    };
+    scene.camera = OrbitCamera {
+        target: Vec3::ZERO,
+        distance: 7.0,
+        yaw_degrees: 0.0,
+        pitch_degrees: 15.0,
+        fov_degrees: 45.0,
+    };
+    scene
 }
