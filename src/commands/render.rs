@@ -1,6 +1,6 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
-use super::session::{accumulate, load_scene, renderer_for};
+use super::session::{accumulate, load_scene, renderer_for, trace_frame};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::{GpuContext, Renderer};
@@ -133,14 +133,9 @@ fn accumulate_to_error(
 ) -> Result<Option<ErrorEstimate>> {
     let mut last_check: Option<Instant> = None;
     while renderer.accumulated_samples() < max_spp {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.trace(ctx, &mut encoder, None);
-        ctx.queue.submit([encoder.finish()]);
         // Waiting for each frame keeps the GPU no further ahead than the
         // check: a target reached is not overshot by a queue of frames.
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .context("waiting for the GPU")?;
+        trace_frame(ctx, renderer)?;
         bar.set_position(u64::from(renderer.accumulated_samples()));
         if last_check.is_some_and(|t| t.elapsed() < ERROR_CHECK_INTERVAL) {
             continue;

@@ -85,13 +85,20 @@ pub fn accumulate(
     mut progress: impl FnMut(u32),
 ) -> Result<()> {
     while renderer.accumulated_samples() < spp {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.trace(ctx, &mut encoder, None);
-        ctx.queue.submit([encoder.finish()]);
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .context("waiting for the GPU")?;
+        trace_frame(ctx, renderer)?;
         progress(renderer.accumulated_samples());
     }
+    Ok(())
+}
+
+/// Traces one frame and waits for the GPU, so that the caller is never
+/// more than a frame ahead of it.
+pub fn trace_frame(ctx: &GpuContext, renderer: &mut Renderer) -> Result<()> {
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    renderer.trace(ctx, &mut encoder, None);
+    ctx.queue.submit([encoder.finish()]);
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .context("waiting for the GPU")?;
     Ok(())
 }
