@@ -30,7 +30,22 @@ pub struct ConvergenceBenchArgs {
     /// Where references are kept between runs.
     #[arg(long, default_value = "target/marbre-references")]
     pub cache: PathBuf,
+    /// Also writes the measured rows to this CSV file
+    /// (spp,seconds,samples_per_second,rmse).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Also writes the reference (cached or rendered) to this EXR file.
+    #[arg(long)]
+    pub reference_out: Option<PathBuf>,
 }
+
+/// Untimed frames before the reference's samples, one more than before a
+/// measured render: each frame's random sequence depends on how many frames
+/// the renderer traced before it, so the reference's samples are not those
+/// of the measured renders. Were they the same, an n-spp render would be
+/// the reference's first n samples and its RMSE against it would read
+/// σ·√(1/n − 1/N) instead of σ·√(1/n + 1/N), flattering the renderer.
+const REFERENCE_WARM_UP_FRAMES: u32 = 2;
 
 /// Root-mean-square error over every pixel and colour channel.
 pub fn rmse(image: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
@@ -50,7 +65,13 @@ fn reference_path(args: &ConvergenceBenchArgs) -> Result<PathBuf> {
     std::fs::read(&args.preset)
         .with_context(|| format!("reading {}", args.preset.display()))?
         .hash(&mut hasher);
-    (args.size, args.reference_spp, env!("CARGO_PKG_VERSION")).hash(&mut hasher);
+    (
+        args.size,
+        args.reference_spp,
+        REFERENCE_WARM_UP_FRAMES,
+        env!("CARGO_PKG_VERSION"),
+    )
+        .hash(&mut hasher);
     crate::gpu::shader_source::sources_fingerprint().hash(&mut hasher);
     Ok(args
         .cache
@@ -62,11 +83,15 @@ fn render(
     preset: &Path,
     size: (u32, u32),
     spp: u32,
+    warm_up_frames: u32,
 ) -> Result<(Vec<[f32; 4]>, f64)> {
     let loaded = load_scene(preset, None)?;
     let mut renderer = renderer_for(ctx, &loaded, size)?;
-    // One warm-up frame compiles the shader; it is not timed.
-    accumulate(ctx, &mut renderer, 1, |_| {})?;
+    // The first warm-up frame compiles the shader; none is timed.
+    for _ in 0..warm_up_frames {
+        renderer.reset_accumulation();
+        accumulate(ctx, &mut renderer, 1, |_| {})?;
+    }
     renderer.reset_accumulation();
     let start = Instant::now();
     accumulate(ctx, &mut renderer, spp, |_| {})?;
@@ -97,7 +122,13 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
             pixels
         }
         None => {
-            let (pixels, seconds) = render(&ctx, &args.preset, args.size, args.reference_spp)?;
+            let (pixels, seconds) = render(
+                &ctx,
+                &args.preset,
+                args.size,
+                args.reference_spp,
+                REFERENCE_WARM_UP_FRAMES,
+            )?;
             std::fs::create_dir_all(&args.cache)?;
             image_io::save_exr(w, h, &pixels, &cached)?;
             println!(
@@ -107,11 +138,17 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
             pixels
         }
     };
+    if let Some(path) = &args.reference_out {
+        image_io::save_exr(w, h, &reference, path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("reference written to {}", path.display());
+    }
+    let mut csv = String::from("spp,seconds,samples_per_second,rmse\n");
     println!("| spp | seconds | samples/s | RMSE | RMSE × √seconds |");
     println!("|---|---|---|---|---|");
     let mut points = Vec::new();
     for &spp in &args.spp {
-        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp)?;
+        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp, 1)?;
         let error = rmse(&pixels, &reference);
         let samples = f64::from(w * h) * f64::from(spp) / seconds;
         println!(
@@ -119,7 +156,11 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
             samples / 1e6,
             error * seconds.sqrt()
         );
+        csv.push_str(&format!("{spp},{seconds},{samples},{error}\n"));
         points.push((seconds, error));
+    }
+    if let Some(path) = &args.csv {
+        std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;
     }
     // Monte Carlo error falls as 1/√time: RMSE·√t is the constant that
     // predicts the time to any error, t(E) = (RMSE·√t / E)².
