@@ -1,0 +1,198 @@
+//! The findings in words, computed from the points: what a reader would
+//! otherwise work out from the tables. Variants are compared at equal error
+//! (the time each takes to reach the same RMSE), not at equal samples: a
+//! variant that costs twice as much per sample must halve the variance to
+//! break even.
+
+use super::curve_fit::{Reach, log_log_slope, time_to_reach};
+use super::curves::{Curve, curves_of};
+use super::measure::Point;
+use super::sweeps::Knob;
+
+/// A variant counts as having converged once its error at the most samples
+/// is within this factor of the lowest.
+const PLATEAU: f64 = 1.1;
+
+/// One-line findings about `knob`.
+pub fn findings(knob: Knob, points: &[Point]) -> Vec<String> {
+    let curves = curves_of(points, knob);
+    match knob {
+        Knob::Spp => curves.iter().filter_map(convergence_rate).collect(),
+        Knob::Bounces | Knob::Octaves => ordered(&curves),
+        _ => {
+            let mut scenes: Vec<&str> = curves.iter().map(|c| c.scene).collect();
+            scenes.dedup();
+            scenes
+                .into_iter()
+                .flat_map(|scene| {
+                    let of_scene: Vec<&Curve> =
+                        curves.iter().filter(|c| c.scene == scene).collect();
+                    compared(&of_scene)
+                })
+                .collect()
+        }
+    }
+}
+
+/// The fitted exponents of RMSE against time and against samples.
+fn convergence_rate(curve: &Curve) -> Option<String> {
+    let against_time = log_log_slope(&curve.error_against_time())?;
+    let against_spp = log_log_slope(
+        &curve
+            .points
+            .iter()
+            .map(|p| (f64::from(p.spp), p.errors.rmse))
+            .collect::<Vec<_>>(),
+    )?;
+    let halving = if against_time < 0.0 {
+        format!(
+            "each halving of the error costs {:.1}× the time",
+            2f64.powf(-1.0 / against_time)
+        )
+    } else {
+        "the error does not fall with time".to_string()
+    };
+    Some(format!(
+        "{}: RMSE ∝ time^{against_time:.2} and ∝ spp^{against_spp:.2}, fitted over {} renders of {} to {} spp (Monte Carlo predicts −0.5): {halving}.",
+        curve.scene,
+        curve.points.len(),
+        curve.points[0].spp,
+        curve.last().spp,
+    ))
+}
+
+/// For a knob whose variants are increasing values (bounces, octaves): from
+/// which value on the error stops falling, and what the last costs per frame
+/// against the first.
+fn ordered(curves: &[Curve]) -> Vec<String> {
+    let (Some(first), Some(last)) = (curves.first(), curves.last()) else {
+        return Vec::new();
+    };
+    let spp = first.last().spp;
+    let lowest = curves
+        .iter()
+        .map(|c| c.last().errors.rmse)
+        .fold(f64::INFINITY, f64::min);
+    let mut lines = vec![format!(
+        "{}: at {spp} spp the RMSE goes from {:.4} ({}) to {:.4} ({}).",
+        first.scene,
+        first.last().errors.rmse,
+        first.variant,
+        last.last().errors.rmse,
+        last.variant,
+    )];
+    if let Some(converged) = curves
+        .iter()
+        .find(|c| c.last().errors.rmse <= PLATEAU * lowest)
+    {
+        lines.push(format!(
+            "{}: from {} on, the RMSE at {spp} spp is within {:.0} % of the lowest ({lowest:.4}); what more adds is below that much noise.",
+            first.scene,
+            converged.variant,
+            (PLATEAU - 1.0) * 100.0,
+        ));
+    }
+    lines.push(format!(
+        "{}: a frame of {} costs {:.2}× one of {} ({:.2} against {:.2} ms).",
+        first.scene,
+        last.variant,
+        last.last().ms_per_frame / first.last().ms_per_frame,
+        first.variant,
+        last.last().ms_per_frame,
+        first.last().ms_per_frame,
+    ));
+    lines
+}
+
+/// For the variants of one scene: which is best with few samples and with
+/// many, and how much time the best with many saves over each other one at
+/// equal error.
+fn compared(curves: &[&Curve]) -> Vec<String> {
+    let Some(first) = curves.first() else {
+        return Vec::new();
+    };
+    let (fewest, most) = (first.points[0].spp, first.last().spp);
+    let (Some(low), Some(high)) = (lowest_at(curves, fewest), lowest_at(curves, most)) else {
+        return Vec::new();
+    };
+    let names = |tied: &[(&Curve, &Point)]| {
+        tied.iter()
+            .map(|(c, _)| format!("{}'s", c.variant))
+            .collect::<Vec<_>>()
+            .join(" and ")
+    };
+    let mut lines = vec![format!(
+        "{}: the lowest RMSE at {fewest} spp is {} ({:.4}), at {most} spp {} ({:.4}).",
+        first.scene,
+        names(&low),
+        low[0].1.errors.rmse,
+        names(&high),
+        high[0].1.errors.rmse,
+    )];
+    // Of variants with equal error (the same image, as the specialised and
+    // uber shaders make), the quicker one wins.
+    let (best, _) = high
+        .iter()
+        .min_by(|a, b| a.1.seconds.total_cmp(&b.1.seconds))
+        .copied()
+        .expect("lowest_at returns at least one");
+    for other in curves.iter().filter(|c| c.variant != best.variant) {
+        lines.push(equal_error(best, other));
+    }
+    lines
+}
+
+/// The curves with the lowest RMSE at `spp` (several if they tie), with
+/// their point there.
+fn lowest_at<'c, 'p>(
+    curves: &[&'c Curve<'p>],
+    spp: u32,
+) -> Option<Vec<(&'c Curve<'p>, &'p Point)>> {
+    let at: Vec<(&Curve, &Point)> = curves
+        .iter()
+        .filter_map(|&c| c.at_spp(spp).map(|p| (c, p)))
+        .collect();
+    let lowest = at
+        .iter()
+        .map(|(_, p)| p.errors.rmse)
+        .fold(f64::INFINITY, f64::min);
+    let tied: Vec<_> = at
+        .into_iter()
+        .filter(|(_, p)| p.errors.rmse <= lowest * (1.0 + 1e-6))
+        .collect();
+    (!tied.is_empty()).then_some(tied)
+}
+
+/// How long `fast` takes to reach the error `slow` has at its most samples,
+/// against how long `slow` took.
+fn equal_error(fast: &Curve, slow: &Curve) -> String {
+    let target = slow.last();
+    let subject = format!(
+        "{}: {} against the RMSE of {} at {} spp ({:.4}, {:.2} s)",
+        fast.scene, fast.variant, slow.variant, target.spp, target.errors.rmse, target.seconds
+    );
+    let ratio = |t: f64| {
+        let r = target.seconds / t;
+        if r >= 1.0 {
+            format!("{r:.1}× less time")
+        } else {
+            format!("{:.1}× more time", 1.0 / r)
+        }
+    };
+    match time_to_reach(&fast.error_against_time(), target.errors.rmse) {
+        Reach::At(t) => format!("{subject}: reaches it in {t:.2} s, {}.", ratio(t)),
+        Reach::AtMost(t) => format!(
+            "{subject}: already below it at {} spp ({t:.2} s), at least {}.",
+            fast.points[0].spp,
+            ratio(t)
+        ),
+        Reach::Never => {
+            let lowest = fast
+                .points
+                .iter()
+                .map(|p| p.errors.rmse)
+                .fold(f64::INFINITY, f64::min);
+            format!("{subject}: never reaches it within the sweep (its lowest is {lowest:.4}).")
+        }
+    }
+}

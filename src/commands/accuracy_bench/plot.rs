@@ -1,0 +1,114 @@
+//! One PNG per knob: log RMSE against log seconds, a curve per variant.
+//! On these axes Monte Carlo noise is a line of slope −1/2, a bias is a
+//! floor the curve flattens onto, and the variant further down-left at
+//! equal height is the cheaper way to that error.
+
+use super::curves::Curve;
+use super::sweeps::Knob;
+use anyhow::{Context, Result, anyhow};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+const SIZE: (u32, u32) = (900, 600);
+const FONT: &str = "sans-serif";
+
+/// The plots' text is drawn from a font compiled in (egui's Ubuntu
+/// Light), so no system font is needed.
+fn register_font() -> Result<()> {
+    static REGISTER: Once = Once::new();
+    let mut result = Ok(());
+    REGISTER.call_once(|| {
+        result = plotters::style::register_font(
+            FONT,
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        )
+        .map_err(|_| anyhow!("the plot font does not parse"));
+    });
+    result
+}
+
+/// Writes the plot of `knob`'s curves to `path`, captioned with the adapter.
+pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<()> {
+    register_font()?;
+    let series: Vec<(String, Vec<(f64, f64)>)> = curves
+        .iter()
+        .map(|c| {
+            let points = c
+                .error_against_time()
+                .into_iter()
+                .filter(|&(t, e)| t > 0.0 && e > 0.0)
+                .collect();
+            (label(c, curves), points)
+        })
+        .collect();
+    let all = || series.iter().flat_map(|(_, p)| p.iter().copied());
+    let range = |values: Vec<f64>| {
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(0.0, f64::max);
+        // A margin in the logs, and a non-empty range for a single point.
+        (lo / 1.5, hi * 1.5)
+    };
+    let (t0, t1) = range(all().map(|p| p.0).collect());
+    let (e0, e1) = range(all().map(|p| p.1).collect());
+    if !(t0.is_finite() && e0.is_finite() && t0 > 0.0 && e0 > 0.0) {
+        return Err(anyhow!(
+            "no positive time and error to plot for {}",
+            knob.id()
+        ));
+    }
+    let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{}: RMSE against time ({adapter})", knob.title()),
+                (FONT, 20),
+            )
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d((t0..t1).log_scale(), (e0..e1).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("seconds (wall clock, log)")
+            .y_desc("RMSE (log)")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 16))
+            .draw()?;
+        for (i, (name, points)) in series.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            chart
+                .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))?
+                .label(name.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
+                });
+            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FONT, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        root.present()?;
+    }
+    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, pixels)
+        .context("the plot's buffer has the wrong size")?;
+    image
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// The variant, with its scene where the knob is swept on several.
+fn label(curve: &Curve, all: &[Curve]) -> String {
+    if all.iter().all(|c| c.scene == curve.scene) {
+        curve.variant.to_string()
+    } else {
+        format!("{}: {}", curve.scene, curve.variant)
+    }
+}

@@ -1,0 +1,436 @@
+//! The knobs, and for each the scenes it is swept on, its variants and the
+//! reference each variant is measured against. One knob moves at a time;
+//! everything else stays as the scene has it.
+
+use super::scenes;
+use crate::commands::session::LoadedScene;
+use crate::envmap::EnvImage;
+use crate::gpu::FeatureSet;
+use crate::lights::LightSelection;
+use crate::noise::HashKind;
+use crate::scene::{Scene, Strategy};
+use crate::texture::{ImageFilter, ImageSet};
+use anyhow::Result;
+use std::path::Path;
+
+/// What a sweep varies. The names are the `--knobs` values and the CSV's
+/// `knob` column.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Knob {
+    Spp,
+    Bounces,
+    LightSelection,
+    Strategy,
+    EnvSampling,
+    Octaves,
+    OctaveClamping,
+    Filtering,
+    Hash,
+    Shader,
+}
+
+impl Knob {
+    pub const ALL: [Knob; 10] = [
+        Knob::Spp,
+        Knob::Bounces,
+        Knob::LightSelection,
+        Knob::Strategy,
+        Knob::EnvSampling,
+        Knob::Octaves,
+        Knob::OctaveClamping,
+        Knob::Filtering,
+        Knob::Hash,
+        Knob::Shader,
+    ];
+
+    pub fn id(self) -> &'static str {
+        match self {
+            Knob::Spp => "spp",
+            Knob::Bounces => "bounces",
+            Knob::LightSelection => "light-selection",
+            Knob::Strategy => "strategy",
+            Knob::EnvSampling => "env-sampling",
+            Knob::Octaves => "octaves",
+            Knob::OctaveClamping => "octave-clamping",
+            Knob::Filtering => "filtering",
+            Knob::Hash => "hash",
+            Knob::Shader => "shader",
+        }
+    }
+
+    pub fn title(self) -> &'static str {
+        match self {
+            Knob::Spp => "Samples per pixel",
+            Knob::Bounces => "Maximum bounces",
+            Knob::LightSelection => "Light selection",
+            Knob::Strategy => "Direct-light strategy",
+            Knob::EnvSampling => "Environment sampling",
+            Knob::Octaves => "Fractal octaves",
+            Knob::OctaveClamping => "Footprint clamping of octaves",
+            Knob::Filtering => "Texture filtering",
+            Knob::Hash => "Noise hash",
+            Knob::Shader => "Specialised or uber shader",
+        }
+    }
+}
+
+/// How big a run is. Sized for lavapipe on two shared CPU cores, where a
+/// sample per pixel of the Cornell box costs about 15 µs a pixel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scale {
+    pub size: (u32, u32),
+    /// The spp knob renders 1, 2, 4 … up to this many samples per pixel.
+    pub max_spp: u32,
+    /// The spp knob's reference: many times `max_spp`, so that its own
+    /// noise (its variance adds to each point's) leaves the slope alone.
+    pub spp_reference: u32,
+    /// Every other knob renders each variant at these counts, one curve of
+    /// error against time per variant...
+    pub variant_spp: Vec<u32>,
+    /// ...but the bounces, variants of the costliest scene (the Cornell
+    /// box at up to 8 bounces), at these.
+    pub bounce_spp: Vec<u32>,
+    pub reference_spp: u32,
+    /// The maximum bounces swept (against 16).
+    pub bounces: Vec<u32>,
+    /// The octave counts swept (against 16).
+    pub octaves: Vec<u32>,
+}
+
+impl Scale {
+    /// About a minute.
+    pub fn quick() -> Self {
+        Self {
+            size: (48, 48),
+            max_spp: 64,
+            spp_reference: 1024,
+            variant_spp: vec![1, 4, 16],
+            bounce_spp: vec![1, 4, 16],
+            reference_spp: 256,
+            bounces: vec![1, 2, 4, 8],
+            octaves: vec![1, 2, 4, 8, 12],
+        }
+    }
+
+    /// About a quarter of an hour.
+    pub fn full() -> Self {
+        Self {
+            size: (64, 64),
+            max_spp: 1024,
+            spp_reference: 8192,
+            variant_spp: vec![1, 4, 16, 64, 256],
+            bounce_spp: vec![1, 4, 16, 64],
+            reference_spp: 2048,
+            bounces: (1..=8).collect(),
+            octaves: (1..=12).collect(),
+        }
+    }
+}
+
+/// One value of the knob: the scene rendered, the shader's features if not
+/// the scene's own, and the scene whose reference it is measured against.
+pub struct Variant {
+    pub name: String,
+    pub scene: Scene,
+    pub features: Option<FeatureSet>,
+    pub reference: Scene,
+}
+
+/// A knob swept on one scene.
+pub struct Sweep {
+    pub knob: Knob,
+    pub scene_name: String,
+    pub env: Option<EnvImage>,
+    pub images: ImageSet,
+    pub variants: Vec<Variant>,
+    pub spp: Vec<u32>,
+    pub reference_spp: u32,
+}
+
+impl Sweep {
+    /// `variants` of `base`, each at the scale's variant counts.
+    fn new(
+        knob: Knob,
+        scene_name: &str,
+        base: LoadedScene,
+        variants: Vec<Variant>,
+        scale: &Scale,
+    ) -> Self {
+        Self {
+            knob,
+            scene_name: scene_name.into(),
+            env: base.env,
+            images: base.images,
+            variants,
+            spp: scale.variant_spp.clone(),
+            reference_spp: scale.reference_spp,
+        }
+    }
+}
+
+/// Named scenes, each with its shader specialised, all measured against
+/// the reference of `reference`.
+fn against(reference: &Scene, variants: Vec<(String, Scene)>) -> Vec<Variant> {
+    variants
+        .into_iter()
+        .map(|(name, scene)| Variant {
+            name,
+            scene,
+            features: None,
+            reference: reference.clone(),
+        })
+        .collect()
+}
+
+/// `base` with `change` applied.
+fn with(base: &Scene, change: impl FnOnce(&mut Scene)) -> Scene {
+    let mut scene = base.clone();
+    change(&mut scene);
+    scene
+}
+
+/// The sweeps of `knob`. `root` holds `presets/` and `envmaps/`.
+pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
+    Ok(match knob {
+        Knob::Spp => {
+            let scene = scenes::matte_spheres(&root.join("envmaps").join("sky.exr"));
+            let variants = against(&scene, vec![("path tracing".into(), scene.clone())]);
+            let loaded = scenes::prepared(scene)?;
+            let mut sweep = Sweep::new(knob, "matte spheres under sky", loaded, variants, scale);
+            sweep.spp = doublings(scale.max_spp);
+            sweep.reference_spp = scale.spp_reference;
+            vec![sweep]
+        }
+        Knob::Bounces => {
+            let mut cornell = scenes::preset(root, "cornell")?;
+            scenes::hide_the_ceiling(&mut cornell.scene);
+            let base = cornell.scene.clone();
+            let variants = scale
+                .bounces
+                .iter()
+                .map(|&b| {
+                    (
+                        plural(b, "bounce"),
+                        with(&base, |s| s.render.max_bounces = b),
+                    )
+                })
+                .collect();
+            let reference = with(&base, |s| s.render.max_bounces = 16);
+            let variants = against(&reference, variants);
+            let mut sweep = Sweep::new(
+                knob,
+                "cornell (light out of view)",
+                cornell,
+                variants,
+                scale,
+            );
+            sweep.spp.clone_from(&scale.bounce_spp);
+            vec![sweep]
+        }
+        Knob::LightSelection => {
+            let panels = scenes::preset(root, "two_panels")?;
+            let base = panels.scene.clone();
+            let variants = LightSelection::ALL
+                .iter()
+                .map(|&rule| {
+                    let scene = with(&base, |s| s.render.transport.light_selection = rule);
+                    (rule.label().to_string(), scene)
+                })
+                .collect();
+            let reference = with(&base, |s| {
+                s.render.transport.light_selection = LightSelection::Power;
+            });
+            vec![Sweep::new(
+                knob,
+                "two_panels",
+                panels,
+                against(&reference, variants),
+                scale,
+            )]
+        }
+        Knob::Strategy => {
+            let base = scenes::glossy_two_lights();
+            let variants = Strategy::ALL
+                .iter()
+                .map(|&strategy| {
+                    let scene = with(&base, |s| s.render.transport.strategy = strategy);
+                    (strategy.label().to_string(), scene)
+                })
+                .collect();
+            let reference = with(&base, |s| s.render.transport.strategy = Strategy::MisPower);
+            let loaded = scenes::prepared(base)?;
+            vec![Sweep::new(
+                knob,
+                "glossy",
+                loaded,
+                against(&reference, variants),
+                scale,
+            )]
+        }
+        Knob::EnvSampling => ["sky", "esplanade"]
+            .iter()
+            .map(|name| {
+                let map = root.join("envmaps").join(format!("{name}.exr"));
+                let base = scenes::environment_lit(&map);
+                let variants = [("cosine (BSDF only)", false), ("importance", true)]
+                    .iter()
+                    .map(|&(label, on)| {
+                        (
+                            label.to_string(),
+                            with(&base, |s| s.render.env_importance = on),
+                        )
+                    })
+                    .collect();
+                let reference = with(&base, |s| s.render.env_importance = true);
+                let loaded = scenes::prepared(base)?;
+                Ok(Sweep::new(
+                    knob,
+                    name,
+                    loaded,
+                    against(&reference, variants),
+                    scale,
+                ))
+            })
+            .collect::<Result<_>>()?,
+        Knob::Octaves => {
+            let variants = scale
+                .octaves
+                .iter()
+                .map(|&n| {
+                    (
+                        plural(n, "octave"),
+                        scenes::fbm_ground(n as f32, HashKind::Pcg),
+                    )
+                })
+                .collect();
+            let reference = scenes::fbm_ground(16.0, HashKind::Pcg);
+            let loaded = scenes::prepared(reference.clone())?;
+            vec![Sweep::new(
+                knob,
+                "fbm ground",
+                loaded,
+                against(&reference, variants),
+                scale,
+            )]
+        }
+        Knob::OctaveClamping => {
+            let base = scenes::grazing("fBm")?;
+            let variants = vec![
+                ("point sampled".into(), base.clone()),
+                (
+                    "clamped".into(),
+                    with(&base, |s| s.render.clamp_octaves = true),
+                ),
+            ];
+            let loaded = scenes::prepared(base.clone())?;
+            vec![Sweep::new(
+                knob,
+                "grazing fBm",
+                loaded,
+                against(&base, variants),
+                scale,
+            )]
+        }
+        Knob::Filtering => {
+            let image = root.join("presets").join("images").join("uv_grid.png");
+            let nearest = scenes::image_ground(&image, ImageFilter::Nearest);
+            let images = [
+                ("nearest", ImageFilter::Nearest),
+                ("bilinear", ImageFilter::Bilinear),
+                ("mipmapped (trilinear)", ImageFilter::Trilinear),
+            ]
+            .iter()
+            .map(|&(label, filter)| (label.to_string(), scenes::image_ground(&image, filter)))
+            .collect();
+            let checker = scenes::grazing("2D checker")?;
+            let checkers = vec![
+                ("point sampled".into(), checker.clone()),
+                (
+                    "box filtered".into(),
+                    with(&checker, |s| s.render.filter_checkers = true),
+                ),
+            ];
+            vec![
+                Sweep::new(
+                    knob,
+                    "grazing image",
+                    scenes::prepared(nearest.clone())?,
+                    against(&nearest, images),
+                    scale,
+                ),
+                Sweep::new(
+                    knob,
+                    "grazing checker",
+                    scenes::prepared(checker.clone())?,
+                    against(&checker, checkers),
+                    scale,
+                ),
+            ]
+        }
+        Knob::Hash => {
+            let loaded = scenes::prepared(scenes::fbm_ground(10.0, HashKind::Pcg))?;
+            // The two hashes draw different noise, neither wrong: each is
+            // measured against its own reference, and what differs is the
+            // time to reach an error.
+            let variants = HashKind::ALL
+                .iter()
+                .map(|&hash| {
+                    let scene = scenes::fbm_ground(10.0, hash);
+                    Variant {
+                        name: hash.label().to_string(),
+                        scene: scene.clone(),
+                        features: None,
+                        reference: scene,
+                    }
+                })
+                .collect();
+            vec![Sweep::new(knob, "fbm ground", loaded, variants, scale)]
+        }
+        Knob::Shader => {
+            let default = scenes::preset(root, "default")?;
+            let scene = default.scene.clone();
+            let mut variants = against(
+                &scene,
+                vec![
+                    ("specialised".into(), scene.clone()),
+                    ("uber".into(), scene.clone()),
+                ],
+            );
+            variants[1].features = Some(FeatureSet::all());
+            vec![Sweep::new(knob, "default", default, variants, scale)]
+        }
+    })
+}
+
+/// "1 bounce", "2 bounces".
+fn plural(n: u32, noun: &str) -> String {
+    format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
+}
+
+/// 1, 2, 4 … up to `max`.
+fn doublings(max: u32) -> Vec<u32> {
+    std::iter::successors(Some(1u32), |&n| n.checked_mul(2))
+        .take_while(|&n| n <= max.max(1))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_spp_knob_doubles_up_to_its_maximum() {
+        assert_eq!(doublings(1), [1]);
+        assert_eq!(doublings(64), [1, 2, 4, 8, 16, 32, 64]);
+        assert_eq!(doublings(100), [1, 2, 4, 8, 16, 32, 64]);
+    }
+
+    #[test]
+    fn knob_ids_are_their_command_line_names() {
+        use clap::ValueEnum;
+        for knob in Knob::ALL {
+            let value = knob.to_possible_value().unwrap();
+            assert_eq!(value.get_name(), knob.id());
+        }
+    }
+}
