@@ -138,3 +138,36 @@ fn render(
     accumulate(ctx, &mut renderer, spp, progress)?;
     Ok(renderer.read_radiance(ctx)?.2)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Mesh;
+    use crate::test_dir::TempDir;
+
+    /// The file name follows everything that decides the pixels, and only
+    /// that: the same inputs find the same file.
+    #[test]
+    fn the_key_changes_with_the_scene_its_files_the_size_and_the_samples() {
+        let dir = TempDir::new("reference-keys");
+        let obj = dir.path("box.obj");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let cache = ReferenceCache::new(dir.path("cache"));
+        let mut scene = Scene::default();
+        scene.meshes.push(Mesh {
+            obj: obj.clone(),
+            ..Mesh::default()
+        });
+        let key = |scene: &Scene, size, spp| cache.path_of(scene, size, spp).unwrap();
+        let base = key(&scene, (8, 8), 64);
+        assert_eq!(base, key(&scene.clone(), (8, 8), 64));
+        assert_ne!(base, key(&scene, (8, 9), 64));
+        assert_ne!(base, key(&scene, (8, 8), 128));
+        let mut moved = scene.clone();
+        moved.camera.distance += 1.0;
+        assert_ne!(base, key(&moved, (8, 8), 64));
+        std::fs::write(&obj, "v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_ne!(base, key(&scene, (8, 8), 64), "the OBJ file changed");
+        assert!(base.starts_with(dir.path("cache")));
+    }
+}

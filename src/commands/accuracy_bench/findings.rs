@@ -13,6 +13,19 @@ use super::sweeps::Knob;
 /// is within this factor of the lowest.
 const PLATEAU: f64 = 1.1;
 
+/// Times within this factor of each other are "about the same": timings on
+/// a shared machine drift by more.
+const SAME_TIME: f64 = 1.05;
+
+/// Seconds, or milliseconds below one second.
+fn duration(seconds: f64) -> String {
+    if seconds < 1.0 {
+        format!("{:.0} ms", seconds * 1000.0)
+    } else {
+        format!("{seconds:.2} s")
+    }
+}
+
 /// One-line findings about `knob`.
 pub fn findings(knob: Knob, points: &[Point]) -> Vec<String> {
     let curves = curves_of(points, knob);
@@ -168,22 +181,30 @@ fn lowest_at<'c, 'p>(
 fn equal_error(fast: &Curve, slow: &Curve) -> String {
     let target = slow.last();
     let subject = format!(
-        "{}: {} against the RMSE of {} at {} spp ({:.4}, {:.2} s)",
-        fast.scene, fast.variant, slow.variant, target.spp, target.errors.rmse, target.seconds
+        "{}: {} against the RMSE of {} at {} spp ({:.4}, {})",
+        fast.scene,
+        fast.variant,
+        slow.variant,
+        target.spp,
+        target.errors.rmse,
+        duration(target.seconds)
     );
     let ratio = |t: f64| {
         let r = target.seconds / t;
-        if r >= 1.0 {
+        if r >= SAME_TIME {
             format!("{r:.1}× less time")
-        } else {
+        } else if r <= 1.0 / SAME_TIME {
             format!("{:.1}× more time", 1.0 / r)
+        } else {
+            "about the same time".to_string()
         }
     };
     match time_to_reach(&fast.error_against_time(), target.errors.rmse) {
-        Reach::At(t) => format!("{subject}: reaches it in {t:.2} s, {}.", ratio(t)),
+        Reach::At(t) => format!("{subject}: reaches it in {}, {}.", duration(t), ratio(t)),
         Reach::AtMost(t) => format!(
-            "{subject}: already below it at {} spp ({t:.2} s), at least {}.",
+            "{subject}: already below it at {} spp ({}), at least {}.",
             fast.points[0].spp,
+            duration(t),
             ratio(t)
         ),
         Reach::Never => {
@@ -194,5 +215,125 @@ fn equal_error(fast: &Curve, slow: &Curve) -> String {
                 .fold(f64::INFINITY, f64::min);
             format!("{subject}: never reaches it within the sweep (its lowest is {lowest:.4}).")
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::commands::accuracy_bench::error_metrics::ErrorMetrics;
+    use crate::commands::accuracy_bench::frame_timer::TimerKind;
+
+    fn point(knob: Knob, variant: &str, spp: u32, seconds: f64, rmse: f64) -> Point {
+        Point {
+            knob,
+            scene: "scene".into(),
+            variant: variant.into(),
+            spp,
+            ms_per_frame: 1000.0 * seconds / f64::from(spp),
+            seconds,
+            errors: ErrorMetrics {
+                rmse,
+                relmse: rmse * rmse,
+                mae: rmse,
+            },
+            timer: TimerKind::WallClock,
+        }
+    }
+
+    /// Error ∝ spp^-1/2 at 10 ms a sample: slope −0.5 against both, and
+    /// halving the error takes four times the samples.
+    #[test]
+    fn the_spp_finding_reports_the_fitted_rate() {
+        let points: Vec<Point> = [1, 2, 4, 8, 16]
+            .iter()
+            .map(|&n| {
+                point(
+                    Knob::Spp,
+                    "path",
+                    n,
+                    0.01 * f64::from(n),
+                    0.3 / f64::from(n).sqrt(),
+                )
+            })
+            .collect();
+        let lines = findings(Knob::Spp, &points);
+        assert_eq!(lines.len(), 1);
+        assert!(
+            lines[0].contains("time^-0.50 and ∝ spp^-0.50"),
+            "{}",
+            lines[0]
+        );
+        assert!(lines[0].contains("costs 4.0× the time"), "{}", lines[0]);
+    }
+
+    /// `good` has half the error of `bad` at every count for the same time:
+    /// it reaches bad's error at 16 spp (0.5) at 4 spp, in a quarter of
+    /// the time.
+    #[test]
+    fn variants_are_compared_at_equal_error() {
+        let mut points = Vec::new();
+        for n in [1, 4, 16] {
+            let t = f64::from(n);
+            points.push(point(Knob::Strategy, "bad", n, t, 2.0 / t.sqrt()));
+            points.push(point(Knob::Strategy, "good", n, t, 1.0 / t.sqrt()));
+        }
+        let lines = findings(Knob::Strategy, &points);
+        assert_eq!(
+            lines[0],
+            "scene: the lowest RMSE at 1 spp is good's (1.0000), at 16 spp good's (0.2500)."
+        );
+        assert!(lines[1].starts_with("scene: good against the RMSE of bad at 16 spp (0.5000"));
+        assert!(
+            lines[1].ends_with("reaches it in 4.00 s, 4.0× less time."),
+            "{}",
+            lines[1]
+        );
+        assert_eq!(lines.len(), 2);
+    }
+
+    /// Two variants drawing the same image (the specialised and uber
+    /// shaders) tie on error; the quicker one wins.
+    #[test]
+    fn of_tied_variants_the_quicker_wins() {
+        let mut points = Vec::new();
+        for n in [1, 4] {
+            let t = f64::from(n);
+            points.push(point(Knob::Shader, "slow", n, 3.0 * t, 1.0 / t.sqrt()));
+            points.push(point(Knob::Shader, "fast", n, t, 1.0 / t.sqrt()));
+        }
+        let lines = findings(Knob::Shader, &points);
+        assert!(
+            lines[0].contains("at 1 spp is slow's and fast's"),
+            "{}",
+            lines[0]
+        );
+        assert!(
+            lines[1].starts_with("scene: fast against the RMSE of slow"),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[1].contains("3.0× less time"), "{}", lines[1]);
+    }
+
+    /// Bias that stops falling after 3 bounces: 0.5, 0.2, 0.105, 0.1.
+    #[test]
+    fn an_ordered_knob_reports_where_the_error_levels_off() {
+        let points: Vec<Point> = [0.5, 0.2, 0.105, 0.1]
+            .iter()
+            .zip(1..)
+            .map(|(&e, b)| point(Knob::Bounces, &format!("{b} bounces"), 64, f64::from(b), e))
+            .collect();
+        let lines = findings(Knob::Bounces, &points);
+        assert!(
+            lines[1].starts_with("scene: from 3 bounces on"),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[2].contains("costs 4.00× one of 1 bounces"),
+            "{}",
+            lines[2]
+        );
     }
 }

@@ -44,11 +44,14 @@ pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<
         })
         .collect();
     let all = || series.iter().flat_map(|(_, p)| p.iter().copied());
+    // From just below the power of ten under the least value (plotters'
+    // log axis puts grid lines and labels only from the first power of ten
+    // in range, and rounding can put an exact one out), to a margin above
+    // the greatest.
     let range = |values: Vec<f64>| {
         let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = values.iter().copied().fold(0.0, f64::max);
-        // A margin in the logs, and a non-empty range for a single point.
-        (lo / 1.5, hi * 1.5)
+        (0.99 * 10f64.powf((lo / 1.2).log10().floor()), hi * 1.5)
     };
     let (t0, t1) = range(all().map(|p| p.0).collect());
     let (e0, e1) = range(all().map(|p| p.1).collect());
@@ -73,6 +76,10 @@ pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<
             .build_cartesian_2d((t0..t1).log_scale(), (e0..e1).log_scale())?;
         chart
             .configure_mesh()
+            .x_labels(12)
+            .y_labels(12)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
             .x_desc("seconds (wall clock, log)")
             .y_desc("RMSE (log)")
             .label_style((FONT, 14))
@@ -104,11 +111,40 @@ pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// An axis label: 1, 2 and 5 times a power of ten, to two significant
+/// digits (not the float steps of the log axis, 0.30000000000000004); the
+/// other grid lines go unlabelled, or their labels would overlap.
+fn tick(v: f64) -> String {
+    let decade = v.log10().floor();
+    let mantissa = v / 10f64.powf(decade);
+    if ![1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
+        return String::new();
+    }
+    let decimals = (1 - decade as i32).max(0) as usize;
+    format!("{v:.decimals$}")
+}
+
 /// The variant, with its scene where the knob is swept on several.
 fn label(curve: &Curve, all: &[Curve]) -> String {
     if all.iter().all(|c| c.scene == curve.scene) {
         curve.variant.to_string()
     } else {
         format!("{}: {}", curve.scene, curve.variant)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_label_one_two_and_five_to_two_significant_digits() {
+        assert_eq!(tick(0.20000000000000004), "0.20");
+        assert_eq!(tick(0.005), "0.0050");
+        assert_eq!(tick(0.010000000001), "0.010");
+        assert_eq!(tick(2.0), "2.0");
+        assert_eq!(tick(50.0), "50");
+        assert_eq!(tick(0.30000000000000004), "");
+        assert_eq!(tick(7000.0), "");
     }
 }
