@@ -9,6 +9,10 @@ use super::curves::{Curve, curves_of};
 use super::measure::Point;
 use super::sweeps::Knob;
 
+/// Variants whose errors are within this factor make the same image (the
+/// specialised and uber shaders differ in the last bits of a float).
+const TIE: f64 = 1.001;
+
 /// A variant counts as having converged once its error at the most samples
 /// is within this factor of the lowest.
 const PLATEAU: f64 = 1.1;
@@ -150,7 +154,14 @@ fn compared(curves: &[&Curve]) -> Vec<String> {
         .copied()
         .expect("lowest_at returns at least one");
     for other in curves.iter().filter(|c| c.variant != best.variant) {
-        lines.push(equal_error(best, other));
+        lines.push(equal_error(best, other, other.last()));
+    }
+    // A variant best with few samples but not with many (a filter: less
+    // noise, some bias) is worth the time the winner needs to catch up.
+    if let Some((early, at_fewest)) = low.first()
+        && !high.iter().any(|(c, _)| c.variant == early.variant)
+    {
+        lines.push(equal_error(best, early, at_fewest));
     }
     lines
 }
@@ -171,15 +182,14 @@ fn lowest_at<'c, 'p>(
         .fold(f64::INFINITY, f64::min);
     let tied: Vec<_> = at
         .into_iter()
-        .filter(|(_, p)| p.errors.rmse <= lowest * (1.0 + 1e-6))
+        .filter(|(_, p)| p.errors.rmse <= lowest * TIE)
         .collect();
     (!tied.is_empty()).then_some(tied)
 }
 
-/// How long `fast` takes to reach the error `slow` has at its most samples,
-/// against how long `slow` took.
-fn equal_error(fast: &Curve, slow: &Curve) -> String {
-    let target = slow.last();
+/// How long `fast` takes to reach the error of `slow` at `target` (one of
+/// its points), against how long `slow` took there.
+fn equal_error(fast: &Curve, slow: &Curve, target: &Point) -> String {
     let subject = format!(
         "{}: {} against the RMSE of {} at {} spp ({:.4}, {})",
         fast.scene,
@@ -290,6 +300,38 @@ mod tests {
             lines[1]
         );
         assert_eq!(lines.len(), 2);
+    }
+
+    /// A filter with no noise but a bias of 0.3 wins at 1 spp; point
+    /// sampling (error 1/√spp) wins at 64, and needs 4^(1 + ln 0.6 / ln 0.5)
+    /// = 11.1 s to get down to the filter's 1-spp error.
+    #[test]
+    fn a_variant_best_only_with_few_samples_is_caught_up_with() {
+        let mut points = Vec::new();
+        for n in [1, 4, 16, 64] {
+            let t = f64::from(n);
+            points.push(point(Knob::Filtering, "filtered", n, t, 0.3));
+            points.push(point(Knob::Filtering, "point", n, t, 1.0 / t.sqrt()));
+        }
+        let lines = findings(Knob::Filtering, &points);
+        assert_eq!(lines.len(), 3, "{lines:?}");
+        assert!(lines[0].contains("at 1 spp is filtered's (0.3000), at 64 spp point's (0.1250)"));
+        assert!(
+            lines[1].contains("RMSE of filtered at 64 spp"),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[1].ends_with("5.8× less time."), "{}", lines[1]);
+        assert!(
+            lines[2].contains("RMSE of filtered at 1 spp (0.3000, 1.00 s)"),
+            "{}",
+            lines[2]
+        );
+        assert!(
+            lines[2].ends_with("reaches it in 11.11 s, 11.1× more time."),
+            "{}",
+            lines[2]
+        );
     }
 
     /// Two variants drawing the same image (the specialised and uber

@@ -40,13 +40,10 @@ pub struct Bench<'a> {
 impl Bench<'_> {
     /// Every point of `sweep`.
     pub fn measure(&self, sweep: &Sweep) -> Result<Vec<Point>> {
-        let mut references: Vec<(&Scene, Vec<[f32; 4]>)> = Vec::new();
-        for variant in &sweep.variants {
-            if !references.iter().any(|(s, _)| *s == &variant.reference) {
-                let pixels = self.reference(sweep, &variant.reference)?;
-                references.push((&variant.reference, pixels));
-            }
-        }
+        let references = distinct_references(sweep)
+            .into_iter()
+            .map(|scene| Ok((scene, self.reference(sweep, scene)?)))
+            .collect::<Result<Vec<_>>>()?;
         let mut points = Vec::new();
         for variant in &sweep.variants {
             let reference = references
@@ -85,14 +82,8 @@ impl Bench<'_> {
 
     /// The samples per pixel `sweep` renders, its references included.
     pub fn samples(sweep: &Sweep) -> u64 {
-        let mut distinct: Vec<&Scene> = Vec::new();
-        for variant in &sweep.variants {
-            if !distinct.contains(&&variant.reference) {
-                distinct.push(&variant.reference);
-            }
-        }
         let per_variant: u64 = sweep.spp.iter().map(|&n| u64::from(n)).sum();
-        distinct.len() as u64 * u64::from(sweep.reference_spp)
+        distinct_references(sweep).len() as u64 * u64::from(sweep.reference_spp)
             + sweep.variants.len() as u64 * per_variant
     }
 
@@ -138,6 +129,18 @@ impl Bench<'_> {
         accumulate(self.ctx, &mut renderer, 1, |_| {})?;
         Ok(renderer)
     }
+}
+
+/// The scenes whose references the variants of `sweep` are measured
+/// against, each once.
+fn distinct_references(sweep: &Sweep) -> Vec<&Scene> {
+    let mut distinct: Vec<&Scene> = Vec::new();
+    for variant in &sweep.variants {
+        if !distinct.contains(&&variant.reference) {
+            distinct.push(&variant.reference);
+        }
+    }
+    distinct
 }
 
 /// `scene` with the sweep's environment and images.

@@ -85,11 +85,8 @@ pub struct Scale {
     /// noise (its variance adds to each point's) leaves the slope alone.
     pub spp_reference: u32,
     /// Every other knob renders each variant at these counts, one curve of
-    /// error against time per variant...
+    /// error against time per variant.
     pub variant_spp: Vec<u32>,
-    /// ...but the bounces, variants of the costliest scene (the Cornell
-    /// box at up to 8 bounces), at these.
-    pub bounce_spp: Vec<u32>,
     pub reference_spp: u32,
     /// The maximum bounces swept (against 16).
     pub bounces: Vec<u32>,
@@ -105,7 +102,6 @@ impl Scale {
             max_spp: 64,
             spp_reference: 1024,
             variant_spp: vec![1, 4, 16],
-            bounce_spp: vec![1, 4, 16],
             reference_spp: 256,
             bounces: vec![1, 2, 4, 8],
             octaves: vec![1, 2, 4, 8, 12],
@@ -117,9 +113,8 @@ impl Scale {
         Self {
             size: (64, 64),
             max_spp: 1024,
-            spp_reference: 8192,
+            spp_reference: 16384,
             variant_spp: vec![1, 4, 16, 64, 256],
-            bounce_spp: vec![1, 4, 16, 64],
             reference_spp: 2048,
             bounces: (1..=8).collect(),
             octaves: (1..=12).collect(),
@@ -217,15 +212,13 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 .collect();
             let reference = with(&base, |s| s.render.max_bounces = 16);
             let variants = against(&reference, variants);
-            let mut sweep = Sweep::new(
+            vec![Sweep::new(
                 knob,
                 "cornell (light out of view)",
                 cornell,
                 variants,
                 scale,
-            );
-            sweep.spp.clone_from(&scale.bounce_spp);
-            vec![sweep]
+            )]
         }
         Knob::LightSelection => {
             let panels = scenes::preset(root, "two_panels")?;
