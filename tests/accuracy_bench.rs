@@ -87,6 +87,11 @@ fn the_quick_bench_covers_every_knob_and_finds_the_monte_carlo_rate() {
         root: PathBuf::from(env!("CARGO_MANIFEST_DIR")),
     };
     let results = accuracy_bench::run_on(&ctx, &args, false).unwrap();
+    // An empty cache: every reference rendered, and kept for the next run.
+    assert_eq!(results.references_cached, 0);
+    let kept = std::fs::read_dir(&args.cache).unwrap().count();
+    assert!(results.references_rendered >= Knob::ALL.len());
+    assert_eq!(kept, results.references_rendered);
 
     let rows = read_rows(&out.join("results.csv"));
     assert_eq!(rows.len(), results.points.len());

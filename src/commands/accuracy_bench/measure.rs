@@ -5,12 +5,15 @@
 use super::error_metrics::ErrorMetrics;
 use super::frame_timer::{FrameTimer, TimerKind};
 use super::sweeps::{Knob, Sweep, Variant};
-use crate::commands::references::ReferenceCache;
+use crate::commands::references::{Reference, ReferenceCache};
 use crate::commands::session::{LoadedScene, accumulate, renderer_for};
 use crate::gpu::{GpuContext, Renderer};
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
+
+/// Untimed frames before a variant's first timed one.
+const WARM_UP_FRAMES: u32 = 3;
 
 /// One render of one variant at one sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,6 +30,13 @@ pub struct Point {
     pub timer: TimerKind,
 }
 
+/// What a sweep measured.
+pub struct Measured {
+    pub points: Vec<Point>,
+    pub references_rendered: usize,
+    pub references_cached: usize,
+}
+
 /// What a sweep needs besides itself.
 pub struct Bench<'a> {
     pub ctx: &'a GpuContext,
@@ -39,7 +49,7 @@ pub struct Bench<'a> {
 
 impl Bench<'_> {
     /// Every point of `sweep`.
-    pub fn measure(&self, sweep: &Sweep) -> Result<Vec<Point>> {
+    pub fn measure(&self, sweep: &Sweep) -> Result<Measured> {
         let references = distinct_references(sweep)
             .into_iter()
             .map(|scene| Ok((scene, self.reference(sweep, scene)?)))
@@ -49,7 +59,7 @@ impl Bench<'_> {
             let reference = references
                 .iter()
                 .find(|(s, _)| *s == &variant.reference)
-                .map(|(_, pixels)| pixels)
+                .map(|(_, reference)| &reference.pixels)
                 .context("every reference was rendered above")?;
             let mut renderer = self.renderer(sweep, variant)?;
             for &spp in &sweep.spp {
@@ -77,7 +87,11 @@ impl Bench<'_> {
                 });
             }
         }
-        Ok(points)
+        Ok(Measured {
+            points,
+            references_rendered: references.iter().filter(|(_, r)| !r.cached).count(),
+            references_cached: references.iter().filter(|(_, r)| r.cached).count(),
+        })
     }
 
     /// The samples per pixel `sweep` renders, its references included.
@@ -87,7 +101,7 @@ impl Bench<'_> {
             + sweep.variants.len() as u64 * per_variant
     }
 
-    fn reference(&self, sweep: &Sweep, scene: &Scene) -> Result<Vec<[f32; 4]>> {
+    fn reference(&self, sweep: &Sweep, scene: &Scene) -> Result<Reference> {
         self.progress.set_message(format!(
             "{}: {} reference, {} spp",
             sweep.knob.id(),
@@ -107,12 +121,12 @@ impl Bench<'_> {
             .with_context(|| format!("the reference of {}", sweep.scene_name))?;
         self.progress
             .set_position(start + u64::from(sweep.reference_spp));
-        Ok(reference.pixels)
+        Ok(reference)
     }
 
-    /// A fresh renderer of `variant`, one sample per pixel a frame, its
-    /// shader warmed up by one untimed frame (drivers that compile at the
-    /// first draw do it there).
+    /// A fresh renderer of `variant`, one sample per pixel a frame, warmed
+    /// up by a few untimed frames: drivers that compile at the first draw
+    /// do it there, and on lavapipe the next few frames still run slow.
     ///
     /// Fresh, so that every variant of a sweep draws the same random
     /// numbers (the shader seeds from the frame count): the variants'
@@ -126,7 +140,7 @@ impl Bench<'_> {
         if variant.features.is_some() {
             renderer.set_feature_override(self.ctx, variant.features.clone())?;
         }
-        accumulate(self.ctx, &mut renderer, 1, |_| {})?;
+        accumulate(self.ctx, &mut renderer, WARM_UP_FRAMES, |_| {})?;
         Ok(renderer)
     }
 }

@@ -62,6 +62,8 @@ pub struct BenchResults {
     pub adapter: String,
     /// Wall-clock seconds of the whole run, references included.
     pub seconds: f64,
+    pub references_rendered: usize,
+    pub references_cached: usize,
     pub timer: TimerKind,
     pub points: Vec<Point>,
     /// Per knob swept, its findings in words.
@@ -72,10 +74,12 @@ pub fn run(args: &AccuracyBenchArgs) -> Result<()> {
     let ctx = GpuContext::headless()?;
     let results = run_on(&ctx, args, true)?;
     println!(
-        "adapter: {}; time per frame: {}; {:.0} s",
+        "adapter: {}; time per frame: {}; {:.0} s ({} references rendered, {} from the cache)",
         results.adapter,
         results.timer.name(),
-        results.seconds
+        results.seconds,
+        results.references_rendered,
+        results.references_cached,
     );
     for (knob, lines) in &results.findings {
         println!("\n{}", knob.title());
@@ -130,14 +134,19 @@ pub fn run_on(
         timer: &timer,
         progress: &progress,
     };
-    let mut points = Vec::new();
+    let (mut points, mut rendered, mut cached) = (Vec::new(), 0, 0);
     for sweep in &sweeps {
-        points.extend(bench.measure(sweep)?);
+        let measured = bench.measure(sweep)?;
+        points.extend(measured.points);
+        rendered += measured.references_rendered;
+        cached += measured.references_cached;
     }
     progress.finish_and_clear();
     let results = BenchResults {
         adapter: ctx.describe(),
         seconds: started.elapsed().as_secs_f64(),
+        references_rendered: rendered,
+        references_cached: cached,
         timer: timer.kind(),
         findings: knobs
             .iter()
@@ -171,6 +180,8 @@ fn write(args: &AccuracyBenchArgs, scale: &Scale, results: &BenchResults) -> Res
         scale,
         quick: args.quick,
         seconds: results.seconds,
+        references_rendered: results.references_rendered,
+        references_cached: results.references_cached,
     };
     report::write_markdown(&out.join("results.md"), &run, &knobs)
 }

@@ -19,6 +19,8 @@ pub struct RunInfo<'a> {
     pub quick: bool,
     /// Of the whole run, references included.
     pub seconds: f64,
+    pub references_rendered: usize,
+    pub references_cached: usize,
 }
 
 /// What the report says about one knob.
@@ -88,8 +90,8 @@ pub fn write_markdown(path: &Path, run: &RunInfo, knobs: &[KnobReport]) -> Resul
     );
     let _ = writeln!(
         md,
-        "* the run took {:.0} s, references included",
-        run.seconds
+        "* the run took {:.0} s, with {} references rendered and {} read from the cache",
+        run.seconds, run.references_rendered, run.references_cached
     );
     md.push_str("* errors on linear radiance against each variant's high-spp reference: RMSE, relMSE = mean of (x − ref)² / (ref² + 0.01), MAE\n");
     for knob in knobs {
