@@ -1,7 +1,8 @@
 //! One PNG per knob: log RMSE against log seconds, a curve per variant.
 //! On these axes Monte Carlo noise is a line of slope −1/2, a bias is a
 //! floor the curve flattens onto, and the variant further down-left at
-//! equal height is the cheaper way to that error.
+//! equal height is the cheaper way to that error. Nothing is both quick and
+//! accurate, so the legend goes in the lower left corner.
 
 use super::curves::Curve;
 use super::sweeps::Knob;
@@ -78,6 +79,7 @@ pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<
             .configure_mesh()
             .x_labels(12)
             .y_labels(12)
+            .max_light_lines(4)
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
             .x_desc("seconds (wall clock, log)")
@@ -100,7 +102,7 @@ pub fn plot(path: &Path, knob: Knob, curves: &[Curve], adapter: &str) -> Result<
             .label_font((FONT, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .draw()?;
         root.present()?;
     }
