@@ -39,8 +39,8 @@ use sweeps::Scale;
 
 #[derive(Args, Debug, Clone)]
 pub struct AccuracyBenchArgs {
-    /// A small run (48×48, few samples, cheap references): about a minute
-    /// on two CPU cores.
+    /// A small run (48×48, few samples, cheap references): half a minute
+    /// on two CPU cores (lavapipe, release build).
     #[arg(long)]
     pub quick: bool,
     /// The knobs to sweep (default: all).
