@@ -1,8 +1,8 @@
 //! The points of one variant on one scene, in order of samples: one curve
 //! of the plots and one subject of the findings.
 
+use super::knob::Knob;
 use super::measure::Point;
-use super::sweeps::Knob;
 
 pub struct Curve<'a> {
     pub scene: &'a str,

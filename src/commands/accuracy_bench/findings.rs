@@ -6,8 +6,8 @@
 
 use super::curve_fit::{Reach, log_log_slope, time_to_reach};
 use super::curves::{Curve, curves_of};
+use super::knob::Knob;
 use super::measure::Point;
-use super::sweeps::Knob;
 
 /// Variants whose errors are within this factor make the same image (the
 /// specialised and uber shaders differ in the last bits of a float).

@@ -4,7 +4,8 @@
 
 use super::error_metrics::ErrorMetrics;
 use super::frame_timer::{FrameTimer, TimerKind};
-use super::sweeps::{Knob, Sweep, Variant};
+use super::knob::Knob;
+use super::sweeps::{Sweep, Variant};
 use crate::commands::references::{Reference, ReferenceCache};
 use crate::commands::session::{LoadedScene, accumulate, renderer_for};
 use crate::gpu::{GpuContext, Renderer};

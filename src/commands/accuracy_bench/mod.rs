@@ -13,18 +13,20 @@ mod curves;
 mod error_metrics;
 mod findings;
 mod frame_timer;
+mod knob;
 mod measure;
 mod plot;
 mod report;
+mod scale;
 mod scenes;
 mod sweeps;
 
 pub use curve_fit::log_log_slope;
 pub use error_metrics::ErrorMetrics;
 pub use frame_timer::TimerKind;
+pub use knob::Knob;
 pub use measure::Point;
 pub use report::CSV_HEADER;
-pub use sweeps::Knob;
 
 use super::references::ReferenceCache;
 use crate::gpu::GpuContext;
@@ -33,9 +35,9 @@ use clap::Args;
 use frame_timer::FrameTimer;
 use indicatif::{ProgressBar, ProgressStyle};
 use measure::Bench;
+use scale::Scale;
 use std::path::PathBuf;
 use std::time::Instant;
-use sweeps::Scale;
 
 #[derive(Args, Debug, Clone)]
 pub struct AccuracyBenchArgs {

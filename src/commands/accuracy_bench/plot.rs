@@ -5,7 +5,7 @@
 //! accurate, so the legend goes in the lower left corner.
 
 use super::curves::Curve;
-use super::sweeps::Knob;
+use super::knob::Knob;
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use std::path::Path;

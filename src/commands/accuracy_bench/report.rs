@@ -2,8 +2,9 @@
 //! tools; `results.md`, a table and findings per knob with its plot, for
 //! people.
 
+use super::knob::Knob;
 use super::measure::Point;
-use super::sweeps::{Knob, Scale};
+use super::scale::Scale;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;

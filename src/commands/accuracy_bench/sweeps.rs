@@ -1,7 +1,9 @@
-//! The knobs, and for each the scenes it is swept on, its variants and the
+//! For each knob, the scenes it is swept on, its variants and the
 //! reference each variant is measured against. One knob moves at a time;
 //! everything else stays as the scene has it.
 
+use super::knob::Knob;
+use super::scale::Scale;
 use super::scenes;
 use crate::commands::session::LoadedScene;
 use crate::envmap::EnvImage;
@@ -12,115 +14,6 @@ use crate::scene::{Scene, Strategy};
 use crate::texture::{ImageFilter, ImageSet};
 use anyhow::Result;
 use std::path::Path;
-
-/// What a sweep varies. The names are the `--knobs` values and the CSV's
-/// `knob` column.
-#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Knob {
-    Spp,
-    Bounces,
-    LightSelection,
-    Strategy,
-    EnvSampling,
-    Octaves,
-    OctaveClamping,
-    Filtering,
-    Hash,
-    Shader,
-}
-
-impl Knob {
-    pub const ALL: [Knob; 10] = [
-        Knob::Spp,
-        Knob::Bounces,
-        Knob::LightSelection,
-        Knob::Strategy,
-        Knob::EnvSampling,
-        Knob::Octaves,
-        Knob::OctaveClamping,
-        Knob::Filtering,
-        Knob::Hash,
-        Knob::Shader,
-    ];
-
-    pub fn id(self) -> &'static str {
-        match self {
-            Knob::Spp => "spp",
-            Knob::Bounces => "bounces",
-            Knob::LightSelection => "light-selection",
-            Knob::Strategy => "strategy",
-            Knob::EnvSampling => "env-sampling",
-            Knob::Octaves => "octaves",
-            Knob::OctaveClamping => "octave-clamping",
-            Knob::Filtering => "filtering",
-            Knob::Hash => "hash",
-            Knob::Shader => "shader",
-        }
-    }
-
-    pub fn title(self) -> &'static str {
-        match self {
-            Knob::Spp => "Samples per pixel",
-            Knob::Bounces => "Maximum bounces",
-            Knob::LightSelection => "Light selection",
-            Knob::Strategy => "Direct-light strategy",
-            Knob::EnvSampling => "Environment sampling",
-            Knob::Octaves => "Fractal octaves",
-            Knob::OctaveClamping => "Footprint clamping of octaves",
-            Knob::Filtering => "Texture filtering",
-            Knob::Hash => "Noise hash",
-            Knob::Shader => "Specialised or uber shader",
-        }
-    }
-}
-
-/// How big a run is. Sized for lavapipe on two shared CPU cores, where a
-/// sample per pixel of the Cornell box costs about 13 µs a pixel.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Scale {
-    pub size: (u32, u32),
-    /// The spp knob renders 1, 2, 4 … up to this many samples per pixel.
-    pub max_spp: u32,
-    /// The spp knob's reference: many times `max_spp`, so that its own
-    /// noise (its variance adds to each point's) leaves the slope alone.
-    pub spp_reference: u32,
-    /// Every other knob renders each variant at these counts, one curve of
-    /// error against time per variant.
-    pub variant_spp: Vec<u32>,
-    pub reference_spp: u32,
-    /// The maximum bounces swept (against 16).
-    pub bounces: Vec<u32>,
-    /// The octave counts swept (against 16).
-    pub octaves: Vec<u32>,
-}
-
-impl Scale {
-    /// Half a minute in a release build, references included.
-    pub fn quick() -> Self {
-        Self {
-            size: (48, 48),
-            max_spp: 64,
-            spp_reference: 1024,
-            variant_spp: vec![1, 4, 16],
-            reference_spp: 256,
-            bounces: vec![1, 2, 4, 8],
-            octaves: vec![1, 2, 4, 8, 12],
-        }
-    }
-
-    /// Eight minutes in a release build, three with the references cached.
-    pub fn full() -> Self {
-        Self {
-            size: (64, 64),
-            max_spp: 1024,
-            spp_reference: 16384,
-            variant_spp: vec![1, 4, 16, 64, 256],
-            reference_spp: 2048,
-            bounces: (1..=8).collect(),
-            octaves: (1..=12).collect(),
-        }
-    }
-}
 
 /// One value of the knob: the scene rendered, the shader's features if not
 /// the scene's own, and the scene whose reference it is measured against.
@@ -416,14 +309,5 @@ mod tests {
         assert_eq!(doublings(1), [1]);
         assert_eq!(doublings(64), [1, 2, 4, 8, 16, 32, 64]);
         assert_eq!(doublings(100), [1, 2, 4, 8, 16, 32, 64]);
-    }
-
-    #[test]
-    fn knob_ids_are_their_command_line_names() {
-        use clap::ValueEnum;
-        for knob in Knob::ALL {
-            let value = knob.to_possible_value().unwrap();
-            assert_eq!(value.get_name(), knob.id());
-        }
     }
 }
