@@ -3,7 +3,9 @@
 //! tests rely on them.
 
 use clap::{Args, Parser, Subcommand};
-use marbre::commands::{bench, bvh_bench, convergence_bench, noise, render};
+use marbre::commands::{
+    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -42,8 +44,13 @@ enum Command {
     Render(render::RenderArgs),
     /// Evaluate noise at `x,y,z` lines read from stdin, one value per line.
     Noise(noise::NoiseArgs),
+    /// Accuracy against time: one knob at a time (samples, bounces, light
+    /// selection, strategies, environment sampling, octaves, filtering,
+    /// hash, shader), each variant's error against a cached high-spp
+    /// reference; writes a CSV, a Markdown report and plots.
+    Bench(accuracy_bench::AccuracyBenchArgs),
     /// Time every shipped preset at several resolutions.
-    Bench(bench::BenchArgs),
+    BenchPresets(presets_bench::PresetsBenchArgs),
     /// Build the BVH of a heavy generated mesh and time its GPU traversal.
     BenchBvh(bvh_bench::BvhBenchArgs),
     /// Time and error at increasing samples per pixel against a cached
@@ -57,7 +64,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Noise(args)) => noise::run(&args),
-        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Bench(args)) => accuracy_bench::run(&args),
+        Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),
         Some(Command::BenchConvergence(args)) => convergence_bench::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {

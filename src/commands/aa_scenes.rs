@@ -2,7 +2,7 @@
 //! ground under a white constant environment, seen at a grazing angle. Each
 //! point reflects exactly its albedo (every bounce escapes), so the only
 //! error left in one sample per pixel is the texture's own aliasing. Shared
-//! by `marbre bench` and the tests.
+//! by `marbre bench-presets`, `marbre bench` and the tests.
 
 use crate::noise::{FractalParams, NoiseSettings};
 use crate::scene::{EnvSource, Ground, Material, OrbitCamera, Pattern, Scene, Texture};

@@ -4,13 +4,14 @@
 //! time to reach each error, so renderers and settings can be compared at
 //! equal error rather than equal samples.
 
+use super::accuracy_bench::ErrorMetrics;
+use super::references::ReferenceCache;
 use super::render::parse_size;
 use super::session::{accumulate, load_scene, renderer_for};
 use crate::gpu::GpuContext;
 use crate::image_io;
 use anyhow::{Context, Result};
 use clap::Args;
-use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -39,59 +40,16 @@ pub struct ConvergenceBenchArgs {
     pub reference_out: Option<PathBuf>,
 }
 
-/// Untimed frames before the reference's samples, one more than before a
-/// measured render: each frame's random sequence depends on how many frames
-/// the renderer traced before it, so the reference's samples are not those
-/// of the measured renders. Were they the same, an n-spp render would be
-/// the reference's first n samples and its RMSE against it would read
-/// σ·√(1/n − 1/N) instead of σ·√(1/n + 1/N), flattering the renderer.
-const REFERENCE_WARM_UP_FRAMES: u32 = 2;
-
-/// Root-mean-square error over every pixel and colour channel.
-pub fn rmse(image: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
-    let sum: f64 = image
-        .iter()
-        .zip(reference)
-        .map(|(a, b)| (0..3).map(|c| f64::from(a[c] - b[c]).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * image.len().max(1)) as f64).sqrt()
-}
-
-/// The reference's file: keyed by the preset's text, its meshes' files,
-/// the size, the sample count and this build, so a change to any of them
-/// renders a new one.
-fn reference_path(args: &ConvergenceBenchArgs) -> Result<PathBuf> {
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    std::fs::read(&args.preset)
-        .with_context(|| format!("reading {}", args.preset.display()))?
-        .hash(&mut hasher);
-    (
-        args.size,
-        args.reference_spp,
-        REFERENCE_WARM_UP_FRAMES,
-        env!("CARGO_PKG_VERSION"),
-    )
-        .hash(&mut hasher);
-    crate::gpu::shader_source::sources_fingerprint().hash(&mut hasher);
-    Ok(args
-        .cache
-        .join(format!("reference-{:016x}.exr", hasher.finish())))
-}
-
 fn render(
     ctx: &GpuContext,
     preset: &Path,
     size: (u32, u32),
     spp: u32,
-    warm_up_frames: u32,
 ) -> Result<(Vec<[f32; 4]>, f64)> {
     let loaded = load_scene(preset, None)?;
     let mut renderer = renderer_for(ctx, &loaded, size)?;
-    // The first warm-up frame compiles the shader; none is timed.
-    for _ in 0..warm_up_frames {
-        renderer.reset_accumulation();
-        accumulate(ctx, &mut renderer, 1, |_| {})?;
-    }
+    // One warm-up frame compiles the shader; it is not timed.
+    accumulate(ctx, &mut renderer, 1, |_| {})?;
     renderer.reset_accumulation();
     let start = Instant::now();
     accumulate(ctx, &mut renderer, spp, |_| {})?;
@@ -110,34 +68,20 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
         args.preset.display(),
         args.reference_spp
     );
-    let cached = reference_path(args)?;
-    // A cached reference of the wrong size (a hash collision) is re-rendered.
-    let cached_pixels = crate::envmap::load(&cached)
-        .ok()
-        .filter(|l| (l.image.width, l.image.height) == args.size)
-        .map(|l| l.image.pixels);
-    let reference = match cached_pixels {
-        Some(pixels) => {
-            println!("reference: {} (cached)", cached.display());
-            pixels
-        }
-        None => {
-            let (pixels, seconds) = render(
-                &ctx,
-                &args.preset,
-                args.size,
-                args.reference_spp,
-                REFERENCE_WARM_UP_FRAMES,
-            )?;
-            std::fs::create_dir_all(&args.cache)?;
-            image_io::save_exr(w, h, &pixels, &cached)?;
-            println!(
-                "reference: rendered in {seconds:.1} s, saved to {}",
-                cached.display()
-            );
-            pixels
-        }
-    };
+    let loaded = load_scene(&args.preset, None)?;
+    let reference = ReferenceCache::new(&args.cache).get_or_render(
+        &ctx,
+        &loaded,
+        args.size,
+        args.reference_spp,
+        |_| {},
+    )?;
+    if reference.cached {
+        println!("reference: {} (cached)", reference.path.display());
+    } else {
+        println!("reference: rendered, saved to {}", reference.path.display());
+    }
+    let reference = reference.pixels;
     if let Some(path) = &args.reference_out {
         image_io::save_exr(w, h, &reference, path)
             .with_context(|| format!("writing {}", path.display()))?;
@@ -148,16 +92,16 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
     println!("|---|---|---|---|---|");
     let mut points = Vec::new();
     for &spp in &args.spp {
-        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp, 1)?;
-        let error = rmse(&pixels, &reference);
+        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp)?;
+        let error = ErrorMetrics::between(&pixels, &reference).rmse;
         let samples = f64::from(w * h) * f64::from(spp) / seconds;
         println!(
             "| {spp} | {seconds:.2} | {:.3} M | {error:.5} | {:.5} |",
             samples / 1e6,
             error * seconds.sqrt()
         );
-        csv.push_str(&format!("{spp},{seconds},{samples},{error}\n"));
         points.push((seconds, error));
+        csv.push_str(&format!("{spp},{seconds},{samples},{error}\n"));
     }
     if let Some(path) = &args.csv {
         std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;

@@ -1,9 +1,11 @@
 //! The headless commands: each is a thin layer over the library.
 
 pub mod aa_scenes;
-pub mod bench;
+pub mod accuracy_bench;
 pub mod bvh_bench;
 pub mod convergence_bench;
 pub mod noise;
+pub mod presets_bench;
+pub mod references;
 pub mod render;
 pub mod session;

@@ -652,12 +652,14 @@ impl Renderer {
         self.accumulation.reset();
     }
 
-    /// Records one trace pass: `samples_per_frame` more samples per pixel.
+    /// Records one trace pass: `samples_per_frame` more samples per pixel,
+    /// timed by `timestamp_writes` if given (the viewer's
+    /// [`PassTimer::render_pass`], the benchmarks' own query sets).
     pub fn trace(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        timer: Option<&PassTimer>,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         if !self.scene.render.accumulate {
             self.accumulation.reset();
@@ -703,7 +705,7 @@ impl Renderer {
                 label: Some("trace"),
                 color_attachments: &self.accumulation.attachments(),
                 depth_stencil_attachment: None,
-                timestamp_writes: timer.and_then(|t| t.render_pass(Pass::Trace)),
+                timestamp_writes,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

@@ -1,4 +1,4 @@
-//! `marbre bench`: milliseconds per frame for every shipped preset.
+//! `marbre bench-presets`: milliseconds per frame for every shipped preset.
 
 use super::aa_scenes;
 use super::session::{accumulate, load_scene, renderer_for};
@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
-pub struct BenchArgs {
+pub struct PresetsBenchArgs {
     /// Folder of presets to time.
     #[arg(long, default_value = "presets")]
     pub presets: PathBuf,
@@ -62,7 +62,7 @@ fn time_build(ctx: &GpuContext, loaded: &super::session::LoadedScene) -> Result<
     Ok((built, start.elapsed().as_secs_f64() * 1000.0))
 }
 
-pub fn run(args: &BenchArgs) -> Result<()> {
+pub fn run(args: &PresetsBenchArgs) -> Result<()> {
     let ctx = GpuContext::headless()?;
     let mut presets: Vec<PathBuf> = std::fs::read_dir(&args.presets)
         .with_context(|| format!("reading {}", args.presets.display()))?
