@@ -26,12 +26,18 @@ pub struct LoadedScene {
 pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<LoadedScene> {
     let loaded = preset::load(preset_path)?;
     let mut scene = loaded.preset.scene;
-    let mut notes = loaded.notes;
     if let Some(env) = env_override {
         scene.environment.source = EnvSource::LatLong {
             path: env.to_owned(),
         };
     }
+    prepare_scene(scene, loaded.notes)
+}
+
+/// Loads what `scene` reads (its environment, meshes and images) and
+/// clamps what they bring, adding to `notes`: a scene built in code gets
+/// exactly what a preset's would.
+pub fn prepare_scene(mut scene: Scene, mut notes: Vec<String>) -> Result<LoadedScene> {
     // A cube map arrives resampled to lat-long (`cubemap::load_source`).
     let env = cubemap::load_source(&scene.environment.source)?.map(|l| {
         notes.extend(l.notes);

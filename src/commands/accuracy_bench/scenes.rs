@@ -2,8 +2,7 @@
 //! that the knob swept is what decides the error.
 
 use crate::commands::aa_scenes;
-use crate::commands::session::{LoadedScene, load_images, load_scene};
-use crate::cubemap;
+use crate::commands::session::{LoadedScene, load_scene};
 use crate::noise::{FractalParams, HashKind, NoiseSettings};
 use crate::scene::{
     EnvSource, Ground, Integrator, Material, OrbitCamera, Pattern, Scene, Sphere, Texture,
@@ -24,22 +23,6 @@ pub fn preset(root: &Path, name: &str) -> Result<LoadedScene> {
 pub fn hide_the_ceiling(cornell: &mut Scene) {
     cornell.camera.target = Vec3::new(0.0, 0.8, 0.0);
     cornell.camera.fov_degrees = 30.0;
-}
-
-/// A built scene with its environment map and image textures loaded, as a
-/// preset's would be.
-pub fn prepared(scene: Scene) -> Result<LoadedScene> {
-    let env = cubemap::load_source(&scene.environment.source)
-        .context("loading the environment map")?
-        .map(|l| l.image);
-    let mut notes = Vec::new();
-    let images = load_images(&scene, &mut notes)?;
-    Ok(LoadedScene {
-        scene,
-        env,
-        images,
-        notes,
-    })
 }
 
 fn lambert(albedo: f32) -> Material {

@@ -5,7 +5,7 @@
 use super::knob::Knob;
 use super::scale::Scale;
 use super::scenes;
-use crate::commands::session::LoadedScene;
+use crate::commands::session::{LoadedScene, prepare_scene};
 use crate::envmap::EnvImage;
 use crate::gpu::FeatureSet;
 use crate::lights::LightSelection;
@@ -83,7 +83,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
         Knob::Spp => {
             let scene = scenes::matte_spheres(&root.join("envmaps").join("sky.exr"));
             let variants = against(&scene, vec![("path tracing".into(), scene.clone())]);
-            let loaded = scenes::prepared(scene)?;
+            let loaded = prepare_scene(scene, Vec::new())?;
             let mut sweep = Sweep::new(knob, "matte spheres under sky", loaded, variants, scale);
             sweep.spp = doublings(scale.max_spp);
             sweep.reference_spp = scale.spp_reference;
@@ -144,7 +144,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 })
                 .collect();
             let reference = with(&base, |s| s.render.transport.strategy = Strategy::MisPower);
-            let loaded = scenes::prepared(base)?;
+            let loaded = prepare_scene(base, Vec::new())?;
             vec![Sweep::new(
                 knob,
                 "glossy",
@@ -168,7 +168,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                     })
                     .collect();
                 let reference = with(&base, |s| s.render.env_importance = true);
-                let loaded = scenes::prepared(base)?;
+                let loaded = prepare_scene(base, Vec::new())?;
                 Ok(Sweep::new(
                     knob,
                     name,
@@ -190,7 +190,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 })
                 .collect();
             let reference = scenes::fbm_ground(16.0, HashKind::Pcg);
-            let loaded = scenes::prepared(reference.clone())?;
+            let loaded = prepare_scene(reference.clone(), Vec::new())?;
             vec![Sweep::new(
                 knob,
                 "fbm ground",
@@ -208,7 +208,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                     with(&base, |s| s.render.clamp_octaves = true),
                 ),
             ];
-            let loaded = scenes::prepared(base.clone())?;
+            let loaded = prepare_scene(base.clone(), Vec::new())?;
             vec![Sweep::new(
                 knob,
                 "grazing fBm",
@@ -240,21 +240,21 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 Sweep::new(
                     knob,
                     "grazing image",
-                    scenes::prepared(nearest.clone())?,
+                    prepare_scene(nearest.clone(), Vec::new())?,
                     against(&nearest, images),
                     scale,
                 ),
                 Sweep::new(
                     knob,
                     "grazing checker",
-                    scenes::prepared(checker.clone())?,
+                    prepare_scene(checker.clone(), Vec::new())?,
                     against(&checker, checkers),
                     scale,
                 ),
             ]
         }
         Knob::Hash => {
-            let loaded = scenes::prepared(scenes::fbm_ground(10.0, HashKind::Pcg))?;
+            let loaded = prepare_scene(scenes::fbm_ground(10.0, HashKind::Pcg), Vec::new())?;
             // The two hashes draw different noise, neither wrong: each is
             // measured against its own reference, and what differs is the
             // time to reach an error.
