@@ -492,6 +492,9 @@ impl Renderer {
             scene: std::mem::take(&mut pending.target.scene),
             params: pending.target.params.take(),
         };
+        // A new pipeline draws a new image even for the same scene (a
+        // feature compiled out): the samples of the old one must go.
+        self.reset_accumulation();
         self.apply(ctx, target);
     }
 
