@@ -3,6 +3,7 @@
 //! compute harness.
 
 pub mod accumulation;
+pub mod accumulation_harness;
 pub mod async_readback;
 pub mod auto_exposure;
 pub mod bvh_harness;

@@ -199,6 +199,7 @@ impl Renderer {
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
                 entry(16, float_texture(false)),
+                entry(18, float_texture(false)),
                 entry(non_finite::BINDING, storage(false)),
                 entry(MeshBuffers::BINDINGS[0], storage(true)),
                 entry(MeshBuffers::BINDINGS[1], storage(true)),
@@ -320,7 +321,7 @@ impl Renderer {
             &module,
             layout,
             "fs_trace",
-            &[ACCUMULATION_FORMAT; 2],
+            &[ACCUMULATION_FORMAT; 3],
             &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
@@ -700,6 +701,10 @@ impl Renderer {
             bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
             bind(5, wgpu::BindingResource::TextureView(previous_mean)),
             bind(16, wgpu::BindingResource::TextureView(previous_spread)),
+            bind(
+                18,
+                wgpu::BindingResource::TextureView(self.accumulation.latest_compensation_view()),
+            ),
             bind(6, self.perm_buffer.as_entire_binding()),
             bind(7, self.texture_param_buffer.as_entire_binding()),
             bind(
