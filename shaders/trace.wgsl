@@ -7,6 +7,16 @@
 @group(0) @binding(5) var previous: texture_2d<f32>;
 @group(0) @binding(16) var previous_spread: texture_2d<f32>;
 
+// Samples dropped for being NaN or infinite since the accumulation began
+// (gpu/non_finite.rs; cleared before its first frame). A correct renderer
+// never adds to them: the tests and the Stats panel read them.
+struct NonFiniteCounters {
+    nan: atomic<u32>,
+    infinite: atomic<u32>,
+    pixels: atomic<u32>,
+}
+@group(0) @binding(17) var<storage, read_write> non_finite: NonFiniteCounters;
+
 // What one frame leaves per pixel: the running mean of every sample so far,
 // and the running weighted second moment about it (Welford's update).
 struct Accumulated {
@@ -248,22 +258,33 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
     let pixel = vec2u(position.xy);
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);
+    var dropped = 0u;
     for (var k = 0u; k < spp; k++) {
         rng_seed(pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
         let jitter = vec2f(rand(), rand());
         let l = trace_path(vec2f(pixel) + jitter);
-        // A non-finite sample never reaches the accumulation target.
-        if !any_non_finite(l) {
-            sum += l;
+        // A non-finite sample never reaches the accumulation target: it is
+        // dropped and counted. Dividing each sample before adding keeps the
+        // sum of finite samples finite too (spp samples near f32::MAX).
+        if any_non_finite(l) {
+            dropped++;
+            if any_nan(l) {
+                atomicAdd(&non_finite.nan, 1u);
+            } else {
+                atomicAdd(&non_finite.infinite, 1u);
+            }
+        } else {
+            sum += l / f32(spp);
         }
     }
-    let x = sum / f32(spp);
+    let x = sum;
     let n = f32(frame.accumulated);
     // The first frame ignores what the targets held before (a resize or a
     // reset leaves stale texels, which must not leak in, even as NaN * 0).
     let first = frame.accumulated == 0u;
     let prev = select(textureLoad(previous, pixel, 0).xyz, vec3f(0.0), first);
-    let prev_spread = select(textureLoad(previous_spread, pixel, 0).xyz, vec3f(0.0), first);
+    let prev_spread_texel = select(textureLoad(previous_spread, pixel, 0), vec4f(0.0), first);
+    let prev_spread = prev_spread_texel.xyz;
     // A running mean: its rounding error does not grow with the frame count.
     let w = f32(spp) / (n + f32(spp));
     let mean = prev + (x - prev) * w;
@@ -272,6 +293,14 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
     // x_i. With F frames of equal spp, E[spread] = (F - 1)/F · σ²/spp, so the
     // variance of the pixel's mean is estimated by spread / (F - 1)
     // (gpu::error_meter).
-    let spread = prev_spread + ((x - prev) * (x - mean) - prev_spread) * w;
-    return Accumulated(vec4f(mean, 1.0), vec4f(spread, 1.0));
+    // Squares of radiances above ~1e19 overflow: the spread saturates at
+    // the largest float instead of becoming infinite.
+    let spread = min(prev_spread + ((x - prev) * (x - mean) - prev_spread) * w, vec3f(F32_MAX));
+    // The spread's alpha counts this pixel's dropped samples (the magenta
+    // debug view paints where it is not zero).
+    let prev_dropped = prev_spread_texel.w;
+    if dropped > 0u && prev_dropped == 0.0 {
+        atomicAdd(&non_finite.pixels, 1u);
+    }
+    return Accumulated(vec4f(mean, 1.0), vec4f(spread, prev_dropped + f32(dropped)));
 }

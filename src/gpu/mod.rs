@@ -14,6 +14,7 @@ pub mod geometry_buffers;
 pub mod mesh_buffers;
 pub mod metering_grid;
 pub mod noise_harness;
+pub mod non_finite;
 pub mod pass_timer;
 pub mod pipeline_build;
 pub mod pipelines;
@@ -28,4 +29,5 @@ pub mod texture_harness;
 
 pub use context::GpuContext;
 pub use features::{Feature, FeatureSet};
+pub use non_finite::NonFiniteCounts;
 pub use renderer::{DisplayTarget, Renderer, Viewport};
