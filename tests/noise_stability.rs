@@ -16,12 +16,12 @@
 use glam::{DVec3, Vec2, Vec3};
 use marbre::commands::session::{accumulate, load_scene, renderer_for};
 use marbre::gpu::GpuContext;
-use marbre::preset;
 use marbre::gpu::noise_harness::{Evaluate, evaluate_scalar};
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::noise::gradient::GRADIENT_NOISE_BOUND;
 use marbre::noise::perlin::{IMPROVED_NOISE_BOUND, improved_noise};
 use marbre::noise::{self, FractalParams, FractalShape, HashKind, NoiseKind, NoiseSettings};
+use marbre::preset;
 use marbre::scene::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 use marbre::texture::TextureTransform;
 
@@ -71,7 +71,10 @@ fn settings(kind: NoiseKind, hash: HashKind) -> NoiseSettings {
 
 fn cases(hash: HashKind) -> Vec<Case> {
     let mut out = Vec::new();
-    for (kind, label) in [(NoiseKind::Gradient, "gradient"), (NoiseKind::Perlin, "perlin")] {
+    for (kind, label) in [
+        (NoiseKind::Gradient, "gradient"),
+        (NoiseKind::Perlin, "perlin"),
+    ] {
         let s = settings(kind, hash);
         out.push(Case {
             name: label,
@@ -158,7 +161,11 @@ fn box_offset(distance: f64) -> DVec3 {
 /// (centred on the origin for the baseline), placed in f64 and rounded once
 /// to f32, as a hit point would be.
 fn points(distance: f64, n: usize) -> Vec<Vec3> {
-    let a = [0.819_172_513_396_164_4_f64, 0.671_043_606_703_789, 0.549_700_477_901_970_5];
+    let a = [
+        0.819_172_513_396_164_4_f64,
+        0.671_043_606_703_789,
+        0.549_700_477_901_970_5,
+    ];
     let corner = box_offset(distance) - DVec3::splat(BOX_CELLS / 2.0);
     (0..n)
         .map(|k| {
@@ -205,7 +212,10 @@ const DISTRIBUTION_SAMPLES: usize = 8192;
 
 fn assert_all_finite(values: &[f32], what: &str) {
     if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        panic!("{what}: value {i} is non-finite (bits {:#010x})", v.to_bits());
+        panic!(
+            "{what}: value {i} is non-finite (bits {:#010x})",
+            v.to_bits()
+        );
     }
 }
 
@@ -251,7 +261,8 @@ fn far_noise_stays_continuous_on_the_cpu() {
                     .map(|&(a, f)| a * lip * ((q * f) - (p * f)).abs().element_sum())
                     .sum();
                 let slack: f32 = octaves.iter().map(|o| 2.0 * ARITHMETIC * o.0).sum();
-                let jump = (cpu(&case.settings, case.what, q) - cpu(&case.settings, case.what, p)).abs();
+                let jump =
+                    (cpu(&case.settings, case.what, q) - cpu(&case.settings, case.what, p)).abs();
                 assert!(
                     jump <= moved + slack,
                     "{} {:?} at {d:e}: |n({q}) − n({p})| = {jump} > {moved} + {slack}",
@@ -315,13 +326,19 @@ fn octaves_finer_than_f32_spacing_vanish_far_out() {
     for p in &far {
         assert_eq!(noise::noise(*p * 32.0, s.kind, s.hash), 0.0, "{p}");
     }
-    let turbulence = |pts: &[Vec3]| -> Vec<f32> { pts.iter().map(|&p| noise::turbulence(p, &s)).collect() };
+    let turbulence =
+        |pts: &[Vec3]| -> Vec<f32> { pts.iter().map(|&p| noise::turbulence(p, &s)).collect() };
     let near = points(0.0, DISTRIBUTION_SAMPLES);
     let (m_near, _, _) = mean_and_moments(&turbulence(&near));
     let (m_far, _, _) = mean_and_moments(&turbulence(&far));
     let (z_mean, _) = distribution_z_scores(&turbulence(&near), &turbulence(&far));
-    eprintln!("Perlin turbulence mean near the origin {m_near:.4}, at 1e6 {m_far:.4} ({z_mean:.1}σ)");
-    assert!(m_far < m_near && z_mean > Z_LIMIT, "{m_near} vs {m_far}: {z_mean}σ");
+    eprintln!(
+        "Perlin turbulence mean near the origin {m_near:.4}, at 1e6 {m_far:.4} ({z_mean:.1}σ)"
+    );
+    assert!(
+        m_far < m_near && z_mean > Z_LIMIT,
+        "{m_near} vs {m_far}: {z_mean}σ"
+    );
 }
 
 /// The GPU (the real WGSL) equals the CPU within Σᵢ Aᵢ · 2·ARITHMETIC at
@@ -348,7 +365,12 @@ fn far_noise_on_the_gpu_equals_the_cpu() {
             let what = format!("{} {:?} at {d:e}", case.name, case.what);
             assert_all_finite(&gpu, &what);
             let worst = worst_disagreement(&case, &gpu, &pts);
-            assert!(worst.0 <= bound, "{what}: GPU − CPU = {} at {}", worst.0, worst.1);
+            assert!(
+                worst.0 <= bound,
+                "{what}: GPU − CPU = {} at {}",
+                worst.0,
+                worst.1
+            );
         }
     }
 }
@@ -378,13 +400,27 @@ fn the_sin_hash_breaks_down_far_from_the_origin() {
         what: Evaluate::Noise,
     };
     let integer_hash_bound = 2.0 * ARITHMETIC;
-    let baseline_gpu = evaluate_scalar(&ctx, &case.settings, case.what, &points(0.0, DISTRIBUTION_SAMPLES)).unwrap();
+    let baseline_gpu = evaluate_scalar(
+        &ctx,
+        &case.settings,
+        case.what,
+        &points(0.0, DISTRIBUTION_SAMPLES),
+    )
+    .unwrap();
     for d in DISTANCES {
         let pts = points(d, DISTRIBUTION_SAMPLES);
         let gpu = evaluate_scalar(&ctx, &case.settings, case.what, &pts).unwrap();
-        let cpu_values: Vec<f32> = pts.iter().map(|&p| cpu(&case.settings, case.what, p)).collect();
+        let cpu_values: Vec<f32> = pts
+            .iter()
+            .map(|&p| cpu(&case.settings, case.what, p))
+            .collect();
         let worst = worst_disagreement(&case, &gpu, &pts);
-        let mean_abs = gpu.iter().zip(&cpu_values).map(|(g, c)| f64::from((g - c).abs())).sum::<f64>() / pts.len() as f64;
+        let mean_abs = gpu
+            .iter()
+            .zip(&cpu_values)
+            .map(|(g, c)| f64::from((g - c).abs()))
+            .sum::<f64>()
+            / pts.len() as f64;
         let (_, var_gpu, _) = mean_and_moments(&gpu);
         let (_, var_cpu, _) = mean_and_moments(&cpu_values);
         let (zm, zv) = distribution_z_scores(&baseline_gpu, &gpu);
@@ -529,8 +565,16 @@ fn rebased_far_noise_equals_the_exact_noise_on_the_cpu() {
                 "{:?} offset {offset}: rebased error {rebased:.2e} (bound {bound:.2e}), not rebased {plain:.2e}",
                 s.kind
             );
-            assert!(rebased <= bound, "{:?} at {offset}: {rebased} > {bound}", s.kind);
-            assert!(plain > 4.0 * bound, "{:?} at {offset}: rebasing made no difference ({plain})", s.kind);
+            assert!(
+                rebased <= bound,
+                "{:?} at {offset}: {rebased} > {bound}",
+                s.kind
+            );
+            assert!(
+                plain > 4.0 * bound,
+                "{:?} at {offset}: rebasing made no difference ({plain})",
+                s.kind
+            );
         }
     }
 }
@@ -560,7 +604,11 @@ fn rebased_far_noise_equals_the_exact_noise_on_the_gpu() {
             assert_all_finite(&gpu, "rebased fBm");
             for (g, p) in gpu.iter().zip(&surface) {
                 let exact = fbm_f64(p.as_dvec3() - offset.as_dvec3(), &s, truth) as f32;
-                assert!((g - exact).abs() <= bound, "{:?} at {offset}, {p}: GPU {g} vs exact {exact}", s.kind);
+                assert!(
+                    (g - exact).abs() <= bound,
+                    "{:?} at {offset}, {p}: GPU {g} vs exact {exact}",
+                    s.kind
+                );
             }
         }
     }
@@ -574,12 +622,50 @@ fn extremes() -> Vec<(&'static str, FractalParams)> {
     vec![
         ("octaves 0", with(FractalParams { octaves: 0.0, ..d })),
         ("octaves 16", with(FractalParams { octaves: 16.0, ..d })),
-        ("frequency 0", with(FractalParams { frequency: 0.0, ..d })),
-        ("frequency 1e6", with(FractalParams { frequency: 1e6, ..d })),
-        ("persistence 0", with(FractalParams { persistence: 0.0, ..d })),
-        ("persistence 1.5", with(FractalParams { octaves: 16.0, persistence: 1.5, ..d })),
-        ("lacunarity 1", with(FractalParams { octaves: 16.0, lacunarity: 1.0, ..d })),
-        ("amplitude 0", with(FractalParams { amplitude: 0.0, ..d })),
+        (
+            "frequency 0",
+            with(FractalParams {
+                frequency: 0.0,
+                ..d
+            }),
+        ),
+        (
+            "frequency 1e6",
+            with(FractalParams {
+                frequency: 1e6,
+                ..d
+            }),
+        ),
+        (
+            "persistence 0",
+            with(FractalParams {
+                persistence: 0.0,
+                ..d
+            }),
+        ),
+        (
+            "persistence 1.5",
+            with(FractalParams {
+                octaves: 16.0,
+                persistence: 1.5,
+                ..d
+            }),
+        ),
+        (
+            "lacunarity 1",
+            with(FractalParams {
+                octaves: 16.0,
+                lacunarity: 1.0,
+                ..d
+            }),
+        ),
+        (
+            "amplitude 0",
+            with(FractalParams {
+                amplitude: 0.0,
+                ..d
+            }),
+        ),
         (
             "every knob at its maximum",
             FractalParams {
@@ -615,24 +701,49 @@ fn shape_value(s: &NoiseSettings, shape: FractalShape, p: Vec3) -> f32 {
 fn parameter_extremes_evaluate_finite_and_to_their_closed_form_on_the_cpu() {
     for kind in NoiseKind::ALL {
         for (name, fractal) in extremes() {
-            let s = NoiseSettings { kind, hash: HashKind::Pcg, fractal };
-            let case = Case { name, settings: s, what: Evaluate::Fbm };
+            let s = NoiseSettings {
+                kind,
+                hash: HashKind::Pcg,
+                fractal,
+            };
+            let case = Case {
+                name,
+                settings: s,
+                what: Evaluate::Fbm,
+            };
             let bound = value_bound(&case);
             let weights: f32 = octaves(&case).iter().map(|o| o.0).sum();
             for p in extreme_points() {
-                for shape in [FractalShape::Signed, FractalShape::Absolute, FractalShape::Ridged] {
+                for shape in [
+                    FractalShape::Signed,
+                    FractalShape::Absolute,
+                    FractalShape::Ridged,
+                ] {
                     let v = shape_value(&s, shape, p);
-                    let limit = if shape == FractalShape::Ridged { weights } else { bound };
-                    assert!(v.is_finite() && v.abs() <= limit, "{kind:?} {name} {shape:?} at {p}: {v} (bound {limit})");
+                    let limit = if shape == FractalShape::Ridged {
+                        weights
+                    } else {
+                        bound
+                    };
+                    assert!(
+                        v.is_finite() && v.abs() <= limit,
+                        "{kind:?} {name} {shape:?} at {p}: {v} (bound {limit})"
+                    );
                 }
                 let v = noise::fbm(p, &s);
-                let first = fractal.amplitude * noise::noise(p * fractal.frequency, kind, HashKind::Pcg);
+                let first =
+                    fractal.amplitude * noise::noise(p * fractal.frequency, kind, HashKind::Pcg);
                 match name {
-                    "octaves 0" | "frequency 0" | "amplitude 0" => assert_eq!(v, 0.0, "{kind:?} {name} at {p}"),
+                    "octaves 0" | "frequency 0" | "amplitude 0" => {
+                        assert_eq!(v, 0.0, "{kind:?} {name} at {p}")
+                    }
                     "persistence 0" => assert_eq!(v, first, "{kind:?} {name} at {p}"),
                     "lacunarity 1" => {
                         let expected = first * (1.0 - 0.5f32.powi(16)) / 0.5;
-                        assert!((v - expected).abs() <= 1e-5, "{kind:?} {name} at {p}: {v} vs {expected}");
+                        assert!(
+                            (v - expected).abs() <= 1e-5,
+                            "{kind:?} {name} at {p}: {v} vs {expected}"
+                        );
                     }
                     _ => {}
                 }
@@ -654,14 +765,27 @@ fn parameter_extremes_on_the_gpu_equal_the_cpu() {
     let pts = extreme_points();
     for kind in NoiseKind::ALL {
         for (name, fractal) in extremes() {
-            let s = NoiseSettings { kind, hash: HashKind::Pcg, fractal };
+            let s = NoiseSettings {
+                kind,
+                hash: HashKind::Pcg,
+                fractal,
+            };
             for what in [Evaluate::Fbm, Evaluate::Turbulence] {
-                let case = Case { name, settings: s, what };
+                let case = Case {
+                    name,
+                    settings: s,
+                    what,
+                };
                 let bound: f32 = octaves(&case).iter().map(|o| 2.0 * ARITHMETIC * o.0).sum();
                 let gpu = evaluate_scalar(&ctx, &s, what, &pts).unwrap();
                 assert_all_finite(&gpu, name);
                 let worst = worst_disagreement(&case, &gpu, &pts);
-                assert!(worst.0 <= bound, "{kind:?} {name} {what:?}: GPU − CPU = {} at {} (bound {bound})", worst.0, worst.1);
+                assert!(
+                    worst.0 <= bound,
+                    "{kind:?} {name} {what:?}: GPU − CPU = {} at {} (bound {bound})",
+                    worst.0,
+                    worst.1
+                );
             }
         }
     }
@@ -688,7 +812,10 @@ fn out_of_range_parameters_are_clamped_at_load_with_a_note_each() {
         "distortion 1000 clamped to 100",
         "exposure -40 clamped",
     ] {
-        assert!(notes.contains(expected), "no note `{expected}` in:\n{notes}");
+        assert!(
+            notes.contains(expected),
+            "no note `{expected}` in:\n{notes}"
+        );
     }
     assert_eq!(loaded.notes.len(), 7, "{notes}");
     let scene = &loaded.preset.scene;
@@ -698,7 +825,14 @@ fn out_of_range_parameters_are_clamped_at_load_with_a_note_each() {
     };
     let f = noise.fractal;
     assert_eq!(
-        (f.octaves, f.frequency, f.amplitude, f.persistence, f.lacunarity, f.distortion),
+        (
+            f.octaves,
+            f.frequency,
+            f.amplitude,
+            f.persistence,
+            f.lacunarity,
+            f.distortion
+        ),
         (16.0, 1e6, -100.0, 1.5, 1.0, 100.0)
     );
 }
@@ -718,23 +852,34 @@ fn in_range_extremes_load_unchanged() {
     }
 }
 
-/// Renders a hard-case preset small and few-sampled; every read-back
-/// radiance is finite, and displayed pixels exist.
+/// Renders a hard-case preset small and few-sampled: the trace pass
+/// dropped no non-finite sample (it drops them before accumulating, so
+/// the image alone could not show one), every read-back radiance is
+/// finite, and the displayed image exists.
 fn render_finite(ctx: &GpuContext, name: &str) -> Vec<[f32; 4]> {
     let loaded = load_scene(&hard_case(name), None).unwrap();
     let mut renderer = renderer_for(ctx, &loaded, (48, 32)).unwrap();
     accumulate(ctx, &mut renderer, 4, |_| {}).unwrap();
+    let dropped = renderer.count_non_finite(ctx).unwrap();
+    assert!(
+        dropped.is_zero(),
+        "{name}: non-finite samples dropped: {dropped:?}"
+    );
     let (_, _, pixels) = renderer.read_radiance(ctx).unwrap();
     for (i, p) in pixels.iter().enumerate() {
-        assert!(p.iter().all(|c| c.is_finite()), "{name}: pixel {i} is {p:?}");
+        assert!(
+            p.iter().all(|c| c.is_finite()),
+            "{name}: pixel {i} is {p:?}"
+        );
     }
     let shown = renderer.read_display(ctx).unwrap();
     assert_eq!(shown.dimensions(), (48, 32), "{name}");
     pixels
 }
 
-/// The parameter extremes and the far-off noise render: finite radiance in
-/// every pixel, at both ends of the exposure slider too.
+/// The parameter extremes and the far-off noise render: no non-finite
+/// sample and finite radiance in every pixel, at both ends of the exposure
+/// slider too.
 #[test]
 fn hard_case_presets_render_finite() {
     let Some(ctx) = gpu_or_skip("hard_case_presets_render_finite") else {
@@ -790,13 +935,15 @@ mod properties {
             r(FractalParams::PERSISTENCE),
             r(FractalParams::LACUNARITY),
         )
-            .prop_map(|(octaves, frequency, amplitude, persistence, lacunarity)| FractalParams {
-                octaves,
-                frequency,
-                amplitude,
-                persistence,
-                lacunarity,
-                distortion: 0.0,
+            .prop_map(|(octaves, frequency, amplitude, persistence, lacunarity)| {
+                FractalParams {
+                    octaves,
+                    frequency,
+                    amplitude,
+                    persistence,
+                    lacunarity,
+                    distortion: 0.0,
+                }
             })
     }
 
@@ -890,12 +1037,23 @@ mod properties {
             .new_tree(&mut runner)
             .unwrap()
             .current();
-        for case in cases(HashKind::Pcg).into_iter().chain(cases(HashKind::PcgTiled)) {
+        for case in cases(HashKind::Pcg)
+            .into_iter()
+            .chain(cases(HashKind::PcgTiled))
+        {
             let bound: f32 = octaves(&case).iter().map(|o| 2.0 * ARITHMETIC * o.0).sum();
             let gpu = evaluate_scalar(&ctx, &case.settings, case.what, &batch).unwrap();
             assert_all_finite(&gpu, case.name);
             let worst = worst_disagreement(&case, &gpu, &batch);
-            assert!(worst.0 <= bound, "{} {:?} {:?}: GPU − CPU = {} at {}", case.name, case.settings.hash, case.what, worst.0, worst.1);
+            assert!(
+                worst.0 <= bound,
+                "{} {:?} {:?}: GPU − CPU = {} at {}",
+                case.name,
+                case.settings.hash,
+                case.what,
+                worst.0,
+                worst.1
+            );
         }
     }
 }

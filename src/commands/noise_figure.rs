@@ -39,7 +39,10 @@ pub fn write(path: &Path) -> Result<()> {
     let ctx = GpuContext::headless()?;
     let adapter = ctx.adapter.get_info().name;
     register_font()?;
-    let size = (PANEL.0 * HASHES.len() as u32, PANEL.1 * DISTANCES.len() as u32 + 40);
+    let size = (
+        PANEL.0 * HASHES.len() as u32,
+        PANEL.1 * DISTANCES.len() as u32 + 40,
+    );
     let mut pixels = vec![0u8; (size.0 * size.1 * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
@@ -120,10 +123,6 @@ fn panel(
 /// The text is drawn from a font compiled in (egui's Ubuntu Light), so no
 /// system font is needed.
 fn register_font() -> Result<()> {
-    plotters::style::register_font(
-        FONT,
-        FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| anyhow!("the figure's font does not parse"))
+    plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
+        .map_err(|_| anyhow!("the figure's font does not parse"))
 }

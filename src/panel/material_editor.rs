@@ -626,22 +626,44 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
     let f = &mut noise.fractal;
     ui.add(slider(&mut f.octaves, FractalParams::OCTAVES, "octaves"))
         .on_hover_text("Number of noise layers; a fractional part fades the last one in");
-    ui.add(typed_beyond(slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true)))
-        .on_hover_text("Frequency of the first octave, in cycles per scene unit (type up to 1e6)");
+    ui.add(typed_beyond(
+        slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true),
+    ))
+    .on_hover_text("Frequency of the first octave, in cycles per scene unit (type up to 1e6)");
     limit(&mut f.frequency, FractalParams::FREQUENCY);
-    ui.add(typed_beyond(slider(&mut f.amplitude, 0.0..=2.0, "amplitude")))
-        .on_hover_text("Amplitude of the first octave (type any value in ±100)");
+    ui.add(typed_beyond(slider(
+        &mut f.amplitude,
+        0.0..=2.0,
+        "amplitude",
+    )))
+    .on_hover_text("Amplitude of the first octave (type any value in ±100)");
     limit(&mut f.amplitude, FractalParams::AMPLITUDE);
-    ui.add(slider(&mut f.persistence, FractalParams::PERSISTENCE, "persistence"))
-        .on_hover_text(
-            "Amplitude ratio between successive octaves (0.5: each half as strong; \
+    ui.add(slider(
+        &mut f.persistence,
+        FractalParams::PERSISTENCE,
+        "persistence",
+    ))
+    .on_hover_text(
+        "Amplitude ratio between successive octaves (0.5: each half as strong; \
              above 1 the finest octaves dominate)",
-        );
-    ui.add(typed_beyond(slider(&mut f.lacunarity, 1.0..=4.0, "lacunarity")))
-        .on_hover_text("Frequency ratio between successive octaves (2: each twice as fine; type up to 8)");
+    );
+    ui.add(typed_beyond(slider(
+        &mut f.lacunarity,
+        1.0..=4.0,
+        "lacunarity",
+    )))
+    .on_hover_text(
+        "Frequency ratio between successive octaves (2: each twice as fine; type up to 8)",
+    );
     limit(&mut f.lacunarity, FractalParams::LACUNARITY);
-    ui.add(typed_beyond(slider(&mut f.distortion, 0.0..=4.0, "distortion")))
-        .on_hover_text("Domain warp: moves the point by noise before summing (0: none; type any value in ±100)");
+    ui.add(typed_beyond(slider(
+        &mut f.distortion,
+        0.0..=4.0,
+        "distortion",
+    )))
+    .on_hover_text(
+        "Domain warp: moves the point by noise before summing (0: none; type any value in ±100)",
+    );
     limit(&mut f.distortion, FractalParams::DISTORTION);
 }
 

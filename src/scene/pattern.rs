@@ -8,8 +8,8 @@
 use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum, rebase::rebase};
 use crate::texture;
 use glam::{Affine3A, Vec2, Vec3};
-use std::ops::RangeInclusive;
 use serde::{Deserialize, Serialize};
+use std::ops::RangeInclusive;
 
 /// What drives a property across a surface. Each pattern yields a blend
 /// factor `t` in [0, 1] between the texture's two children: `a` where
@@ -99,7 +99,7 @@ impl Signal {
     /// The sum at a surface point given in object and world coordinates.
     pub fn eval(&self, point: &SurfacePoint) -> f32 {
         let p = match self.mapping {
-            Some(m) => self.to_noise_space().transform_point3(m.space_point(point)),
+            Some(m) => self.noise_space_map().transform_point3(m.space_point(point)),
             None => point.object,
         };
         fractal_sum(p, &self.noise, self.shape)
@@ -108,15 +108,15 @@ impl Signal {
     /// The map from surface to noise coordinates, its translation rebased by
     /// whole periods of the noise (`noise::rebase`): the same sum in exact
     /// arithmetic, taken near the origin where f32 resolves it.
-    fn to_noise_space(&self) -> Affine3A {
+    fn noise_space_map(&self) -> Affine3A {
         let mut m = self.mapping.unwrap_or_default().transform.to_texture();
         m.translation = rebase(m.translation.into(), &self.noise).into();
         m
     }
 
-    /// The rows of [`Signal::to_noise_space`], as the shader reads them.
+    /// The rows of [`Signal::noise_space_map`], as the shader reads them.
     pub fn rows(&self) -> [[f32; 4]; 3] {
-        affine_rows(&self.to_noise_space())
+        affine_rows(&self.noise_space_map())
     }
 }
 
@@ -511,8 +511,18 @@ fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) 
         }
     };
     clamp("octaves", &mut f.octaves, FractalParams::OCTAVES, d.octaves);
-    clamp("frequency", &mut f.frequency, FractalParams::FREQUENCY, d.frequency);
-    clamp("amplitude", &mut f.amplitude, FractalParams::AMPLITUDE, d.amplitude);
+    clamp(
+        "frequency",
+        &mut f.frequency,
+        FractalParams::FREQUENCY,
+        d.frequency,
+    );
+    clamp(
+        "amplitude",
+        &mut f.amplitude,
+        FractalParams::AMPLITUDE,
+        d.amplitude,
+    );
     clamp(
         "persistence",
         &mut f.persistence,
