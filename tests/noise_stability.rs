@@ -365,6 +365,10 @@ fn far_noise_on_the_gpu_equals_the_cpu() {
             let what = format!("{} {:?} at {d:e}", case.name, case.what);
             assert_all_finite(&gpu, &what);
             let worst = worst_disagreement(&case, &gpu, &pts);
+            eprintln!(
+                "{what}: max |GPU − CPU| {:.2e} (bound {bound:.1e})",
+                worst.0
+            );
             assert!(
                 worst.0 <= bound,
                 "{what}: GPU − CPU = {} at {}",

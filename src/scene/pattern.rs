@@ -99,7 +99,9 @@ impl Signal {
     /// The sum at a surface point given in object and world coordinates.
     pub fn eval(&self, point: &SurfacePoint) -> f32 {
         let p = match self.mapping {
-            Some(m) => self.noise_space_map().transform_point3(m.space_point(point)),
+            Some(m) => self
+                .noise_space_map()
+                .transform_point3(m.space_point(point)),
             None => point.object,
         };
         fractal_sum(p, &self.noise, self.shape)
