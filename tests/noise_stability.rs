@@ -42,7 +42,7 @@ const DIRECTION: DVec3 = DVec3::new(0.6, -0.48, 0.64);
 /// `g·d` (|g|₁ ≤ 3, |d|∞ ≤ 1) carries 3 roundings, ≤ 3·2⁻²⁴·3 ≈ 5.4e-7;
 /// the fade weights carry ≤ 6 roundings (≈ 3.6e-7), times a corner
 /// difference of at most 6 at each of the 3 interpolation levels, plus
-/// the lerp's own roundings: ≈ 3·(2.2e-6 + 3·6e-8·3) + 5.4e-7 ≈ 8e-6.
+/// the lerp's own roundings: ≈ 3·(2.2e-6 + 3·6e-8·3) + 5.4e-7 ≈ 9e-6.
 /// 1e-5 covers it, on either side of a comparison.
 const ARITHMETIC: f32 = 1e-5;
 
