@@ -22,7 +22,7 @@ use marbre::noise::gradient::GRADIENT_NOISE_BOUND;
 use marbre::noise::perlin::{IMPROVED_NOISE_BOUND, improved_noise};
 use marbre::noise::{self, FractalParams, FractalShape, HashKind, NoiseKind, NoiseSettings};
 use marbre::preset;
-use marbre::scene::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
+use marbre::scene::{MappingSpace, Pattern, Property, Signal, SurfacePoint, TextureMapping};
 use marbre::texture::TextureTransform;
 
 /// The distances from the origin the issue names, the origin first as the
@@ -750,6 +750,40 @@ fn parameter_extremes_evaluate_finite_and_to_their_closed_form_on_the_cpu() {
                         );
                     }
                     _ => {}
+                }
+            }
+        }
+    }
+}
+
+/// Every material of the extremes presets, evaluated by the CPU reference
+/// of the generated texture code at points over its sphere, near the
+/// origin and at 1e3 (object coordinates): every property finite, and each
+/// within the span of the two values its pattern blends (a pattern's blend
+/// factor is clamped to [0, 1], so a property never leaves [a, b]): here
+/// [0, 1] for every one of them, roughness 0 and 1 and opacity 0 included.
+#[test]
+fn extreme_presets_evaluate_finite_and_in_range_on_the_cpu() {
+    for name in [
+        "noise_parameter_extremes.ron",
+        "noise_parameter_extremes_out_of_range.ron",
+    ] {
+        let scene = preset::load(&hard_case(name)).unwrap().preset.scene;
+        for sphere in &scene.spheres {
+            for p in extreme_points() {
+                let at = SurfacePoint {
+                    object: p,
+                    world: p + sphere.center,
+                    uv: Vec2::new(0.25, 0.5),
+                };
+                for property in Property::ALL {
+                    let v = sphere.material.value_at(property, &at);
+                    assert!(
+                        v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0,
+                        "{name}, {}: {} = {v} at {p}",
+                        sphere.name,
+                        property.name()
+                    );
                 }
             }
         }
