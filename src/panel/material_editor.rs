@@ -19,8 +19,12 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
         texture_ui(ui, property.name(), hint, m.texture_mut(property), kind, 1);
         if property == Property::Emission {
             ui.add(
-                slider(&mut m.emission_strength, 0.0..=100.0, "emission strength")
-                    .logarithmic(true),
+                slider(
+                    &mut m.emission_strength,
+                    0.0..=Material::MAX_EMISSION_STRENGTH,
+                    "emission strength",
+                )
+                .logarithmic(true),
             )
             .on_hover_text("Emitted radiance is the emission colour times this");
         }
@@ -33,8 +37,12 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
         ValueKind::Scalar,
         1,
     );
-    ui.add(slider(&mut m.bump_height, -0.5..=0.5, "bump height"))
-        .on_hover_text("Height in scene units of a bump value of 1; 0 turns the bump off");
+    ui.add(slider(
+        &mut m.bump_height,
+        -Material::MAX_BUMP_HEIGHT..=Material::MAX_BUMP_HEIGHT,
+        "bump height",
+    ))
+    .on_hover_text("Height in scene units of a bump value of 1; 0 turns the bump off");
     layers_ui(ui, &mut m.layers);
 }
 

@@ -229,6 +229,14 @@ impl Layer {
 }
 
 impl Material {
+    /// The brightest emission the panel reaches and a preset may hold: an
+    /// emitter of 1e6 (the stability suite's hard case) and no further, so
+    /// that a light's power stays far from f32 overflow.
+    pub const MAX_EMISSION_STRENGTH: f32 = 1.0e6;
+    /// The panel's bump range, in scene units: beyond it the perturbed
+    /// normal is dominated by the height's gradient.
+    pub const MAX_BUMP_HEIGHT: f32 = 0.5;
+
     /// The base texture of `property` (before layers).
     pub fn texture(&self, property: Property) -> &Texture {
         match property {
@@ -368,6 +376,24 @@ impl Material {
             notes.push(format!("{what}: negative emission strength set to 0"));
             self.emission_strength = 0.0;
         }
+        if self.emission_strength > Self::MAX_EMISSION_STRENGTH {
+            notes.push(format!(
+                "{what}: emission strength {} clamped to {}",
+                self.emission_strength,
+                Self::MAX_EMISSION_STRENGTH
+            ));
+            self.emission_strength = Self::MAX_EMISSION_STRENGTH;
+        }
+        if self.bump_height.abs() > Self::MAX_BUMP_HEIGHT {
+            let clamped = self
+                .bump_height
+                .clamp(-Self::MAX_BUMP_HEIGHT, Self::MAX_BUMP_HEIGHT);
+            notes.push(format!(
+                "{what}: bump height {} clamped to {clamped}",
+                self.bump_height
+            ));
+            self.bump_height = clamped;
+        }
     }
 }
 
@@ -410,6 +436,35 @@ mod optional_property_serde {
 mod tests {
     use super::*;
     use crate::scene::{Child, MathOp};
+
+    /// Values the panel cannot reach are clamped at load, each with a note
+    /// that names the field; values it can reach are kept.
+    #[test]
+    fn emission_and_bump_beyond_the_panel_are_clamped_with_a_note() {
+        let mut m = Material {
+            emission_strength: 5.0e7,
+            bump_height: -3.0,
+            ..Material::default()
+        };
+        let mut notes = Vec::new();
+        m.sanitize("sphere 0", &mut notes);
+        assert_eq!(m.emission_strength, Material::MAX_EMISSION_STRENGTH);
+        assert_eq!(m.bump_height, -Material::MAX_BUMP_HEIGHT);
+        assert!(
+            notes.iter().any(|n| n.contains("emission strength")),
+            "{notes:?}"
+        );
+        assert!(notes.iter().any(|n| n.contains("bump height")), "{notes:?}");
+        let mut reachable = Material {
+            emission_strength: 1.0e6,
+            bump_height: 0.5,
+            ..Material::default()
+        };
+        let mut none = Vec::new();
+        reachable.sanitize("sphere 1", &mut none);
+        assert!(none.is_empty(), "{none:?}");
+        assert_eq!(reachable.emission_strength, 1.0e6);
+    }
 
     fn to_ron(m: &Material) -> String {
         ron::ser::to_string_pretty(m, ron::ser::PrettyConfig::default()).unwrap()
