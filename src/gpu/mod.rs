@@ -10,6 +10,7 @@ pub mod compute_harness;
 pub mod context;
 pub mod error_meter;
 pub mod features;
+pub mod geometry_harness;
 pub mod geometry_buffers;
 pub mod mesh_buffers;
 pub mod metering_grid;

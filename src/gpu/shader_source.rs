@@ -87,6 +87,18 @@ const SOURCES: &[(&str, &str)] = &[
         "bvh_harness.wgsl",
         include_str!("../../shaders/bvh_harness.wgsl"),
     ),
+    (
+        "ray_geometry.wgsl",
+        include_str!("../../shaders/ray_geometry.wgsl"),
+    ),
+    (
+        "shading_normal.wgsl",
+        include_str!("../../shaders/shading_normal.wgsl"),
+    ),
+    (
+        "geometry_harness.wgsl",
+        include_str!("../../shaders/geometry_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,10 +117,13 @@ pub enum Program {
     TextureHarness,
     /// The compute pass that sends rays through a triangle mesh's BVH.
     BvhHarness,
+    /// The compute pass that runs the ray geometry (sphere distance, ray
+    /// offset, shading normal) on given inputs.
+    GeometryHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 7] = [
+    pub const ALL: [Program; 8] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -116,6 +131,7 @@ impl Program {
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
+        Program::GeometryHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -148,6 +164,7 @@ impl Program {
                     out.push("bvh.wgsl");
                 }
                 out.extend([
+                    "ray_geometry.wgsl",
                     "intersect.wgsl",
                     "random.wgsl",
                     "bsdf.wgsl",
@@ -162,7 +179,7 @@ impl Program {
                 }
                 out.extend(["fullscreen.wgsl", "trace.wgsl"]);
                 if features.contains(Feature::Bump) {
-                    out.extend(["texture_shading.wgsl", "bump.wgsl"]);
+                    out.extend(["texture_shading.wgsl", "shading_normal.wgsl", "bump.wgsl"]);
                 }
             }
             Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
@@ -183,6 +200,12 @@ impl Program {
                 ]);
             }
             Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
+            Program::GeometryHarness => out.extend([
+                "texture_shading.wgsl",
+                "ray_geometry.wgsl",
+                "shading_normal.wgsl",
+                "geometry_harness.wgsl",
+            ]),
         }
         out
     }

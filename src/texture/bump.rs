@@ -1,13 +1,14 @@
 //! Bump mapping: a height field's gradient over the surface's (u, v) tilts
-//! the shading normal.
+//! the shading normal, which is then kept facing the viewer.
 
 use glam::Vec3;
 
 /// The normal of the surface displaced by a small height `h(u, v)` along
 /// `n` (Blinn 1978), given ∂h/∂u, ∂h/∂v and the tangents ∂p/∂u, ∂p/∂v of an
 /// orthogonal frame: `normalize(n − (∂h/∂u)·∂p/∂u/|∂p/∂u|² −
-/// (∂h/∂v)·∂p/∂v/|∂p/∂v|²)`. A zero-length or non-finite result falls back
-/// to `n`, so a degenerate frame or gradient never makes a NaN normal.
+/// (∂h/∂v)·∂p/∂v/|∂p/∂v|²)`. A vanished or non-finite result falls back to
+/// `n`, so a degenerate frame or gradient never makes a NaN normal, nor one
+/// pointing wherever rounding left it (see [`MIN_TILTED_LENGTH`]).
 pub fn bumped_normal(n: Vec3, dp_du: Vec3, dp_dv: Vec3, dh_du: f32, dh_dv: f32) -> Vec3 {
     let along = |dp: Vec3, dh: f32| {
         let len2 = dp.length_squared();
@@ -19,10 +20,53 @@ pub fn bumped_normal(n: Vec3, dp_du: Vec3, dp_dv: Vec3, dh_du: f32, dh_dv: f32) 
     };
     let tilted = n - along(dp_du, dh_du) - along(dp_dv, dh_dv);
     let len = tilted.length();
-    if len > 0.0 && len.is_finite() {
+    if len >= MIN_TILTED_LENGTH && len.is_finite() {
         tilted / len
     } else {
         n
+    }
+}
+
+/// The shortest tilted normal [`bumped_normal`] normalises (of a unit `n`).
+/// The tilt lies in the tangent plane, so with a proper frame the tilted
+/// normal is at least 1 long; a shorter one means the tangents had a part
+/// along `n` that cancelled it (a degenerate frame), and its direction is
+/// rounding noise: measured, a tangent equal to `n` with a slope of 1 left
+/// a vector of length 6e-8 pointing along ±n at random. 1e-3 keeps every
+/// proper result and rejects those.
+pub const MIN_TILTED_LENGTH: f32 = 1e-3;
+
+/// The least cosine between the shading normal and the viewer that
+/// [`facing_shading_normal`] lets through (`FACING_MIN_COS` in
+/// `shaders/shading_normal.wgsl`): 0.57° above the view's horizon.
+pub const FACING_MIN_COS: f32 = 0.01;
+
+/// The shading normal the BSDF may use, given the bumped normal `n_s`, the
+/// geometric normal `n_g` (facing the viewer) and the direction `wo` to the
+/// viewer, all unit length; the twin of `facing_shading_normal` in
+/// `shaders/shading_normal.wgsl`.
+///
+/// A bump can tilt `n_s` away from the viewer: every BSDF value is then 0
+/// (a black pixel on a lit surface), and one that barely faces it divides
+/// by n·wo ≈ 0. So a normal with n_s·wo below [`FACING_MIN_COS`] is bent
+/// towards the viewer, `normalize(n_s + (FACING_MIN_COS − n_s·wo)·wo)`, the
+/// least change (within the plane of n_s and wo) that leaves it facing
+/// the viewer; its cosine with wo is then FACING_MIN_COS / √(1 +
+/// FACING_MIN_COS² − (n_s·wo)²) ≥ FACING_MIN_COS / √(1 + FACING_MIN_COS²).
+/// pbrt-v4 and Mitsuba likewise keep shading normals on the viewer's side
+/// of the geometric one. Where even the bent normal is unusable (a
+/// non-finite input), `n_g` serves.
+pub fn facing_shading_normal(n_s: Vec3, n_g: Vec3, wo: Vec3) -> Vec3 {
+    let c = n_s.dot(wo);
+    if c >= FACING_MIN_COS {
+        return n_s;
+    }
+    let bent = n_s + (FACING_MIN_COS - c) * wo;
+    let len = bent.length();
+    if len > 0.0 && len.is_finite() {
+        bent / len
+    } else {
+        n_g
     }
 }
 
