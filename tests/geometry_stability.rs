@@ -1120,7 +1120,11 @@ fn bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks() {
     let values = central(&steep);
     let darkest = values.iter().copied().fold(f32::INFINITY, f32::min);
     let brightest = values.iter().copied().fold(0.0, f32::max);
-    println!("steep bump: pixels from {darkest} to {brightest}");
+    let dark = values.iter().filter(|&&v| v <= 0.05 * albedo).count();
+    println!(
+        "steep bump: pixels from {darkest} to {brightest}, {dark} of {} dark",
+        values.len()
+    );
     assert!(brightest <= albedo + 1e-3, "{brightest}");
     assert!(darkest > 0.05 * albedo, "a black pixel: {darkest}");
 }
