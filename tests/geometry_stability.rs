@@ -828,6 +828,10 @@ fn render_loaded(
     accumulate(ctx, &mut renderer, spp, |_| {}).unwrap();
     let (w, h, pixels) = renderer.read_radiance(ctx).unwrap();
     assert_eq!((w, h), size);
+    // The trace pass drops non-finite samples before they reach a pixel:
+    // its counters must say it dropped none.
+    let dropped = renderer.count_non_finite(ctx).unwrap();
+    assert!(dropped.is_zero(), "non-finite samples dropped: {dropped:?}");
     for (i, p) in pixels.iter().enumerate() {
         assert!(p.iter().all(|c| c.is_finite()), "pixel {i}: {p:?}");
     }

@@ -38,6 +38,14 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/env_lookup.wgsl"),
     ),
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
+    (
+        "accumulate.wgsl",
+        include_str!("../../shaders/accumulate.wgsl"),
+    ),
+    (
+        "accumulation_harness.wgsl",
+        include_str!("../../shaders/accumulation_harness.wgsl"),
+    ),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     (
         "metering_grid.wgsl",
@@ -117,13 +125,16 @@ pub enum Program {
     TextureHarness,
     /// The compute pass that sends rays through a triangle mesh's BVH.
     BvhHarness,
+    /// The compute pass that runs the accumulation update over long
+    /// streams of frames.
+    AccumulationHarness,
     /// The compute pass that runs the ray geometry (sphere distance, ray
     /// offset, shading normal) on given inputs.
     GeometryHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 8] = [
+    pub const ALL: [Program; 9] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -131,6 +142,7 @@ impl Program {
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
+        Program::AccumulationHarness,
         Program::GeometryHarness,
     ];
 
@@ -177,7 +189,7 @@ impl Program {
                 if features.contains(Feature::EnvSampling) {
                     out.push("env_sampling.wgsl");
                 }
-                out.extend(["fullscreen.wgsl", "trace.wgsl"]);
+                out.extend(["fullscreen.wgsl", "accumulate.wgsl", "trace.wgsl"]);
                 if features.contains(Feature::Bump) {
                     out.extend(["texture_shading.wgsl", "shading_normal.wgsl", "bump.wgsl"]);
                 }
@@ -200,6 +212,9 @@ impl Program {
                 ]);
             }
             Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
+            Program::AccumulationHarness => {
+                out.extend(["hash.wgsl", "accumulate.wgsl", "accumulation_harness.wgsl"])
+            }
             Program::GeometryHarness => out.extend([
                 "texture_shading.wgsl",
                 "ray_geometry.wgsl",
