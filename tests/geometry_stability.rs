@@ -22,9 +22,7 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec2, Vec3};
-use marbre::commands::session::{
-    LoadedScene, accumulate, load_scene, prepare_scene, renderer_for,
-};
+use marbre::commands::session::{LoadedScene, accumulate, load_scene, prepare_scene, renderer_for};
 use marbre::geometry::{NO_HIT, offset_ray, sphere_distance};
 use marbre::gpu::geometry_harness::{
     ShadingQuery, SphereQuery, offset_rays, shading_normals, sphere_distances,
@@ -131,8 +129,7 @@ fn sphere_reference(q: &SphereQuery) -> SphereReference {
     let perp = f + b * d;
     let disc = r * r - perp.length_squared();
     let (fl, pl) = (f.length(), perp.length());
-    let disc_error =
-        2.0 * (U * r * r + 16.0 * U * fl * pl + 3.0 * U * pl * pl + U * disc.abs());
+    let disc_error = 2.0 * (U * r * r + 16.0 * U * fl * pl + 3.0 * U * pl * pl + U * disc.abs());
     let c = f.length_squared() - r * r;
     let mut t = None;
     let mut t_error = f64::INFINITY;
@@ -351,7 +348,12 @@ fn sphere_distance_matches_double_precision_on_the_cpu_where_the_naive_quadratic
             .iter()
             .map(|q| sphere_distance(q.origin, q.direction, q.center, q.radius))
             .collect();
-        assert_precise(scene, "CPU twin", &compare(&queries, &stable), queries.len());
+        assert_precise(
+            scene,
+            "CPU twin",
+            &compare(&queries, &stable),
+            queries.len(),
+        );
         let naive: Vec<f32> = queries.iter().map(naive_sphere_distance).collect();
         let naive = compare(&queries, &naive);
         println!("{scene}, naive quadratic: {naive:?}");
@@ -378,11 +380,13 @@ fn sphere_distance_matches_double_precision_on_the_gpu() {
             .iter()
             .zip(&gpu)
             .filter(|(q, t)| {
-                sphere_distance(q.origin, q.direction, q.center, q.radius).to_bits()
-                    == t.to_bits()
+                sphere_distance(q.origin, q.direction, q.center, q.radius).to_bits() == t.to_bits()
             })
             .count();
-        println!("{scene}: {same} of {} bit-identical to the CPU twin", queries.len());
+        println!(
+            "{scene}: {same} of {} bit-identical to the CPU twin",
+            queries.len()
+        );
     }
 }
 
@@ -449,7 +453,8 @@ fn grazing_rays_on_spheres_hit_the_near_side_or_miss_as_in_double_precision() {
         .map(|q| sphere_distance(q.origin, q.direction, q.center, q.radius))
         .collect();
     check_grazing("CPU twin", &queries, &cpu);
-    let Some(ctx) = gpu_or_skip("grazing_rays_on_spheres_hit_the_near_side_or_miss_as_in_double_precision")
+    let Some(ctx) =
+        gpu_or_skip("grazing_rays_on_spheres_hit_the_near_side_or_miss_as_in_double_precision")
     else {
         return;
     };
@@ -514,8 +519,16 @@ fn check_shadows(who: &str, queries: &[SphereQuery], blocked: &[bool], got: &[f3
         }
     }
     let occluded = blocked.iter().filter(|&&b| b).count();
-    println!("grazing shadows, {who}: {} wrong of {} ({occluded} occluded)", wrong.len(), queries.len());
-    assert!(wrong.is_empty(), "{who}: {:?}", &wrong[..wrong.len().min(5)]);
+    println!(
+        "grazing shadows, {who}: {} wrong of {} ({occluded} occluded)",
+        wrong.len(),
+        queries.len()
+    );
+    assert!(
+        wrong.is_empty(),
+        "{who}: {:?}",
+        &wrong[..wrong.len().min(5)]
+    );
     assert!(occluded > queries.len() / 10);
 }
 
@@ -531,7 +544,12 @@ fn shadow_rays_from_a_grazingly_lit_ground_stop_at_the_occluder() {
     else {
         return;
     };
-    check_shadows("WGSL", &queries, &blocked, &sphere_distances(&ctx, &queries).unwrap());
+    check_shadows(
+        "WGSL",
+        &queries,
+        &blocked,
+        &sphere_distances(&ctx, &queries).unwrap(),
+    );
 }
 
 // ---- case 3: the ray offset at every scale --------------------------------
@@ -552,7 +570,9 @@ fn check_offset(p: Vec3, n: Vec3, q: Vec3) -> Result<(), String> {
     }
     let moved = (q.as_dvec3() - p.as_dvec3()).dot(n.as_dvec3());
     if moved <= 0.0 {
-        return Err(format!("{p} along {n} went to {q}: {moved} across the plane"));
+        return Err(format!(
+            "{p} along {n} went to {q}: {moved} across the plane"
+        ));
     }
     for i in 0..3 {
         let step = (f64::from(q[i]) - f64::from(p[i])).abs();
@@ -608,7 +628,11 @@ fn offset_ray_on_the_gpu_equals_the_cpu_twin() {
     let gpu = offset_rays(&ctx, &pairs).unwrap();
     for (&(p, n), &q) in pairs.iter().zip(&gpu) {
         check_offset(p, n, q).unwrap();
-        assert_eq!(q.to_array().map(f32::to_bits), offset_ray(p, n).to_array().map(f32::to_bits), "{p} {n}");
+        assert_eq!(
+            q.to_array().map(f32::to_bits),
+            offset_ray(p, n).to_array().map(f32::to_bits),
+            "{p} {n}"
+        );
     }
 }
 
@@ -654,17 +678,31 @@ fn leaving_sphere_rays(scale: f64) -> (Vec<SphereQuery>, Vec<SphereQuery>) {
     (outward, inward)
 }
 
-fn check_leaving(who: &str, scale: f64, outward: &[SphereQuery], inward: &[SphereQuery], distance: impl Fn(&[SphereQuery]) -> Vec<f32>) {
+fn check_leaving(
+    who: &str,
+    scale: f64,
+    outward: &[SphereQuery],
+    inward: &[SphereQuery],
+    distance: impl Fn(&[SphereQuery]) -> Vec<f32>,
+) {
     let out = distance(outward);
     let self_hits: Vec<_> = outward
         .iter()
         .zip(&out)
         .filter(|(_, t)| **t < NO_HIT || !t.is_finite())
         .collect();
-    assert!(self_hits.is_empty(), "{who}, scale {scale}: {} rays met the sphere they left: {:?}", self_hits.len(), &self_hits[..self_hits.len().min(3)]);
+    assert!(
+        self_hits.is_empty(),
+        "{who}, scale {scale}: {} rays met the sphere they left: {:?}",
+        self_hits.len(),
+        &self_hits[..self_hits.len().min(3)]
+    );
     let inside = distance(inward);
     for (q, &t) in inward.iter().zip(&inside) {
-        assert!(t.is_finite() && t < NO_HIT, "{who}, scale {scale}: {q:?} escaped the sphere");
+        assert!(
+            t.is_finite() && t < NO_HIT,
+            "{who}, scale {scale}: {q:?} escaped the sphere"
+        );
         let reference = sphere_reference(q).t.expect("an inside ray hits");
         assert!(
             (f64::from(t) - reference).abs() <= sphere_reference(q).t_error,
@@ -679,11 +717,15 @@ fn rays_leaving_a_sphere_never_meet_it_again_at_any_scale() {
     for scale in [1e-3, 1.0, 1e3, 1e4] {
         let (outward, inward) = leaving_sphere_rays(scale);
         let cpu = |qs: &[SphereQuery]| -> Vec<f32> {
-            qs.iter().map(|q| sphere_distance(q.origin, q.direction, q.center, q.radius)).collect()
+            qs.iter()
+                .map(|q| sphere_distance(q.origin, q.direction, q.center, q.radius))
+                .collect()
         };
         check_leaving("CPU twin", scale, &outward, &inward, cpu);
         if let Some(ctx) = &ctx {
-            check_leaving("WGSL", scale, &outward, &inward, |qs| sphere_distances(ctx, qs).unwrap());
+            check_leaving("WGSL", scale, &outward, &inward, |qs| {
+                sphere_distances(ctx, qs).unwrap()
+            });
         }
         // The fixed offset, for contrast: lost in the rounding at large
         // scales, where the ray starts under the surface.
@@ -692,11 +734,17 @@ fn rays_leaving_a_sphere_never_meet_it_again_at_any_scale() {
             .map(|q| {
                 let n = (q.origin - q.center).normalize();
                 let p = q.center + n * q.radius;
-                SphereQuery { origin: p + 1e-4 * n, ..*q }
+                SphereQuery {
+                    origin: p + 1e-4 * n,
+                    ..*q
+                }
             })
             .collect();
         let naive_hits = cpu(&naive).iter().filter(|t| **t < NO_HIT).count();
-        println!("scale {scale}: a fixed offset of 1e-4 meets the sphere again for {naive_hits} of {} rays", naive.len());
+        println!(
+            "scale {scale}: a fixed offset of 1e-4 meets the sphere again for {naive_hits} of {} rays",
+            naive.len()
+        );
         if scale >= 1e3 {
             assert!(naive_hits > 0, "the contrast should show at scale {scale}");
         }
@@ -756,7 +804,11 @@ fn shading_queries() -> Vec<ShadingQuery> {
 /// it facing the viewer, it is the bumped normal untouched. Where the bump
 /// could not make a normal at all, it is the geometric one.
 fn check_shading(q: &ShadingQuery, bumped: Vec3, shading: Vec3) -> Result<(), String> {
-    let why = |what: &str| Err(format!("{what}: {q:?} → bumped {bumped}, shading {shading}"));
+    let why = |what: &str| {
+        Err(format!(
+            "{what}: {q:?} → bumped {bumped}, shading {shading}"
+        ))
+    };
     if !shading.is_finite() || !bumped.is_finite() {
         return why("non-finite");
     }
@@ -792,8 +844,14 @@ fn shading_normals_stay_finite_and_face_the_viewer() {
         check_shading(q, bumped, shading).unwrap();
         bent += usize::from(shading != bumped);
     }
-    println!("{bent} of {} bumped normals faced away and were bent", queries.len());
-    assert!(bent > queries.len() / 20, "the queries should make normals face away");
+    println!(
+        "{bent} of {} bumped normals faced away and were bent",
+        queries.len()
+    );
+    assert!(
+        bent > queries.len() / 20,
+        "the queries should make normals face away"
+    );
     let Some(ctx) = gpu_or_skip("shading_normals_stay_finite_and_face_the_viewer") else {
         return;
     };
@@ -804,7 +862,11 @@ fn shading_normals_stay_finite_and_face_the_viewer() {
             q.normal,
             q.wo,
         );
-        assert!((cpu - g.shading).length() < 1e-5, "{q:?}: CPU {cpu}, GPU {}", g.shading);
+        assert!(
+            (cpu - g.shading).length() < 1e-5,
+            "{q:?}: CPU {cpu}, GPU {}",
+            g.shading
+        );
     }
 }
 
@@ -915,7 +977,10 @@ fn a_sphere_in_a_white_furnace_has_no_dark_silhouette_ring() {
                 // The silhouette (22 pixels in radius) cannot hide between
                 // 8 × 8 points and cover more than a sliver.
                 let expected = 1.0 - (1.0 - albedo) * coarse;
-                assert!((v - expected).abs() < 0.02, "({x}, {y}): {v}, not {expected}");
+                assert!(
+                    (v - expected).abs() < 0.02,
+                    "({x}, {y}): {v}, not {expected}"
+                );
                 continue;
             }
             let coverage = sphere_coverage(&scene, size, (x, y), 128);
@@ -932,9 +997,14 @@ fn a_sphere_in_a_white_furnace_has_no_dark_silhouette_ring() {
     }
     let mean = sum_diff / f64::from(ring);
     let mean_error = sum_var.sqrt() / f64::from(ring);
-    println!("silhouette ring: {ring} pixels, mean deviation {mean:.5} (standard error {mean_error:.5})");
+    println!(
+        "silhouette ring: {ring} pixels, mean deviation {mean:.5} (standard error {mean_error:.5})"
+    );
     assert!(ring > 100, "{ring}");
-    assert!(mean.abs() <= 5.0 * mean_error + grid_error / 4.0, "{mean} ± {mean_error}");
+    assert!(
+        mean.abs() <= 5.0 * mean_error + grid_error / 4.0,
+        "{mean} ± {mean_error}"
+    );
 }
 
 /// The fraction of pixels lit by the point light, and which: with one
@@ -978,7 +1048,12 @@ fn a_scene_lights_the_same_pixels_at_every_scale() {
         let pixels = render(name);
         let mask = lit_mask(&pixels);
         let fraction = mask.iter().filter(|&&l| l).count() as f64 / n;
-        let differ = mask.iter().zip(&reference_mask).filter(|(a, b)| a != b).count() as f64 / n;
+        let differ = mask
+            .iter()
+            .zip(&reference_mask)
+            .filter(|(a, b)| a != b)
+            .count() as f64
+            / n;
         // Lit pixels keep their radiance, but for those whose sample
         // crossed a silhouette (sphere at one scale, ground at the other).
         let shifted = pixels
@@ -993,9 +1068,18 @@ fn a_scene_lights_the_same_pixels_at_every_scale() {
             100.0 * differ,
             100.0 * shifted
         );
-        assert!((fraction - lit).abs() <= 0.005 * lit, "{name}: {fraction} lit, scale 1 {lit}");
-        assert!(differ <= 0.005 * lit, "{name}: {differ} of the pixels differ");
-        assert!(shifted <= 0.005 * lit, "{name}: {shifted} of the pixels differ in radiance");
+        assert!(
+            (fraction - lit).abs() <= 0.005 * lit,
+            "{name}: {fraction} lit, scale 1 {lit}"
+        );
+        assert!(
+            differ <= 0.005 * lit,
+            "{name}: {differ} of the pixels differ"
+        );
+        assert!(
+            shifted <= 0.005 * lit,
+            "{name}: {shifted} of the pixels differ in radiance"
+        );
     }
 }
 
@@ -1036,7 +1120,11 @@ fn degenerate_obj_geometry_is_reported_and_renders_as_without_it() {
             .iter()
             .any(|n| n.contains(file) && words.iter().all(|w| n.contains(w)))
     };
-    assert!(noted(&["1 triangles", "NaN", "dropped"]), "{:?}", loaded.notes);
+    assert!(
+        noted(&["1 triangles", "NaN", "dropped"]),
+        "{:?}",
+        loaded.notes
+    );
     assert!(noted(&["4 triangles", "zero area"]), "{:?}", loaded.notes);
     let geometry = &loaded.scene.meshes[0].geometry.0;
     assert_eq!(geometry.len(), 18, "the NaN triangle is not rendered");
@@ -1044,26 +1132,42 @@ fn degenerate_obj_geometry_is_reported_and_renders_as_without_it() {
 
     let table = LightTable::build(&loaded.scene, &emitter_triangles(&loaded.scene));
     assert_eq!(table.lights.len(), 2, "only the light's two real triangles");
-    assert!(table.notes.iter().any(|n| n.contains("2 emissive triangles with zero area")), "{:?}", table.notes);
+    assert!(
+        table
+            .notes
+            .iter()
+            .any(|n| n.contains("2 emissive triangles with zero area")),
+        "{:?}",
+        table.notes
+    );
     let emitters = emitter_triangles(&loaded.scene);
     for selection in LightSelection::ALL {
-        let sum: f32 = (0..table.lights.len()).map(|i| table.pmf(i, selection)).sum();
+        let sum: f32 = (0..table.lights.len())
+            .map(|i| table.pmf(i, selection))
+            .sum();
         assert!((sum - 1.0).abs() < 1e-6, "{selection:?}: {sum}");
         for (i, light) in table.lights.iter().enumerate() {
             let pmf = table.pmf(i, selection);
             let area = triangle_area(&emitters[light.primitive as usize].vertices);
             let density = pmf / area;
-            assert!(pmf > 0.0 && density.is_finite() && density > 0.0, "{selection:?} {i}");
+            assert!(
+                pmf > 0.0 && density.is_finite() && density > 0.0,
+                "{selection:?} {i}"
+            );
         }
     }
 
-    let Some(ctx) = gpu_or_skip("degenerate_obj_geometry_is_reported_and_renders_as_without_it") else {
+    let Some(ctx) = gpu_or_skip("degenerate_obj_geometry_is_reported_and_renders_as_without_it")
+    else {
         return;
     };
     let size = (48, 48);
     let (renderer, degenerate) = render_loaded(&ctx, &loaded, size, 16);
     assert!(
-        renderer.light_notes().iter().any(|n| n.contains("zero area")),
+        renderer
+            .light_notes()
+            .iter()
+            .any(|n| n.contains("zero area")),
         "the renderer warns: {:?}",
         renderer.light_notes()
     );
@@ -1084,7 +1188,10 @@ fn degenerate_obj_geometry_is_reported_and_renders_as_without_it() {
     assert_eq!(keep.len(), 14);
     let (_, reference) = render_loaded(&ctx, &clean, size, 16);
     let lit = degenerate.iter().filter(|p| p[0] > 0.01).count();
-    assert!(lit > degenerate.len() / 3, "the light reaches the scene: {lit}");
+    assert!(
+        lit > degenerate.len() / 3,
+        "the light reaches the scene: {lit}"
+    );
     for (i, (a, b)) in degenerate.iter().zip(&reference).enumerate() {
         for c in 0..3 {
             assert!(
@@ -1107,7 +1214,8 @@ fn degenerate_obj_geometry_is_reported_and_renders_as_without_it() {
 /// fallback a shading normal that faced away made every sample 0.
 #[test]
 fn bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks() {
-    let Some(ctx) = gpu_or_skip("bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks") else {
+    let Some(ctx) = gpu_or_skip("bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks")
+    else {
         return;
     };
     let loaded = load_scene(&hard_case("geometry_bump_zero_normal.ron"), None).unwrap();
@@ -1123,7 +1231,10 @@ fn bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks() {
     };
     let (_, vanished) = render_loaded(&ctx, &loaded, size, 16);
     for v in central(&vanished) {
-        assert!((v - albedo).abs() < 2e-3, "the fallback to the geometric normal gives {v}");
+        assert!(
+            (v - albedo).abs() < 2e-3,
+            "the fallback to the geometric normal gives {v}"
+        );
     }
     let mut steep = LoadedScene {
         scene: loaded.scene.clone(),
@@ -1155,7 +1266,10 @@ fn every_geometry_hard_case_preset_loads_and_renders_finite() {
         .map(|e| e.unwrap().path())
         .filter(|p| {
             p.extension().is_some_and(|x| x == "ron")
-                && p.file_name().unwrap().to_string_lossy().starts_with("geometry_")
+                && p.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .starts_with("geometry_")
         })
         .collect();
     presets.sort();
@@ -1164,7 +1278,13 @@ fn every_geometry_hard_case_preset_loads_and_renders_finite() {
     for path in presets {
         let loaded = load_scene(&path, None).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let expected_notes = path.ends_with("geometry_degenerate_obj.ron");
-        assert_eq!(!loaded.notes.is_empty(), expected_notes, "{}: {:?}", path.display(), loaded.notes);
+        assert_eq!(
+            !loaded.notes.is_empty(),
+            expected_notes,
+            "{}: {:?}",
+            path.display(),
+            loaded.notes
+        );
         if let Some(ctx) = &ctx {
             render_loaded(ctx, &loaded, (24, 24), 2);
         }

@@ -150,10 +150,7 @@ mod tests {
                 ref e => panic!("{name}: {e:?}"),
             }
         };
-        assert_eq!(
-            constant("QUERY_POINTS"),
-            Literal::U32(QUERY_POINTS as u32)
-        );
+        assert_eq!(constant("QUERY_POINTS"), Literal::U32(QUERY_POINTS as u32));
         assert_eq!(constant("NO_HIT"), Literal::F32(crate::geometry::NO_HIT));
         use crate::geometry::ray_offset::{FLOAT_SCALE, INT_SCALE, ORIGIN};
         assert_eq!(constant("OFFSET_ORIGIN"), Literal::F32(ORIGIN));

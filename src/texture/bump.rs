@@ -31,8 +31,9 @@ pub fn bumped_normal(n: Vec3, dp_du: Vec3, dp_dv: Vec3, dh_du: f32, dh_dv: f32) 
 /// The tilt lies in the tangent plane, so with a proper frame the tilted
 /// normal is at least 1 long; a shorter one means the tangents had a part
 /// along `n` that cancelled it (a degenerate frame), and its direction is
-/// rounding noise: measured, a tangent equal to `n` with a slope of 1 left
-/// a vector of length 6e-8 pointing along ±n at random. 1e-3 keeps every
+/// rounding noise: with a tangent equal to `n` and a slope of 1, 24 % of
+/// 10,000 random unit normals left a non-zero vector (at most 1.5e-7 long),
+/// 19 % of them pointing along −n, below the surface. 1e-3 keeps every
 /// proper result and rejects those.
 pub const MIN_TILTED_LENGTH: f32 = 1e-3;
 
@@ -92,6 +93,49 @@ mod tests {
         // Longer tangents (a bigger object for the same uv) tilt it less.
         let bigger = bumped_normal(Vec3::Z, 2.0 * Vec3::X, Vec3::Y, s, 0.0);
         assert!(bigger.z > got.z);
+    }
+
+    /// Unit vectors spread over the sphere (a Fibonacci lattice).
+    fn directions(n: usize) -> impl Iterator<Item = Vec3> {
+        (0..n).map(move |k| {
+            let z = 1.0 - (2 * k + 1) as f32 / n as f32;
+            let phi = k as f32 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z).normalize()
+        })
+    }
+
+    /// A tangent along the normal with a slope of 1 cancels the normal to
+    /// a rounding residue, whose direction is noise: the normal stays.
+    #[test]
+    fn a_tilt_that_cancels_the_normal_falls_back_to_it() {
+        for n in directions(10_000) {
+            assert_eq!(bumped_normal(n, n, n.any_orthonormal_vector(), 1.0, 0.0), n);
+        }
+    }
+
+    /// A normal that faces the viewer by FACING_MIN_COS is kept; one that
+    /// does not is bent within the plane of it and the viewer to face it by
+    /// FACING_MIN_COS / √(1 + FACING_MIN_COS² − c²), c its old cosine.
+    #[test]
+    fn normals_facing_away_are_bent_just_above_the_view() {
+        let n_g = Vec3::Z;
+        for wo in directions(200).filter(|w| w.z > 0.0) {
+            for n_s in directions(200).filter(|n| n.z > 0.0) {
+                let got = facing_shading_normal(n_s, n_g, wo);
+                let c = n_s.dot(wo);
+                if c >= FACING_MIN_COS {
+                    assert_eq!(got, n_s);
+                    continue;
+                }
+                let expected = FACING_MIN_COS / (1.0 + FACING_MIN_COS.powi(2) - c * c).sqrt();
+                assert!((got.dot(wo) - expected).abs() < 1e-5, "{n_s} {wo}: {got}");
+                assert!((got.length() - 1.0).abs() < 1e-5);
+                assert!(got.cross(n_s).dot(wo).abs() < 1e-5, "left the plane");
+                assert!(got.dot(n_g) > 0.0);
+            }
+        }
+        assert_eq!(facing_shading_normal(Vec3::NAN, n_g, Vec3::Y), n_g);
     }
 
     #[test]
