@@ -31,7 +31,7 @@ use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::lights::{EmitterTriangle, LightSelection, LightTable, triangle_area};
 use marbre::scene::mesh::{Geometry, TriangleMesh};
-use marbre::scene::{EnvSource, OrbitCamera, Scene, Sphere};
+use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere};
 use marbre::texture::bump::{FACING_MIN_COS, facing_shading_normal};
 use marbre::texture::bumped_normal;
 use proptest::prelude::*;
@@ -1005,6 +1005,119 @@ fn a_sphere_in_a_white_furnace_has_no_dark_silhouette_ring() {
         mean.abs() <= 5.0 * mean_error + grid_error / 4.0,
         "{mean} ± {mean_error}"
     );
+}
+
+/// Issue 6, case 2 on the ground plane, rendered: a Lambert ground of
+/// albedo ρ with a unit sphere resting on it, lit only by a point light of
+/// intensity I, 1e4 away at an elevation of 1e-6 to 0.1 rad (one bounce, no
+/// environment). A ground point p in the light reflects ρ/π · I · cos θ / d²
+/// (cos θ = (L − p)·y / d), one in the sphere's shadow nothing. Every
+/// pixel whose footprint (its corners and centre, in double precision) lies
+/// wholly on the ground and wholly lit must read the closed form within
+/// 1e-3 (the light is so far that it changes by 2e-5 across a footprint;
+/// the rest is f32 rounding), and one wholly shadowed, where the shadow ray
+/// passes within 0.99 of the sphere's centre, exactly 0: a shadow ray that
+/// skims the ground neither meets the ground it leaves (acne) nor slips
+/// through the sphere (a leak). The intensity keeps the lit ground near 1.
+#[test]
+fn a_grazingly_lit_ground_matches_the_closed_form_and_keeps_its_shadow() {
+    let Some(ctx) =
+        gpu_or_skip("a_grazingly_lit_ground_matches_the_closed_form_and_keeps_its_shadow")
+    else {
+        return;
+    };
+    let albedo = 0.5f64;
+    let size = (48u32, 48u32);
+    for elevation in [1e-6f64, 1e-4, 1e-2, 0.1] {
+        let light = DVec3::new(elevation.cos(), elevation.sin(), 0.0) * 1.0e4;
+        let intensity = 1.0e8 / elevation.sin() * std::f64::consts::PI;
+        let mut scene = Scene {
+            ground: Some(Ground {
+                height: 0.0,
+                material: lambert(albedo as f32),
+            }),
+            point_light: Some(PointLight {
+                position: light.as_vec3(),
+                color: Vec3::ONE,
+                intensity: intensity as f32,
+            }),
+            ..Scene::default()
+        };
+        scene.spheres.push(Sphere {
+            name: "occluder".into(),
+            center: Vec3::Y,
+            radius: 1.0,
+            material: lambert(0.5),
+        });
+        scene.environment.source = EnvSource::None;
+        scene.camera = OrbitCamera {
+            target: Vec3::new(-4.0, 0.0, 0.0),
+            distance: 10.0,
+            yaw_degrees: -90.0,
+            pitch_degrees: 50.0,
+            fov_degrees: 50.0,
+        };
+        scene.render.max_bounces = 1;
+        let pixels = render_scene(&ctx, scene.clone(), size, 4);
+        let light_f32 = light.as_vec3().as_dvec3();
+        let (mut lit, mut shadowed) = (0, 0);
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let corners =
+                    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)].map(|(i, j)| {
+                        let at = Vec2::new(x as f32 + i, y as f32 + j);
+                        let (o, d) = camera_ray(&scene, size, at);
+                        let (o, d) = (o.as_dvec3(), d.as_dvec3());
+                        let ground_t = -o.y / d.y;
+                        let f = o - DVec3::Y;
+                        let b = -f.dot(d);
+                        let on_sphere = b > 0.0 && (f + b * d).length() < 1.02;
+                        let p = o + d * ground_t;
+                        let to_light = (light_f32 - p).normalize();
+                        let g = p - DVec3::Y;
+                        let perp = (g - to_light * g.dot(to_light)).length();
+                        let ahead = g.dot(to_light) < 0.0;
+                        (
+                            ground_t > 0.0 && !on_sphere,
+                            ahead && perp < 0.99,
+                            !ahead || perp > 1.01,
+                            p,
+                        )
+                    });
+                if !corners.iter().all(|c| c.0) {
+                    continue;
+                }
+                let v = f64::from(pixels[(y * size.0 + x) as usize][0]);
+                if corners.iter().all(|c| c.1) {
+                    assert_eq!(
+                        v, 0.0,
+                        "elevation {elevation}: ({x}, {y}) lit in the shadow"
+                    );
+                    shadowed += 1;
+                } else if corners.iter().all(|c| c.2) {
+                    let p = corners[4].3;
+                    let to_light = light_f32 - p;
+                    let d = to_light.length();
+                    let expected = albedo / std::f64::consts::PI
+                        * f64::from(intensity as f32)
+                        * (to_light.y / d)
+                        / (d * d);
+                    assert!(
+                        (v - expected).abs() <= 1e-3 * expected,
+                        "elevation {elevation}: ({x}, {y}) reads {v}, not {expected}"
+                    );
+                    lit += 1;
+                }
+            }
+        }
+        println!(
+            "elevation {elevation}: {lit} lit and {shadowed} shadowed ground pixels as the closed form"
+        );
+        assert!(lit > 500, "{elevation}: {lit}");
+        if elevation >= 1e-2 {
+            assert!(shadowed > 20, "{elevation}: {shadowed}");
+        }
+    }
 }
 
 /// The fraction of pixels lit by the point light, and which: with one
