@@ -31,7 +31,7 @@ use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::lights::{EmitterTriangle, LightSelection, LightTable, triangle_area};
 use marbre::scene::mesh::{Geometry, TriangleMesh};
-use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere};
+use marbre::scene::{EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, Sphere, Texture};
 use marbre::texture::bump::{FACING_MIN_COS, facing_shading_normal};
 use marbre::texture::bumped_normal;
 use proptest::prelude::*;
@@ -1432,4 +1432,59 @@ fn a_closed_tessellated_sphere_renders_without_cracks() {
         }
     }
     assert!(inside > 600, "{inside}");
+}
+
+/// Issue 6, case 6 for analytic emitters: an emissive sphere whose area
+/// underflows f32 (radius 1e-20, 1e-19) is left out of the light table
+/// with a note, and one merely tiny (1e-10) stays in; none makes a
+/// non-finite sample in a render where the ground and a ball would show
+/// one (the light sampler divides by the sphere's cone, 0 here).
+#[test]
+fn emitters_too_small_to_sample_render_finite() {
+    let Some(ctx) = gpu_or_skip("emitters_too_small_to_sample_render_finite") else {
+        return;
+    };
+    for (radius, in_table) in [(1e-20f32, false), (1e-19, false), (1e-10, true)] {
+        let mut scene = Scene {
+            ground: Some(Ground {
+                height: 0.0,
+                material: lambert(0.5),
+            }),
+            ..Scene::default()
+        };
+        scene.spheres.push(Sphere {
+            name: "tiny".into(),
+            center: Vec3::Y,
+            radius,
+            material: Material {
+                emission: Texture::color(Vec3::splat(1.0)),
+                ..lambert(0.5)
+            },
+        });
+        scene.spheres.push(Sphere {
+            name: "ball".into(),
+            center: Vec3::new(2.0, 1.0, 0.0),
+            radius: 1.0,
+            material: lambert(0.5),
+        });
+        scene.camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 6.0,
+            yaw_degrees: 0.0,
+            pitch_degrees: 30.0,
+            fov_degrees: 50.0,
+        };
+        let loaded = prepare_scene(scene, Vec::new()).unwrap();
+        let (renderer, _) = render_loaded(&ctx, &loaded, (32, 32), 4);
+        let noted = renderer
+            .light_notes()
+            .iter()
+            .any(|n| n.contains("sphere `tiny`"));
+        assert_eq!(
+            noted,
+            !in_table,
+            "radius {radius}: {:?}",
+            renderer.light_notes()
+        );
+    }
 }
