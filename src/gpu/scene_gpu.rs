@@ -158,6 +158,7 @@ pub fn hash_id(h: HashKind) -> u32 {
     match h {
         HashKind::Pcg => 0,
         HashKind::Sin => 1,
+        HashKind::PcgTiled => 2,
     }
 }
 
@@ -182,7 +183,7 @@ pub fn material(m: &Material) -> MaterialGpu {
         let mapping = signal.mapping.unwrap_or_default();
         out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
         out.signals[k].footprint_scale = mapping.footprint_scale()[2];
-        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&mapping.rows());
+        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&signal.rows());
     }
     out
 }
