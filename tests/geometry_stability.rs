@@ -799,8 +799,9 @@ fn shading_queries() -> Vec<ShadingQuery> {
 }
 
 /// The shading normal is unit length, finite, on the geometric normal's
-/// side, faces the viewer by at least FACING_MIN_COS/√(1 + FACING_MIN_COS²)
-/// (less the rounding of a normalisation, 1e-6), and where the bump left
+/// side, faces the viewer by at least c_min/√(1 + c_min²), c_min =
+/// min(FACING_MIN_COS, n_g·wo) (less the rounding of a normalisation,
+/// 1e-6), and where the bump left
 /// it facing the viewer, it is the bumped normal untouched. Where the bump
 /// could not make a normal at all, it is the geometric one.
 fn check_shading(q: &ShadingQuery, bumped: Vec3, shading: Vec3) -> Result<(), String> {
@@ -815,7 +816,9 @@ fn check_shading(q: &ShadingQuery, bumped: Vec3, shading: Vec3) -> Result<(), St
     if (shading.length() - 1.0).abs() > 1e-5 {
         return why("not unit length");
     }
-    let min_cos = f64::from(FACING_MIN_COS) / (1.0 + f64::from(FACING_MIN_COS).powi(2)).sqrt();
+    // c_min / √(1 + c_min²) bounds c_min / √(1 + c_min² − c²) below.
+    let c_min = f64::from(FACING_MIN_COS).min(q.normal.as_dvec3().dot(q.wo.as_dvec3()));
+    let min_cos = c_min / (1.0 + c_min * c_min).sqrt();
     let facing = shading.as_dvec3().dot(q.wo.as_dvec3());
     if facing < min_cos - 1e-6 {
         return why("faces away from the viewer");
@@ -824,7 +827,7 @@ fn check_shading(q: &ShadingQuery, bumped: Vec3, shading: Vec3) -> Result<(), St
         return why("below the geometric surface");
     }
     // (The margin: the GPU's dot product may round otherwise at the edge.)
-    if bumped.dot(q.wo) >= FACING_MIN_COS + 1e-6 && shading != bumped {
+    if bumped.dot(q.wo) >= c_min as f32 + 1e-6 && shading != bumped {
         return why("changed a normal that faced the viewer");
     }
     let degenerate = !(q.dh_du.is_finite() && q.dh_dv.is_finite()) || q.dp_du == q.normal;

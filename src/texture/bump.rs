@@ -38,8 +38,9 @@ pub fn bumped_normal(n: Vec3, dp_du: Vec3, dp_dv: Vec3, dh_du: f32, dh_dv: f32) 
 pub const MIN_TILTED_LENGTH: f32 = 1e-3;
 
 /// The least cosine between the shading normal and the viewer that
-/// [`facing_shading_normal`] lets through (`FACING_MIN_COS` in
-/// `shaders/shading_normal.wgsl`): 0.57° above the view's horizon.
+/// [`facing_shading_normal`] asks for (`FACING_MIN_COS` in
+/// `shaders/shading_normal.wgsl`): 0.57° above the view's horizon, or less
+/// where the geometric normal itself faces the viewer less.
 pub const FACING_MIN_COS: f32 = 0.01;
 
 /// The shading normal the BSDF may use, given the bumped normal `n_s`, the
@@ -49,20 +50,22 @@ pub const FACING_MIN_COS: f32 = 0.01;
 ///
 /// A bump can tilt `n_s` away from the viewer: every BSDF value is then 0
 /// (a black pixel on a lit surface), and one that barely faces it divides
-/// by n·wo ≈ 0. So a normal with n_s·wo below [`FACING_MIN_COS`] is bent
-/// towards the viewer, `normalize(n_s + (FACING_MIN_COS − n_s·wo)·wo)`, the
-/// least change (within the plane of n_s and wo) that leaves it facing
-/// the viewer; its cosine with wo is then FACING_MIN_COS / √(1 +
-/// FACING_MIN_COS² − (n_s·wo)²) ≥ FACING_MIN_COS / √(1 + FACING_MIN_COS²).
-/// pbrt-v4 and Mitsuba likewise keep shading normals on the viewer's side
-/// of the geometric one. Where even the bent normal is unusable (a
-/// non-finite input), `n_g` serves.
+/// by n·wo ≈ 0. So a normal with n_s·wo below c_min = min(FACING_MIN_COS,
+/// n_g·wo) is bent towards the viewer, `normalize(n_s + (c_min −
+/// n_s·wo)·wo)`, the least change (within the plane of n_s and wo) that
+/// leaves it facing the viewer; its cosine with wo is then c_min / √(1 +
+/// c_min² − (n_s·wo)²). Asking no more than the geometric normal gives
+/// leaves an unbumped normal seen at a grazing angle as it is. pbrt-v4 and
+/// Mitsuba likewise keep shading normals on the viewer's side of the
+/// geometric one. Where even the bent normal is unusable (a non-finite
+/// input), `n_g` serves.
 pub fn facing_shading_normal(n_s: Vec3, n_g: Vec3, wo: Vec3) -> Vec3 {
     let c = n_s.dot(wo);
-    if c >= FACING_MIN_COS {
+    let c_min = FACING_MIN_COS.min(n_g.dot(wo));
+    if c >= c_min {
         return n_s;
     }
-    let bent = n_s + (FACING_MIN_COS - c) * wo;
+    let bent = n_s + (c_min - c) * wo;
     let len = bent.length();
     if len > 0.0 && len.is_finite() {
         bent / len
@@ -114,21 +117,24 @@ mod tests {
         }
     }
 
-    /// A normal that faces the viewer by FACING_MIN_COS is kept; one that
-    /// does not is bent within the plane of it and the viewer to face it by
-    /// FACING_MIN_COS / √(1 + FACING_MIN_COS² − c²), c its old cosine.
+    /// A normal that faces the viewer by c_min = min(FACING_MIN_COS,
+    /// n_g·wo) is kept; one that does not is bent within the plane of it
+    /// and the viewer to face it by c_min / √(1 + c_min² − c²), c its old
+    /// cosine. The geometric normal itself is always kept.
     #[test]
     fn normals_facing_away_are_bent_just_above_the_view() {
         let n_g = Vec3::Z;
         for wo in directions(200).filter(|w| w.z > 0.0) {
+            assert_eq!(facing_shading_normal(n_g, n_g, wo), n_g);
+            let c_min = FACING_MIN_COS.min(wo.z);
             for n_s in directions(200).filter(|n| n.z > 0.0) {
                 let got = facing_shading_normal(n_s, n_g, wo);
                 let c = n_s.dot(wo);
-                if c >= FACING_MIN_COS {
+                if c >= c_min {
                     assert_eq!(got, n_s);
                     continue;
                 }
-                let expected = FACING_MIN_COS / (1.0 + FACING_MIN_COS.powi(2) - c * c).sqrt();
+                let expected = c_min / (1.0 + c_min * c_min - c * c).sqrt();
                 assert!((got.dot(wo) - expected).abs() < 1e-5, "{n_s} {wo}: {got}");
                 assert!((got.length() - 1.0).abs() < 1e-5);
                 assert!(got.cross(n_s).dot(wo).abs() < 1e-5, "left the plane");
