@@ -21,10 +21,12 @@ fn height_at(hit: Hit, fp: Footprint, signals: vec4f, du: f32, dv: f32) -> f32 {
     return surface_height(hit.material, p, pw, hit.uv + vec2f(du, dv), fp, offset_signals);
 }
 
-fn bumped_shading_normal(hit: Hit, fp: Footprint, signals: vec4f) -> vec3f {
+// The bumped normal, kept facing the viewer `wo` (shading_normal.wgsl).
+fn bumped_shading_normal(hit: Hit, fp: Footprint, signals: vec4f, wo: vec3f) -> vec3f {
     let height = materials[hit.material].bump_height;
     let dh_du = height_at(hit, fp, signals, BUMP_STEP, 0.0) - height_at(hit, fp, signals, -BUMP_STEP, 0.0);
     let dh_dv = height_at(hit, fp, signals, 0.0, BUMP_STEP) - height_at(hit, fp, signals, 0.0, -BUMP_STEP);
     let scale = height / (2.0 * BUMP_STEP);
-    return bumped_normal(hit.n, hit.dp_du, hit.dp_dv, scale * dh_du, scale * dh_dv);
+    let tilted = bumped_normal(hit.n, hit.dp_du, hit.dp_dv, scale * dh_du, scale * dh_dv);
+    return facing_shading_normal(tilted, hit.n, wo);
 }

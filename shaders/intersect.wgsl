@@ -1,5 +1,5 @@
 // Ray-scene intersection. Rays start on robustly offset origins (see
-// offset_ray), so t > 0 is the only lower bound needed.
+// offset_ray in ray_geometry.wgsl), so t > 0 is the only lower bound needed.
 
 struct Hit {
     t: f32,
@@ -24,43 +24,15 @@ struct Hit {
     front: bool,
 }
 
-const NO_HIT: f32 = 3.0e38;
-
 const SHAPE_SPHERE: u32 = 0u;
 const SHAPE_CYLINDER: u32 = 1u;
 const SHAPE_POLYGON: u32 = 2u;
 const SHAPE_GROUND: u32 = 3u;
 const SHAPE_TRIANGLE: u32 = 4u;
 
-// Smallest positive root of |o + t d - c| = r, d unit length, or NO_HIT.
-// Haines et al. (Ray Tracing Gems ch. 7): the discriminant is computed from
-// the perpendicular distance, which keeps precision for small spheres far
-// away, and the roots by the stable quadratic (no cancellation).
+// The sphere's distance (ray_geometry.wgsl) read from the uniform array.
 fn intersect_sphere(o: vec3f, d: vec3f, s: Sphere) -> f32 {
-    let f = o - s.center;
-    let b = -dot(f, d);
-    let perp = f + b * d;
-    let r2 = s.radius * s.radius;
-    let disc = r2 - dot(perp, perp);
-    if disc < 0.0 {
-        return NO_HIT;
-    }
-    let q = b + select(-1.0, 1.0, b >= 0.0) * sqrt(disc);
-    if q == 0.0 {
-        return NO_HIT;
-    }
-    let c = dot(f, f) - r2;
-    let t0 = c / q;
-    let t1 = q;
-    let near = min(t0, t1);
-    let far = max(t0, t1);
-    if near > 0.0 {
-        return near;
-    }
-    if far > 0.0 {
-        return far;
-    }
-    return NO_HIT;
+    return sphere_distance(o, d, s.center, s.radius);
 }
 
 #if CYLINDER
@@ -315,25 +287,4 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
     }
 #endif
     return false;
-}
-
-// Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection"
-// (Ray Tracing Gems ch. 6): move the origin off the surface by a number of
-// ULPs proportional to its magnitude, so it works at every scene scale. `n`
-// points to the side the new ray leaves on.
-fn offset_ray(p: vec3f, n: vec3f) -> vec3f {
-    let origin = 1.0 / 32.0;
-    let float_scale = 1.0 / 65536.0;
-    let int_scale = 256.0;
-    let of_i = vec3i(int_scale * n);
-    let p_i = vec3f(
-        bitcast<f32>(bitcast<i32>(p.x) + select(of_i.x, -of_i.x, p.x < 0.0)),
-        bitcast<f32>(bitcast<i32>(p.y) + select(of_i.y, -of_i.y, p.y < 0.0)),
-        bitcast<f32>(bitcast<i32>(p.z) + select(of_i.z, -of_i.z, p.z < 0.0)),
-    );
-    return vec3f(
-        select(p_i.x, p.x + float_scale * n.x, abs(p.x) < origin),
-        select(p_i.y, p.y + float_scale * n.y, abs(p.y) < origin),
-        select(p_i.z, p.z + float_scale * n.z, abs(p.z) < origin),
-    );
 }

@@ -11,12 +11,15 @@ fn bump_along(dp: vec3f, dh: f32) -> vec3f {
     return select(vec3f(0.0), dp * (dh / len2), len2 > 0.0);
 }
 
-// Blinn's bump: the normal tilted by the height gradient over uv; a zero or
-// non-finite result (tested on the bits) falls back to the normal.
+// Blinn's bump: the normal tilted by the height gradient over uv; a
+// vanished (shorter than MIN_TILTED_LENGTH) or non-finite result (tested on
+// the bits) falls back to the normal (Rust: texture::bump::bumped_normal).
+const MIN_TILTED_LENGTH: f32 = 1e-3;
+
 fn bumped_normal(n: vec3f, dp_du: vec3f, dp_dv: vec3f, dh_du: f32, dh_dv: f32) -> vec3f {
     let tilted = n - bump_along(dp_du, dh_du) - bump_along(dp_dv, dh_dv);
     let len = length(tilted);
-    let usable = len > 0.0 && !is_non_finite(len);
+    let usable = len >= MIN_TILTED_LENGTH && !is_non_finite(len);
     return select(n, tilted / len, usable);
 }
 

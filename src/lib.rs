@@ -7,6 +7,7 @@ pub mod commands;
 pub mod cubemap;
 pub mod env_sampling;
 pub mod envmap;
+pub mod geometry;
 pub mod gpu;
 pub mod image_io;
 pub mod lights;

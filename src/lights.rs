@@ -126,7 +126,10 @@ impl LightTable {
         {
             let l = emitted[i];
             if l > 0.0 {
-                let area = 4.0 * PI * sphere.radius * sphere.radius;
+                // The shaders sample a sphere through r²: a subnormal one is
+                // 0 where the GPU flushes it, and so is the sphere's area.
+                let r2 = sphere.radius * sphere.radius;
+                let area = if r2.is_normal() { 4.0 * PI * r2 } else { 0.0 };
                 table.push(
                     LightKind::Sphere,
                     i as u32,
@@ -140,7 +143,8 @@ impl LightTable {
             let l = emitted.get(t.material as usize).copied().unwrap_or(0.0);
             if l > 0.0 {
                 let area = triangle_area(&t.vertices);
-                if area > 0.0 && area.is_finite() {
+                // A subnormal area is zero where the GPU flushes it.
+                if area.is_normal() {
                     table.lights.push(LightGpu {
                         kind: LightKind::Triangle as u32,
                         primitive: i as u32,
@@ -161,8 +165,10 @@ impl LightTable {
         table
     }
 
+    /// Adds a light of `power`, or a note where it has none to sample:
+    /// zero, subnormal (GPUs flush it to zero) or not finite.
     fn push(&mut self, kind: LightKind, primitive: u32, power: f32, what: &str) {
-        if power > 0.0 && power.is_finite() {
+        if power.is_normal() && power > 0.0 {
             self.lights.push(LightGpu {
                 kind: kind as u32,
                 primitive,
@@ -275,6 +281,28 @@ mod tests {
         let table = LightTable::build(&scene, &[flat]);
         assert_eq!(table.lights.len(), 1);
         assert!(table.notes[0].contains("zero area"), "{:?}", table.notes);
+    }
+
+    /// Emitters too small for f32 (a sphere of radius 1e-19, whose r² is
+    /// subnormal; a triangle of 1e-20 on a side) count as zero-area: the
+    /// GPU flushes such values to 0, where a pdf would divide by them.
+    #[test]
+    fn emitters_of_subnormal_area_are_left_out_with_a_note() {
+        let scene = Scene {
+            spheres: vec![Sphere {
+                radius: 1e-19,
+                material: emitter(1.0),
+                ..Sphere::default()
+            }],
+            ..Scene::default()
+        };
+        let tiny = EmitterTriangle {
+            vertices: [Vec3::ZERO, Vec3::X * 1e-20, Vec3::Y * 1e-20],
+            material: 0,
+        };
+        let table = LightTable::build(&scene, &[tiny]);
+        assert!(table.lights.is_empty(), "{:?}", table.lights);
+        assert_eq!(table.notes.len(), 2, "{:?}", table.notes);
     }
 
     /// The pmf sums to one in both modes, and bisection inverts the cdf.

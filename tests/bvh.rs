@@ -15,6 +15,7 @@ use marbre::accel::{Bvh, BvhNode, MeshHit, TriangleHit, TriangleVerts, intersect
 use marbre::gpu::GpuContext;
 use marbre::gpu::bvh_harness::{BvhHarness, Ray};
 use marbre::gpu::testing::gpu_or_skip;
+use proptest::prelude::*;
 use std::collections::HashMap;
 
 /// xorshift64*, so the tests need no random crate and repeat exactly.
@@ -717,5 +718,162 @@ fn gpu_traversal_of_degenerate_meshes() {
             let original = broken.bvh.permutation[h.triangle as usize];
             assert!(!original.is_multiple_of(3), "a NaN triangle was hit");
         }
+    }
+}
+
+// ---- edge-on (issue 6, case 11) ------------------------------------------
+
+/// Rays that see the UV sphere edge-on along its shared edges: each lies in
+/// the plane through a shared edge and the sphere's normal at the point it
+/// is aimed at (a vertex of the edge, or a point of it), so the edge
+/// projects onto the ray's own pixel and, in exact arithmetic, the ray runs
+/// along the boundary between the two triangles for its whole length. It
+/// comes from 11° to 90° above the tangent plane (faces lean at most 7.5°
+/// from it, so the first hit is the point aimed at), from either way along
+/// the edge, 0.5 to 1000 units away.
+fn edge_on_sphere_rays(n: usize, rng: &mut Rng) -> (IndexedMesh, Vec<AimedRay>) {
+    let sphere = sphere();
+    let edges = shared_edges(&sphere);
+    let rays = (0..n)
+        .map(|k| {
+            let (a, b) = edges[rng.index(edges.len())];
+            let (a, b) = (sphere.positions[a as usize], sphere.positions[b as usize]);
+            let target = if k % 2 == 0 {
+                a
+            } else {
+                a + (b - a) * rng.range(0.01, 0.99)
+            };
+            let normal = target.normalize();
+            let along = (b - a) - normal * (b - a).dot(normal);
+            let along = along.normalize() * if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let elevation = rng.range(0.2, std::f32::consts::FRAC_PI_2);
+            let approach = normal * elevation.sin() + along * elevation.cos();
+            let distance = 0.5 * 2000f32.powf(rng.next());
+            let origin = target + approach * distance;
+            AimedRay {
+                ray: Ray {
+                    origin,
+                    direction: (target - origin).normalize(),
+                    t_max: T_MAX,
+                },
+                distance,
+            }
+        })
+        .collect();
+    (sphere, rays)
+}
+
+/// Issue 6, case 11: 1,000 rays along shared edges of a closed tessellated
+/// sphere, at its vertices and edges, all hit it where aimed, by brute
+/// force and through the BVH on the CPU, and through bvh.wgsl on the GPU
+/// (closest and any hit). The naive Möller–Trumbore test's misses are
+/// printed for contrast.
+#[test]
+fn a_sphere_seen_edge_on_along_its_shared_edges_has_no_cracks() {
+    let mut rng = Rng(0xed9e_0011);
+    let (mesh, rays) = edge_on_sphere_rays(1000, &mut rng);
+    let tris = mesh.triangles();
+    let bvh_mesh = Mesh::new(tris.clone());
+    let mut naive_misses = 0;
+    for aimed in &rays {
+        let ray = &aimed.ray;
+        let brute = brute_force(&tris, ray).map(|(_, h)| h.t);
+        assert!(
+            check_aimed_hit("edge-on", aimed, brute),
+            "the triangle test let {ray:?} through"
+        );
+        let through_bvh = bvh_mesh.cpu(ray).map(|h| h.t);
+        assert!(
+            check_aimed_hit("edge-on", aimed, through_bvh),
+            "the BVH let {ray:?} through"
+        );
+        let naive = tris.iter().any(|t| {
+            moller_trumbore(ray.origin, ray.direction, *t)
+                .is_some_and(|t| (t - aimed.distance).abs() < 1e-3 * aimed.distance)
+        });
+        naive_misses += usize::from(!naive);
+    }
+    println!(
+        "edge-on: 0 of {} rays missed on the CPU; naive Möller–Trumbore missed {naive_misses}",
+        rays.len()
+    );
+    assert!(naive_misses > 0, "the rays are too easy to show anything");
+    let Some(ctx) = gpu_or_skip("a_sphere_seen_edge_on_along_its_shared_edges_has_no_cracks")
+    else {
+        return;
+    };
+    let harness = bvh_mesh.harness(&ctx);
+    let plain: Vec<Ray> = rays.iter().map(|a| a.ray).collect();
+    let hits = harness.closest(&ctx, &plain).unwrap();
+    let occluded = harness.occluded(&ctx, &plain).unwrap();
+    for ((aimed, hit), occluded) in rays.iter().zip(&hits).zip(&occluded) {
+        let t = hit.map(|h| h.t);
+        assert!(t.is_none_or(f32::is_finite), "{:?}", aimed.ray);
+        assert!(
+            check_aimed_hit("edge-on (GPU)", aimed, t) && *occluded,
+            "the GPU let {:?} through",
+            aimed.ray
+        );
+    }
+}
+
+// ---- property tests (issue 6) ----------------------------------------------
+
+/// A vertex in [-2, 2]³ on a grid of 1/8, so that soups share vertices,
+/// edges and planes exactly and hold ties and degenerate triangles.
+fn grid_vertex() -> impl Strategy<Value = Vec3> {
+    [-16i32..=16, -16i32..=16, -16i32..=16]
+        .prop_map(|c| Vec3::from_array(c.map(|k| k as f32 / 8.0)))
+}
+
+/// Triangle soups of 1 to 120 triangles: random ones, some on the grid
+/// (shared edges, duplicates), some with repeated vertices (zero area).
+fn triangle_soup() -> impl Strategy<Value = Vec<[Vec3; 3]>> {
+    let free = [-2.0f32..2.0, -2.0f32..2.0, -2.0f32..2.0].prop_map(Vec3::from_array);
+    let vertex = prop_oneof![free, grid_vertex()];
+    let triangle = prop_oneof![
+        6 => [vertex.clone(), vertex.clone(), vertex.clone()],
+        1 => (vertex.clone(), vertex).prop_map(|(a, b)| [a, b, a]),
+    ];
+    proptest::collection::vec(triangle, 1..120)
+}
+
+/// Rays from [-3, 3]³, half aimed at a soup's vertex (where neighbours
+/// meet), half in any direction, of any length from 0.1 to 10.
+fn ray_strategy() -> impl Strategy<Value = (Vec3, Vec3, bool, f32)> {
+    (
+        [-3.0f32..3.0, -3.0f32..3.0, -3.0f32..3.0].prop_map(Vec3::from_array),
+        [-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0].prop_map(Vec3::from_array),
+        any::<bool>(),
+        0.1f32..10.0,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Closest hits through the BVH equal brute force (distance to the bit,
+    /// the same triangle unless tied), any-hit queries agree, every
+    /// triangle lies in exactly one leaf, and every node bounds its
+    /// children and triangles.
+    #[test]
+    fn bvh_equals_brute_force_and_bounds_its_leaves(
+        soup in triangle_soup(),
+        rays in proptest::collection::vec(ray_strategy(), 64),
+    ) {
+        check_structure("proptest soup", &soup);
+        let rays: Vec<Ray> = rays
+            .iter()
+            .enumerate()
+            .map(|(k, &(origin, direction, aimed, length))| {
+                let direction = if aimed {
+                    soup[k % soup.len()][k % 3] - origin
+                } else {
+                    direction
+                };
+                Ray { origin, direction: direction * length, t_max: T_MAX }
+            })
+            .collect();
+        check_against_brute_force("proptest soup", &Mesh::new(soup), &rays, 0);
     }
 }

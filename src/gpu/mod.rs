@@ -12,6 +12,7 @@ pub mod context;
 pub mod error_meter;
 pub mod features;
 pub mod geometry_buffers;
+pub mod geometry_harness;
 pub mod mesh_buffers;
 pub mod metering_grid;
 pub mod noise_harness;

@@ -95,6 +95,18 @@ const SOURCES: &[(&str, &str)] = &[
         "bvh_harness.wgsl",
         include_str!("../../shaders/bvh_harness.wgsl"),
     ),
+    (
+        "ray_geometry.wgsl",
+        include_str!("../../shaders/ray_geometry.wgsl"),
+    ),
+    (
+        "shading_normal.wgsl",
+        include_str!("../../shaders/shading_normal.wgsl"),
+    ),
+    (
+        "geometry_harness.wgsl",
+        include_str!("../../shaders/geometry_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,10 +128,13 @@ pub enum Program {
     /// The compute pass that runs the accumulation update over long
     /// streams of frames.
     AccumulationHarness,
+    /// The compute pass that runs the ray geometry (sphere distance, ray
+    /// offset, shading normal) on given inputs.
+    GeometryHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 8] = [
+    pub const ALL: [Program; 9] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -128,6 +143,7 @@ impl Program {
         Program::TextureHarness,
         Program::BvhHarness,
         Program::AccumulationHarness,
+        Program::GeometryHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -160,6 +176,7 @@ impl Program {
                     out.push("bvh.wgsl");
                 }
                 out.extend([
+                    "ray_geometry.wgsl",
                     "intersect.wgsl",
                     "random.wgsl",
                     "bsdf.wgsl",
@@ -174,7 +191,7 @@ impl Program {
                 }
                 out.extend(["fullscreen.wgsl", "accumulate.wgsl", "trace.wgsl"]);
                 if features.contains(Feature::Bump) {
-                    out.extend(["texture_shading.wgsl", "bump.wgsl"]);
+                    out.extend(["texture_shading.wgsl", "shading_normal.wgsl", "bump.wgsl"]);
                 }
             }
             Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
@@ -198,6 +215,12 @@ impl Program {
             Program::AccumulationHarness => {
                 out.extend(["hash.wgsl", "accumulate.wgsl", "accumulation_harness.wgsl"])
             }
+            Program::GeometryHarness => out.extend([
+                "texture_shading.wgsl",
+                "ray_geometry.wgsl",
+                "shading_normal.wgsl",
+                "geometry_harness.wgsl",
+            ]),
         }
         out
     }
