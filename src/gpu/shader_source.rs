@@ -33,6 +33,7 @@ const SOURCES: &[(&str, &str)] = &[
     ),
     ("random.wgsl", include_str!("../../shaders/random.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
     (
         "env_lookup.wgsl",
         include_str!("../../shaders/env_lookup.wgsl"),
@@ -87,6 +88,10 @@ const SOURCES: &[(&str, &str)] = &[
         "bvh_harness.wgsl",
         include_str!("../../shaders/bvh_harness.wgsl"),
     ),
+    (
+        "sampling_harness.wgsl",
+        include_str!("../../shaders/sampling_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,10 +110,13 @@ pub enum Program {
     TextureHarness,
     /// The compute pass that sends rays through a triangle mesh's BVH.
     BvhHarness,
+    /// The compute pass that runs the BSDF, environment and MIS sampling
+    /// functions on given inputs.
+    SamplingHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 7] = [
+    pub const ALL: [Program; 8] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -116,6 +124,7 @@ impl Program {
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
+        Program::SamplingHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -151,6 +160,7 @@ impl Program {
                     "intersect.wgsl",
                     "random.wgsl",
                     "bsdf.wgsl",
+                    "surface.wgsl",
                     "env_lookup.wgsl",
                     "mis.wgsl",
                 ]);
@@ -183,6 +193,16 @@ impl Program {
                 ]);
             }
             Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
+            Program::SamplingHarness => out.extend([
+                "hash.wgsl",
+                "random.wgsl",
+                "env_mapping.wgsl",
+                "bsdf.wgsl",
+                "env_lookup.wgsl",
+                "mis.wgsl",
+                "env_sampling.wgsl",
+                "sampling_harness.wgsl",
+            ]),
         }
         out
     }
