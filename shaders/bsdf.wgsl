@@ -103,10 +103,13 @@ fn sample_bsdf_with(s: SurfacePoint, n: vec3f, wo: vec3f, u: vec4f) -> BsdfSampl
     let u2 = u.z;
     let specular = u.w < specular_probability(s);
     // GGX half vectors have pdf D(h) cos θh; the diffuse lobe is cosine-weighted.
-    // sin θ in closed form too, not as sqrt(1 − cos²θ), which loses its
-    // digits where cos θ is near 1 (a narrow GGX lobe).
+    // GGX's cos²θ = (1 − u) / (1 + (α² − 1) u) and sin²θ = α² u / (same),
+    // the denominator summed as (1 − u) + α² u: both numerators then add
+    // up to it and h stays unit length (1 + (α² − 1) u cancels for u near
+    // 1). sin θ in closed form, not sqrt(1 − cos²θ), which loses its
+    // digits where cos θ is near 1 (a narrow lobe).
     let a2 = s.alpha * s.alpha;
-    let ggx = 1.0 + (a2 - 1.0) * u1;
+    let ggx = (1.0 - u1) + a2 * u1;
     let cos_t = select(sqrt(max(0.0, 1.0 - u1)), sqrt((1.0 - u1) / ggx), specular);
     let sin_t = select(sqrt(u1), sqrt(a2 * u1 / ggx), specular);
     let phi = TWO_PI * u2;

@@ -117,10 +117,13 @@ pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
     let mirror = u[0] < s.mirror;
     let (u1, u2) = (u[1], u[2]);
     let specular = u[3] < specular_probability(s);
-    // sin θ in closed form too, not as sqrt(1 − cos²θ), which loses its
-    // digits where cos θ is near 1 (a narrow GGX lobe).
+    // GGX's cos²θ = (1 − u) / (1 + (α² − 1) u) and sin²θ = α² u / (same),
+    // the denominator summed as (1 − u) + α² u: both numerators then add
+    // up to it and h stays unit length (1 + (α² − 1) u cancels for u near
+    // 1). sin θ in closed form, not sqrt(1 − cos²θ), which loses its
+    // digits where cos θ is near 1 (a narrow lobe).
     let a2 = s.alpha * s.alpha;
-    let ggx = 1.0 + (a2 - 1.0) * u1;
+    let ggx = (1.0 - u1) + a2 * u1;
     let (cos_t, sin_t) = if specular {
         (((1.0 - u1) / ggx).sqrt(), (a2 * u1 / ggx).sqrt())
     } else {
