@@ -726,3 +726,63 @@ fn scene_point() -> impl Strategy<Value = Vec3> {
         .prop_map(Vec3::from_array)
 }
 
+
+// ------------------------------------------------------ the presets render
+
+/// This part's presets in `presets/hard-cases/`, each with the views
+/// worth rendering (the seam preset's poles too).
+fn sampling_presets() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/hard-cases");
+    let mut out: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("sampling_") && n.ends_with(".ron"))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// Each preset loads without a clamped value and renders every saved view
+/// with no sample dropped as NaN or Inf by the trace pass (its counters)
+/// and finite pixels: the seam and both poles of sky.exr through a mirror
+/// ball, and the infinite light density against a roughness of 0.05
+/// under the power heuristic.
+#[test]
+fn sampling_presets_render_without_non_finite_samples() {
+    let Some(ctx) = gpu_or_skip("sampling_presets_render_without_non_finite_samples") else {
+        return;
+    };
+    let presets = sampling_presets();
+    assert_eq!(presets.len(), 2, "{presets:?}");
+    for path in presets {
+        let loaded = marbre::preset::load(&path).unwrap();
+        assert!(loaded.notes.is_empty(), "{}: {:?}", path.display(), loaded.notes);
+        let scene = marbre::commands::session::load_scene(&path, None).unwrap();
+        let mut cameras = vec![scene.scene.camera];
+        cameras.extend(scene.scene.views.iter().map(|v| v.camera));
+        for camera in cameras {
+            let mut view = marbre::commands::session::LoadedScene {
+                scene: scene.scene.clone(),
+                env: scene.env.clone(),
+                images: scene.images.clone(),
+                notes: Vec::new(),
+            };
+            view.scene.camera = camera;
+            let mut renderer =
+                marbre::commands::session::renderer_for(&ctx, &view, (32, 32)).unwrap();
+            marbre::commands::session::accumulate(&ctx, &mut renderer, 8, |_| {}).unwrap();
+            let dropped = renderer.count_non_finite(&ctx).unwrap();
+            assert!(
+                dropped.is_zero(),
+                "{} from {camera:?}: dropped {dropped:?}",
+                path.display()
+            );
+            let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
+            assert!(pixels.iter().flatten().all(|c| c.is_finite()));
+        }
+    }
+}
