@@ -2,7 +2,7 @@
 
 struct NoiseParams {
     kind: u32,        // 0 gradient, 1 Perlin
-    hash: u32,        // 0 pcg3d, 1 sin
+    hash: u32,        // 0 pcg3d, 1 sin, 2 pcg3d tiled every 256 cells
     octaves: f32,
     frequency: f32,
     amplitude: f32,

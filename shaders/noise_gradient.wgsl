@@ -6,7 +6,9 @@ fn corner_gradient(cell: vec3i, hash: u32) -> vec3f {
         return gradient_sin(vec3f(cell));
     }
 #endif
-    return gradient_pcg(cell);
+    // hash 2: pcg3d of the cell modulo 256, a lattice that repeats
+    // (noise::rebase); `& 255` is the non-negative remainder, as on the CPU.
+    return gradient_pcg(select(cell, cell & vec3i(255), hash == 2u));
 }
 
 fn gradient_noise(p: vec3f, hash: u32) -> f32 {

@@ -45,6 +45,10 @@ struct Frame {
     // Russian roulette from this bounce on (0: never).
     russian_roulette_from: u32,
     triangle_count: u32,
+    // Always 1.0, but the compiler cannot know it (accumulate.wgsl).
+    opaque_one: f32,
+    // The firefly clamp on a sample's largest channel; 0: off.
+    sample_clamp: f32,
 }
 
 const MAX_SIGNALS: u32 = 4u;

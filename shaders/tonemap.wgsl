@@ -11,6 +11,9 @@ struct Display {
     // Maps a target pixel to an accumulation texel: texel = (pixel - origin) * scale.
     origin: vec2f,
     scale: vec2f,
+    // 1: paint the pixels that dropped a non-finite sample magenta.
+    show_non_finite: u32,
+    padding: u32,
 }
 
 // What the auto-exposure pass wrote (auto_exposure.wgsl; same layout).
@@ -24,6 +27,11 @@ struct Metered {
 @group(0) @binding(0) var<uniform> display: Display;
 @group(0) @binding(1) var radiance: texture_2d<f32>;
 @group(0) @binding(2) var<uniform> metered: Metered;
+// The spread target: its alpha counts the pixel's dropped non-finite
+// samples (trace.wgsl).
+@group(0) @binding(3) var spread: texture_2d<f32>;
+
+const MAGENTA: vec4f = vec4f(1.0, 0.0, 1.0, 1.0);
 
 // Narkowicz's fit of the ACES filmic curve.
 fn aces(x: vec3f) -> vec3f {
@@ -54,6 +62,9 @@ fn tone_map(c: vec3f) -> vec3f {
 fn fs_display(@builtin(position) position: vec4f) -> @location(0) vec4f {
     let size = vec2i(textureDimensions(radiance));
     let texel = clamp(vec2i(floor((position.xy - display.origin) * display.scale)), vec2i(0), size - 1);
+    if display.show_non_finite != 0u && textureLoad(spread, texel, 0).a > 0.0 {
+        return MAGENTA;
+    }
     let scale = display.exposure_scale * select(1.0, metered.scale, display.auto_exposure != 0u);
     let c = max(textureLoad(radiance, texel, 0).rgb * scale, vec3f(0.0));
     var mapped = tone_map(c);

@@ -6,12 +6,25 @@
 
 @group(0) @binding(5) var previous: texture_2d<f32>;
 @group(0) @binding(16) var previous_spread: texture_2d<f32>;
+@group(0) @binding(18) var previous_compensation: texture_2d<f32>;
+
+// Samples dropped for being NaN or infinite since the accumulation began
+// (gpu/non_finite.rs; cleared before its first frame). A correct renderer
+// never adds to them: the tests and the Stats panel read them.
+struct NonFiniteCounters {
+    nan: atomic<u32>,
+    infinite: atomic<u32>,
+    pixels: atomic<u32>,
+}
+@group(0) @binding(17) var<storage, read_write> non_finite: NonFiniteCounters;
 
 // What one frame leaves per pixel: the running mean of every sample so far,
-// and the running weighted second moment about it (Welford's update).
+// the running weighted second moment about it (Welford's update), and the
+// mean's Kahan compensation (accumulate.wgsl).
 struct Accumulated {
     @location(0) mean: vec4f,
     @location(1) spread: vec4f,
+    @location(2) compensation: vec4f,
 }
 
 fn camera_ray(pixel: vec2f) -> vec3f {
@@ -248,30 +261,56 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
     let pixel = vec2u(position.xy);
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);
+    var dropped = 0u;
     for (var k = 0u; k < spp; k++) {
         rng_seed(pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
         let jitter = vec2f(rand(), rand());
-        let l = trace_path(vec2f(pixel) + jitter);
-        // A non-finite sample never reaches the accumulation target.
-        if !any_non_finite(l) {
-            sum += l;
+        var l = trace_path(vec2f(pixel) + jitter);
+        // The optional firefly clamp (biased; off by default).
+        let brightest = max(l.x, max(l.y, l.z));
+        if frame.sample_clamp > 0.0 && brightest > frame.sample_clamp {
+            l *= frame.sample_clamp / brightest;
+        }
+        // A non-finite sample never reaches the accumulation target: it is
+        // dropped and counted. Dividing each sample before adding keeps the
+        // sum of finite samples finite too (spp samples near f32::MAX).
+        if any_non_finite(l) {
+            dropped++;
+            if any_nan(l) {
+                atomicAdd(&non_finite.nan, 1u);
+            } else {
+                atomicAdd(&non_finite.infinite, 1u);
+            }
+        } else {
+            sum += l / f32(spp);
         }
     }
-    let x = sum / f32(spp);
-    let n = f32(frame.accumulated);
+    let x = sum;
     // The first frame ignores what the targets held before (a resize or a
     // reset leaves stale texels, which must not leak in, even as NaN * 0).
     let first = frame.accumulated == 0u;
     let prev = select(textureLoad(previous, pixel, 0).xyz, vec3f(0.0), first);
-    let prev_spread = select(textureLoad(previous_spread, pixel, 0).xyz, vec3f(0.0), first);
-    // A running mean: its rounding error does not grow with the frame count.
-    let w = f32(spp) / (n + f32(spp));
-    let mean = prev + (x - prev) * w;
+    let prev_spread_texel = select(textureLoad(previous_spread, pixel, 0), vec4f(0.0), first);
+    let prev_spread = prev_spread_texel.xyz;
+    let prev_compensation = select(textureLoad(previous_compensation, pixel, 0).xyz, vec3f(0.0), first);
+    // A compensated running mean: its rounding error does not grow with the
+    // frame count.
+    let w = frame_weight(frame.accumulated, spp);
+    let updated = compensated_mean_update(prev, prev_compensation, x, w, frame.opaque_one);
+    let mean = updated.mean;
     // Weighted Welford (West 1979), kept divided by the weight like the
     // mean: spread = Σ spp_i (x_i - mean)² / Σ spp_i over the frames' means
     // x_i. With F frames of equal spp, E[spread] = (F - 1)/F · σ²/spp, so the
     // variance of the pixel's mean is estimated by spread / (F - 1)
     // (gpu::error_meter).
-    let spread = prev_spread + ((x - prev) * (x - mean) - prev_spread) * w;
-    return Accumulated(vec4f(mean, 1.0), vec4f(spread, 1.0));
+    // Squares of radiances above ~1e19 overflow: the spread saturates at
+    // the largest float instead of becoming infinite.
+    let spread = min(prev_spread + ((x - prev) * (x - mean) - prev_spread) * w, vec3f(F32_MAX));
+    // The spread's alpha counts this pixel's dropped samples (the magenta
+    // debug view paints where it is not zero).
+    let prev_dropped = prev_spread_texel.w;
+    if dropped > 0u && prev_dropped == 0.0 {
+        atomicAdd(&non_finite.pixels, 1u);
+    }
+    return Accumulated(vec4f(mean, 1.0), vec4f(spread, prev_dropped + f32(dropped)), vec4f(updated.compensation, 0.0));
 }

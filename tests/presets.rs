@@ -33,6 +33,18 @@ fn shipped_presets() -> Vec<PathBuf> {
     out
 }
 
+/// Every `presets/hard-cases/*.ron` (issue 6's adversarial scenes), sorted.
+fn hard_case_presets() -> Vec<PathBuf> {
+    let dir = root().join("presets/hard-cases");
+    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("a readable directory entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    out.sort();
+    out
+}
+
 fn load(path: &Path) -> Preset {
     let loaded = preset::load(path).unwrap_or_else(|e| panic!("{e}"));
     assert!(
@@ -493,6 +505,12 @@ fn every_shipped_preset_renders_finite_and_not_black() {
         let (w, h, pixels) = renderer.read_radiance(&ctx).unwrap();
         assert_eq!((w, h), size, "{}", path.display());
         assert_eq!(pixels.len(), (w * h) as usize, "{}", path.display());
+        let dropped = renderer.count_non_finite(&ctx).unwrap();
+        assert!(
+            dropped.is_zero(),
+            "{}: the trace pass dropped non-finite samples: {dropped:?}",
+            path.display()
+        );
         let non_finite: Vec<_> = pixels
             .iter()
             .enumerate()
@@ -524,4 +542,39 @@ fn every_shipped_preset_renders_finite_and_not_black() {
         size.1,
         report.join("\n")
     );
+}
+
+/// The hard cases load (some on purpose with values the loader clamps, and
+/// says so) and render without a single non-finite sample: the counters,
+/// not the image, prove it, since the trace pass drops such samples.
+#[test]
+fn every_hard_case_preset_renders_without_a_non_finite_sample() {
+    let Some(ctx) = gpu_or_skip("every_hard_case_preset_renders_without_a_non_finite_sample")
+    else {
+        return;
+    };
+    let presets = hard_case_presets();
+    assert!(
+        presets.len() >= 12,
+        "one preset per case at least: {presets:?}"
+    );
+    for path in presets {
+        let loaded =
+            load_scene(&path, None).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        let mut renderer = renderer_for(&ctx, &loaded, (48, 32))
+            .unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
+        let dropped = renderer.count_non_finite(&ctx).unwrap();
+        assert!(
+            dropped.is_zero(),
+            "{}: the trace pass dropped non-finite samples: {dropped:?}",
+            path.display()
+        );
+        let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
+        assert!(
+            pixels.iter().all(|p| p.iter().all(|c| c.is_finite())),
+            "{}: a non-finite pixel",
+            path.display()
+        );
+    }
 }

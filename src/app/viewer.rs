@@ -8,7 +8,7 @@ use crate::cubemap;
 use crate::envmap;
 use crate::gpu::pass_timer::{Pass, PassTimer};
 use crate::gpu::readback::read_texture;
-use crate::gpu::{DisplayTarget, FeatureSet, GpuContext, Renderer, Viewport};
+use crate::gpu::{DisplayTarget, FeatureSet, GpuContext, NonFiniteCounts, Renderer, Viewport};
 use crate::panel::{self, PanelAction, PanelState, QualityStats, Stats};
 use crate::preset::{self, Preset};
 use crate::scene::{EnvSource, OrbitCamera, Scene};
@@ -39,6 +39,9 @@ pub struct Viewer {
     convergence: Convergence,
     /// Trace times with shader features compiled out, for the Quality panel.
     feature_costs: FeatureCosts,
+    /// Samples the current accumulation dropped for being NaN or infinite,
+    /// and the accumulation they count.
+    non_finite: (u32, NonFiniteCounts),
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
@@ -117,6 +120,7 @@ impl Viewer {
             timer,
             convergence: Convergence::default(),
             feature_costs: FeatureCosts::default(),
+            non_finite: (0, NonFiniteCounts::default()),
             window,
             surface,
             config,
@@ -385,6 +389,18 @@ impl Viewer {
         controls.stop_at_target && self.convergence.reached(controls.target_error)
     }
 
+    /// Follows the non-finite counters: they restart with the
+    /// accumulation, and a readback arrives a frame or two late.
+    fn observe_non_finite(&mut self) {
+        let generation = self.renderer.accumulation_generation();
+        if self.non_finite.0 != generation {
+            self.non_finite = (generation, NonFiniteCounts::default());
+        }
+        if let Some(counts) = self.renderer.poll_non_finite() {
+            self.non_finite.1 = counts;
+        }
+    }
+
     fn stats(&self) -> Stats {
         let gpu_ms = self.timer.as_ref().and_then(|t| t.ms(Pass::Trace));
         let info = self.ctx.adapter.get_info();
@@ -411,6 +427,7 @@ impl Viewer {
             triangles: mesh.triangles,
             bvh_nodes: mesh.bvh_nodes,
             bvh_build_ms: mesh.bvh_build.as_secs_f32() * 1000.0,
+            non_finite: self.non_finite.1,
             quality: self.quality_stats(),
         }
     }
@@ -562,6 +579,7 @@ impl Viewer {
             self.renderer.accumulation_generation(),
             self.renderer.poll_error(),
         );
+        self.observe_non_finite();
         if let Some(t) = &mut self.timer {
             t.begin_frame();
             if !self.scene.render.auto_exposure {

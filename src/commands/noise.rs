@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::io::{BufRead, Write};
+use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum KindArg {
@@ -18,6 +19,7 @@ pub enum KindArg {
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum HashArg {
     Pcg,
+    PcgTiled,
     Sin,
 }
 
@@ -46,6 +48,10 @@ pub struct NoiseArgs {
     /// Evaluate with the CPU reference instead of the shader.
     #[arg(long)]
     pub cpu: bool,
+    /// Instead of reading points, draw the far-from-the-origin figure (the
+    /// sin hash against pcg3d, GPU against CPU) to this PNG.
+    #[arg(long, value_name = "PNG")]
+    pub stability_figure: Option<PathBuf>,
 }
 
 impl NoiseArgs {
@@ -57,6 +63,7 @@ impl NoiseArgs {
             },
             hash: match self.hash {
                 HashArg::Pcg => HashKind::Pcg,
+                HashArg::PcgTiled => HashKind::PcgTiled,
                 HashArg::Sin => HashKind::Sin,
             },
             fractal: FractalParams {
@@ -124,6 +131,9 @@ pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[Vec3]) -
 }
 
 pub fn run(args: &NoiseArgs) -> Result<()> {
+    if let Some(path) = &args.stability_figure {
+        return super::noise_figure::write(path);
+    }
     let points = parse_points(std::io::stdin().lock())?;
     let settings = args.settings();
     let values = if args.cpu {

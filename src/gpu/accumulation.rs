@@ -1,11 +1,15 @@
 //! The targets the trace pass accumulates into, and how much they hold.
 //!
-//! Two images per pixel, each ping-ponged (a frame reads the latest pair and
-//! writes the other): the running mean of every sample, which is the image,
-//! and the running spread of the frames' means about it, from which
-//! [`super::error_meter`] estimates the image's error. Both are running
-//! averages rather than sums, so their rounding error does not grow with
-//! the frame count.
+//! Three images per pixel, each ping-ponged (a frame reads the latest set
+//! and writes the other): the running mean of every sample, which is the
+//! image; the running spread of the frames' means about it, from which
+//! [`super::error_meter`] estimates the image's error (its alpha counts the
+//! pixel's dropped non-finite samples, see [`super::non_finite`]); and the
+//! Kahan compensation of the mean, the low-order bits its updates lost.
+//! Averages rather than sums, and the mean compensated, so that rounding
+//! error does not grow with the frame count: a plain f32 running mean
+//! drifts by about 1e-3 after 1e6 frames of an HDR pixel, the compensated
+//! one stays within 1e-7 (`tests/accumulation.rs`).
 
 use std::time::{Duration, Instant};
 
@@ -51,6 +55,7 @@ impl PingPong {
 pub struct Accumulation {
     mean: PingPong,
     spread: PingPong,
+    compensation: PingPong,
     /// Index of the pair holding the latest frame.
     latest: usize,
     samples: u32,
@@ -66,6 +71,7 @@ impl Accumulation {
         Self {
             mean: PingPong::new(device, "accumulated mean", size),
             spread: PingPong::new(device, "accumulated spread", size),
+            compensation: PingPong::new(device, "mean compensation", size),
             latest: 0,
             samples: 0,
             frames: 0,
@@ -114,6 +120,11 @@ impl Accumulation {
         )
     }
 
+    /// The Kahan compensation of the latest mean, which the next frame reads.
+    pub fn latest_compensation_view(&self) -> &wgpu::TextureView {
+        &self.compensation.views[self.latest]
+    }
+
     pub fn latest_mean_texture(&self) -> &wgpu::Texture {
         &self.mean.textures[self.latest]
     }
@@ -122,11 +133,16 @@ impl Accumulation {
         &self.spread.textures[self.latest]
     }
 
-    /// The colour attachments a frame writes: mean, then spread (the trace
-    /// shader's locations 0 and 1).
-    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 2] {
+    /// The colour attachments a frame writes: mean, spread, compensation
+    /// (the trace shader's locations 0, 1 and 2).
+    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 3] {
         let write = 1 - self.latest;
-        [&self.mean.views[write], &self.spread.views[write]].map(|view| {
+        [
+            &self.mean.views[write],
+            &self.spread.views[write],
+            &self.compensation.views[write],
+        ]
+        .map(|view| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,

@@ -285,7 +285,9 @@ fn has_area_lights(scene: &Scene) -> bool {
 fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {
     let mut out = match (noise.kind, noise.hash) {
         (NoiseKind::Perlin, _) => vec![Feature::NoisePerlin],
-        (NoiseKind::Gradient, HashKind::Pcg) => vec![Feature::NoiseGradient, Feature::HashPcg],
+        (NoiseKind::Gradient, HashKind::Pcg | HashKind::PcgTiled) => {
+            vec![Feature::NoiseGradient, Feature::HashPcg]
+        }
         (NoiseKind::Gradient, HashKind::Sin) => vec![Feature::NoiseGradient, Feature::HashSin],
     };
     if noise.fractal.distortion != 0.0 {

@@ -3,6 +3,7 @@
 //! compute harness.
 
 pub mod accumulation;
+pub mod accumulation_harness;
 pub mod async_readback;
 pub mod auto_exposure;
 pub mod bvh_harness;
@@ -14,6 +15,7 @@ pub mod geometry_buffers;
 pub mod mesh_buffers;
 pub mod metering_grid;
 pub mod noise_harness;
+pub mod non_finite;
 pub mod pass_timer;
 pub mod pipeline_build;
 pub mod pipelines;
@@ -29,4 +31,5 @@ pub mod texture_harness;
 
 pub use context::GpuContext;
 pub use features::{Feature, FeatureSet};
+pub use non_finite::NonFiniteCounts;
 pub use renderer::{DisplayTarget, Renderer, Viewport};

@@ -9,6 +9,7 @@ use super::error_meter::{self, ErrorEstimate, ErrorMeter};
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
 use super::mesh_buffers::{MeshBuffers, MeshStats};
+use super::non_finite::{self, NonFiniteCounter, NonFiniteCounts};
 use super::pass_timer::{Pass, PassTimer};
 use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use super::pipelines::{
@@ -39,6 +40,9 @@ struct DisplayUniform {
     auto_exposure: u32,
     origin: [f32; 2],
     scale: [f32; 2],
+    /// 1: paint the pixels that dropped a non-finite sample magenta.
+    show_non_finite: u32,
+    padding: u32,
 }
 
 /// The accumulation an auto-exposure metering read: the frame that wrote
@@ -160,6 +164,8 @@ pub struct Renderer {
     accumulation: Accumulation,
     /// Estimates the accumulated image's error from its spread.
     error_meter: ErrorMeter,
+    /// Counts the samples the trace pass dropped for being NaN or infinite.
+    non_finite: NonFiniteCounter,
     size: (u32, u32),
     render_scale: f32,
     frame_index: u32,
@@ -193,6 +199,8 @@ impl Renderer {
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
                 entry(16, float_texture(false)),
+                entry(18, float_texture(false)),
+                entry(non_finite::BINDING, storage(false)),
                 entry(MeshBuffers::BINDINGS[0], storage(true)),
                 entry(MeshBuffers::BINDINGS[1], storage(true)),
                 entry(MeshBuffers::BINDINGS[2], storage(true)),
@@ -205,6 +213,7 @@ impl Renderer {
                 entry(0, uniform()),
                 entry(1, float_texture(false)),
                 entry(2, uniform()),
+                entry(3, float_texture(false)),
             ],
         });
         let images = ImageSet::empty();
@@ -261,6 +270,7 @@ impl Renderer {
         let image_atlas_view = upload_atlas(ctx, images.atlas());
         let accumulation = Accumulation::new(device, size);
         let error_meter = ErrorMeter::new(device)?;
+        let non_finite = NonFiniteCounter::new(device);
         Ok(Self {
             scene: scene.clone(),
             pending: None,
@@ -289,6 +299,7 @@ impl Renderer {
             image_atlas_view,
             accumulation,
             error_meter,
+            non_finite,
             size,
             render_scale: 1.0,
             frame_index: 0,
@@ -310,7 +321,7 @@ impl Renderer {
             &module,
             layout,
             "fs_trace",
-            &[ACCUMULATION_FORMAT; 2],
+            &[ACCUMULATION_FORMAT; 3],
             &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
@@ -517,6 +528,8 @@ impl Renderer {
         traced_now.render.auto_exposure = false;
         traced_before.render.tone_map = ToneMap::default();
         traced_now.render.tone_map = ToneMap::default();
+        traced_before.render.show_non_finite = false;
+        traced_now.render.show_non_finite = false;
         if traced_before != traced_now {
             self.reset_accumulation();
         }
@@ -688,6 +701,10 @@ impl Renderer {
             bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
             bind(5, wgpu::BindingResource::TextureView(previous_mean)),
             bind(16, wgpu::BindingResource::TextureView(previous_spread)),
+            bind(
+                18,
+                wgpu::BindingResource::TextureView(self.accumulation.latest_compensation_view()),
+            ),
             bind(6, self.perm_buffer.as_entire_binding()),
             bind(7, self.texture_param_buffer.as_entire_binding()),
             bind(
@@ -695,6 +712,10 @@ impl Renderer {
                 wgpu::BindingResource::TextureView(&self.image_atlas_view),
             ),
             bind(11, self.env_distribution.0.as_entire_binding()),
+            bind(
+                non_finite::BINDING,
+                self.non_finite.buffer().as_entire_binding(),
+            ),
         ];
         entries.extend(self.geometry.entries());
         entries.extend(self.meshes.entries());
@@ -703,6 +724,9 @@ impl Renderer {
             layout: &self.trace_layout,
             entries: &entries,
         });
+        if self.accumulation.samples() == 0 {
+            self.non_finite.clear(encoder);
+        }
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("trace"),
@@ -724,6 +748,8 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
+        self.non_finite
+            .record_readback(encoder, self.accumulation.generation());
         self.accumulation
             .advance(self.scene.render.samples_per_frame.max(1));
         self.frame_index = self.frame_index.wrapping_add(1);
@@ -803,6 +829,8 @@ impl Renderer {
                 render_size.0 as f32 / viewport.width.max(1.0),
                 render_size.1 as f32 / viewport.height.max(1.0),
             ],
+            show_non_finite: u32::from(self.scene.render.show_non_finite),
+            padding: 0,
         };
         ctx.queue
             .write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
@@ -816,6 +844,10 @@ impl Renderer {
                     wgpu::BindingResource::TextureView(self.accumulation.latest_views().0),
                 ),
                 bind(2, self.auto_exposure.result().as_entire_binding()),
+                bind(
+                    3,
+                    wgpu::BindingResource::TextureView(self.accumulation.latest_views().1),
+                ),
             ],
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -924,6 +956,21 @@ impl Renderer {
     /// Starts the readbacks recorded in the encoder just submitted.
     pub fn after_submit(&self) {
         self.error_meter.after_submit();
+        self.non_finite.after_submit();
+    }
+
+    /// The non-finite samples dropped by the current accumulation, from a
+    /// finished readback (a frame or two old); `None` while none arrived
+    /// or the one that did counted an earlier accumulation.
+    pub fn poll_non_finite(&self) -> Option<NonFiniteCounts> {
+        let (generation, counts) = self.non_finite.poll()?;
+        (generation == self.accumulation.generation()).then_some(counts)
+    }
+
+    /// The non-finite samples dropped since the accumulation began, waiting
+    /// for the GPU: for headless renders and tests.
+    pub fn count_non_finite(&self, ctx: &GpuContext) -> Result<NonFiniteCounts> {
+        self.non_finite.read(ctx)
     }
 
     /// The error estimate of a finished readback, once, a frame or two

@@ -53,7 +53,12 @@ pub struct FrameUniform {
     pub strategy: u32,
     pub russian_roulette_from: u32,
     pub triangle_count: u32,
-    pub _pad: [u32; 3],
+    /// Always 1.0, but a uniform: see `compensated_mean_update` in
+    /// `shaders/accumulate.wgsl`.
+    pub opaque_one: f32,
+    /// The firefly clamp on a sample's largest channel; 0: off.
+    pub sample_clamp: f32,
+    pub _pad: u32,
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -153,6 +158,7 @@ pub fn hash_id(h: HashKind) -> u32 {
     match h {
         HashKind::Pcg => 0,
         HashKind::Sin => 1,
+        HashKind::PcgTiled => 2,
     }
 }
 
@@ -177,7 +183,7 @@ pub fn material(m: &Material) -> MaterialGpu {
         let mapping = signal.mapping.unwrap_or_default();
         out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
         out.signals[k].footprint_scale = mapping.footprint_scale()[2];
-        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&mapping.rows());
+        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&signal.rows());
     }
     out
 }
@@ -326,7 +332,9 @@ pub fn frame_uniform(
         strategy: scene.render.transport.strategy.id(),
         russian_roulette_from: scene.render.transport.russian_roulette_from,
         triangle_count: 0,
-        _pad: [0; 3],
+        opaque_one: 1.0,
+        sample_clamp: scene.render.transport.sample_clamp.unwrap_or(0.0),
+        _pad: 0,
     }
 }
 

@@ -39,6 +39,14 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/env_lookup.wgsl"),
     ),
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
+    (
+        "accumulate.wgsl",
+        include_str!("../../shaders/accumulate.wgsl"),
+    ),
+    (
+        "accumulation_harness.wgsl",
+        include_str!("../../shaders/accumulation_harness.wgsl"),
+    ),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     (
         "metering_grid.wgsl",
@@ -110,13 +118,16 @@ pub enum Program {
     TextureHarness,
     /// The compute pass that sends rays through a triangle mesh's BVH.
     BvhHarness,
+    /// The compute pass that runs the accumulation update over long
+    /// streams of frames.
+    AccumulationHarness,
     /// The compute pass that runs the BSDF, environment and MIS sampling
     /// functions on given inputs.
     SamplingHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 8] = [
+    pub const ALL: [Program; 9] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -124,6 +135,7 @@ impl Program {
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
+        Program::AccumulationHarness,
         Program::SamplingHarness,
     ];
 
@@ -170,7 +182,7 @@ impl Program {
                 if features.contains(Feature::EnvSampling) {
                     out.push("env_sampling.wgsl");
                 }
-                out.extend(["fullscreen.wgsl", "trace.wgsl"]);
+                out.extend(["fullscreen.wgsl", "accumulate.wgsl", "trace.wgsl"]);
                 if features.contains(Feature::Bump) {
                     out.extend(["texture_shading.wgsl", "bump.wgsl"]);
                 }
@@ -193,6 +205,9 @@ impl Program {
                 ]);
             }
             Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
+            Program::AccumulationHarness => {
+                out.extend(["hash.wgsl", "accumulate.wgsl", "accumulation_harness.wgsl"])
+            }
             Program::SamplingHarness => out.extend([
                 "hash.wgsl",
                 "random.wgsl",

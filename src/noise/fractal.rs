@@ -3,6 +3,7 @@
 use super::{HashKind, NoiseKind, gradient::gradient_noise, perlin::improved_noise_f32};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
+use std::ops::RangeInclusive;
 
 /// The knobs of a fractal sum. Octave `i` is `amplitude · persistenceⁱ ·
 /// noise(p · frequency · lacunarityⁱ)`.
@@ -25,6 +26,20 @@ pub struct FractalParams {
 
 impl FractalParams {
     pub const MAX_OCTAVES: f32 = 16.0;
+    /// The values a preset is clamped to at load and the panel lets a user
+    /// type (its sliders drag over the useful part): one source for both, so
+    /// a saved scene always reloads unchanged.
+    pub const OCTAVES: RangeInclusive<f32> = 0.0..=Self::MAX_OCTAVES;
+    pub const FREQUENCY: RangeInclusive<f32> = 0.0..=1e6;
+    pub const AMPLITUDE: RangeInclusive<f32> = -100.0..=100.0;
+    /// Above 1 the octaves grow: the sum is not normalised (that would
+    /// change every existing texture's contrast) but stays bounded, by
+    /// |amplitude| · Σ persistenceⁱ · the noise's bound, at most
+    /// 100 · 1.5¹⁶/0.5 · 1.1 ≈ 1.5e5 over 16 octaves, and every pattern
+    /// clamps its blend factor to [0, 1].
+    pub const PERSISTENCE: RangeInclusive<f32> = 0.0..=1.5;
+    pub const LACUNARITY: RangeInclusive<f32> = 1.0..=8.0;
+    pub const DISTORTION: RangeInclusive<f32> = -100.0..=100.0;
 }
 
 impl Default for FractalParams {

@@ -2,7 +2,7 @@
 //! offset to each corner, and trilinear interpolation by the smoothstep
 //! `u = f²(3 − 2f)`.
 
-use super::hash::{HashKind, gradient_pcg, gradient_sin};
+use super::hash::{HashKind, gradient_pcg, gradient_pcg_tiled, gradient_sin};
 use glam::{IVec3, Vec3};
 
 /// A provable bound on |gradient_noise|: each corner value is
@@ -13,6 +13,7 @@ pub const GRADIENT_NOISE_BOUND: f32 = 3.0;
 fn corner_gradient(cell: IVec3, hash: HashKind) -> Vec3 {
     match hash {
         HashKind::Pcg => gradient_pcg(cell),
+        HashKind::PcgTiled => gradient_pcg_tiled(cell),
         HashKind::Sin => gradient_sin(cell.as_vec3()),
     }
 }
@@ -25,7 +26,10 @@ pub fn gradient_noise(p: Vec3, hash: HashKind) -> f32 {
     let u = f * f * (Vec3::splat(3.0) - 2.0 * f);
     let corner = |dx: i32, dy: i32, dz: i32| {
         let c = IVec3::new(dx, dy, dz);
-        corner_gradient(cell + c, hash).dot(f - c.as_vec3())
+        // Wrapping, as WGSL's i32 addition: beyond 2³¹ the cell saturates
+        // (f32 → i32 `as`, like the shader's conversion) and its +1
+        // neighbour must not overflow.
+        corner_gradient(cell.wrapping_add(c), hash).dot(f - c.as_vec3())
     };
     let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
     let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u.x);

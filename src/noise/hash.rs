@@ -10,6 +10,12 @@ pub enum HashKind {
     /// every GPU agree bit for bit at any distance from the origin.
     #[default]
     Pcg,
+    /// pcg3d of the cell modulo 256 in each axis: the lattice repeats every
+    /// 256 cells, as Perlin's does, so a far-off texture offset can be moved
+    /// back near the origin by whole periods without changing the noise
+    /// (`noise::rebase`), keeping f32's precision. Near the origin it is the
+    /// same noise as `Pcg` in the cells 0..256.
+    PcgTiled,
     /// The lab's `fract(sin(dot(p, k)) * 43758.5453)`. Kept for fidelity with
     /// the course material. It depends on the accuracy of `sin`, which WGSL only
     /// bounds on [-π, π], and the 43758 factor amplifies every error, so GPUs
@@ -18,11 +24,12 @@ pub enum HashKind {
 }
 
 impl HashKind {
-    pub const ALL: [HashKind; 2] = [HashKind::Pcg, HashKind::Sin];
+    pub const ALL: [HashKind; 3] = [HashKind::Pcg, HashKind::PcgTiled, HashKind::Sin];
 
     pub fn label(self) -> &'static str {
         match self {
             HashKind::Pcg => "pcg3d (integer)",
+            HashKind::PcgTiled => "pcg3d tiled (256 cells)",
             HashKind::Sin => "fract(sin) (lab)",
         }
     }
@@ -54,6 +61,15 @@ pub fn gradient_pcg(cell: IVec3) -> Vec3 {
     let h = pcg3d(cell.as_uvec3());
     Vec3::new(unit_signed(h.x), unit_signed(h.y), unit_signed(h.z))
 }
+
+/// Gradient of the cell modulo 256 (`cell & 255` is the non-negative
+/// remainder in two's complement, as in the shader).
+pub fn gradient_pcg_tiled(cell: IVec3) -> Vec3 {
+    gradient_pcg(cell & IVec3::splat(LATTICE_PERIOD - 1))
+}
+
+/// The period, in cells, of the tiled hash and of Perlin's permutation.
+pub const LATTICE_PERIOD: i32 = 256;
 
 /// The lab's hash, in f32 as a shader computes it.
 pub fn gradient_sin(cell: Vec3) -> Vec3 {

@@ -9,6 +9,7 @@ use crate::scene::{
 use crate::texture::{ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
+use std::ops::RangeInclusive;
 use std::path::PathBuf;
 
 /// Every property's texture, the bump, the emission strength and layers.
@@ -616,25 +617,64 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
             .response
             .on_hover_text(
                 "How gradient noise picks a corner's gradient: pcg3d agrees bit for bit \
-                 on every GPU, fract(sin) is the lab's and drifts far from the origin",
+                 on every GPU; tiled, it repeats every 256 cells, so a far offset is \
+                 moved near the origin and stays sharp; fract(sin) is the lab's and \
+                 drifts far from the origin",
             )
             .on_disabled_hover_text("Unused: Perlin noise hashes with its permutation table");
     });
     let f = &mut noise.fractal;
-    ui.add(slider(
-        &mut f.octaves,
-        0.0..=FractalParams::MAX_OCTAVES,
-        "octaves",
+    ui.add(slider(&mut f.octaves, FractalParams::OCTAVES, "octaves"))
+        .on_hover_text("Number of noise layers; a fractional part fades the last one in");
+    ui.add(typed_beyond(
+        slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true),
     ))
-    .on_hover_text("Number of noise layers; a fractional part fades the last one in");
-    ui.add(slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true))
-        .on_hover_text("Frequency of the first octave, in cycles per scene unit");
-    ui.add(slider(&mut f.amplitude, 0.0..=2.0, "amplitude").clamping(SliderClamping::Never))
-        .on_hover_text("Amplitude of the first octave (type any value in the number)");
-    ui.add(slider(&mut f.persistence, 0.0..=1.5, "persistence"))
-        .on_hover_text("Amplitude ratio between successive octaves (0.5: each half as strong)");
-    ui.add(slider(&mut f.lacunarity, 1.0..=4.0, "lacunarity"))
-        .on_hover_text("Frequency ratio between successive octaves (2: each twice as fine)");
-    ui.add(slider(&mut f.distortion, 0.0..=4.0, "distortion"))
-        .on_hover_text("Domain warp: moves the point by noise before summing (0: none)");
+    .on_hover_text("Frequency of the first octave, in cycles per scene unit (type up to 1e6)");
+    limit(&mut f.frequency, FractalParams::FREQUENCY);
+    ui.add(typed_beyond(slider(
+        &mut f.amplitude,
+        0.0..=2.0,
+        "amplitude",
+    )))
+    .on_hover_text("Amplitude of the first octave (type any value in ±100)");
+    limit(&mut f.amplitude, FractalParams::AMPLITUDE);
+    ui.add(slider(
+        &mut f.persistence,
+        FractalParams::PERSISTENCE,
+        "persistence",
+    ))
+    .on_hover_text(
+        "Amplitude ratio between successive octaves (0.5: each half as strong; \
+             above 1 the finest octaves dominate)",
+    );
+    ui.add(typed_beyond(slider(
+        &mut f.lacunarity,
+        1.0..=4.0,
+        "lacunarity",
+    )))
+    .on_hover_text(
+        "Frequency ratio between successive octaves (2: each twice as fine; type up to 8)",
+    );
+    limit(&mut f.lacunarity, FractalParams::LACUNARITY);
+    ui.add(typed_beyond(slider(
+        &mut f.distortion,
+        0.0..=4.0,
+        "distortion",
+    )))
+    .on_hover_text(
+        "Domain warp: moves the point by noise before summing (0: none; type any value in ±100)",
+    );
+    limit(&mut f.distortion, FractalParams::DISTORTION);
+}
+
+/// A slider that drags over its useful range but keeps a typed value beyond
+/// it; [`limit`] then holds it to what a preset may hold, so the panel
+/// reaches exactly the values that load unchanged.
+fn typed_beyond(slider: Slider<'_>) -> Slider<'_> {
+    slider.clamping(SliderClamping::Never)
+}
+
+/// `value` clamped into the range a preset is clamped to at load.
+fn limit(value: &mut f32, range: RangeInclusive<f32>) {
+    *value = value.clamp(*range.start(), *range.end());
 }

@@ -11,13 +11,14 @@ mod material_editor;
 mod quality;
 mod transport;
 
+use crate::gpu::NonFiniteCounts;
 use crate::scene::{
     EnvSource, Environment, OrbitCamera, PointLight, RenderSettings, Scene, ToneMap,
 };
 use egui::emath::Numeric;
 use egui::{
-    CollapsingHeader, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping, TextEdit,
-    Ui,
+    CollapsingHeader, Color32, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping,
+    TextEdit, Ui,
 };
 use glam::Vec3;
 use material_editor::material_ui;
@@ -132,6 +133,8 @@ pub struct Stats {
     pub triangles: usize,
     pub bvh_nodes: usize,
     pub bvh_build_ms: f32,
+    /// Samples the accumulation dropped for being NaN or infinite.
+    pub non_finite: NonFiniteCounts,
     pub quality: QualityStats,
 }
 
@@ -709,7 +712,7 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
             "Scales the radiance by 2^exposure before tone mapping",
         )
     };
-    ui.add(slider(&mut render.exposure, -10.0..=10.0, label).suffix(" stops"))
+    ui.add(slider(&mut render.exposure, -20.0..=20.0, label).suffix(" stops"))
         .on_hover_text(hint);
     ComboBox::new("tone map", "tone map")
         .selected_text(render.tone_map.label())
@@ -732,6 +735,11 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         );
     ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
         .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
+    ui.checkbox(&mut render.show_non_finite, "show non-finite pixels")
+        .on_hover_text(
+            "Debug view: paint magenta every pixel where a path gave a NaN or infinite sample \
+             (the accumulation drops such samples; Stats counts them)",
+        );
     if ui
         .button("Screenshot (F12)")
         .on_hover_text("Save the current image as a PNG")
@@ -739,6 +747,24 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
     {
         actions.push(PanelAction::Screenshot);
     }
+}
+
+/// The NaN and Inf counters: red as soon as one sample was dropped, since a
+/// correct renderer never produces one.
+fn non_finite_ui(ui: &mut Ui, counts: &NonFiniteCounts) {
+    let text = format!(
+        "non-finite samples: {} NaN, {} Inf ({} pixels)",
+        counts.nan, counts.infinite, counts.pixels
+    );
+    let label = if counts.is_zero() {
+        ui.label(text)
+    } else {
+        ui.colored_label(Color32::from_rgb(230, 60, 60), text)
+    };
+    label.on_hover_text(
+        "Samples the accumulation dropped since the image restarted because they were NaN or \
+         infinite; \"show non-finite pixels\" (Render) paints where they fell",
+    );
 }
 
 fn stats_ui(ui: &mut Ui, stats: &Stats) {
@@ -757,6 +783,7 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
     ui.label(format!("{:.2} ms/frame ({clock})", stats.ms_per_frame))
         .on_hover_text("GPU: timestamp queries around the passes; CPU: wall time per frame");
     ui.label(format!("{} samples accumulated", stats.samples));
+    non_finite_ui(ui, &stats.non_finite);
     let (w, h) = stats.resolution;
     ui.label(format!("{w} × {h}"));
     ui.label(format!("{} ({})", stats.adapter, stats.backend));

@@ -70,4 +70,26 @@ pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
             "Also draw light directions from a lat-long map by its luminance, combined with \
              BSDF sampling by MIS: a sun stops making fireflies",
         );
+    let mut clamp_on = t.sample_clamp.is_some();
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut clamp_on, "clamp fireflies")
+            .on_hover_text(
+                "Scale down any sample brighter than this in its largest channel: fewer \
+                 fireflies, but a darker, biased image (the bench measures how much); off by default",
+            );
+        if clamp_on {
+            let value = t.sample_clamp.get_or_insert(DEFAULT_SAMPLE_CLAMP);
+            ui.add(
+                egui::Slider::new(value, 0.1..=1.0e4)
+                    .logarithmic(true)
+                    .text("max"),
+            );
+        } else {
+            t.sample_clamp = None;
+        }
+    });
 }
+
+/// Where the firefly clamp starts when switched on: ten times a white
+/// surface under a sky of radiance 1.
+const DEFAULT_SAMPLE_CLAMP: f32 = 10.0;

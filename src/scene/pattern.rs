@@ -5,10 +5,11 @@
 //! The functions themselves live in the texture library (`crate::texture`);
 //! this is the scene's record of which one and with what parameters.
 
-use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum};
+use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum, rebase::rebase};
 use crate::texture;
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
+use std::ops::RangeInclusive;
 
 /// What drives a property across a surface. Each pattern yields a blend
 /// factor `t` in [0, 1] between the texture's two children: `a` where
@@ -97,8 +98,27 @@ pub struct Signal {
 impl Signal {
     /// The sum at a surface point given in object and world coordinates.
     pub fn eval(&self, point: &SurfacePoint) -> f32 {
-        let p = self.mapping.map_or(point.object, |m| m.point(point));
+        let p = match self.mapping {
+            Some(m) => self
+                .noise_space_map()
+                .transform_point3(m.space_point(point)),
+            None => point.object,
+        };
         fractal_sum(p, &self.noise, self.shape)
+    }
+
+    /// The map from surface to noise coordinates, its translation rebased by
+    /// whole periods of the noise (`noise::rebase`): the same sum in exact
+    /// arithmetic, taken near the origin where f32 resolves it.
+    fn noise_space_map(&self) -> Affine3A {
+        let mut m = self.mapping.unwrap_or_default().transform.to_texture();
+        m.translation = rebase(m.translation.into(), &self.noise).into();
+        m
+    }
+
+    /// The rows of [`Signal::noise_space_map`], as the shader reads them.
+    pub fn rows(&self) -> [[f32; 4]; 3] {
+        affine_rows(&self.noise_space_map())
     }
 }
 
@@ -145,11 +165,17 @@ pub struct TextureMapping {
 
 impl TextureMapping {
     pub fn point(&self, at: &SurfacePoint) -> Vec3 {
-        let p = match self.space {
+        self.transform
+            .to_texture()
+            .transform_point3(self.space_point(at))
+    }
+
+    /// The surface point in the coordinates this mapping reads.
+    fn space_point(&self, at: &SurfacePoint) -> Vec3 {
+        match self.space {
             MappingSpace::Object => at.object,
             MappingSpace::World => at.world,
-        };
-        self.transform.to_texture().transform_point3(p)
+        }
     }
 
     pub fn uv(&self, at: &SurfacePoint) -> Vec2 {
@@ -179,14 +205,18 @@ impl TextureMapping {
     /// The three rows of the affine map, as the shader reads them:
     /// `p' = (dot(r0.xyz, p) + r0.w, …)`.
     pub fn rows(&self) -> [[f32; 4]; 3] {
-        let m = self.transform.to_texture();
-        let (l, t) = (m.matrix3, m.translation);
-        [
-            [l.x_axis.x, l.y_axis.x, l.z_axis.x, t.x],
-            [l.x_axis.y, l.y_axis.y, l.z_axis.y, t.y],
-            [l.x_axis.z, l.y_axis.z, l.z_axis.z, t.z],
-        ]
+        affine_rows(&self.transform.to_texture())
     }
+}
+
+/// The three rows `(dot(r.xyz, p) + r.w)` of an affine map.
+fn affine_rows(m: &Affine3A) -> [[f32; 4]; 3] {
+    let (l, t) = (m.matrix3, m.translation);
+    [
+        [l.x_axis.x, l.y_axis.x, l.z_axis.x, t.x],
+        [l.x_axis.y, l.y_axis.y, l.z_axis.y, t.y],
+        [l.x_axis.z, l.y_axis.z, l.z_axis.z, t.z],
+    ]
 }
 
 impl Pattern {
@@ -471,9 +501,9 @@ impl Pattern {
 
 fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) {
     let d = FractalParams::default();
-    let mut clamp = |name: &str, v: &mut f32, lo: f32, hi: f32, fallback: f32| {
+    let mut clamp = |name: &str, v: &mut f32, range: RangeInclusive<f32>, fallback: f32| {
         let c = if v.is_finite() {
-            v.clamp(lo, hi)
+            v.clamp(*range.start(), *range.end())
         } else {
             fallback
         };
@@ -482,16 +512,35 @@ fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) 
             *v = c;
         }
     };
+    clamp("octaves", &mut f.octaves, FractalParams::OCTAVES, d.octaves);
     clamp(
-        "octaves",
-        &mut f.octaves,
-        0.0,
-        FractalParams::MAX_OCTAVES,
-        d.octaves,
+        "frequency",
+        &mut f.frequency,
+        FractalParams::FREQUENCY,
+        d.frequency,
     );
-    clamp("frequency", &mut f.frequency, 0.0, 1e6, d.frequency);
-    clamp("amplitude", &mut f.amplitude, -100.0, 100.0, d.amplitude);
-    clamp("persistence", &mut f.persistence, 0.0, 1.5, d.persistence);
-    clamp("lacunarity", &mut f.lacunarity, 1.0, 8.0, d.lacunarity);
-    clamp("distortion", &mut f.distortion, -100.0, 100.0, d.distortion);
+    clamp(
+        "amplitude",
+        &mut f.amplitude,
+        FractalParams::AMPLITUDE,
+        d.amplitude,
+    );
+    clamp(
+        "persistence",
+        &mut f.persistence,
+        FractalParams::PERSISTENCE,
+        d.persistence,
+    );
+    clamp(
+        "lacunarity",
+        &mut f.lacunarity,
+        FractalParams::LACUNARITY,
+        d.lacunarity,
+    );
+    clamp(
+        "distortion",
+        &mut f.distortion,
+        FractalParams::DISTORTION,
+        d.distortion,
+    );
 }

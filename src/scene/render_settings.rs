@@ -59,6 +59,9 @@ pub struct RenderSettings {
     /// finds it.
     pub env_importance: bool,
     pub transport: super::transport::TransportSettings,
+    /// Debug view: pixels where a path gave a NaN or infinite sample (which
+    /// the accumulation drops and counts) are painted magenta.
+    pub show_non_finite: bool,
 }
 
 impl RenderSettings {
@@ -121,6 +124,7 @@ impl Default for RenderSettings {
             clamp_octaves: true,
             env_importance: true,
             transport: Default::default(),
+            show_non_finite: false,
         }
     }
 }

@@ -63,6 +63,10 @@ pub struct TransportSettings {
     /// Paths longer than this many bounces may end at random, with the
     /// survivors weighted up (Russian roulette); 0 never ends them early.
     pub russian_roulette_from: u32,
+    /// Firefly clamp: a sample brighter than this (in its largest channel)
+    /// is scaled down to it. Off (`None`) by default: it removes fireflies
+    /// by darkening the image, a bias `marbre bench` measures.
+    pub sample_clamp: Option<f32>,
 }
 
 impl Default for TransportSettings {
@@ -73,6 +77,7 @@ impl Default for TransportSettings {
             light_selection: LightSelection::Power,
             strategy: Strategy::MisPower,
             russian_roulette_from: 3,
+            sample_clamp: None,
         }
     }
 }
@@ -88,6 +93,14 @@ impl TransportSettings {
                 self.light_samples
             ));
             self.light_samples = n;
+        }
+        if let Some(c) = self.sample_clamp
+            && !(c.is_finite() && c > 0.0)
+        {
+            notes.push(format!(
+                "render: sample clamp {c} is not a positive number: off"
+            ));
+            self.sample_clamp = None;
         }
     }
 }

@@ -25,6 +25,10 @@ pub fn render_with(
     accumulate(ctx, &mut r, spp, |_| {}).unwrap();
     let (w, h, pixels) = r.read_radiance(ctx).unwrap();
     assert_eq!((w, h), size);
+    // The trace pass drops non-finite samples, so finite pixels alone prove
+    // nothing: its counters must say it dropped none.
+    let dropped = r.count_non_finite(ctx).unwrap();
+    assert!(dropped.is_zero(), "non-finite samples dropped: {dropped:?}");
     for p in &pixels {
         assert!(p.iter().all(|c| c.is_finite()), "non-finite pixel {p:?}");
     }

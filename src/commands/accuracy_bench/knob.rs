@@ -15,10 +15,11 @@ pub enum Knob {
     Filtering,
     Hash,
     Shader,
+    FireflyClamp,
 }
 
 impl Knob {
-    pub const ALL: [Knob; 10] = [
+    pub const ALL: [Knob; 11] = [
         Knob::Spp,
         Knob::Bounces,
         Knob::LightSelection,
@@ -29,6 +30,7 @@ impl Knob {
         Knob::Filtering,
         Knob::Hash,
         Knob::Shader,
+        Knob::FireflyClamp,
     ];
 
     pub fn id(self) -> &'static str {
@@ -43,6 +45,7 @@ impl Knob {
             Knob::Filtering => "filtering",
             Knob::Hash => "hash",
             Knob::Shader => "shader",
+            Knob::FireflyClamp => "firefly-clamp",
         }
     }
 
@@ -58,6 +61,7 @@ impl Knob {
             Knob::Filtering => "Texture filtering",
             Knob::Hash => "Noise hash",
             Knob::Shader => "Specialised or uber shader",
+            Knob::FireflyClamp => "Firefly clamp (biased)",
         }
     }
 }

@@ -178,6 +178,34 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 ))
             })
             .collect::<Result<_>>()?,
+        Knob::FireflyClamp => {
+            // The esplanade's sun found by BSDF sampling alone: fireflies.
+            // Each clamp trades them for a darker image, measured against
+            // the unclamped, importance-sampled reference.
+            let map = root.join("envmaps").join("esplanade.exr");
+            let base = with(&scenes::environment_lit(&map), |s| {
+                s.render.env_importance = false;
+            });
+            let variants = [None, Some(1000.0), Some(100.0), Some(10.0), Some(1.0)]
+                .iter()
+                .map(|&clamp| {
+                    let label = clamp.map_or("off".to_string(), |c: f32| format!("at {c}"));
+                    (
+                        label,
+                        with(&base, |s| s.render.transport.sample_clamp = clamp),
+                    )
+                })
+                .collect();
+            let reference = with(&base, |s| s.render.env_importance = true);
+            let loaded = prepare_scene(base, Vec::new())?;
+            vec![Sweep::new(
+                knob,
+                "esplanade",
+                loaded,
+                against(&reference, variants),
+                scale,
+            )]
+        }
         Knob::Octaves => {
             let variants = scale
                 .octaves
