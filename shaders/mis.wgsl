@@ -8,17 +8,14 @@ const STRATEGY_LIGHT: u32 = 0u;
 const STRATEGY_BSDF: u32 = 1u;
 const STRATEGY_MIS_BALANCE: u32 = 2u;
 
-// The largest finite f32: a density above it is infinite.
-const F32_MAX: f32 = 3.40282347e38;
-
 // The weight of a sample drawn with density `a` against the other
 // strategy's density `b` for the same direction, under the chosen
 // heuristic; twin of src/mis.rs. Finite and in [0, 1] for any densities,
-// and a pair sums to 1 wherever either is positive. An infinite density (a
-// delta, or one that overflowed) takes all the weight, half each if both
-// are. Otherwise both are divided by the larger first, so neither a + b
-// nor a square overflows (pbrt's guard) and tiny densities keep their
-// ratio.
+// and a pair sums to 1 wherever either is positive. An infinite density
+// (above F32_MAX: a delta, or one that overflowed) takes all the weight,
+// half each if both are. Otherwise both are divided by the larger first,
+// so neither a + b nor a square overflows (pbrt's guard) and tiny
+// densities keep their ratio.
 fn mis_heuristic(a: f32, b: f32) -> f32 {
     let a_infinite = a > F32_MAX;
     let b_infinite = b > F32_MAX;

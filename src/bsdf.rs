@@ -137,6 +137,10 @@ pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
         wi: if mirror { reflect(-wo, n) } else { wi },
         weight: if mirror { Vec3::ONE } else { e.f_cos / e.pdf },
         valid: mirror || e.pdf > 0.0,
-        pdf: if mirror { 0.0 } else { (1.0 - s.mirror) * e.pdf },
+        pdf: if mirror {
+            0.0
+        } else {
+            (1.0 - s.mirror) * e.pdf
+        },
     }
 }

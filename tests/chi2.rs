@@ -170,11 +170,7 @@ fn chi2(grid: &Grid, samples: &[Option<Vec3>], pdf_at_nodes: &[f32]) -> Chi2 {
         observed[s.and_then(|d| grid.cell(d)).unwrap_or(cells)] += 1;
     }
     let n = samples.len() as f64;
-    let mut expected: Vec<f64> = grid
-        .integrate(pdf_at_nodes)
-        .iter()
-        .map(|p| p * n)
-        .collect();
+    let mut expected: Vec<f64> = grid.integrate(pdf_at_nodes).iter().map(|p| p * n).collect();
     let inside: f64 = expected.iter().sum();
     expected.push((n - inside).max(0.0));
     pearson(&observed, &expected)
@@ -221,7 +217,10 @@ fn the_p_value_matches_chi_square_tables() {
         (500.0, 553.127, 0.05),
     ] {
         let q = gamma_q(dof / 2.0, x / 2.0);
-        assert!((q - p).abs() < 1e-3 * p + 1e-5, "Q({dof}, {x}) = {q}, not {p}");
+        assert!(
+            (q - p).abs() < 1e-3 * p + 1e-5,
+            "Q({dof}, {x}) = {q}, not {p}"
+        );
     }
     assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
     assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-12);

@@ -272,7 +272,10 @@ fn the_seam_wraps_on_the_cpu() {
     // same column: the seam is no edge of the distribution's own.
     for (edge, middle) in [(1.0 - 1e-5, 15.5 / 16.0), (1e-5, 0.5 / 16.0)] {
         let (a, b) = (at(edge), at(middle));
-        assert!((a / b - 1.0).abs() < 1e-5, "u = {edge}: {a}, mid-column {b}");
+        assert!(
+            (a / b - 1.0).abs() < 1e-5,
+            "u = {edge}: {a}, mid-column {b}"
+        );
     }
 }
 
@@ -336,10 +339,10 @@ fn check_weights(
         }
     }
     if matches!(strategy, MisStrategy::MisBalance | MisStrategy::MisPower) {
-        for (w, e) in heuristic
-            .iter()
-            .zip([expected_heuristic(a, b, strategy), expected_heuristic(b, a, strategy)])
-        {
+        for (w, e) in heuristic.iter().zip([
+            expected_heuristic(a, b, strategy),
+            expected_heuristic(b, a, strategy),
+        ]) {
             if (f64::from(*w) - e).abs() > tolerance {
                 return Err(format!("{context}: heuristic {w}, f64 says {e}"));
             }
@@ -412,7 +415,13 @@ fn mis_weights_are_finite_and_sum_to_one_on_the_gpu() {
 /// The uniform numbers at and next to the edges of [0, 1): 0, 2^-24 (the
 /// shader's smallest step), ½ and 1 − 2^-24 (its largest `rand()`), and
 /// 1 − ulp.
-const EDGES: [f32; 5] = [0.0, 5.960_464_5e-8, 0.5, 0.999_999_94, 1.0 - f32::EPSILON / 2.0];
+const EDGES: [f32; 5] = [
+    0.0,
+    5.960_464_5e-8,
+    0.5,
+    0.999_999_94,
+    1.0 - f32::EPSILON / 2.0,
+];
 
 fn bsdf_setups() -> Vec<BsdfSetup> {
     let n = Vec3::new(0.3, 0.9, 0.2).normalize();
@@ -469,7 +478,10 @@ fn samplers_stay_finite_at_the_edges_of_the_unit_square_on_the_gpu() {
     let harness = SamplingHarness::new(&ctx, &sunny_map(), wgpu::FilterMode::Linear).unwrap();
     let quads = edge_quads();
     for setup in bsdf_setups() {
-        for (u, s) in quads.iter().zip(harness.bsdf_samples(&ctx, &setup, &quads).unwrap()) {
+        for (u, s) in quads
+            .iter()
+            .zip(harness.bsdf_samples(&ctx, &setup, &quads).unwrap())
+        {
             let what = format!("GPU BSDF sample {u:?} of {setup:?}");
             assert_unit_and_finite(&what, s.wi);
             assert!(s.pdf.is_finite() && s.pdf >= 0.0, "{what}: {s:?}");
@@ -483,7 +495,10 @@ fn samplers_stay_finite_at_the_edges_of_the_unit_square_on_the_gpu() {
         .flat_map(|&a| EDGES.iter().map(move |&b| Vec2::new(a, b)))
         .collect();
     for rotation in [0.0, 123.0] {
-        for (u, (d, pdf)) in pairs.iter().zip(harness.env_samples(&ctx, rotation, &pairs).unwrap()) {
+        for (u, (d, pdf)) in pairs
+            .iter()
+            .zip(harness.env_samples(&ctx, rotation, &pairs).unwrap())
+        {
             assert_unit_and_finite(&format!("GPU env sample {u}"), d);
             assert!(pdf.is_finite() && pdf >= 0.0, "GPU env sample {u}: {pdf}");
         }
@@ -539,7 +554,11 @@ fn bsdf_setup() -> impl Strategy<Value = BsdfSetup> {
         0.0f32..=1.0,
     )
         .prop_map(|(n, w, roughness, diffuse, specular, mirror)| {
-            let w = if w.dot(n) < 0.0 { w - 2.0 * w.dot(n) * n } else { w };
+            let w = if w.dot(n) < 0.0 {
+                w - 2.0 * w.dot(n) * n
+            } else {
+                w
+            };
             let wo = if w.dot(n) < 1e-4 {
                 (w + 1e-3 * n).normalize()
             } else {
@@ -726,7 +745,6 @@ fn scene_point() -> impl Strategy<Value = Vec3> {
         .prop_map(Vec3::from_array)
 }
 
-
 // ------------------------------------------------------ the presets render
 
 /// This part's presets in `presets/hard-cases/`, each with the views
@@ -760,7 +778,12 @@ fn sampling_presets_render_without_non_finite_samples() {
     assert_eq!(presets.len(), 2, "{presets:?}");
     for path in presets {
         let loaded = marbre::preset::load(&path).unwrap();
-        assert!(loaded.notes.is_empty(), "{}: {:?}", path.display(), loaded.notes);
+        assert!(
+            loaded.notes.is_empty(),
+            "{}: {:?}",
+            path.display(),
+            loaded.notes
+        );
         let scene = marbre::commands::session::load_scene(&path, None).unwrap();
         let mut cameras = vec![scene.scene.camera];
         cameras.extend(scene.scene.views.iter().map(|v| v.camera));

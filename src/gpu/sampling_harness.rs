@@ -6,7 +6,9 @@
 
 use super::context::GpuContext;
 use super::features::{Feature, FeatureSet};
-use super::pipelines::{buffer_entry, compute_pipeline, entry, float_texture, storage, uniform, upload_rgba16f};
+use super::pipelines::{
+    buffer_entry, compute_pipeline, entry, float_texture, storage, uniform, upload_rgba16f,
+};
 use super::readback::read_buffer;
 use super::shader_source::Program;
 use crate::bsdf::{BsdfEval, BsdfSample, Surface};
