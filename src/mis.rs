@@ -2,8 +2,8 @@
 //! and BSDF sampling of the same light (Veach 1997), guarded so that every
 //! weight is finite and in [0, 1], and a pair sums to 1 wherever either
 //! density is positive, whatever the densities: 0, subnormal, huge or
-//! infinite (a delta, or a density that overflowed, such as a tiny sphere
-//! light's 1 / (2π (1 − cos θmax)) once cos θmax rounds to 1).
+//! infinite (a delta, or a density that overflowed: a sphere light's
+//! 1 / (2π (1 − cos θmax)) for a radius under ~3e-20 of its distance).
 
 use crate::scene::Strategy;
 

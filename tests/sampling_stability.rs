@@ -767,7 +767,7 @@ fn sampling_presets() -> Vec<std::path::PathBuf> {
 /// Each preset loads without a clamped value and renders every saved view
 /// with no sample dropped as NaN or Inf by the trace pass (its counters)
 /// and finite pixels: the seam and both poles of sky.exr through a mirror
-/// ball, and the infinite light density against a roughness of 0.05
+/// ball, and a light density near 1e7 against a roughness of 0.05
 /// under the power heuristic.
 #[test]
 fn sampling_presets_render_without_non_finite_samples() {
