@@ -1,6 +1,8 @@
 // Lambert + GGX (Smith, separable) with an optional perfect mirror.
 // Sampling picks a lobe by its albedo, and weights by the mixture pdf, so the
-// estimator stays unbiased whichever lobe dominates.
+// estimator stays unbiased whichever lobe dominates. Twin of src/bsdf.rs;
+// the surface these functions read is built by surface_at (surface.wgsl),
+// so this file needs nothing of the scene and the sampling harness runs it.
 
 struct SurfacePoint {
     // The shading normal: the geometric one, tilted by the bump texture.
@@ -16,38 +18,14 @@ struct SurfacePoint {
     emission: vec3f,
 }
 
-// The surface at a hit reached by a ray cone `width` wide, along `d`.
-fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
-    let p = hit.texture_point;
-    let fp = hit_footprint(hit, width, d);
-#if NOISE
-    let signals = material_signals(hit.material, p, hit.p, fp.p);
-#else
-    let signals = vec4f(0.0);
-#endif
-    let textures = surface_textures(hit.material, p, hit.p, hit.uv, fp, signals);
-    var s: SurfacePoint;
-    // Math steps can leave [0, 1]: reflectances stay within it, so no
-    // bounce ever adds energy.
-    s.diffuse = clamp(textures.diffuse, vec3f(0.0), vec3f(1.0));
-    s.specular = clamp(textures.specular, vec3f(0.0), vec3f(1.0));
-    let r = clamp(textures.roughness, 0.0, 1.0);
-    s.alpha = max(r * r, 1e-3);
-    s.mirror = clamp(textures.mirror, 0.0, 1.0);
-    s.opacity = clamp(textures.opacity, 0.0, 1.0);
-    s.transmission = clamp(textures.transmission, vec3f(0.0), vec3f(1.0));
-    s.emission = max(textures.emission, vec3f(0.0));
-#if BUMP
-    s.n = bumped_shading_normal(hit, fp, signals, -d);
-#else
-    s.n = hit.n;
-#endif
-    return s;
-}
-
-fn ggx_d(n_h: f32, a: f32) -> f32 {
+// GGX D(h) from cos²θh and sin²θh given apart. The textbook denominator
+// cos²θh (α² − 1) + 1 is 1 − cos²θh + α² cos²θh: near the peak cos θh
+// rounds to 1 in steps of 6e-8, so 1 − cos²θh keeps few digits where a
+// lobe of roughness 0.05 has sin²θh ~ 1e-5 (the chi² test rejected that
+// D against its own samples); sin²θh comes from a cross product instead.
+fn ggx_d(cos2: f32, sin2: f32, a: f32) -> f32 {
     let a2 = a * a;
-    let k = n_h * n_h * (a2 - 1.0) + 1.0;
+    let k = sin2 + cos2 * a2;
     return a2 / (PI * k * k);
 }
 
@@ -80,7 +58,8 @@ fn eval_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> BsdfEval {
     }
     let h = normalize(wi + wo);
     let n_h = max(dot(n, h), 0.0);
-    let d = ggx_d(n_h, s.alpha);
+    let n_x_h = cross(n, h);
+    let d = ggx_d(n_h * n_h, dot(n_x_h, n_x_h), s.alpha);
     let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
     let ps = specular_probability(s);
     let pdf = (1.0 - ps) * n_i * INV_PI + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
@@ -109,14 +88,30 @@ struct BsdfSample {
 // One code path for both lobes, chosen by selects: the lobes differ only in
 // how cos θ is drawn and whether the direction is a half vector.
 fn sample_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f) -> BsdfSample {
-    let mirror = rand() < s.mirror;
+    let u0 = rand();
     let u1 = rand();
     let u2 = rand();
-    let specular = rand() < specular_probability(s);
+    let u3 = rand();
+    return sample_bsdf_with(s, n, wo, vec4f(u0, u1, u2, u3));
+}
+
+// sample_bsdf with its four uniform numbers given (the sampling harness
+// passes them): mirror or not, cos θ, φ, which lobe.
+fn sample_bsdf_with(s: SurfacePoint, n: vec3f, wo: vec3f, u: vec4f) -> BsdfSample {
+    let mirror = u.x < s.mirror;
+    let u1 = u.y;
+    let u2 = u.z;
+    let specular = u.w < specular_probability(s);
     // GGX half vectors have pdf D(h) cos θh; the diffuse lobe is cosine-weighted.
+    // GGX's cos²θ = (1 − u) / (1 + (α² − 1) u) and sin²θ = α² u / (same),
+    // the denominator summed as (1 − u) + α² u: both numerators then add
+    // up to it and h stays unit length (1 + (α² − 1) u cancels for u near
+    // 1). sin θ in closed form, not sqrt(1 − cos²θ), which loses its
+    // digits where cos θ is near 1 (a narrow lobe).
     let a2 = s.alpha * s.alpha;
-    let cos_t = select(sqrt(max(0.0, 1.0 - u1)), sqrt((1.0 - u1) / (1.0 + (a2 - 1.0) * u1)), specular);
-    let sin_t = sqrt(max(0.0, 1.0 - cos_t * cos_t));
+    let ggx = (1.0 - u1) + a2 * u1;
+    let cos_t = select(sqrt(max(0.0, 1.0 - u1)), sqrt((1.0 - u1) / ggx), specular);
+    let sin_t = select(sqrt(u1), sqrt(a2 * u1 / ggx), specular);
     let phi = TWO_PI * u2;
     let local = basis(n) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t);
     let wi = select(local, reflect(-wo, local), specular);

@@ -1,5 +1,7 @@
 // The lab's latitude-longitude mapping; twin of src/envmap.rs.
 // u = (atan2(x, z) + π) / 2π, v = acos(-y) / π: v = 0 looks straight down.
+// v is taken as atan2(|xz|, -y) / π, the same angle, because acos of a y
+// near ±1 (which rounds in steps of 6e-8) loses θ's digits at the poles.
 
 fn env_uv(d: vec3f) -> vec2f {
     // atan2(0, 0) is undefined: at the poles every u is the same texel row.
@@ -7,7 +9,7 @@ fn env_uv(d: vec3f) -> vec2f {
     if d.x != 0.0 || d.z != 0.0 {
         u = (atan2(d.x, d.z) + PI) / TWO_PI;
     }
-    let v = acos(clamp(-d.y, -1.0, 1.0)) / PI;
+    let v = atan2(length(d.xz), -d.y) / PI;
     return vec2f(u, v);
 }
 

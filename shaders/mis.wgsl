@@ -10,20 +10,28 @@ const STRATEGY_MIS_BALANCE: u32 = 2u;
 
 // The weight of a sample drawn with density `a` against the other
 // strategy's density `b` for the same direction, under the chosen
-// heuristic. Guarded as pbrt's power heuristic is: an infinite density (a
-// delta) takes all the weight, and none is NaN when both are 0.
+// heuristic; twin of src/mis.rs. Finite and in [0, 1] for any densities,
+// and a pair sums to 1 wherever either is positive. An infinite density
+// (above F32_MAX: a delta, or one that overflowed) takes all the weight,
+// half each if both are. Otherwise both are divided by the larger first,
+// so neither a + b nor a square overflows (pbrt's guard) and tiny
+// densities keep their ratio.
 fn mis_heuristic(a: f32, b: f32) -> f32 {
-    if a >= 3.0e38 {
-        return 1.0;
+    let a_infinite = a > F32_MAX;
+    let b_infinite = b > F32_MAX;
+    if a_infinite || b_infinite {
+        return select(select(0.0, 1.0, a_infinite), 0.5, a_infinite && b_infinite);
     }
-    if frame.strategy == STRATEGY_MIS_BALANCE {
-        return select(0.0, a / (a + b), a + b > 0.0);
-    }
-    // Squares of densities above ~1e19 overflow: scale both first.
     let m = max(a, b);
-    let sa = select(0.0, a / m, m > 0.0);
-    let sb = select(0.0, b / m, m > 0.0);
-    return select(0.0, sa * sa / (sa * sa + sb * sb), m > 0.0);
+    if m <= 0.0 {
+        return 0.0;
+    }
+    let sa = a / m;
+    let sb = b / m;
+    if frame.strategy == STRATEGY_MIS_BALANCE {
+        return sa / (sa + sb);
+    }
+    return sa * sa / (sa * sa + sb * sb);
 }
 
 // The weight of a light sample of density `light_pdf` whose direction the

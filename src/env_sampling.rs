@@ -19,7 +19,7 @@
 //! distribution is built at most [`EnvDistribution::MAX_WIDTH`] cells wide
 //! (box-averaged from the map) so the GPU's binary searches stay short.
 
-use crate::envmap::{EnvImage, rotate_y};
+use crate::envmap::{EnvImage, direction_to_uv, rotate_y, uv_to_texel_uv};
 use crate::texture::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -142,6 +142,20 @@ impl EnvDistribution {
         (d, pdf)
     }
 
+    /// The solid-angle density with which [`EnvDistribution::sample`] and
+    /// [`EnvDistribution::direction`] draw the world direction `d` for a
+    /// map turned by `rotation_degrees`: the twin of the shader's
+    /// `env_pdf` (0 at the poles, never NaN).
+    pub fn pdf_direction(&self, d: Vec3, rotation_degrees: f32) -> f32 {
+        let uv = direction_to_uv(rotate_y(d, rotation_degrees));
+        let sin_theta = (PI * uv.y).sin();
+        if sin_theta > 0.0 {
+            self.pdf_texel_uv(uv_to_texel_uv(uv)) / (2.0 * PI * PI * sin_theta)
+        } else {
+            0.0
+        }
+    }
+
     /// The GPU's copy: the marginal CDF, then every row's.
     pub fn gpu_data(&self) -> Vec<f32> {
         let mut out = self.marginal.clone();
@@ -192,7 +206,6 @@ fn sample_cdf(cdf: &[f32], u: f32) -> (u32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::envmap::{direction_to_uv, uv_to_texel_uv};
 
     fn map(width: u32, height: u32, bright: (u32, u32)) -> EnvImage {
         let mut image = crate::envmap::constant(width, height, [0.1, 0.1, 0.1]);

@@ -530,10 +530,14 @@ static SRGB8_TO_LINEAR: std::sync::LazyLock<[f32; 256]> =
 ///
 /// `u` is 0.5 towards +z, 0.75 towards +x, 0.25 towards -x, and 0 or 1
 /// towards -z (the seam, where `u` wraps; texture sampling must repeat in u).
-/// `v` is 0 looking straight down and 1 straight up. `d.y` is clamped to
-/// [-1, 1] before the `acos` so a slightly non-unit vector cannot give NaN,
-/// and at the poles (`d.x == 0 && d.z == 0`, where the azimuth is undefined)
-/// `u` is 0.5. The result is finite for every finite `d`.
+/// `v` is 0 looking straight down and 1 straight up. It is computed as
+/// `atan2(|d.xz|, -d.y) / π`, equal to the lab's `acos(-d.y) / π` for a
+/// unit vector but exact near the poles, where `acos` of a y that rounds
+/// in steps of 6e-8 loses digits of θ (0.5 % of it at θ = 0.003, and with
+/// it the environment pdf's 1 / sin θ); it also needs no clamp for a
+/// slightly non-unit vector. At the poles (`d.x == 0 && d.z == 0`, where
+/// the azimuth is undefined) `u` is 0.5. The result is finite for every
+/// finite `d`.
 ///
 /// Note that `v` grows upwards while image rows grow downwards: use
 /// [`uv_to_texel_uv`] to address an [`EnvImage`] or its texture.
@@ -544,7 +548,7 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
     } else {
         (d.x.atan2(d.z) + PI) / (2.0 * PI)
     };
-    let v = (-d.y.clamp(-1.0, 1.0)).acos() / PI;
+    let v = Vec2::new(d.x, d.z).length().atan2(-d.y) / PI;
     Vec2::new(u, v)
 }
 

@@ -3,6 +3,7 @@
 pub mod accel;
 pub mod app;
 pub mod atomic_write;
+pub mod bsdf;
 pub mod commands;
 pub mod cubemap;
 pub mod env_sampling;
@@ -11,6 +12,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod image_io;
 pub mod lights;
+pub mod mis;
 pub mod noise;
 pub mod obj_loader;
 pub mod obj_syntax;

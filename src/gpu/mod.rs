@@ -23,6 +23,7 @@ pub mod pipelines;
 pub mod preprocess;
 pub mod readback;
 pub mod renderer;
+pub mod sampling_harness;
 pub mod scene_gpu;
 pub mod shader_source;
 pub mod testing;

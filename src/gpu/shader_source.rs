@@ -33,6 +33,7 @@ const SOURCES: &[(&str, &str)] = &[
     ),
     ("random.wgsl", include_str!("../../shaders/random.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
     (
         "env_lookup.wgsl",
         include_str!("../../shaders/env_lookup.wgsl"),
@@ -107,6 +108,10 @@ const SOURCES: &[(&str, &str)] = &[
         "geometry_harness.wgsl",
         include_str!("../../shaders/geometry_harness.wgsl"),
     ),
+    (
+        "sampling_harness.wgsl",
+        include_str!("../../shaders/sampling_harness.wgsl"),
+    ),
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -131,10 +136,13 @@ pub enum Program {
     /// The compute pass that runs the ray geometry (sphere distance, ray
     /// offset, shading normal) on given inputs.
     GeometryHarness,
+    /// The compute pass that runs the BSDF, environment and MIS sampling
+    /// functions on given inputs.
+    SamplingHarness,
 }
 
 impl Program {
-    pub const ALL: [Program; 9] = [
+    pub const ALL: [Program; 10] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -144,6 +152,7 @@ impl Program {
         Program::BvhHarness,
         Program::AccumulationHarness,
         Program::GeometryHarness,
+        Program::SamplingHarness,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -180,6 +189,7 @@ impl Program {
                     "intersect.wgsl",
                     "random.wgsl",
                     "bsdf.wgsl",
+                    "surface.wgsl",
                     "env_lookup.wgsl",
                     "mis.wgsl",
                 ]);
@@ -220,6 +230,16 @@ impl Program {
                 "ray_geometry.wgsl",
                 "shading_normal.wgsl",
                 "geometry_harness.wgsl",
+            ]),
+            Program::SamplingHarness => out.extend([
+                "hash.wgsl",
+                "random.wgsl",
+                "env_mapping.wgsl",
+                "bsdf.wgsl",
+                "env_lookup.wgsl",
+                "mis.wgsl",
+                "env_sampling.wgsl",
+                "sampling_harness.wgsl",
             ]),
         }
         out
