@@ -21,9 +21,9 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Every `presets/*.ron`, sorted.
-fn shipped_presets() -> Vec<PathBuf> {
-    let dir = root().join("presets");
+/// Every `*.ron` in `presets/<folder>`, sorted.
+fn presets_in(folder: &str) -> Vec<PathBuf> {
+    let dir = root().join(folder);
     let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .map(|e| e.expect("a readable directory entry").path())
@@ -33,16 +33,14 @@ fn shipped_presets() -> Vec<PathBuf> {
     out
 }
 
-/// Every `presets/hard-cases/*.ron` (issue 6's adversarial scenes), sorted.
+/// Every `presets/*.ron`.
+fn shipped_presets() -> Vec<PathBuf> {
+    presets_in("presets")
+}
+
+/// Every `presets/hard-cases/*.ron` (issue 6's adversarial scenes).
 fn hard_case_presets() -> Vec<PathBuf> {
-    let dir = root().join("presets/hard-cases");
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("a readable directory entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
-        .collect();
-    out.sort();
-    out
+    presets_in("presets/hard-cases")
 }
 
 fn load(path: &Path) -> Preset {

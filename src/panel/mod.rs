@@ -712,7 +712,8 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
             "Scales the radiance by 2^exposure before tone mapping",
         )
     };
-    ui.add(slider(&mut render.exposure, -20.0..=20.0, label).suffix(" stops"))
+    let stops = RenderSettings::MAX_EXPOSURE_STOPS;
+    ui.add(slider(&mut render.exposure, -stops..=stops, label).suffix(" stops"))
         .on_hover_text(hint);
     ComboBox::new("tone map", "tone map")
         .selected_text(render.tone_map.label())

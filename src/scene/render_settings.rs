@@ -67,6 +67,8 @@ pub struct RenderSettings {
 impl RenderSettings {
     pub const MAX_SAMPLES_PER_FRAME: u32 = 64;
     pub const MAX_BOUNCES: u32 = 16;
+    /// The exposure (or compensation) range of the panel and of presets.
+    pub const MAX_EXPOSURE_STOPS: f32 = 20.0;
 
     pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
         let d = Self::default();
@@ -86,7 +88,7 @@ impl RenderSettings {
             ));
             self.max_bounces = b;
         }
-        if !self.exposure.is_finite() || self.exposure.abs() > 20.0 {
+        if !self.exposure.is_finite() || self.exposure.abs() > Self::MAX_EXPOSURE_STOPS {
             let what = if self.auto_exposure {
                 "exposure compensation"
             } else {
@@ -94,7 +96,8 @@ impl RenderSettings {
             };
             notes.push(format!("render: {what} {} clamped", self.exposure));
             self.exposure = if self.exposure.is_finite() {
-                self.exposure.clamp(-20.0, 20.0)
+                self.exposure
+                    .clamp(-Self::MAX_EXPOSURE_STOPS, Self::MAX_EXPOSURE_STOPS)
             } else {
                 d.exposure
             };
