@@ -37,12 +37,15 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
         ValueKind::Scalar,
         1,
     );
-    ui.add(slider(
+    ui.add(typed_beyond(slider(
         &mut m.bump_height,
-        -Material::MAX_BUMP_HEIGHT..=Material::MAX_BUMP_HEIGHT,
+        -Material::BUMP_HEIGHT_DRAG_RANGE..=Material::BUMP_HEIGHT_DRAG_RANGE,
         "bump height",
-    ))
-    .on_hover_text("Height in scene units of a bump value of 1; 0 turns the bump off");
+    )))
+    .on_hover_text(
+        "Height in scene units of a bump value of 1; 0 turns the bump off (drag within ±0.5, \
+         or type any value: a steep bump bends shading normals away, and marbre falls back)",
+    );
     layers_ui(ui, &mut m.layers);
 }
 

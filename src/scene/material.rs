@@ -233,9 +233,10 @@ impl Material {
     /// emitter of 1e6 (the stability suite's hard case) and no further, so
     /// that a light's power stays far from f32 overflow.
     pub const MAX_EMISSION_STRENGTH: f32 = 1.0e6;
-    /// The panel's bump range, in scene units: beyond it the perturbed
-    /// normal is dominated by the height's gradient.
-    pub const MAX_BUMP_HEIGHT: f32 = 0.5;
+    /// The bump heights the panel's slider drags over, in scene units;
+    /// any finite value may be typed or loaded (steep bumps are a hard case
+    /// the shading-normal fallbacks handle).
+    pub const BUMP_HEIGHT_DRAG_RANGE: f32 = 0.5;
 
     /// The base texture of `property` (before layers).
     pub fn texture(&self, property: Property) -> &Texture {
@@ -384,16 +385,6 @@ impl Material {
             ));
             self.emission_strength = Self::MAX_EMISSION_STRENGTH;
         }
-        if self.bump_height.abs() > Self::MAX_BUMP_HEIGHT {
-            let clamped = self
-                .bump_height
-                .clamp(-Self::MAX_BUMP_HEIGHT, Self::MAX_BUMP_HEIGHT);
-            notes.push(format!(
-                "{what}: bump height {} clamped to {clamped}",
-                self.bump_height
-            ));
-            self.bump_height = clamped;
-        }
     }
 }
 
@@ -437,27 +428,25 @@ mod tests {
     use super::*;
     use crate::scene::{Child, MathOp};
 
-    /// Values the panel cannot reach are clamped at load, each with a note
-    /// that names the field; values it can reach are kept.
+    /// An emission the panel cannot reach is clamped at load with a note
+    /// that names the field; values it can reach (any finite bump height
+    /// can be typed) are kept.
     #[test]
-    fn emission_and_bump_beyond_the_panel_are_clamped_with_a_note() {
+    fn emission_beyond_the_panel_is_clamped_with_a_note() {
         let mut m = Material {
             emission_strength: 5.0e7,
-            bump_height: -3.0,
             ..Material::default()
         };
         let mut notes = Vec::new();
         m.sanitize("sphere 0", &mut notes);
         assert_eq!(m.emission_strength, Material::MAX_EMISSION_STRENGTH);
-        assert_eq!(m.bump_height, -Material::MAX_BUMP_HEIGHT);
         assert!(
             notes.iter().any(|n| n.contains("emission strength")),
             "{notes:?}"
         );
-        assert!(notes.iter().any(|n| n.contains("bump height")), "{notes:?}");
         let mut reachable = Material {
             emission_strength: 1.0e6,
-            bump_height: 0.5,
+            bump_height: 1.0e38,
             ..Material::default()
         };
         let mut none = Vec::new();
