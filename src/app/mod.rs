@@ -8,6 +8,7 @@
 mod camera_input;
 mod convergence;
 mod feature_costs;
+mod history;
 mod screenshots;
 mod viewer;
 

@@ -2,6 +2,7 @@
 
 use super::convergence::Convergence;
 use super::feature_costs::FeatureCosts;
+use super::history::History;
 use super::{ViewerOptions, camera_input, screenshots};
 use crate::commands::session::{load_images, load_scene, preset_or_default, renderer_for};
 use crate::cubemap;
@@ -39,6 +40,8 @@ pub struct Viewer {
     convergence: Convergence,
     /// Trace times with shader features compiled out, for the Quality panel.
     feature_costs: FeatureCosts,
+    /// Undo and redo of scene edits (Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y).
+    history: History,
     /// Samples the current accumulation dropped for being NaN or infinite,
     /// and the accumulation they count.
     non_finite: (u32, NonFiniteCounts),
@@ -116,7 +119,9 @@ impl Viewer {
         }
         let timer = PassTimer::new(&ctx);
         let preset_camera = loaded.scene.camera;
+        let history = History::new(&loaded.scene);
         Ok(Self {
+            history,
             timer,
             convergence: Convergence::default(),
             feature_costs: FeatureCosts::default(),
@@ -332,6 +337,21 @@ impl Viewer {
         }
     }
 
+    /// Undoes or redoes one step of scene edits, keeping the view.
+    fn step_history(&mut self, request: HistoryRequest) {
+        let restored = match request {
+            HistoryRequest::Undo => self.history.undo(&self.scene),
+            HistoryRequest::Redo => self.history.redo(&self.scene),
+        };
+        match restored {
+            Some(scene) => self.scene = scene,
+            None => self.panel.info(match request {
+                HistoryRequest::Undo => "nothing to undo",
+                HistoryRequest::Redo => "nothing to redo",
+            }),
+        }
+    }
+
     fn handle_actions(&mut self, actions: Vec<PanelAction>) {
         for action in actions {
             match action {
@@ -345,6 +365,8 @@ impl Viewer {
                 PanelAction::Screenshot => self.screenshot_requested = true,
                 PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
                 PanelAction::ToggleFeature(feature) => self.toggle_feature(feature),
+                PanelAction::Undo => self.step_history(HistoryRequest::Undo),
+                PanelAction::Redo => self.step_history(HistoryRequest::Redo),
             }
         }
     }
@@ -440,8 +462,12 @@ impl Viewer {
         let mut actions = Vec::new();
         let mut image_rect = egui::Rect::NOTHING;
         let mut dragging = false;
+        self.panel.can_undo = self.history.can_undo();
+        self.panel.can_redo = self.history.can_redo();
         let (scene, panel_state) = (&mut self.scene, &mut self.panel);
+        let mut history_request = None;
         let output = self.egui_ctx.run_ui(raw_input, |ui| {
+            history_request = history_shortcut(ui.ctx());
             egui::Panel::right("marbre-panel")
                 .default_size(PANEL_WIDTH)
                 .show(ui, |ui| {
@@ -460,6 +486,9 @@ impl Viewer {
             dragging = camera_input::apply(ui, &response, &mut scene.camera);
         });
         self.handle_actions(actions);
+        if let Some(request) = history_request {
+            self.step_history(request);
+        }
         (output, image_rect, dragging)
     }
 
@@ -528,6 +557,11 @@ impl Viewer {
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.scene().clone();
         }
+        // What the scene now is, after any refused edit was put back: one
+        // step of the undo history unless a drag or typing goes on.
+        let gesture = self.egui_ctx.input(|i| i.pointer.any_down())
+            || self.egui_ctx.egui_wants_keyboard_input();
+        self.history.observe(&self.scene, gesture);
         // Only an edit can add an image or change a path.
         if edited {
             self.reload_images_if_needed();
@@ -747,4 +781,33 @@ impl Viewer {
         crate::image_io::save_png(&image, path)
             .with_context(|| format!("saving the window screenshot {}", path.display()))
     }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum HistoryRequest {
+    Undo,
+    Redo,
+}
+
+/// Ctrl+Z undoes, Ctrl+Shift+Z and Ctrl+Y redo (Cmd on macOS), unless a
+/// text field has the keyboard: there the keys edit the text.
+fn history_shortcut(ctx: &egui::Context) -> Option<HistoryRequest> {
+    use egui::{Key, KeyboardShortcut, Modifiers};
+    if ctx.egui_wants_keyboard_input() {
+        return None;
+    }
+    ctx.input_mut(|i| {
+        // The shifted shortcut first: Ctrl+Z would also match it.
+        let redo = i.consume_shortcut(&KeyboardShortcut::new(
+            Modifiers::COMMAND | Modifiers::SHIFT,
+            Key::Z,
+        )) || i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Y));
+        if redo {
+            Some(HistoryRequest::Redo)
+        } else if i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Z)) {
+            Some(HistoryRequest::Undo)
+        } else {
+            None
+        }
+    })
 }

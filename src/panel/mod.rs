@@ -73,6 +73,9 @@ pub struct PanelState {
     cube_pending: Option<bool>,
     /// The target error and what to do on reaching it.
     pub quality: QualityControls,
+    /// Whether the app has edits to undo and to redo (enables the buttons).
+    pub can_undo: bool,
+    pub can_redo: bool,
 }
 
 impl PanelState {
@@ -87,6 +90,8 @@ impl PanelState {
             cube_seen: None,
             cube_pending: None,
             quality: QualityControls::default(),
+            can_undo: false,
+            can_redo: false,
         }
     }
 
@@ -152,6 +157,8 @@ pub enum PanelAction {
     /// Compile a shader feature out (or back in), to time the scene
     /// without it.
     ToggleFeature(crate::gpu::Feature),
+    Undo,
+    Redo,
 }
 
 /// Draws the whole panel contents into `ui` and returns the buttons pressed.
@@ -280,6 +287,20 @@ fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>
             .clicked()
         {
             actions.push(PanelAction::SavePresetAs(path()));
+        }
+    });
+    ui.horizontal(|ui| {
+        let undo = ui
+            .add_enabled(state.can_undo, egui::Button::new("Undo"))
+            .on_hover_text("Undo the last edit (Ctrl+Z); a whole slider drag is one edit");
+        if undo.clicked() {
+            actions.push(PanelAction::Undo);
+        }
+        let redo = ui
+            .add_enabled(state.can_redo, egui::Button::new("Redo"))
+            .on_hover_text("Redo what was undone (Ctrl+Shift+Z or Ctrl+Y)");
+        if redo.clicked() {
+            actions.push(PanelAction::Redo);
         }
     });
     let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);

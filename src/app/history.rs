@@ -1,0 +1,180 @@
+//! Undo and redo of scene edits (issue 7).
+//!
+//! The viewer shows the history every frame's scene after the UI ran; a
+//! scene that differs from the last one seen is an edit, recorded as the
+//! scene before it. Edits made while one gesture goes on (a slider dragged,
+//! a number typed: the pointer held or a text field focused) coalesce into
+//! one step, so one Ctrl+Z undoes a whole drag, as in Blender.
+//!
+//! The camera is not part of a step: orbiting is looking, not editing (as
+//! Blender keeps view navigation out of its undo), so undo keeps the view
+//! the user has now.
+
+use crate::scene::Scene;
+
+/// Steps kept; the oldest are forgotten first.
+const MAX_STEPS: usize = 200;
+
+pub struct History {
+    /// The scenes before each step, oldest first.
+    undo: Vec<Scene>,
+    /// The scenes undone, most recent last.
+    redo: Vec<Scene>,
+    /// The scene as last seen, camera excluded.
+    last: Scene,
+    /// A gesture is under way and its edits join the latest step.
+    step_open: bool,
+}
+
+impl History {
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            undo: Vec::new(),
+            redo: Vec::new(),
+            last: without_camera(scene),
+            step_open: false,
+        }
+    }
+
+    /// Records `scene` if it differs from the last one seen; `gesture` says
+    /// whether the user is still dragging or typing.
+    pub fn observe(&mut self, scene: &Scene, gesture: bool) {
+        let now = without_camera(scene);
+        if now != self.last {
+            if !self.step_open {
+                self.undo.push(std::mem::replace(&mut self.last, now));
+                if self.undo.len() > MAX_STEPS {
+                    self.undo.remove(0);
+                }
+                self.redo.clear();
+            } else {
+                self.last = now;
+            }
+        }
+        self.step_open = gesture;
+    }
+
+    /// The scene before the latest step, seen from `current`'s camera; the
+    /// current scene becomes redoable. `None` with nothing to undo.
+    pub fn undo(&mut self, current: &Scene) -> Option<Scene> {
+        let previous = self.undo.pop()?;
+        self.redo.push(without_camera(current));
+        Some(self.restore(previous, current))
+    }
+
+    /// The scene the latest undo left, seen from `current`'s camera.
+    pub fn redo(&mut self, current: &Scene) -> Option<Scene> {
+        let next = self.redo.pop()?;
+        self.undo.push(without_camera(current));
+        Some(self.restore(next, current))
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    fn restore(&mut self, mut scene: Scene, current: &Scene) -> Scene {
+        self.last = scene.clone();
+        self.step_open = false;
+        scene.camera = current.camera;
+        scene
+    }
+}
+
+/// `scene` with the default camera: what a step compares and keeps.
+fn without_camera(scene: &Scene) -> Scene {
+    Scene {
+        camera: Default::default(),
+        ..scene.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_exposure(exposure: f32) -> Scene {
+        let mut scene = Scene::default();
+        scene.render.exposure = exposure;
+        scene
+    }
+
+    #[test]
+    fn each_edit_is_a_step_undone_and_redone_in_order() {
+        let mut h = History::new(&with_exposure(0.0));
+        h.observe(&with_exposure(1.0), false);
+        h.observe(&with_exposure(2.0), false);
+        let one = h.undo(&with_exposure(2.0)).unwrap();
+        assert_eq!(one.render.exposure, 1.0);
+        h.observe(&one, false);
+        let zero = h.undo(&one).unwrap();
+        assert_eq!(zero.render.exposure, 0.0);
+        assert!(h.undo(&zero).is_none(), "nothing before the first scene");
+        assert_eq!(h.redo(&zero).unwrap().render.exposure, 1.0);
+        assert_eq!(h.redo(&one).unwrap().render.exposure, 2.0);
+        assert!(!h.can_redo());
+    }
+
+    /// A slider dragged through many values is one step.
+    #[test]
+    fn a_drag_coalesces_into_one_step() {
+        let mut h = History::new(&with_exposure(0.0));
+        for k in 1..=30 {
+            h.observe(&with_exposure(k as f32 * 0.1), true);
+        }
+        // The pointer is released: the gesture ends without a change.
+        h.observe(&with_exposure(3.0), false);
+        let before = h.undo(&with_exposure(3.0)).unwrap();
+        assert_eq!(before.render.exposure, 0.0);
+        assert!(!h.can_undo());
+    }
+
+    /// A new edit after an undo forgets what could be redone.
+    #[test]
+    fn an_edit_after_undo_clears_redo() {
+        let mut h = History::new(&with_exposure(0.0));
+        h.observe(&with_exposure(1.0), false);
+        let zero = h.undo(&with_exposure(1.0)).unwrap();
+        h.observe(&zero, false);
+        assert!(h.can_redo());
+        h.observe(&with_exposure(5.0), false);
+        assert!(!h.can_redo());
+    }
+
+    /// Orbiting is not a step, and undo keeps the current view.
+    #[test]
+    fn camera_moves_are_not_steps_and_undo_keeps_the_view() {
+        let mut h = History::new(&with_exposure(0.0));
+        let mut moved = with_exposure(0.0);
+        moved.camera.yaw_degrees = 40.0;
+        h.observe(&moved, true);
+        h.observe(&moved, false);
+        assert!(!h.can_undo());
+        let mut edited = moved.clone();
+        edited.render.exposure = 1.0;
+        h.observe(&edited, false);
+        let undone = h.undo(&edited).unwrap();
+        assert_eq!(undone.render.exposure, 0.0);
+        assert_eq!(undone.camera.yaw_degrees, 40.0);
+    }
+
+    #[test]
+    fn the_oldest_steps_are_forgotten_past_the_limit() {
+        let mut h = History::new(&with_exposure(0.0));
+        for k in 1..=(MAX_STEPS + 10) {
+            h.observe(&with_exposure(k as f32), false);
+        }
+        let mut current = with_exposure((MAX_STEPS + 10) as f32);
+        let mut undone = 0;
+        while let Some(previous) = h.undo(&current) {
+            current = previous;
+            undone += 1;
+        }
+        assert_eq!(undone, MAX_STEPS);
+        assert_eq!(current.render.exposure, 10.0);
+    }
+}
