@@ -20,7 +20,8 @@ pub struct History {
     undo: Vec<Scene>,
     /// The scenes undone, most recent last.
     redo: Vec<Scene>,
-    /// The scene as last seen, camera excluded.
+    /// The scene as last seen; its camera is set to the one compared with
+    /// it, so that only the rest counts.
     last: Scene,
     /// A gesture is under way and its edits join the latest step.
     step_open: bool,
@@ -31,24 +32,25 @@ impl History {
         Self {
             undo: Vec::new(),
             redo: Vec::new(),
-            last: without_camera(scene),
+            last: scene.clone(),
             step_open: false,
         }
     }
 
     /// Records `scene` if it differs from the last one seen; `gesture` says
     /// whether the user is still dragging or typing.
+    ///
+    /// Called every frame: the scene is cloned only when it changed.
     pub fn observe(&mut self, scene: &Scene, gesture: bool) {
-        let now = without_camera(scene);
-        if now != self.last {
+        self.last.camera = scene.camera;
+        if *scene != self.last {
+            let before = std::mem::replace(&mut self.last, scene.clone());
             if !self.step_open {
-                self.undo.push(std::mem::replace(&mut self.last, now));
+                self.undo.push(before);
                 if self.undo.len() > MAX_STEPS {
                     self.undo.remove(0);
                 }
                 self.redo.clear();
-            } else {
-                self.last = now;
             }
         }
         self.step_open = gesture;
@@ -58,14 +60,14 @@ impl History {
     /// current scene becomes redoable. `None` with nothing to undo.
     pub fn undo(&mut self, current: &Scene) -> Option<Scene> {
         let previous = self.undo.pop()?;
-        self.redo.push(without_camera(current));
+        self.redo.push(current.clone());
         Some(self.restore(previous, current))
     }
 
     /// The scene the latest undo left, seen from `current`'s camera.
     pub fn redo(&mut self, current: &Scene) -> Option<Scene> {
         let next = self.redo.pop()?;
-        self.undo.push(without_camera(current));
+        self.undo.push(current.clone());
         Some(self.restore(next, current))
     }
 
@@ -77,19 +79,12 @@ impl History {
         !self.redo.is_empty()
     }
 
+    /// A kept scene, seen from `current`'s camera.
     fn restore(&mut self, mut scene: Scene, current: &Scene) -> Scene {
+        scene.camera = current.camera;
         self.last = scene.clone();
         self.step_open = false;
-        scene.camera = current.camera;
         scene
-    }
-}
-
-/// `scene` with the default camera: what a step compares and keeps.
-fn without_camera(scene: &Scene) -> Scene {
-    Scene {
-        camera: Default::default(),
-        ..scene.clone()
     }
 }
 
