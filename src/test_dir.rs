@@ -1,6 +1,6 @@
 //! A scratch folder for unit tests that write files.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A fresh, empty directory for one test, removed on drop. `name` keeps
 /// tests running in parallel apart; the process id keeps runs apart.
@@ -12,6 +12,11 @@ impl TempDir {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         TempDir(dir)
+    }
+
+    /// The folder itself.
+    pub fn root(&self) -> &Path {
+        &self.0
     }
 
     pub fn path(&self, file: &str) -> PathBuf {

@@ -18,7 +18,7 @@ use super::pipelines::{
 };
 use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
-use super::shader_source::{Program, assemble};
+use super::shader_source::{Program, assemble, sources_generation};
 use super::texture_codegen;
 use crate::env_sampling::EnvDistribution;
 use crate::envmap::EnvImage;
@@ -88,6 +88,8 @@ struct PipelineKey {
     features: FeatureSet,
     code: String,
     switches: RenderSwitches,
+    /// The shader files' generation (`marbre --dev` reloads them).
+    sources: u64,
 }
 
 /// The render settings the trace shader reads as override constants
@@ -222,6 +224,7 @@ impl Renderer {
             features,
             code: textures.wgsl,
             switches: RenderSwitches::of(scene),
+            sources: sources_generation(),
         };
         let (trace_pipeline, trace_shader_bytes) =
             Self::build_trace_pipeline(&ctx.device, &trace_layout, &key)?;
@@ -433,6 +436,7 @@ impl Renderer {
             features,
             code,
             switches: RenderSwitches::of(scene),
+            sources: sources_generation(),
         };
         if key == self.key {
             self.pending = None;

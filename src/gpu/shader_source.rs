@@ -246,18 +246,72 @@ impl Program {
     }
 }
 
-/// The WGSL text of `program` specialised for `features`. The trace program
-/// also takes the scene's generated texture code
-/// ([`super::texture_codegen::generate`]); the others ignore it.
-/// A hash of every WGSL source: results cached on disk (benchmark
+/// WGSL read from a folder at run time (`marbre --dev`), replacing the
+/// embedded copies until the process ends, so an edited shader can be
+/// tried without rebuilding marbre.
+struct DevSources {
+    files: Vec<(&'static str, String)>,
+    /// Counts the loads: a pipeline built from older text is stale.
+    generation: u64,
+}
+
+static DEV_SOURCES: std::sync::RwLock<Option<DevSources>> = std::sync::RwLock::new(None);
+
+/// Reads every shader file from `dir` (the repository's `shaders/`), to be
+/// used instead of the embedded copies from now on; returns the new
+/// generation. On error nothing changes.
+pub fn load_dev_sources(dir: &std::path::Path) -> anyhow::Result<u64> {
+    let mut files = Vec::with_capacity(SOURCES.len());
+    for (name, _) in SOURCES {
+        let path = dir.join(name);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        files.push((*name, text));
+    }
+    let mut dev = DEV_SOURCES.write().unwrap_or_else(|e| e.into_inner());
+    let generation = dev.as_ref().map_or(1, |d| d.generation + 1);
+    *dev = Some(DevSources { files, generation });
+    Ok(generation)
+}
+
+/// Which sources [`assemble`] reads: 0 for the embedded ones, else the
+/// count of [`load_dev_sources`] calls. Part of a pipeline's key.
+pub fn sources_generation() -> u64 {
+    let dev = DEV_SOURCES.read().unwrap_or_else(|e| e.into_inner());
+    dev.as_ref().map_or(0, |d| d.generation)
+}
+
+/// The text of shader file `name`: the dev copy if loaded, else embedded.
+fn source_text(name: &str) -> String {
+    let dev = DEV_SOURCES.read().unwrap_or_else(|e| e.into_inner());
+    let dev_text = dev
+        .as_ref()
+        .and_then(|d| d.files.iter().find(|(n, _)| *n == name))
+        .map(|(_, text)| text.clone());
+    dev_text.unwrap_or_else(|| {
+        let (_, text) = SOURCES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .expect("every listed file is embedded");
+        (*text).to_owned()
+    })
+}
+
+/// A hash of every WGSL source in use: results cached on disk (benchmark
 /// references) are keyed by it, so a shader change invalidates them.
 pub fn sources_fingerprint() -> u64 {
     use std::hash::{Hash, Hasher};
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    SOURCES.hash(&mut hasher);
+    for (name, _) in SOURCES {
+        name.hash(&mut hasher);
+        source_text(name).hash(&mut hasher);
+    }
     hasher.finish()
 }
 
+/// The WGSL text of `program` specialised for `features`. The trace program
+/// also takes the scene's generated texture code
+/// ([`super::texture_codegen::generate`]); the others ignore it.
 pub fn assemble(
     program: Program,
     features: &FeatureSet,
@@ -266,12 +320,8 @@ pub fn assemble(
     let defines = features.defines();
     let mut module = String::new();
     for name in program.files(features) {
-        let (_, text) = SOURCES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .expect("every listed file is embedded");
         module.push_str(&format!("// ---- {name}\n"));
-        module.push_str(&preprocess(text, name, &defines)?);
+        module.push_str(&preprocess(&source_text(name), name, &defines)?);
     }
     if program == Program::Trace {
         module.push_str("// ---- generated textures\n");

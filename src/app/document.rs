@@ -1,0 +1,112 @@
+//! The preset being edited: the file it lives in, and whether the scene on
+//! screen has edits that file does not have yet.
+//!
+//! The camera is left out of that comparison, as it is of the undo history:
+//! orbiting is looking, not editing, so it never asks "save changes?". A
+//! camera saved on purpose goes in with the next Save.
+
+use crate::preset::{self, Preset, PresetError};
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+
+pub struct Document {
+    /// The preset file: Save writes here.
+    pub path: PathBuf,
+    /// The preset's description, kept so that saving does not lose it.
+    pub description: String,
+    /// The scene as last loaded or saved; its camera is set to the one it
+    /// is compared with, so that only the rest counts.
+    saved: Scene,
+    /// The text last written to or read from `path`: a change the file
+    /// watcher reports with this content is our own save, not an outside
+    /// edit.
+    saved_text: Option<String>,
+}
+
+impl Document {
+    pub fn new(path: &Path, description: String, scene: &Scene) -> Self {
+        Self {
+            path: path.to_owned(),
+            description,
+            saved: scene.clone(),
+            saved_text: std::fs::read_to_string(path).ok(),
+        }
+    }
+
+    /// Whether `scene` has edits the file does not have (camera aside).
+    /// Called every frame: nothing is cloned.
+    pub fn is_dirty(&mut self, scene: &Scene) -> bool {
+        self.saved.camera = scene.camera;
+        *scene != self.saved
+    }
+
+    /// Saves `scene` to `path` atomically; from then on the document is
+    /// that file, clean.
+    pub fn save(&mut self, scene: &Scene, path: &Path) -> Result<(), PresetError> {
+        let preset = self.preset(scene);
+        let text = preset::to_text(&preset, path)?;
+        crate::atomic_write::write_atomic(path, text.as_bytes()).map_err(|cause| {
+            PresetError::Write {
+                path: path.to_owned(),
+                cause,
+            }
+        })?;
+        self.path = path.to_owned();
+        self.saved = scene.clone();
+        self.saved_text = Some(text);
+        Ok(())
+    }
+
+    /// The preset that saving `scene` writes.
+    pub fn preset(&self, scene: &Scene) -> Preset {
+        Preset {
+            description: self.description.clone(),
+            scene: scene.clone(),
+            ..Preset::default()
+        }
+    }
+
+    /// Whether the file on disk now differs from what this document last
+    /// read or wrote there: an edit made outside the app.
+    pub fn changed_on_disk(&self) -> bool {
+        std::fs::read_to_string(&self.path).ok() != self.saved_text
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_dir::TempDir;
+
+    #[test]
+    fn an_edit_makes_it_dirty_and_a_camera_move_does_not() {
+        let scene = Scene::default();
+        let mut document = Document::new(Path::new("unsaved.ron"), String::new(), &scene);
+        let mut moved = scene.clone();
+        moved.camera.distance *= 2.0;
+        assert!(!document.is_dirty(&moved));
+        let mut edited = moved.clone();
+        edited.render.exposure += 1.0;
+        assert!(document.is_dirty(&edited));
+        assert!(!document.is_dirty(&moved), "undoing the edit cleans it");
+    }
+
+    #[test]
+    fn saving_cleans_it_and_its_own_save_is_not_an_outside_change() {
+        let dir = TempDir::new("document-save");
+        let path = dir.path("scene.ron");
+        let scene = Scene::default();
+        let mut document = Document::new(&path, "a test".into(), &scene);
+        let mut edited = scene.clone();
+        edited.render.exposure = 2.0;
+        assert!(document.is_dirty(&edited));
+        document.save(&edited, &path).unwrap();
+        assert!(!document.is_dirty(&edited));
+        assert!(!document.changed_on_disk());
+        let loaded = preset::load(&path).unwrap().preset;
+        assert_eq!(loaded.description, "a test");
+        assert_eq!(loaded.scene.render.exposure, 2.0);
+        std::fs::write(&path, "(description: \"edited outside\")").unwrap();
+        assert!(document.changed_on_disk());
+    }
+}

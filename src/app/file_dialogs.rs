@@ -1,0 +1,85 @@
+//! Native file dialogs (rfd: the desktop portal, or zenity), run on a
+//! worker thread so the window keeps drawing while one is open.
+//!
+//! Where no dialog can open (no desktop portal and no zenity, as under a
+//! bare X server or over SSH), the viewer falls back to the typed path in
+//! the panel and to dropping a file on the window; [`dialogs_available`]
+//! says which route to take before anything hangs.
+
+use std::path::PathBuf;
+use std::sync::mpsc;
+
+/// What a dialog is for: the viewer acts on the chosen path accordingly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DialogPurpose {
+    OpenPreset,
+    SavePresetAs,
+    OpenEnvironment,
+}
+
+/// A dialog open on a worker thread.
+pub struct OpenDialog {
+    purpose: DialogPurpose,
+    receiver: mpsc::Receiver<Option<PathBuf>>,
+}
+
+/// Whether a native dialog can be shown here: on Linux and the BSDs rfd
+/// talks to the desktop portal over the session bus, or runs zenity.
+pub fn dialogs_available() -> bool {
+    if cfg!(any(target_os = "windows", target_os = "macos")) {
+        return true;
+    }
+    std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some() || on_path("zenity")
+}
+
+fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
+}
+
+impl OpenDialog {
+    /// Opens the dialog for `purpose`, starting in `start`'s folder.
+    pub fn open(purpose: DialogPurpose, start: Option<PathBuf>) -> Self {
+        let (sender, receiver) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut dialog = rfd::FileDialog::new();
+            if let Some(dir) = start.as_ref().and_then(|p| p.parent()) {
+                dialog = dialog.set_directory(dir);
+            }
+            let chosen = match purpose {
+                DialogPurpose::OpenPreset => dialog
+                    .set_title("Open preset")
+                    .add_filter("marbre preset", &["ron"])
+                    .pick_file(),
+                DialogPurpose::SavePresetAs => {
+                    let name = start
+                        .as_ref()
+                        .and_then(|p| p.file_name())
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_else(|| "scene.ron".into());
+                    dialog
+                        .set_title("Save preset as")
+                        .add_filter("marbre preset", &["ron"])
+                        .set_file_name(name)
+                        .save_file()
+                }
+                DialogPurpose::OpenEnvironment => dialog
+                    .set_title("Open environment map")
+                    .add_filter("environment map", &["exr", "hdr", "png", "jpg", "jpeg"])
+                    .pick_file(),
+            };
+            // The viewer may have closed: then nobody listens.
+            let _ = sender.send(chosen);
+        });
+        Self { purpose, receiver }
+    }
+
+    /// The outcome once the dialog has closed: `Some(None)` if cancelled.
+    pub fn poll(&self) -> Option<(DialogPurpose, Option<PathBuf>)> {
+        match self.receiver.try_recv() {
+            Ok(chosen) => Some((self.purpose, chosen)),
+            Err(mpsc::TryRecvError::Empty) => None,
+            Err(mpsc::TryRecvError::Disconnected) => Some((self.purpose, None)),
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! The questions the viewer asks before it could lose work: unsaved edits
+//! before another preset replaces them or the app quits, an outside change
+//! to the preset file while there are unsaved edits, and a recovery file
+//! left by a run that did not end cleanly. Each is a modal dialog; Esc or
+//! a click outside it is the cautious answer (cancel, keep my edits, decide
+//! later).
+
+use super::recovery::RecoveryOffer;
+use std::path::PathBuf;
+
+/// What waits for the user's answer.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Prompt {
+    /// Load this preset, replacing a scene with unsaved edits.
+    LoadPreset(PathBuf),
+    /// Quit with unsaved edits.
+    Quit,
+    /// The preset file changed on disk while the scene has unsaved edits.
+    ReloadFromDisk,
+    /// Recover the scene a previous run autosaved.
+    Recover(RecoveryOffer),
+}
+
+/// The user's answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Answer {
+    /// Save the edits, then go on (load or quit).
+    SaveFirst,
+    /// Go on and lose the edits (load, quit, reload from disk, recover).
+    Proceed,
+    /// Do nothing: keep the scene as it is.
+    Cancel,
+}
+
+/// Draws `prompt` as a modal dialog; the answer once given.
+pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<Answer> {
+    let (title, text, buttons): (&str, String, &[(&str, Answer)]) = match prompt {
+        Prompt::LoadPreset(path) => (
+            "Unsaved changes",
+            format!(
+                "{preset_name} has unsaved changes. Save them before opening {}?",
+                path.display()
+            ),
+            &[
+                ("Save", Answer::SaveFirst),
+                ("Don't save", Answer::Proceed),
+                ("Cancel", Answer::Cancel),
+            ],
+        ),
+        Prompt::Quit => (
+            "Unsaved changes",
+            format!("{preset_name} has unsaved changes. Save them before quitting?"),
+            &[
+                ("Save", Answer::SaveFirst),
+                ("Quit without saving", Answer::Proceed),
+                ("Cancel", Answer::Cancel),
+            ],
+        ),
+        Prompt::ReloadFromDisk => (
+            "Preset changed on disk",
+            format!(
+                "{preset_name} was changed by another program, and the scene here has unsaved \
+                 changes. Reload it from disk (your changes are lost), or keep yours (saving \
+                 then overwrites the file)?"
+            ),
+            &[
+                ("Reload from disk", Answer::Proceed),
+                ("Keep my changes", Answer::Cancel),
+            ],
+        ),
+        Prompt::Recover(offer) => (
+            "Recover unsaved changes",
+            format!(
+                "marbre did not close cleanly last time. Unsaved changes to {} were autosaved \
+                 at {}. Recover them?",
+                offer.source.display(),
+                offer.saved_at
+            ),
+            &[("Recover", Answer::Proceed), ("Discard", Answer::Cancel)],
+        ),
+    };
+    let mut answer = None;
+    let response = egui::Modal::new(egui::Id::new("marbre prompt")).show(ctx, |ui| {
+        ui.set_max_width(420.0);
+        ui.heading(title);
+        ui.label(text);
+        ui.separator();
+        ui.horizontal(|ui| {
+            for (label, choice) in buttons {
+                if ui.button(*label).clicked() {
+                    answer = Some(*choice);
+                }
+            }
+        });
+    });
+    if answer.is_none() && response.should_close() {
+        answer = Some(Answer::Cancel);
+    }
+    answer
+}
