@@ -1,0 +1,383 @@
+//! Files in and out of the viewer: presets and environment maps (typed,
+//! dropped, picked in a dialog or from the recent list), saves, hot reload,
+//! and the answers to the prompts that guard unsaved edits.
+//!
+//! Every load builds the new scene aside and installs it only if all of it
+//! loaded, so a bad file leaves the scene on screen as it was and says why
+//! in the panel.
+
+use super::Viewer;
+use crate::app::document::Document;
+use crate::app::file_dialogs::{DialogPurpose, OpenDialog, dialogs_available};
+use crate::app::file_watch::{FileWatch, is_same_file};
+use crate::app::prompts::{Answer, Prompt};
+use crate::app::recovery;
+use crate::commands::session::{load_images, load_scene};
+use crate::cubemap;
+use crate::envmap;
+use crate::gpu::shader_source;
+use crate::preset;
+use crate::scene::{EnvSource, Scene};
+use crate::texture::ImageSet;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+impl Viewer {
+    /// A file dropped on the window or picked from the recent list: a
+    /// `.ron` is a preset, anything else an environment map.
+    pub(super) fn load_dropped(&mut self, path: &Path) {
+        let is_preset = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+        if is_preset {
+            self.request_load_preset(path);
+        } else {
+            self.load_environment(path);
+        }
+    }
+
+    /// Loads `path`, first asking what to do with unsaved edits.
+    pub(super) fn request_load_preset(&mut self, path: &Path) {
+        if self.document.is_dirty(&self.scene) {
+            self.prompt = Some(Prompt::LoadPreset(path.to_owned()));
+        } else {
+            self.load_preset(path);
+        }
+    }
+
+    /// Replaces the scene with the preset at `path`; on failure the scene
+    /// stays as it was and the panel says why. Returns whether it loaded.
+    fn load_preset(&mut self, path: &Path) -> bool {
+        let loaded = match load_scene(path, None) {
+            Ok(loaded) => loaded,
+            Err(e) => {
+                self.panel.error(format!("{e:#}"));
+                return false;
+            }
+        };
+        if let Err(e) = self.apply_scene(
+            loaded.scene.clone(),
+            loaded.env.as_ref(),
+            Some(loaded.images.clone()),
+        ) {
+            self.panel.error(format!("{}: {e:#}", path.display()));
+            return false;
+        }
+        self.preset_camera = self.scene.camera;
+        let description = preset::load(path)
+            .map(|l| l.preset.description)
+            .unwrap_or_default();
+        self.document = Document::new(path, description, &self.scene);
+        self.panel.preset_path = path.display().to_string();
+        if let EnvSource::LatLong { path } = &self.scene.environment.source {
+            self.panel.env_path = path.display().to_string();
+        }
+        self.panel.info(format!("loaded {}", path.display()));
+        for note in loaded.notes {
+            self.panel.info(note);
+        }
+        self.opened(path);
+        self.start_watching();
+        true
+    }
+
+    /// Remembers `path` in the recent files (saved at once, so a crash
+    /// keeps the list).
+    pub(super) fn opened(&mut self, path: &Path) {
+        self.settings.remember(path);
+        self.save_settings();
+    }
+
+    pub(super) fn load_environment(&mut self, path: &Path) {
+        self.load_environment_source(EnvSource::LatLong {
+            path: path.to_owned(),
+        });
+    }
+
+    /// Loads a lat-long or cube map (a cube resampled to lat-long) and
+    /// installs it with `source`; on failure the scene stays as it was.
+    pub(super) fn load_environment_source(&mut self, source: EnvSource) {
+        let what = source
+            .paths()
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
+        match cubemap::load_source(&source) {
+            Ok(Some(l)) => {
+                let mut scene = self.scene.clone();
+                scene.environment.source = source;
+                if let Err(e) = self.apply_scene(scene, Some(&l.image), None) {
+                    self.panel.error(format!("{what}: {e:#}"));
+                    return;
+                }
+                if let EnvSource::LatLong { path } = &self.scene.environment.source {
+                    self.panel.env_path = path.display().to_string();
+                    let path = path.clone();
+                    self.opened(&path);
+                }
+                self.panel.info(format!("environment {what}"));
+                for note in l.notes {
+                    self.panel.info(note);
+                }
+            }
+            Ok(None) => {}
+            Err(e) => self.panel.error(format!("{e:#}")),
+        }
+    }
+
+    /// Installs a whole new scene and environment, and its images if given;
+    /// on failure nothing changes.
+    pub(super) fn apply_scene(
+        &mut self,
+        scene: Scene,
+        env: Option<&envmap::EnvImage>,
+        images: Option<ImageSet>,
+    ) -> Result<()> {
+        self.renderer.set_scene(&self.ctx, &scene)?;
+        if let Some(images) = images {
+            self.renderer.set_images(&self.ctx, images)?;
+        }
+        self.renderer.set_environment(&self.ctx, env);
+        self.scene = scene;
+        Ok(())
+    }
+
+    /// Loads the images an edit added or changed (a new image node, a typed
+    /// path), reporting unreadable files; the renderer shows placeholders
+    /// for those.
+    pub(super) fn reload_images_if_needed(&mut self) {
+        if self.scene.image_sources() == self.renderer.images().sources() {
+            return;
+        }
+        let mut notes = Vec::new();
+        let result = load_images(&self.scene, &mut notes)
+            .and_then(|images| self.renderer.set_images(&self.ctx, images));
+        for note in notes {
+            self.panel.error(note);
+        }
+        if let Err(e) = result {
+            self.panel.error(format!("{e:#}"));
+        }
+    }
+
+    /// Saves the scene to `path` (atomically); returns whether it saved.
+    pub(super) fn save_preset(&mut self, path: &Path) -> bool {
+        match self.document.save(&self.scene, path) {
+            Ok(()) => {
+                self.panel.preset_path = path.display().to_string();
+                self.panel.info(format!("saved {}", path.display()));
+                self.opened(path);
+                self.start_watching();
+                true
+            }
+            Err(e) => {
+                self.panel.error(e.to_string());
+                false
+            }
+        }
+    }
+
+    /// Opens a native file dialog; where none can open, points the user
+    /// to the typed path and to drag and drop instead.
+    pub(super) fn open_dialog(&mut self, purpose: DialogPurpose) {
+        if self.dialog.is_some() {
+            return;
+        }
+        if !dialogs_available() {
+            self.panel.info(
+                "no file dialog here (no desktop portal, no zenity): type the path in the \
+                 field and press Enter, or drop the file on the window",
+            );
+            match purpose {
+                DialogPurpose::OpenEnvironment => self.panel.focus_env_path = true,
+                _ => self.panel.focus_preset_path = true,
+            }
+            return;
+        }
+        let start = match purpose {
+            DialogPurpose::OpenEnvironment => self.settings.recent_files.first().cloned(),
+            _ => Some(self.document.path.clone()),
+        };
+        self.dialog = Some(OpenDialog::open(purpose, start));
+    }
+
+    /// Acts on a dialog that has closed.
+    pub(super) fn poll_dialog(&mut self) {
+        let Some((purpose, chosen)) = self.dialog.as_ref().and_then(OpenDialog::poll) else {
+            return;
+        };
+        self.dialog = None;
+        let Some(path) = chosen else {
+            return;
+        };
+        match purpose {
+            DialogPurpose::OpenPreset => self.request_load_preset(&path),
+            DialogPurpose::SavePresetAs => {
+                self.save_preset(&path);
+            }
+            DialogPurpose::OpenEnvironment => self.load_environment(&path),
+        }
+    }
+
+    /// Carries out what the user answered to the open prompt.
+    pub(super) fn answer_prompt(&mut self, answer: Answer) {
+        let Some(prompt) = self.prompt.take() else {
+            return;
+        };
+        let path = self.document.path.clone();
+        match (prompt, answer) {
+            (_, Answer::Cancel) | (Prompt::ReloadFromDisk, Answer::SaveFirst) => {}
+            (Prompt::LoadPreset(next), Answer::SaveFirst) => {
+                if self.save_preset(&path) {
+                    self.load_preset(&next);
+                }
+            }
+            (Prompt::LoadPreset(next), Answer::Proceed) => {
+                self.load_preset(&next);
+            }
+            (Prompt::Quit, Answer::SaveFirst) => {
+                if self.save_preset(&path) {
+                    self.quit();
+                }
+            }
+            (Prompt::Quit, Answer::Proceed) => self.quit(),
+            (Prompt::ReloadFromDisk, Answer::Proceed) => self.reload_from_disk(),
+            (Prompt::Recover(offer), Answer::Proceed) => self.recover(&offer),
+            (Prompt::Recover(_), Answer::SaveFirst) => {}
+        }
+        // Declining a recovery deletes it; so does accepting it once the
+        // scene is back (it is autosaved again while unsaved).
+        if let Some(dir) = &self.config_dir
+            && matches!(self.prompt, None)
+            && recovery::pending_offer(dir).is_some()
+        {
+            recovery::discard(dir);
+        }
+    }
+
+    /// Reopens the scene a crashed run autosaved, as unsaved edits of the
+    /// preset it came from.
+    fn recover(&mut self, offer: &recovery::RecoveryOffer) {
+        let loaded = match load_scene(&offer.preset, None) {
+            Ok(loaded) => loaded,
+            Err(e) => {
+                self.panel.error(format!("cannot recover: {e:#}"));
+                return;
+            }
+        };
+        if let Err(e) = self.apply_scene(
+            loaded.scene.clone(),
+            loaded.env.as_ref(),
+            Some(loaded.images.clone()),
+        ) {
+            self.panel.error(format!("cannot recover: {e:#}"));
+            return;
+        }
+        // The document is the original preset (Save writes there), compared
+        // with what that file holds, so the recovered edits show unsaved.
+        let original = preset::load(&offer.source).ok();
+        let description = original
+            .as_ref()
+            .map(|l| l.preset.description.clone())
+            .unwrap_or_default();
+        let saved = original.map_or_else(Scene::default, |l| l.preset.scene);
+        self.document = Document::new(&offer.source, description, &saved);
+        self.panel.preset_path = offer.source.display().to_string();
+        self.panel.info(format!(
+            "recovered the unsaved changes to {} from {}",
+            offer.source.display(),
+            offer.saved_at
+        ));
+        self.start_watching();
+    }
+
+    /// Watches the preset's folder, and `shaders/` in `--dev` mode.
+    pub(super) fn start_watching(&mut self) {
+        if self.watch.is_none() {
+            match FileWatch::new() {
+                Ok(watch) => self.watch = Some(watch),
+                Err(e) => self.panel.error(format!("hot reload is off: {e:#}")),
+            }
+        }
+        if let Some(watch) = &mut self.watch
+            && let Err(e) = watch.watch_folder_of(&self.document.path)
+        {
+            self.panel.error(format!("hot reload is off: {e:#}"));
+        }
+        if self.options.dev && self.shader_watch.is_none() {
+            let shaders = dev_shader_dir();
+            let watch = FileWatch::new().and_then(|mut w| {
+                w.watch_folder_of(&shaders.join("trace.wgsl"))?;
+                Ok(w)
+            });
+            match watch {
+                Ok(watch) => {
+                    self.shader_watch = Some(watch);
+                    self.panel.info(format!(
+                        "--dev: editing a shader in {} rebuilds the trace pipeline",
+                        shaders.display()
+                    ));
+                }
+                Err(e) => self.panel.error(format!("shader hot reload is off: {e:#}")),
+            }
+        }
+    }
+
+    /// Acts on files changed outside the app: the preset reloads (or asks,
+    /// with unsaved edits); a shader in `--dev` mode rebuilds the pipeline,
+    /// a failed build keeping the old one and showing why.
+    pub(super) fn poll_file_watch(&mut self) {
+        let preset_changed = self.watch.as_ref().is_some_and(|w| {
+            w.changed()
+                .iter()
+                .any(|p| is_same_file(p, &self.document.path))
+        });
+        if preset_changed && self.document.changed_on_disk() {
+            if self.document.is_dirty(&self.scene) {
+                if self.prompt.is_none() {
+                    self.prompt = Some(Prompt::ReloadFromDisk);
+                }
+            } else {
+                self.reload_from_disk();
+            }
+        }
+        let shaders_changed = self.shader_watch.as_ref().is_some_and(|w| {
+            w.changed()
+                .iter()
+                .any(|p| p.extension().is_some_and(|e| e == "wgsl"))
+        });
+        if shaders_changed {
+            self.reload_shaders();
+        }
+    }
+
+    /// Loads the preset file again after an outside edit, keeping the
+    /// user's view unless the edit moved the camera.
+    fn reload_from_disk(&mut self) {
+        let (camera, preset_camera) = (self.scene.camera, self.preset_camera);
+        let path = self.document.path.clone();
+        if self.load_preset(&path) && self.scene.camera == preset_camera {
+            self.scene.camera = camera;
+        }
+    }
+
+    fn reload_shaders(&mut self) {
+        let dir = dev_shader_dir();
+        match shader_source::load_dev_sources(&dir) {
+            Ok(generation) => {
+                self.panel
+                    .info(format!("shaders reloaded from {} (#{generation})", dir.display()));
+                if let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
+                    self.panel.error(format!("{e:#}"));
+                }
+            }
+            Err(e) => self.panel.error(format!("cannot reload shaders: {e:#}")),
+        }
+    }
+}
+
+/// The `shaders/` folder `--dev` reads: the source tree's.
+fn dev_shader_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")
+}

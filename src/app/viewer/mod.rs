@@ -1,0 +1,517 @@
+//! One window's state: surface, renderer, egui, the scene being edited, and
+//! what keeps the user's work safe (the document, autosave, prompts).
+//!
+//! The viewer's code is split by concern: `files` (presets, environment
+//! maps, dialogs, recent files, hot reload, the unsaved-changes prompts),
+//! `frame` (one frame on the GPU, stats), `device` (recreating everything
+//! after a lost device).
+
+mod device;
+mod files;
+mod frame;
+
+use super::convergence::Convergence;
+use super::device_watch::DeviceWatch;
+use super::document::Document;
+use super::feature_costs::FeatureCosts;
+use super::file_dialogs::OpenDialog;
+use super::file_watch::FileWatch;
+use super::history::History;
+use super::prompts::{self, Prompt};
+use super::recovery::{self, Autosave};
+use super::settings::Settings;
+use super::shortcuts::{self, Shortcut};
+use super::{ViewerOptions, camera_input};
+use crate::commands::session::{DEFAULT_PRESET, load_scene, renderer_for};
+use crate::gpu::pass_timer::PassTimer;
+use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
+use crate::panel::{self, PanelAction, PanelState};
+use crate::preset;
+use crate::scene::{EnvSource, OrbitCamera, Scene};
+use anyhow::{Context as _, Result};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+use winit::event::{ElementState, KeyEvent, WindowEvent};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Fullscreen, Window};
+
+/// Width of the side panel, in points, when the window opens.
+const PANEL_WIDTH: f32 = 380.0;
+/// Height of the Quality strip under the image, in points, when the window
+/// opens.
+const QUALITY_HEIGHT: f32 = 190.0;
+
+pub struct Viewer {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    ctx: GpuContext,
+    renderer: Renderer,
+    /// GPU time of each pass, where the adapter has timestamp queries.
+    timer: Option<PassTimer>,
+    /// Lost devices and uncaptured GPU errors.
+    device_watch: DeviceWatch,
+    /// The error estimates since the last change, for the Quality panel.
+    convergence: Convergence,
+    /// Trace times with shader features compiled out, for the Quality panel.
+    feature_costs: FeatureCosts,
+    /// Undo and redo of scene edits (Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y).
+    history: History,
+    /// Samples the current accumulation dropped for being NaN or infinite,
+    /// and the accumulation they count.
+    non_finite: (u32, NonFiniteCounts),
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    scene: Scene,
+    /// The preset file being edited and what it holds.
+    document: Document,
+    /// The camera the preset was loaded with, for the panel's Reset.
+    preset_camera: OrbitCamera,
+    panel: PanelState,
+    options: ViewerOptions,
+    /// Window size, last preset, recent files; saved on exit.
+    settings: Settings,
+    /// Where settings and the recovery file live (none: not persisted).
+    config_dir: Option<PathBuf>,
+    /// Copies unsaved edits to the recovery file now and then.
+    autosave: Option<Autosave>,
+    /// A question waiting for the user's answer (unsaved changes, recovery).
+    prompt: Option<Prompt>,
+    /// A native file dialog open on its thread.
+    dialog: Option<OpenDialog>,
+    /// The preset's folder, and `shaders/` in `--dev` mode, for hot reload.
+    watch: Option<FileWatch>,
+    shader_watch: Option<FileWatch>,
+    show_help: bool,
+    ui_hidden: bool,
+    /// The user chose to quit: the loop exits after this frame.
+    quitting: bool,
+    frames: u64,
+    last_frame: Instant,
+    fps: f32,
+    ms_per_frame: f32,
+    screenshot_requested: bool,
+}
+
+/// The preset to open: the command line's, else the last one (if it still
+/// exists), else the default.
+fn startup_preset(options: &ViewerOptions, settings: &Settings) -> PathBuf {
+    if let Some(path) = &options.preset {
+        return path.clone();
+    }
+    settings
+        .last_preset
+        .clone()
+        .filter(|p| p.is_file())
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_PRESET))
+}
+
+impl Viewer {
+    pub fn new(
+        window: Arc<Window>,
+        options: ViewerOptions,
+        settings: Settings,
+        config_dir: Option<PathBuf>,
+    ) -> Result<Self> {
+        let mut preset_path = startup_preset(&options, &settings);
+        let mut startup_notes = Vec::new();
+        let loaded = match load_scene(&preset_path, options.env.as_deref()) {
+            Ok(loaded) => loaded,
+            // The last session's preset no longer loads: say why, and
+            // start on the default one rather than not at all.
+            Err(e) if options.preset.is_none() && preset_path != Path::new(DEFAULT_PRESET) => {
+                startup_notes.push(format!("{e:#}; opened the default preset instead"));
+                preset_path = PathBuf::from(DEFAULT_PRESET);
+                load_scene(&preset_path, options.env.as_deref())?
+            }
+            Err(e) => return Err(e),
+        };
+        let description = preset::load(&preset_path)
+            .map(|l| l.preset.description)
+            .unwrap_or_default();
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
+        let surface = instance
+            .create_surface(window.clone())
+            .context("creating the window surface")?;
+        let ctx = GpuContext::for_surface(instance, &surface)?;
+        let device_watch = DeviceWatch::default();
+        device_watch.attach(&ctx.device);
+        let size = window.inner_size();
+        let config = surface_config(&surface, &ctx, size);
+        surface.configure(&ctx.device, &config);
+        let renderer = renderer_for(&ctx, &loaded, (config.width, config.height))?;
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(ctx.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(&ctx.device, config.format, Default::default());
+        let env_path = match &loaded.scene.environment.source {
+            EnvSource::LatLong { path } => path.display().to_string(),
+            _ => String::new(),
+        };
+        let mut panel = PanelState::new(preset_path.display().to_string(), env_path);
+        for note in startup_notes {
+            panel.error(note);
+        }
+        panel.info(format!("loaded {}", preset_path.display()));
+        for note in &loaded.notes {
+            panel.info(note.clone());
+        }
+        let timer = PassTimer::new(&ctx);
+        let preset_camera = loaded.scene.camera;
+        let history = History::new(&loaded.scene);
+        let document = Document::new(&preset_path, description, &loaded.scene);
+        let scripted = options.exit_after_frames.is_some();
+        // A run that crashed left its unsaved edits: offer them first.
+        let prompt = config_dir
+            .as_deref()
+            .filter(|_| !scripted)
+            .and_then(recovery::pending_offer)
+            .map(Prompt::Recover);
+        let autosave = config_dir.clone().map(Autosave::new);
+        let mut viewer = Self {
+            history,
+            timer,
+            device_watch,
+            convergence: Convergence::default(),
+            feature_costs: FeatureCosts::default(),
+            non_finite: (0, NonFiniteCounts::default()),
+            window,
+            surface,
+            config,
+            ctx,
+            renderer,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            scene: loaded.scene,
+            document,
+            preset_camera,
+            panel,
+            options,
+            settings,
+            config_dir,
+            autosave,
+            prompt,
+            dialog: None,
+            watch: None,
+            shader_watch: None,
+            show_help: false,
+            ui_hidden: false,
+            quitting: false,
+            frames: 0,
+            last_frame: Instant::now(),
+            fps: 0.0,
+            ms_per_frame: 0.0,
+            screenshot_requested: false,
+        };
+        viewer.opened(&preset_path);
+        viewer.start_watching();
+        Ok(viewer)
+    }
+
+    pub fn request_redraw(&self) {
+        self.window.request_redraw();
+    }
+
+    /// Handles one window event; `Ok(false)` asks the loop to exit.
+    pub fn handle_event(&mut self, event: &WindowEvent) -> Result<bool> {
+        let consumed = self
+            .egui_state
+            .on_window_event(&self.window, event)
+            .consumed;
+        match event {
+            WindowEvent::CloseRequested => self.request_quit(),
+            WindowEvent::Resized(size) => {
+                // A minimised window has zero size: keep the last valid
+                // configuration, and draw nothing until it comes back.
+                if size.width > 0 && size.height > 0 {
+                    self.config.width = size.width;
+                    self.config.height = size.height;
+                    self.surface.configure(&self.ctx.device, &self.config);
+                }
+            }
+            WindowEvent::DroppedFile(path) => self.load_dropped(path),
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        logical_key: Key::Named(NamedKey::F12),
+                        state: ElementState::Pressed,
+                        ..
+                    },
+                ..
+            } if !consumed => self.screenshot_requested = true,
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        logical_key: Key::Character(text),
+                        state: ElementState::Pressed,
+                        ..
+                    },
+                ..
+            } if !consumed => {
+                // Keys 1–9 recall the preset's saved views.
+                if let Ok(digit @ 1..=9) = text.parse::<usize>() {
+                    self.scene.recall_view(digit - 1);
+                }
+            }
+            WindowEvent::RedrawRequested => return self.redraw(),
+            _ => {}
+        }
+        Ok(!self.quitting)
+    }
+
+    /// The window's close button or the system asks to quit: with unsaved
+    /// edits the user chooses first (a scripted run just ends).
+    fn request_quit(&mut self) {
+        if self.options.exit_after_frames.is_none() && self.document.is_dirty(&self.scene) {
+            self.prompt = Some(Prompt::Quit);
+        } else {
+            self.quit();
+        }
+    }
+
+    /// Ends the session cleanly: no recovery file is left, and the
+    /// settings remember the window and the preset.
+    fn quit(&mut self) {
+        if let Some(autosave) = &mut self.autosave {
+            autosave.finish();
+        }
+        if !self.window.fullscreen().is_some() {
+            let size = self.window.inner_size();
+            self.settings.window_size = Some((size.width, size.height));
+        }
+        self.settings.last_preset = Some(
+            std::path::absolute(&self.document.path).unwrap_or_else(|_| self.document.path.clone()),
+        );
+        self.save_settings();
+        self.quitting = true;
+    }
+
+    fn save_settings(&mut self) {
+        if let Some(dir) = &self.config_dir
+            && let Err(e) = self.settings.save(dir)
+        {
+            self.panel.error(format!("cannot save settings: {e:#}"));
+        }
+    }
+
+    /// Undoes or redoes one step of scene edits, keeping the view.
+    fn step_history(&mut self, undo: bool) {
+        let restored = if undo {
+            self.history.undo(&self.scene)
+        } else {
+            self.history.redo(&self.scene)
+        };
+        match restored {
+            Some(scene) => self.scene = scene,
+            None => self
+                .panel
+                .info(if undo { "nothing to undo" } else { "nothing to redo" }),
+        }
+    }
+
+    fn handle_actions(&mut self, actions: Vec<PanelAction>) {
+        for action in actions {
+            match action {
+                PanelAction::LoadPreset(p) => self.request_load_preset(&p),
+                PanelAction::SavePreset => self.save_preset(&self.document.path.clone()),
+                PanelAction::SavePresetAs(p) => self.save_preset(&p),
+                PanelAction::BrowsePreset => self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset),
+                PanelAction::BrowseSavePresetAs => {
+                    self.open_dialog(super::file_dialogs::DialogPurpose::SavePresetAs)
+                }
+                PanelAction::BrowseEnvironment => {
+                    self.open_dialog(super::file_dialogs::DialogPurpose::OpenEnvironment)
+                }
+                PanelAction::OpenRecent(p) => self.load_dropped(&p),
+                PanelAction::LoadEnvironment(p) => self.load_environment(&p),
+                PanelAction::Screenshot => self.screenshot_requested = true,
+                PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
+                PanelAction::ToggleFeature(feature) => self.toggle_feature(feature),
+                PanelAction::Undo => self.step_history(true),
+                PanelAction::Redo => self.step_history(false),
+            }
+        }
+    }
+
+    fn handle_shortcuts(&mut self, pressed: Vec<Shortcut>) {
+        use super::file_dialogs::DialogPurpose;
+        for shortcut in pressed {
+            match shortcut {
+                Shortcut::Undo => self.step_history(true),
+                Shortcut::Redo => self.step_history(false),
+                Shortcut::Save => self.save_preset(&self.document.path.clone()),
+                Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
+                Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
+                Shortcut::Help => self.show_help = !self.show_help,
+                Shortcut::Close => self.show_help = false,
+                Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
+                Shortcut::Fullscreen => {
+                    let fullscreen = match self.window.fullscreen() {
+                        Some(_) => None,
+                        None => Some(Fullscreen::Borderless(None)),
+                    };
+                    self.window.set_fullscreen(fullscreen);
+                }
+            }
+        }
+    }
+
+    /// Compiles `feature` out of the shader (or back in) to time the scene
+    /// without it; a set that cannot be built is refused with the reason.
+    fn toggle_feature(&mut self, feature: crate::gpu::Feature) {
+        self.feature_costs.toggle(feature);
+        let request = self
+            .renderer
+            .request_feature_override(&self.ctx, self.feature_costs.override_set());
+        if let Err(e) = request {
+            self.feature_costs.toggle(feature);
+            self.panel
+                .error(format!("cannot compile {feature:?} out: {e:#}"));
+        }
+    }
+
+    /// Runs the UI for one frame; returns the image rectangle in points and
+    /// whether the camera is being dragged.
+    fn run_ui(&mut self) -> (egui::FullOutput, egui::Rect, bool) {
+        let raw_input = self.egui_state.take_egui_input(&self.window);
+        let stats = self.stats();
+        let mut actions = Vec::new();
+        let mut image_rect = egui::Rect::NOTHING;
+        let mut dragging = false;
+        self.panel.can_undo = self.history.can_undo();
+        self.panel.can_redo = self.history.can_redo();
+        self.panel.unsaved = self.document.is_dirty(&self.scene);
+        self.panel.recent_files.clone_from(&self.settings.recent_files);
+        let preset_name = self.document_name();
+        let (scene, panel_state) = (&mut self.scene, &mut self.panel);
+        let (prompt, ui_hidden) = (&self.prompt, self.ui_hidden);
+        let mut show_help = self.show_help;
+        let mut pressed = Vec::new();
+        let mut answer = None;
+        let output = self.egui_ctx.run_ui(raw_input, |ui| {
+            pressed = shortcuts::pressed(ui.ctx());
+            if !ui_hidden {
+                egui::Panel::right("marbre-panel")
+                    .default_size(PANEL_WIDTH)
+                    .show(ui, |ui| {
+                        egui::ScrollArea::vertical().show(ui, |ui| {
+                            actions = panel::draw(ui, scene, panel_state, &stats);
+                        });
+                    });
+                egui::Panel::bottom("marbre-quality")
+                    .resizable(true)
+                    .default_size(QUALITY_HEIGHT)
+                    .show(ui, |ui| {
+                        actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                    });
+            }
+            image_rect = ui.available_rect_before_wrap();
+            let response = ui.allocate_rect(image_rect, egui::Sense::click_and_drag());
+            dragging = camera_input::apply(ui, &response, &mut scene.camera);
+            panel::help::draw_help_overlay(ui.ctx(), &mut show_help);
+            if let Some(prompt) = prompt {
+                answer = prompts::show(ui.ctx(), prompt, &preset_name);
+            }
+        });
+        self.show_help = show_help;
+        self.handle_actions(actions);
+        self.handle_shortcuts(pressed);
+        if let Some(answer) = answer {
+            self.answer_prompt(answer);
+        }
+        (output, image_rect, dragging)
+    }
+
+    fn redraw(&mut self) -> Result<bool> {
+        if let Some(reason) = self.device_watch.take_lost() {
+            self.recover_device(&reason)?;
+        }
+        for message in self.device_watch.take_messages() {
+            self.panel.error(format!("GPU error: {message}"));
+        }
+        self.poll_dialog();
+        self.poll_file_watch();
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f32();
+        self.last_frame = now;
+        self.ms_per_frame = 0.9 * self.ms_per_frame + 0.1 * dt * 1000.0;
+        self.fps = 1000.0 / self.ms_per_frame.max(1e-3);
+
+        let (mut output, image_rect, dragging) = self.run_ui();
+        self.egui_state
+            .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
+        // Texture uploads are applied now, whatever happens to this frame;
+        // frees wait until the frame that may still use them is submitted.
+        for (id, deltas) in output.textures_delta.set.drain() {
+            for delta in &deltas {
+                self.egui_renderer
+                    .update_texture(&self.ctx.device, &self.ctx.queue, id, delta);
+            }
+        }
+        let to_free: Vec<egui::TextureId> = output.textures_delta.free.drain().collect();
+        let result = self.draw_frame(output, image_rect, dragging);
+        for id in &to_free {
+            self.egui_renderer.free_texture(id);
+        }
+        self.autosave();
+        result.map(|go_on| go_on && !self.quitting)
+    }
+
+    /// Copies unsaved edits to the recovery file when it is time.
+    fn autosave(&mut self) {
+        let dirty = self.document.is_dirty(&self.scene);
+        let Some(autosave) = &mut self.autosave else {
+            return;
+        };
+        let (document, scene) = (&self.document, &self.scene);
+        if let Err(e) = autosave.tick(dirty, &document.path, || document.preset(scene)) {
+            self.panel.error(format!("autosave failed: {e:#}"));
+        }
+    }
+
+    /// The preset's file name, for prompts.
+    fn document_name(&self) -> String {
+        self.document
+            .path
+            .file_name()
+            .map_or_else(|| "The scene".to_owned(), |n| n.to_string_lossy().into_owned())
+    }
+}
+
+/// The swapchain configuration for `size` (at least 1×1).
+fn surface_config(
+    surface: &wgpu::Surface<'_>,
+    ctx: &GpuContext,
+    size: winit::dpi::PhysicalSize<u32>,
+) -> wgpu::SurfaceConfiguration {
+    let caps = surface.get_capabilities(&ctx.adapter);
+    let format = caps
+        .formats
+        .iter()
+        .copied()
+        // egui blends in gamma space, so it wants a non-sRGB target; the
+        // display pass then encodes sRGB itself.
+        .find(|f| !f.is_srgb())
+        .unwrap_or(caps.formats[0]);
+    wgpu::SurfaceConfiguration {
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        format,
+        width: size.width.max(1),
+        height: size.height.max(1),
+        present_mode: wgpu::PresentMode::AutoVsync,
+        desired_maximum_frame_latency: 2,
+        alpha_mode: caps.alpha_modes[0],
+        view_formats: vec![],
+        color_space: wgpu::SurfaceColorSpace::Auto,
+    }
+}
