@@ -7,6 +7,7 @@
 //! the user touched it, which is why sliders do not clamp existing values and
 //! colours are written back only on a change.
 
+pub mod help;
 mod material_editor;
 mod quality;
 mod transport;
