@@ -84,7 +84,8 @@ fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
                 .id_salt("layer")
                 .show(ui, |ui| {
                     ui.horizontal(|ui| {
-                        ui.text_edit_singleline(&mut layer.name);
+                        ui.text_edit_singleline(&mut layer.name)
+                            .on_hover_text("The layer's name, shown in its header");
                         if ui
                             .small_button("remove layer")
                             .on_hover_text("Delete this layer")
@@ -201,7 +202,11 @@ fn texture_ui(
             .header_response
             .on_hover_text(hint)
             .context_menu(|ui| {
-                if ui.button("copy subtree").clicked() {
+                if ui
+                    .button("copy subtree")
+                    .on_hover_text("Copy this texture and everything nested in it")
+                    .clicked()
+                {
                     ui.ctx()
                         .data_mut(|d| d.insert_temp(clipboard_id(), texture.clone()));
                     ui.close();
@@ -209,6 +214,8 @@ fn texture_ui(
                 let copied: Option<Texture> = ui.ctx().data(|d| d.get_temp(clipboard_id()));
                 if ui
                     .add_enabled(copied.is_some(), egui::Button::new("paste over this"))
+                    .on_hover_text("Replace this texture by the copied subtree")
+                    .on_disabled_hover_text("Copy a subtree first")
                     .clicked()
                 {
                     if let Some(copied) = copied {
@@ -216,7 +223,11 @@ fn texture_ui(
                     }
                     ui.close();
                 }
-                if ui.button("reset to a constant").clicked() {
+                if ui
+                    .button("reset to a constant")
+                    .on_hover_text("Replace this texture by its value at the origin")
+                    .clicked()
+                {
                     let value = texture.eval(Vec3::ZERO, glam::Vec2::ZERO);
                     *texture = match kind {
                         ValueKind::Color => Texture::color(value),
@@ -319,14 +330,18 @@ fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
                 }
                 match op {
                     MathOp::Scale(x) => {
-                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("× "));
+                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("× "))
+                            .on_hover_text("Multiplies the value by this");
                     }
                     MathOp::Bias(x) => {
-                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("+ "));
+                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("+ "))
+                            .on_hover_text("Adds this to the value");
                     }
                     MathOp::Clamp { min, max } => {
-                        ui.add(egui::DragValue::new(min).speed(0.01).prefix("min "));
-                        ui.add(egui::DragValue::new(max).speed(0.01).prefix("max "));
+                        ui.add(egui::DragValue::new(min).speed(0.01).prefix("min "))
+                            .on_hover_text("Values below this are raised to it");
+                        ui.add(egui::DragValue::new(max).speed(0.01).prefix("max "))
+                            .on_hover_text("Values above this are lowered to it");
                     }
                     MathOp::Power(e) => {
                         ui.add(
@@ -334,7 +349,11 @@ fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
                                 .speed(0.01)
                                 .range(MathOp::MIN_EXPONENT..=100.0)
                                 .prefix("^ "),
-                        );
+                        )
+                        .on_hover_text(format!(
+                            "Raises the value (negatives taken as 0) to this exponent, at least {}",
+                            MathOp::MIN_EXPONENT
+                        ));
                     }
                     MathOp::Abs | MathOp::Invert => {}
                 }
@@ -390,8 +409,9 @@ fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
     for (i, stop) in texture.ramp.iter_mut().enumerate() {
         ui.push_id(("stop", i), |ui| {
             ui.horizontal(|ui| {
-                color_button(ui, &mut stop.color);
-                ui.add(slider(&mut stop.position, 0.0..=1.0, "at"));
+                color_button(ui, &mut stop.color).on_hover_text("This stop's colour");
+                ui.add(slider(&mut stop.position, 0.0..=1.0, "at"))
+                    .on_hover_text("The pattern's t at which this colour is reached, 0 to 1");
                 if ui
                     .small_button("✕")
                     .on_hover_text("Remove this stop")
@@ -407,7 +427,12 @@ fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
     }
     if !texture.ramp.is_empty()
         && texture.ramp.len() < MAX_RAMP_STOPS
-        && ui.small_button("add stop").clicked()
+        && ui
+            .small_button("add stop")
+            .on_hover_text(format!(
+                "Another stop 0.1 after the last, in its colour (at most {MAX_RAMP_STOPS} stops)"
+            ))
+            .clicked()
     {
         let last = texture.ramp[texture.ramp.len() - 1];
         texture.ramp.push(RampStop {
@@ -454,15 +479,25 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
                     }
                 };
             }
+            let constant = match kind {
+                ValueKind::Color => "A constant colour",
+                ValueKind::Scalar => "A constant value, 0 to 1",
+            };
+            let hint = if can_nest {
+                format!("{constant}; tick “texture” to nest a whole texture instead")
+            } else {
+                constant.to_owned()
+            };
             match child {
                 Child::Color(c) if kind == ValueKind::Color => {
-                    labelled_color(ui, c, label);
+                    labelled_color(ui, c, label).on_hover_text(hint);
                 }
                 Child::Color(c) => {
-                    ui.add(slider(&mut c.x, 0.0..=1.0, label));
+                    ui.add(slider(&mut c.x, 0.0..=1.0, label))
+                        .on_hover_text(hint);
                 }
                 Child::Scalar(v) => {
-                    ui.add(slider(v, 0.0..=1.0, label));
+                    ui.add(slider(v, 0.0..=1.0, label)).on_hover_text(hint);
                 }
                 Child::Texture(_) => {}
             }
@@ -533,7 +568,8 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
         Pattern::Checker2d { size, phase } => {
             ui.add(slider(&mut size.x, 0.01..=4.0, "cell width (u)").logarithmic(true))
                 .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
-            ui.add(slider(&mut size.y, 0.01..=4.0, "cell height (v)").logarithmic(true));
+            ui.add(slider(&mut size.y, 0.01..=4.0, "cell height (v)").logarithmic(true))
+                .on_hover_text("Height of a cell in (u, v)");
             ui.add(slider(phase, 0.0..=1.0, "row phase"))
                 .on_hover_text("Shift of every other row, in cells: 0.5 lays them like bricks");
         }
@@ -542,20 +578,26 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
             mortar,
             row_offset,
         } => {
-            ui.add(slider(&mut size.x, 0.01..=4.0, "brick width (u)").logarithmic(true));
-            ui.add(slider(&mut size.y, 0.01..=4.0, "brick height (v)").logarithmic(true));
+            ui.add(slider(&mut size.x, 0.01..=4.0, "brick width (u)").logarithmic(true))
+                .on_hover_text("Width of a brick and its joint, in (u, v) units");
+            ui.add(slider(&mut size.y, 0.01..=4.0, "brick height (v)").logarithmic(true))
+                .on_hover_text("Height of a brick and its joint, in (u, v) units");
             ui.add(slider(mortar, 0.0..=0.2, "mortar width"))
                 .on_hover_text(
                     "Width of the joints, in (u, v) units; a is the mortar, b the bricks",
                 );
-            ui.add(slider(row_offset, 0.0..=1.0, "row offset"));
+            ui.add(slider(row_offset, 0.0..=1.0, "row offset"))
+                .on_hover_text("Shift of every other row, in bricks: 0.5 is the running bond");
         }
         Pattern::Tile {
             mortar_half_width,
             bevel,
         } => {
             ui.add(slider(mortar_half_width, 0.0..=0.5, "mortar half-width"))
-                .on_hover_text("One tile per unit (u, v) square: lay it in a checker cell");
+                .on_hover_text(
+                    "Half the joint width, in (u, v) units; one tile per unit square, so lay it \
+                     in a checker cell",
+                );
             ui.add(slider(bevel, 0.0..=0.5, "bevel")).on_hover_text(
                 "Width over which the tile rises from the mortar: bump it to raise the tiles",
             );
@@ -569,6 +611,7 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
             let mut angle = direction.y.atan2(direction.x).to_degrees();
             if ui
                 .add(slider(&mut angle, -180.0..=180.0, "direction (°)"))
+                .on_hover_text("Angle from +u the waves travel along; the crests run across it")
                 .changed()
             {
                 let a = angle.to_radians();
@@ -578,14 +621,18 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
         Pattern::Cutout { sides, radius } => {
             ui.add(Slider::new(sides, 0..=12).text("sides"))
                 .on_hover_text("A regular polygon; below 3, a disc. a is outside, b inside");
-            ui.add(slider(radius, 0.0..=0.71, "radius"));
+            ui.add(slider(radius, 0.0..=0.71, "radius")).on_hover_text(
+                "From the cell's centre to the polygon's corners (the disc's radius), in (u, v) \
+                 units; 0.71 reaches the cell's corners",
+            );
         }
         Pattern::Wood {
             noise,
             ring_width,
             turbulence_amount,
         } => {
-            ui.add(slider(ring_width, 0.01..=1.0, "ring width").logarithmic(true));
+            ui.add(slider(ring_width, 0.01..=1.0, "ring width").logarithmic(true))
+                .on_hover_text("Width of each ring, in scene units: dark and pale alternate");
             ui.add(slider(turbulence_amount, 0.0..=2.0, "turbulence"))
                 .on_hover_text("How far turbulence moves the rings; a dark, b pale");
             noise_ui(ui, noise);
@@ -599,7 +646,8 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
                 .on_hover_text(
                     "t = max(0, sin(frequency · x + turbulence · T(p))): a dominant, b veins",
                 );
-            ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"));
+            ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"))
+                .on_hover_text("How far turbulence bends the veins (times the fractal sum)");
             noise_ui(ui, noise);
         }
     }
@@ -611,7 +659,17 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
         .selected_text(noise.kind.label())
         .show_ui(ui, |ui| {
             for kind in NoiseKind::ALL {
-                ui.selectable_value(&mut noise.kind, kind, kind.label());
+                ui.selectable_value(&mut noise.kind, kind, kind.label())
+                    .on_hover_text(match kind {
+                        NoiseKind::Gradient => {
+                            "The lab's gradient noise: hashed corner gradients, smoothstep \
+                             interpolation"
+                        }
+                        NoiseKind::Perlin => {
+                            "Perlin's improved noise (2002): permutation table, 12 edge \
+                             gradients, quintic fade"
+                        }
+                    });
             }
         })
         .response
@@ -636,7 +694,10 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
     });
     let f = &mut noise.fractal;
     ui.add(slider(&mut f.octaves, FractalParams::OCTAVES, "octaves"))
-        .on_hover_text("Number of noise layers; a fractional part fades the last one in");
+        .on_hover_text(
+            "More octaves: finer detail, one noise evaluation each; a fractional part fades the \
+             last one in",
+        );
     ui.add(typed_beyond(
         slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true),
     ))
@@ -673,7 +734,8 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
         "distortion",
     )))
     .on_hover_text(
-        "Domain warp: moves the point by noise before summing (0: none; type any value in ±100)",
+        "Domain warp: moves the point by noise before summing, three more noise evaluations \
+         (0: none and free; type any value in ±100)",
     );
     limit(&mut f.distortion, FractalParams::DISTORTION);
 }

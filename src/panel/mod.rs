@@ -7,6 +7,7 @@
 //! the user touched it, which is why sliders do not clamp existing values and
 //! colours are written back only on a change.
 
+pub mod help;
 mod material_editor;
 mod quality;
 mod transport;
@@ -292,13 +293,15 @@ fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>
     ui.horizontal(|ui| {
         let undo = ui
             .add_enabled(state.can_undo, egui::Button::new("Undo"))
-            .on_hover_text("Undo the last edit (Ctrl+Z); a whole slider drag is one edit");
+            .on_hover_text("Undo the last edit (Ctrl+Z); a whole slider drag is one edit")
+            .on_disabled_hover_text("Nothing to undo");
         if undo.clicked() {
             actions.push(PanelAction::Undo);
         }
         let redo = ui
             .add_enabled(state.can_redo, egui::Button::new("Redo"))
-            .on_hover_text("Redo what was undone (Ctrl+Shift+Z or Ctrl+Y)");
+            .on_hover_text("Redo what was undone (Ctrl+Shift+Z or Ctrl+Y)")
+            .on_disabled_hover_text("Nothing to redo");
         if redo.clicked() {
             actions.push(PanelAction::Redo);
         }
@@ -349,7 +352,8 @@ fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
                     0.01,
                     "Centre of the bottom cap",
                 );
-                ui.add(slider(&mut cylinder.radius, 0.01..=10.0, "radius").logarithmic(true));
+                ui.add(slider(&mut cylinder.radius, 0.01..=10.0, "radius").logarithmic(true))
+                    .on_hover_text("Radius of the side and caps, in scene units");
                 ui.add(slider(&mut cylinder.height, 0.01..=10.0, "height").logarithmic(true))
                     .on_hover_text(
                         "Along +y; the side's v runs from 0 at the base to 1 at the top",
@@ -459,6 +463,7 @@ fn source_fields_ui(
                 if ui
                     .add_enabled(!state.env_path.trim().is_empty(), egui::Button::new("Load"))
                     .on_hover_text("Load the map at this path")
+                    .on_disabled_hover_text("Type a path first")
                     .clicked()
                 {
                     actions.push(PanelAction::LoadEnvironment(PathBuf::from(
@@ -520,6 +525,11 @@ fn cube_source_ui(ui: &mut Ui, source: &mut EnvSource, state: &mut PanelState, i
     if ui
         .add_enabled(ready, egui::Button::new("Load"))
         .on_hover_text("Load the cube map at these paths (resampled to lat-long)")
+        .on_disabled_hover_text(if is_faces {
+            "Type all six face paths first"
+        } else {
+            "Type the cross image's path first"
+        })
         .clicked()
     {
         *source = cube_source_from(state, is_faces);
@@ -682,7 +692,8 @@ fn views_ui(ui: &mut Ui, scene: &mut Scene) {
                 {
                     recall = Some(i);
                 }
-                ui.text_edit_singleline(&mut view.name);
+                ui.text_edit_singleline(&mut view.name)
+                    .on_hover_text("The view's name, saved with the preset");
                 if ui
                     .small_button("✕")
                     .on_hover_text("Delete this view")
@@ -740,7 +751,8 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         .selected_text(render.tone_map.label())
         .show_ui(ui, |ui| {
             for t in ToneMap::ALL {
-                ui.selectable_value(&mut render.tone_map, t, t.label());
+                ui.selectable_value(&mut render.tone_map, t, t.label())
+                    .on_hover_text(tone_map_hint(t));
             }
         })
         .response
@@ -764,10 +776,22 @@ fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAc
         );
     if ui
         .button("Screenshot (F12)")
-        .on_hover_text("Save the current image as a PNG")
+        .on_hover_text(
+            "Save the image without the UI into screenshots/: a tone-mapped PNG and a linear \
+             EXR",
+        )
         .clicked()
     {
         actions.push(PanelAction::Screenshot);
+    }
+}
+
+/// What a tone map entry does, for its tooltip.
+fn tone_map_hint(tone_map: ToneMap) -> &'static str {
+    match tone_map {
+        ToneMap::Aces => "Narkowicz's fit of the ACES filmic curve: soft highlights, more contrast",
+        ToneMap::Reinhard => "x / (1 + x) per channel: never clips, but flattens highlights",
+        ToneMap::Clamp => "Clamp to [0, 1]: the linear radiance untouched, highlights clip",
     }
 }
 
@@ -945,6 +969,38 @@ mod tests {
         env.source = cube_source_from(&state, true);
         frame(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
         assert_eq!(state.cube_pending, None);
+    }
+
+    /// The Quality strip, with an estimate, pass times and feature costs
+    /// to show, is drawn without changing the controls or pressing a button.
+    #[test]
+    fn drawing_the_quality_strip_without_input_changes_nothing() {
+        let mut state = PanelState::new(String::new(), String::new());
+        state.quality.stop_at_target = true;
+        let before = state.quality.clone();
+        let stats = Stats {
+            quality: QualityStats {
+                points: vec![[0.5, 0.1], [2.0, 0.05]],
+                latest: Some(crate::gpu::error_meter::ErrorEstimate {
+                    rmse: 0.01,
+                    relative: 0.05,
+                    frames: 40,
+                    samples: 40,
+                    seconds: 2.0,
+                    generation: 0,
+                }),
+                passes: vec![("trace", Some(3.5)), ("display", None)],
+                scene_features: vec![crate::gpu::Feature::PatternCutout],
+                with_all_ms: Some(3.5),
+                without_ms: vec![Some(3.1)],
+                ..QualityStats::default()
+            },
+            ..Stats::default()
+        };
+        let mut actions = Vec::new();
+        frame(|ui| actions = draw_quality(ui, &mut state, &stats));
+        assert_eq!(state.quality, before);
+        assert!(actions.is_empty(), "{actions:?}");
     }
 
     #[test]

@@ -100,6 +100,10 @@ fn convergence_ui(ui: &mut Ui, controls: &mut QualityControls, stats: &QualitySt
                     .speed(0.05)
                     .suffix(" %"),
             )
+            .on_hover_text(
+                "The relative error to aim at, 0.05 to 50 %: half the error takes about four \
+                 times as long",
+            )
             .changed()
         {
             controls.target_error = percent / 100.0;
@@ -117,11 +121,13 @@ fn convergence_ui(ui: &mut Ui, controls: &mut QualityControls, stats: &QualitySt
     ui.add(Checkbox::new(
         &mut controls.stop_at_target,
         "stop tracing at the target",
-    ));
+    ))
+    .on_hover_text("At the target, the image stays and the GPU rests; any change starts again");
     ui.add(Checkbox::new(
         &mut controls.screenshot_at_target,
         "save a screenshot when the target is reached",
-    ));
+    ))
+    .on_hover_text("Saves a PNG and an EXR into screenshots/, once each time the image restarts");
     if stats.paused_at_target {
         ui.label("paused: target reached (any change starts again)");
     }
@@ -209,6 +215,10 @@ fn feature_costs_ui(ui: &mut Ui, stats: &QualityStats, actions: &mut Vec<PanelAc
             let mut compiled_in = !stats.disabled.contains(feature);
             if ui
                 .checkbox(&mut compiled_in, format!("{feature:?}"))
+                .on_hover_text(
+                    "Ticked: compiled in. Untick to rebuild the shader without it and time the \
+                     trace pass (the image is then wrong)",
+                )
                 .changed()
             {
                 actions.push(PanelAction::ToggleFeature(*feature));

@@ -83,6 +83,10 @@ pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
                 egui::Slider::new(value, 0.1..=1.0e4)
                     .logarithmic(true)
                     .text("max"),
+            )
+            .on_hover_text(
+                "The brightest a sample may be in its largest channel; lower removes more \
+                 fireflies and darkens more",
             );
         } else {
             t.sample_clamp = None;
