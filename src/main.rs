@@ -36,6 +36,11 @@ struct ViewerArgs {
     /// Save the whole window, UI included, as PNG just before exiting.
     #[arg(long)]
     window_screenshot: Option<PathBuf>,
+    /// Development mode: read the shaders from the source tree's `shaders/`
+    /// and rebuild the trace pipeline when one changes (a shader that fails
+    /// to build leaves the old pipeline, and the panel shows the error).
+    #[arg(long)]
+    dev: bool,
 }
 
 #[derive(Subcommand)]
@@ -73,6 +78,7 @@ fn main() -> ExitCode {
             env: cli.viewer.env,
             exit_after_frames: cli.viewer.exit_after_frames,
             window_screenshot: cli.viewer.window_screenshot,
+            dev: cli.viewer.dev,
         }),
     };
     match result {

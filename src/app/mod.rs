@@ -7,14 +7,23 @@
 
 mod camera_input;
 mod convergence;
+mod device_watch;
+mod document;
 mod feature_costs;
+mod file_dialogs;
+mod file_watch;
 mod history;
+mod prompts;
+mod recovery;
 mod screenshots;
+mod settings;
+mod shortcuts;
 mod viewer;
 
 use anyhow::Result;
 use std::path::PathBuf;
 use std::sync::Arc;
+use settings::Settings;
 use viewer::Viewer;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -28,6 +37,9 @@ pub struct ViewerOptions {
     pub env: Option<PathBuf>,
     pub exit_after_frames: Option<u64>,
     pub window_screenshot: Option<PathBuf>,
+    /// Read `shaders/` from the source tree and rebuild the trace pipeline
+    /// when a file there changes.
+    pub dev: bool,
 }
 
 struct App {
@@ -42,13 +54,22 @@ impl ApplicationHandler for App {
         if self.viewer.is_some() {
             return;
         }
+        let config_dir = settings::config_dir();
+        let (settings, note) = config_dir
+            .as_deref()
+            .map_or_else(|| (Settings::default(), None), Settings::load);
+        if let Some(note) = note {
+            log::warn!("{note}");
+        }
+        let (width, height) = settings.window_size.unwrap_or((1280, 720));
         let attributes = Window::default_attributes()
             .with_title("marbre")
-            .with_inner_size(winit::dpi::PhysicalSize::new(1280, 720));
+            .with_inner_size(winit::dpi::PhysicalSize::new(width.max(320), height.max(240)));
+        let options = self.options.clone();
         let result = event_loop
             .create_window(attributes)
             .map_err(anyhow::Error::from)
-            .and_then(|w| Viewer::new(Arc::new(w), self.options.clone()));
+            .and_then(|w| Viewer::new(Arc::new(w), options, settings, config_dir));
         match result {
             Ok(v) => self.viewer = Some(v),
             Err(e) => {

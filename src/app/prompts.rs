@@ -80,7 +80,7 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
         ),
     };
     let mut answer = None;
-    let response = egui::Modal::new(egui::Id::new("marbre prompt")).show(ctx, |ui| {
+    let response = egui::Modal::new(egui::Id::unique("marbre prompt")).show(ctx, |ui| {
         ui.set_max_width(420.0);
         ui.heading(title);
         ui.label(text);

@@ -7,6 +7,7 @@
 //! the user touched it, which is why sliders do not clamp existing values and
 //! colours are written back only on a change.
 
+mod file_ui;
 pub mod help;
 mod material_editor;
 mod quality;
@@ -77,6 +78,14 @@ pub struct PanelState {
     /// Whether the app has edits to undo and to redo (enables the buttons).
     pub can_undo: bool,
     pub can_redo: bool,
+    /// Whether the scene has edits its preset file does not have.
+    pub unsaved: bool,
+    /// Recently opened presets and environment maps, newest first.
+    pub recent_files: Vec<PathBuf>,
+    /// Set to put the keyboard in the preset or environment path field
+    /// (where no file dialog can open); cleared once done.
+    pub focus_preset_path: bool,
+    pub focus_env_path: bool,
 }
 
 impl PanelState {
@@ -93,6 +102,10 @@ impl PanelState {
             quality: QualityControls::default(),
             can_undo: false,
             can_redo: false,
+            unsaved: false,
+            recent_files: Vec::new(),
+            focus_preset_path: false,
+            focus_env_path: false,
         }
     }
 
@@ -160,6 +173,13 @@ pub enum PanelAction {
     ToggleFeature(crate::gpu::Feature),
     Undo,
     Redo,
+    /// Pick a preset to open, a file to save as, or an environment map,
+    /// in a native file dialog.
+    BrowsePreset,
+    BrowseSavePresetAs,
+    BrowseEnvironment,
+    /// Open a file from the recent list (a preset or an environment map).
+    OpenRecent(PathBuf),
 }
 
 /// Draws the whole panel contents into `ui` and returns the buttons pressed.
@@ -173,7 +193,9 @@ pub fn draw(
     ScrollArea::vertical()
         .id_salt("panel scroll")
         .show(ui, |ui| {
-            section(ui, "Preset", true, |ui| preset_ui(ui, state, &mut actions));
+            section(ui, "Preset", true, |ui| {
+                file_ui::preset_ui(ui, state, &mut actions);
+            });
             section(ui, "Materials", true, |ui| materials_ui(ui, scene));
             section(ui, "Environment", true, |ui| {
                 environment_ui(ui, &mut scene.environment, state, &mut actions);
@@ -257,63 +279,6 @@ fn vec3_ui(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, hint: &str) {
         }
         ui.label(label);
     });
-}
-
-fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>) {
-    ui.add(
-        TextEdit::singleline(&mut state.preset_path)
-            .hint_text("presets/scene.ron")
-            .desired_width(f32::INFINITY),
-    )
-    .on_hover_text("Preset file (RON) used by Load and Save as");
-    let path = || PathBuf::from(state.preset_path.trim());
-    ui.horizontal(|ui| {
-        if ui
-            .button("Load")
-            .on_hover_text("Replace the scene with the preset at the path above")
-            .clicked()
-        {
-            actions.push(PanelAction::LoadPreset(path()));
-        }
-        if ui
-            .button("Save")
-            .on_hover_text("Overwrite the preset file the scene was loaded from or last saved to")
-            .clicked()
-        {
-            actions.push(PanelAction::SavePreset);
-        }
-        if ui
-            .button("Save as")
-            .on_hover_text("Write the scene to the path above")
-            .clicked()
-        {
-            actions.push(PanelAction::SavePresetAs(path()));
-        }
-    });
-    ui.horizontal(|ui| {
-        let undo = ui
-            .add_enabled(state.can_undo, egui::Button::new("Undo"))
-            .on_hover_text("Undo the last edit (Ctrl+Z); a whole slider drag is one edit")
-            .on_disabled_hover_text("Nothing to undo");
-        if undo.clicked() {
-            actions.push(PanelAction::Undo);
-        }
-        let redo = ui
-            .add_enabled(state.can_redo, egui::Button::new("Redo"))
-            .on_hover_text("Redo what was undone (Ctrl+Shift+Z or Ctrl+Y)")
-            .on_disabled_hover_text("Nothing to redo");
-        if redo.clicked() {
-            actions.push(PanelAction::Redo);
-        }
-    });
-    let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
-    for message in &state.messages[first..] {
-        if message.is_error {
-            ui.colored_label(ui.visuals().error_fg_color, &message.text);
-        } else {
-            ui.label(&message.text);
-        }
-    }
 }
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
@@ -458,8 +423,12 @@ fn source_fields_ui(
             ui.label(format!("current: {}", path.display()))
                 .on_hover_text("The map the scene uses; relative to the preset file");
             ui.horizontal(|ui| {
-                ui.add(TextEdit::singleline(&mut state.env_path).hint_text("map.exr"))
+                let field = ui
+                    .add(TextEdit::singleline(&mut state.env_path).hint_text("map.exr"))
                     .on_hover_text("Latitude-longitude image: .exr, .hdr, .png or .jpg");
+                if std::mem::take(&mut state.focus_env_path) {
+                    field.request_focus();
+                }
                 if ui
                     .add_enabled(!state.env_path.trim().is_empty(), egui::Button::new("Load"))
                     .on_hover_text("Load the map at this path")
@@ -471,7 +440,16 @@ fn source_fields_ui(
                     )));
                 }
             });
-            ui.weak("or drop a file on the window");
+            ui.horizontal(|ui| {
+                if ui
+                    .button("Open…")
+                    .on_hover_text("Pick a lat-long map in a file dialog")
+                    .clicked()
+                {
+                    actions.push(PanelAction::BrowseEnvironment);
+                }
+                ui.weak("or drop a file on the window");
+            });
         }
         EnvSource::CubeFaces { .. } => cube_source_ui(ui, source, state, true),
         EnvSource::CubeCross { .. } => cube_source_ui(ui, source, state, false),

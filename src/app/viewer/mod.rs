@@ -323,8 +323,12 @@ impl Viewer {
         for action in actions {
             match action {
                 PanelAction::LoadPreset(p) => self.request_load_preset(&p),
-                PanelAction::SavePreset => self.save_preset(&self.document.path.clone()),
-                PanelAction::SavePresetAs(p) => self.save_preset(&p),
+                PanelAction::SavePreset => {
+                    self.save_preset(&self.document.path.clone());
+                }
+                PanelAction::SavePresetAs(p) => {
+                    self.save_preset(&p);
+                }
                 PanelAction::BrowsePreset => self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset),
                 PanelAction::BrowseSavePresetAs => {
                     self.open_dialog(super::file_dialogs::DialogPurpose::SavePresetAs)
@@ -349,7 +353,9 @@ impl Viewer {
             match shortcut {
                 Shortcut::Undo => self.step_history(true),
                 Shortcut::Redo => self.step_history(false),
-                Shortcut::Save => self.save_preset(&self.document.path.clone()),
+                Shortcut::Save => {
+                    self.save_preset(&self.document.path.clone());
+                }
                 Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
                 Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
                 Shortcut::Help => self.show_help = !self.show_help,

@@ -1,0 +1,55 @@
+//! Recovering from a lost GPU device: a new device on the adapter the
+//! window can present with, and every GPU resource made again from the
+//! scene model (the CPU side is the source of truth, so nothing the user
+//! made is lost; the accumulated samples start over).
+
+use super::{Viewer, surface_config};
+use crate::commands::session::{LoadedScene, renderer_for};
+use crate::cubemap;
+use crate::gpu::GpuContext;
+use crate::gpu::pass_timer::PassTimer;
+use anyhow::{Context as _, Result};
+
+impl Viewer {
+    /// Replaces the lost device and everything made on it.
+    pub(super) fn recover_device(&mut self, reason: &str) -> Result<()> {
+        log::warn!("recreating the GPU device after it was lost: {reason}");
+        let ctx = GpuContext::for_surface(self.ctx.instance.clone(), &self.surface)
+            .context("recreating the GPU device after it was lost")?;
+        self.device_watch.attach(&ctx.device);
+        self.config = surface_config(&self.surface, &ctx, self.window.inner_size());
+        self.surface.configure(&ctx.device, &self.config);
+        // The environment's pixels live only on the GPU: read the file
+        // again (a source that no longer loads falls back to none).
+        let mut notes = Vec::new();
+        let env = match cubemap::load_source(&self.scene.environment.source) {
+            Ok(loaded) => loaded.map(|l| l.image),
+            Err(e) => {
+                notes.push(format!("{e:#}"));
+                None
+            }
+        };
+        let loaded = LoadedScene {
+            scene: self.renderer.scene().clone(),
+            env,
+            images: self.renderer.images().clone(),
+            notes: Vec::new(),
+        };
+        let size = self.renderer.size();
+        self.renderer = renderer_for(&ctx, &loaded, size)?;
+        self.timer = PassTimer::new(&ctx);
+        self.egui_renderer =
+            egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());
+        // The new egui renderer has no font atlas: rebuilding the fonts
+        // sends the whole atlas again with the next frame.
+        self.egui_ctx.set_fonts(egui::FontDefinitions::default());
+        self.ctx = ctx;
+        self.panel.error(format!(
+            "the GPU device was lost ({reason}); recreated it and every GPU resource from the scene"
+        ));
+        for note in notes {
+            self.panel.error(note);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,364 @@
+//! One frame on the GPU: the edits carried to the renderer, the trace,
+//! metering and display passes, egui on top, present; and the figures the
+//! panel shows about it.
+
+use super::Viewer;
+use crate::app::screenshots;
+use crate::gpu::pass_timer::Pass;
+use crate::gpu::readback::read_texture;
+use crate::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
+use crate::panel::{QualityStats, Stats};
+use anyhow::{Context as _, Result};
+use std::path::Path;
+
+impl Viewer {
+    fn quality_stats(&self) -> QualityStats {
+        let scene_features: Vec<_> = FeatureSet::for_scene(&self.scene).0.into_iter().collect();
+        QualityStats {
+            points: self.convergence.points().to_vec(),
+            latest: self.convergence.latest(),
+            paused_at_target: self.paused_at_target(),
+            passes: self.timer.as_ref().map_or_else(Vec::new, |t| {
+                Pass::ALL.iter().map(|&p| (p.label(), t.ms(p))).collect()
+            }),
+            without_ms: scene_features
+                .iter()
+                .map(|&f| self.feature_costs.without(f))
+                .collect(),
+            scene_features,
+            disabled: self.feature_costs.disabled().clone(),
+            with_all_ms: self.feature_costs.with_all(),
+        }
+    }
+
+    /// Whether tracing rests: the user asked to stop at the target error,
+    /// and the estimate of the current image is there.
+    fn paused_at_target(&self) -> bool {
+        let controls = &self.panel.quality;
+        controls.stop_at_target && self.convergence.reached(controls.target_error)
+    }
+
+    /// Follows the non-finite counters: they restart with the
+    /// accumulation, and a readback arrives a frame or two late.
+    fn observe_non_finite(&mut self) {
+        let generation = self.renderer.accumulation_generation();
+        if self.non_finite.0 != generation {
+            self.non_finite = (generation, NonFiniteCounts::default());
+        }
+        if let Some(counts) = self.renderer.poll_non_finite() {
+            self.non_finite.1 = counts;
+        }
+    }
+
+    pub(super) fn stats(&self) -> Stats {
+        let gpu_ms = self.timer.as_ref().and_then(|t| t.ms(Pass::Trace));
+        let info = self.ctx.adapter.get_info();
+        let mesh = self.renderer.mesh_stats();
+        Stats {
+            fps: self.fps,
+            ms_per_frame: gpu_ms.unwrap_or(self.ms_per_frame),
+            ms_is_gpu: gpu_ms.is_some(),
+            samples: self.renderer.accumulated_samples(),
+            adapter: info.name,
+            backend: format!("{:?}", info.backend),
+            features: self
+                .renderer
+                .features()
+                .0
+                .iter()
+                .map(|f| format!("{f:?}"))
+                .collect(),
+            shader_bytes: self.renderer.trace_shader_bytes(),
+            building: self.renderer.is_building(),
+            last_build_ms: self.renderer.last_build().map(|d| d.as_secs_f32() * 1000.0),
+            resolution: self.renderer.render_size(),
+            lights: mesh.lights,
+            triangles: mesh.triangles,
+            bvh_nodes: mesh.bvh_nodes,
+            bvh_build_ms: mesh.bvh_build.as_secs_f32() * 1000.0,
+            non_finite: self.non_finite.1,
+            quality: self.quality_stats(),
+        }
+    }
+
+    pub(super) fn draw_frame(
+        &mut self,
+        output: egui::FullOutput,
+        image_rect: egui::Rect,
+        dragging: bool,
+    ) -> Result<bool> {
+        // A map (lat-long or cube) chosen in the panel needs its image
+        // loaded first.
+        if self.scene.environment.source.is_map()
+            && self.scene.environment.source != self.renderer.scene().environment.source
+        {
+            let source = std::mem::replace(
+                &mut self.scene.environment.source,
+                self.renderer.scene().environment.source.clone(),
+            );
+            self.load_environment_source(source);
+        }
+        // A structural edit that changes the scene's features ends any
+        // feature-cost experiment: the new shader is specialised again.
+        if self
+            .feature_costs
+            .follow_scene(&FeatureSet::for_scene(&self.scene))
+        {
+            self.renderer.forget_feature_override();
+        }
+        // Structural edits build their shader off this thread: the old one
+        // keeps rendering until the new one is ready.
+        let edited = self.scene != *self.renderer.scene();
+        if edited && let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
+            // Keep what is on screen; show why the edit was refused.
+            self.panel.error(format!("{e:#}"));
+            self.scene = self.renderer.scene().clone();
+        }
+        if let Some(Err(e)) = self.renderer.poll_build(&self.ctx) {
+            // The shader failed to build: the old one stays, and so does
+            // the scene it renders.
+            self.panel.error(format!("{e:#}"));
+            self.scene = self.renderer.scene().clone();
+        }
+        // What the scene now is, after any refused edit was put back: one
+        // step of the undo history unless a drag or typing goes on.
+        let gesture = self.egui_ctx.input(|i| i.pointer.any_down())
+            || self.egui_ctx.egui_wants_keyboard_input();
+        self.history.observe(&self.scene, gesture);
+        // Only an edit can add an image or change a path.
+        if edited {
+            self.reload_images_if_needed();
+        }
+        // Minimised: nothing to draw into (the surface keeps its last
+        // valid size until the window comes back).
+        let size = self.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(true);
+        }
+        let ppp = output.pixels_per_point;
+        let viewport = Viewport {
+            x: (image_rect.min.x * ppp).round().max(0.0),
+            y: (image_rect.min.y * ppp).round().max(0.0),
+            width: (image_rect.width() * ppp).round().max(1.0),
+            height: (image_rect.height() * ppp).round().max(1.0),
+        };
+        self.renderer
+            .resize(&self.ctx, (viewport.width as u32, viewport.height as u32));
+        self.renderer.set_render_scale(if dragging {
+            self.scene.render.interactive_scale
+        } else {
+            1.0
+        });
+
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.ctx.device, &self.config);
+                return Ok(true);
+            }
+            _ => return Ok(true),
+        };
+        let target = frame.texture.create_view(&Default::default());
+        let is_last = self
+            .options
+            .exit_after_frames
+            .is_some_and(|n| self.frames + 1 >= n);
+        let capture = if is_last && self.options.window_screenshot.is_some() {
+            Some(self.capture_texture())
+        } else {
+            None
+        };
+        // Runs the callbacks of finished readbacks (they otherwise wait for
+        // the next submit), so the timer and the error meter are free to
+        // measure this frame, both of them.
+        if let Err(e) = self.ctx.device.poll(wgpu::PollType::Poll) {
+            log::warn!("polling the device: {e}");
+        }
+        self.convergence.observe(
+            self.renderer.accumulation_generation(),
+            self.renderer.poll_error(),
+        );
+        self.observe_non_finite();
+        if let Some(t) = &mut self.timer {
+            t.begin_frame();
+            if !self.scene.render.auto_exposure {
+                t.forget(Pass::AutoExposure);
+            }
+        }
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        if !self.paused_at_target() {
+            let trace_writes = self.timer.as_ref().and_then(|t| t.render_pass(Pass::Trace));
+            self.renderer.trace(&self.ctx, &mut encoder, trace_writes);
+            self.renderer
+                .meter_error(&self.ctx, &mut encoder, self.timer.as_ref());
+        }
+        let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: ppp,
+        };
+        let extra = self.egui_renderer.update_buffers(
+            &self.ctx.device,
+            &self.ctx.queue,
+            &mut encoder,
+            &paint_jobs,
+            &screen,
+        );
+        let background = wgpu::LoadOp::Clear(wgpu::Color {
+            r: 0.02,
+            g: 0.02,
+            b: 0.02,
+            a: 1.0,
+        });
+        let views: Vec<&wgpu::TextureView> = std::iter::once(&target)
+            .chain(capture.as_ref().map(|(_, v)| v))
+            .collect();
+        for view in views {
+            let target = DisplayTarget {
+                view,
+                format: self.config.format,
+                viewport,
+                load: background,
+            };
+            self.renderer
+                .display(&self.ctx, &mut encoder, &target, self.timer.as_ref())?;
+            let mut pass = encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("egui"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    timestamp_writes: self.timer.as_ref().and_then(|t| t.render_pass(Pass::Ui)),
+                    ..Default::default()
+                })
+                .forget_lifetime();
+            self.egui_renderer.render(&mut pass, &paint_jobs, &screen);
+        }
+        if let Some(t) = &mut self.timer {
+            t.resolve(&mut encoder);
+        }
+        self.ctx
+            .queue
+            .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
+        if let Some(t) = &mut self.timer {
+            t.after_submit();
+        }
+        self.renderer.after_submit();
+        self.record_feature_cost();
+        self.ctx.queue.present(frame);
+        self.frames += 1;
+        let controls = &self.panel.quality;
+        if controls.screenshot_at_target
+            && self
+                .convergence
+                .take_screenshot_moment(controls.target_error)
+        {
+            self.screenshot_requested = true;
+        }
+        if self.screenshot_requested {
+            self.screenshot_requested = false;
+            self.take_screenshot();
+        }
+        if let (Some((texture, _)), Some(path)) = (capture, self.options.window_screenshot.clone())
+        {
+            self.save_window_capture(&texture, &path)?;
+        }
+        if is_last {
+            self.report_quality();
+        }
+        Ok(!is_last)
+    }
+
+    fn take_screenshot(&mut self) {
+        match screenshots::save(
+            &self.ctx,
+            &mut self.renderer,
+            Path::new(screenshots::FOLDER),
+        ) {
+            Ok([png, exr]) => {
+                self.panel
+                    .info(format!("saved {} and {}", png.display(), exr.display()))
+            }
+            Err(e) => self.panel.error(format!("screenshot failed: {e:#}")),
+        }
+    }
+
+    /// One line on stderr when a scripted run (`--exit-after-frames`) ends:
+    /// what the Quality strip showed, for scripts and tests.
+    fn report_quality(&self) {
+        let spp = self.renderer.accumulated_samples();
+        let error = self
+            .convergence
+            .latest()
+            .map_or("none yet".to_owned(), |e| {
+                format!(
+                    "{:.4} relative (RMSE {:.5}) at {} spp",
+                    e.relative, e.rmse, e.samples
+                )
+            });
+        let trace = match self.timer.as_ref().and_then(|t| t.ms(Pass::Trace)) {
+            Some(ms) => format!("{ms:.1} ms per frame (GPU timestamps)"),
+            None => "not timed (no timestamp queries)".to_owned(),
+        };
+        eprintln!("quality: {spp} spp accumulated; estimated error {error}; trace pass {trace}");
+    }
+
+    /// Feeds the trace pass's time (GPU, or the whole frame's on the CPU
+    /// clock without timestamps) to the feature-cost measurement.
+    fn record_feature_cost(&mut self) {
+        if self.paused_at_target() {
+            return;
+        }
+        let trace_ms = match &mut self.timer {
+            Some(t) => t.take_fresh(Pass::Trace),
+            None => Some(self.last_frame.elapsed().as_secs_f32() * 1000.0),
+        };
+        if let Some(ms) = trace_ms {
+            self.feature_costs.record(self.renderer.features(), ms);
+        }
+    }
+
+    /// An offscreen twin of the swapchain image, so the final frame (UI
+    /// included) can be read back: swapchain images may not be copyable.
+    fn capture_texture(&self) -> (wgpu::Texture, wgpu::TextureView) {
+        let texture = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("window capture"),
+            size: wgpu::Extent3d {
+                width: self.config.width,
+                height: self.config.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.config.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        (texture, view)
+    }
+
+    fn save_window_capture(&self, texture: &wgpu::Texture, path: &Path) -> Result<()> {
+        let mut bytes = read_texture(&self.ctx.device, &self.ctx.queue, texture, 4)?;
+        if matches!(
+            self.config.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        ) {
+            for px in bytes.chunks_exact_mut(4) {
+                px.swap(0, 2);
+            }
+        }
+        let image = image::RgbaImage::from_raw(self.config.width, self.config.height, bytes)
+            .context("window capture has the wrong size")?;
+        crate::image_io::save_png(&image, path)
+            .with_context(|| format!("saving the window screenshot {}", path.display()))
+    }
+}

@@ -1,0 +1,124 @@
+//! The Preset section: the preset's path (typed, or picked in a native
+//! dialog), Open, Save, Save as, the recent files, undo and redo, whether
+//! there are unsaved changes, and the latest messages.
+//!
+//! The typed path stays for systems with no file dialog (no desktop
+//! portal, no zenity): Ctrl+O there focuses this field instead, and Enter
+//! in it loads the preset.
+
+use super::{PanelAction, PanelState, SHOWN_MESSAGES};
+use egui::{Button, TextEdit, Ui};
+use std::path::PathBuf;
+
+pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>) {
+    let field = ui
+        .add(
+            TextEdit::singleline(&mut state.preset_path)
+                .id_salt("preset path")
+                .hint_text("presets/scene.ron")
+                .desired_width(f32::INFINITY),
+        )
+        .on_hover_text("Preset file (RON) used by Load and Save as; Enter loads it");
+    if std::mem::take(&mut state.focus_preset_path) {
+        field.request_focus();
+    }
+    let path = PathBuf::from(state.preset_path.trim());
+    if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+        actions.push(PanelAction::LoadPreset(path.clone()));
+    }
+    ui.horizontal(|ui| {
+        if ui
+            .button("Load")
+            .on_hover_text("Replace the scene with the preset at the path above")
+            .clicked()
+        {
+            actions.push(PanelAction::LoadPreset(path.clone()));
+        }
+        if ui
+            .button("Open…")
+            .on_hover_text("Pick a preset in a file dialog (Ctrl+O)")
+            .clicked()
+        {
+            actions.push(PanelAction::BrowsePreset);
+        }
+        recent_menu(ui, state, actions);
+    });
+    ui.horizontal(|ui| {
+        if ui
+            .button("Save")
+            .on_hover_text("Overwrite the preset file the scene was loaded from or last saved to (Ctrl+S)")
+            .clicked()
+        {
+            actions.push(PanelAction::SavePreset);
+        }
+        if ui
+            .button("Save as")
+            .on_hover_text("Write the scene to the path above")
+            .clicked()
+        {
+            actions.push(PanelAction::SavePresetAs(path));
+        }
+        if ui
+            .button("Save as…")
+            .on_hover_text("Pick where to save in a file dialog (Ctrl+Shift+S)")
+            .clicked()
+        {
+            actions.push(PanelAction::BrowseSavePresetAs);
+        }
+    });
+    ui.horizontal(|ui| {
+        let undo = ui
+            .add_enabled(state.can_undo, Button::new("Undo"))
+            .on_hover_text("Undo the last edit (Ctrl+Z); a whole slider drag is one edit")
+            .on_disabled_hover_text("Nothing to undo");
+        if undo.clicked() {
+            actions.push(PanelAction::Undo);
+        }
+        let redo = ui
+            .add_enabled(state.can_redo, Button::new("Redo"))
+            .on_hover_text("Redo what was undone (Ctrl+Shift+Z or Ctrl+Y)")
+            .on_disabled_hover_text("Nothing to redo");
+        if redo.clicked() {
+            actions.push(PanelAction::Redo);
+        }
+        if state.unsaved {
+            ui.colored_label(ui.visuals().warn_fg_color, "● unsaved changes")
+                .on_hover_text(
+                    "The scene differs from its preset file (camera aside); autosaved for \
+                     recovery every 20 s, and you are asked before anything replaces it",
+                );
+        }
+    });
+    let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
+    for message in &state.messages[first..] {
+        if message.is_error {
+            ui.colored_label(ui.visuals().error_fg_color, &message.text);
+        } else {
+            ui.label(&message.text);
+        }
+    }
+}
+
+/// The recent presets and environment maps, newest first.
+fn recent_menu(ui: &mut Ui, state: &PanelState, actions: &mut Vec<PanelAction>) {
+    ui.add_enabled_ui(!state.recent_files.is_empty(), |ui| {
+        ui.menu_button("Recent", |ui| {
+            for path in &state.recent_files {
+                let name = path
+                    .file_name()
+                    .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into());
+                if ui
+                    .button(name)
+                    .on_hover_text(path.display().to_string())
+                    .clicked()
+                {
+                    actions.push(PanelAction::OpenRecent(path.clone()));
+                    ui.close();
+                }
+            }
+        })
+        .response
+        .on_hover_text("Presets and environment maps opened or saved lately")
+        .on_disabled_hover_text("Nothing opened yet");
+    });
+}
