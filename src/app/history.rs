@@ -52,8 +52,13 @@ impl History {
                 }
                 self.redo.clear();
             }
+            self.step_open = gesture;
+        } else {
+            // A gesture opens a step only by editing: a text field focused
+            // (or a button held) with no edit yet must not swallow the
+            // edit that ends it.
+            self.step_open &= gesture;
         }
-        self.step_open = gesture;
     }
 
     /// The scene before the latest step, seen from `current`'s camera; the
@@ -129,6 +134,18 @@ mod tests {
     }
 
     /// A new edit after an undo forgets what could be redone.
+    /// A text field focused without an edit, then a click elsewhere that
+    /// both ends the focus and edits (one frame): that edit is a step.
+    #[test]
+    fn a_gesture_without_an_edit_does_not_swallow_the_next_edit() {
+        let mut history = History::new(&with_exposure(0.0));
+        history.observe(&with_exposure(0.0), true);
+        history.observe(&with_exposure(0.0), true);
+        history.observe(&with_exposure(1.0), false);
+        assert!(history.can_undo());
+        assert_eq!(history.undo(&with_exposure(1.0)), Some(with_exposure(0.0)));
+    }
+
     #[test]
     fn an_edit_after_undo_clears_redo() {
         let mut h = History::new(&with_exposure(0.0));

@@ -56,7 +56,6 @@ mod tests {
     fn press(modifiers: Modifiers, key: Key) -> Vec<Shortcut> {
         let ctx = egui::Context::default();
         let input = egui::RawInput {
-            modifiers,
             events: vec![egui::Event::Key {
                 key,
                 physical_key: None,
@@ -67,7 +66,8 @@ mod tests {
             ..Default::default()
         };
         let mut pressed = Vec::new();
-        let _ = ctx.run_ui(input, |ui| pressed = self::pressed(ui.ctx()));
+        ctx.run_ui(input, |ui| pressed = self::pressed(ui.ctx()))
+            .drop_without_applying_deltas();
         pressed
     }
 
