@@ -17,6 +17,8 @@ pub enum Shortcut {
     HideUi,
     /// Esc: close the help overlay.
     Close,
+    /// F12: save the image as PNG and EXR.
+    Screenshot,
 }
 
 /// The shortcuts pressed this frame, consumed so no widget sees them.
@@ -34,6 +36,7 @@ pub fn pressed(ctx: &egui::Context) -> Vec<Shortcut> {
         take(Modifiers::NONE, Key::F1, Shortcut::Help);
         take(Modifiers::NONE, Key::F11, Shortcut::Fullscreen);
         take(Modifiers::NONE, Key::Escape, Shortcut::Close);
+        take(Modifiers::NONE, Key::F12, Shortcut::Screenshot);
         // The shifted shortcuts first: Ctrl+S would also match Ctrl+Shift+S.
         take(Modifiers::COMMAND | Modifiers::SHIFT, Key::S, Shortcut::SaveAs);
         take(Modifiers::COMMAND, Key::S, Shortcut::Save);
@@ -83,6 +86,7 @@ mod tests {
         assert_eq!(press(Modifiers::NONE, Key::F1), [Shortcut::Help]);
         assert_eq!(press(Modifiers::NONE, Key::F11), [Shortcut::Fullscreen]);
         assert_eq!(press(Modifiers::NONE, Key::H), [Shortcut::HideUi]);
+        assert_eq!(press(Modifiers::NONE, Key::F12), [Shortcut::Screenshot]);
         assert_eq!(press(Modifiers::NONE, Key::Z), []);
     }
 }

@@ -82,7 +82,7 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
             actions.push(PanelAction::Redo);
         }
         if state.unsaved {
-            ui.colored_label(ui.visuals().warn_fg_color, "• unsaved changes")
+            ui.colored_label(ui.visuals().warn_fg_color, "unsaved changes")
                 .on_hover_text(
                     "The scene differs from its preset file (camera aside); autosaved for \
                      recovery every 20 s, and you are asked before anything replaces it",

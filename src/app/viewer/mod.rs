@@ -33,7 +33,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 use winit::event::{ElementState, KeyEvent, WindowEvent};
-use winit::keyboard::{Key, NamedKey};
+use winit::keyboard::Key;
 use winit::window::{Fullscreen, Window};
 
 /// Width of the side panel, in points, when the window opens.
@@ -243,15 +243,6 @@ impl Viewer {
             WindowEvent::KeyboardInput {
                 event:
                     KeyEvent {
-                        logical_key: Key::Named(NamedKey::F12),
-                        state: ElementState::Pressed,
-                        ..
-                    },
-                ..
-            } if !consumed => self.screenshot_requested = true,
-            WindowEvent::KeyboardInput {
-                event:
-                    KeyEvent {
                         logical_key: Key::Character(text),
                         state: ElementState::Pressed,
                         ..
@@ -361,6 +352,7 @@ impl Viewer {
                 Shortcut::Help => self.show_help = !self.show_help,
                 Shortcut::Close => self.show_help = false,
                 Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
+                Shortcut::Screenshot => self.screenshot_requested = true,
                 Shortcut::Fullscreen => {
                     let fullscreen = match self.window.fullscreen() {
                         Some(_) => None,
@@ -410,7 +402,11 @@ impl Viewer {
                 egui::Panel::right("marbre-panel")
                     .default_size(PANEL_WIDTH)
                     .show(ui, |ui| {
-                        egui::ScrollArea::vertical().show(ui, |ui| {
+                        // Not shrunk to the content: the panel keeps its
+                        // width as sections open and close.
+                        egui::ScrollArea::vertical()
+                            .auto_shrink([false; 2])
+                            .show(ui, |ui| {
                             actions = panel::draw(ui, scene, panel_state, &stats);
                         });
                     });
