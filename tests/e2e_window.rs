@@ -1,0 +1,220 @@
+//! The viewer driven end to end with synthetic input (xdotool under a
+//! private Xvfb), as a person would use it, each step checked on the
+//! pixels of the screenshot F12 saves:
+//!
+//! 1. the viewer opens `tests/data/e2e/start.ron` (a grey ball under a
+//!    blue sky);
+//! 2. a click in the panel's preset path field, the path of `lit.ron`
+//!    typed, Enter: the image becomes a white ball lit by a point light on
+//!    black (no blue left);
+//! 3. the Point light section opened and its intensity slider dragged to
+//!    the left end: the image goes black;
+//! 4. Ctrl+Z: the light is back, the ball white again.
+//!
+//! The panel is found by its layout: a 1280×720 window (the default size,
+//! with a fresh settings folder), the side panel its default 380 points
+//! wide on the right at scale 1, and the sections folded from the top so
+//! that the Point light section sits at a fixed height whatever messages
+//! the Preset section shows.
+
+mod xvfb;
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+use xvfb::{TempDir, display_or_skip, marbre_log, serial, spawn_marbre, xdotool};
+
+const REPO: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The side panel's left edge at the default window size.
+const PANEL_LEFT: i32 = 900;
+/// Height of a folded section header, in pixels.
+const HEADER_STEP: i32 = 23;
+/// How long one step may take to show: a preset load builds a shader
+/// (seconds on lavapipe), and each frame takes about a second.
+const STEP_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// Mean luma (0..1) and mean blue-minus-red of the image's central
+/// quarter, and the luma of its top-left corner (background).
+#[derive(Debug, Clone, Copy)]
+struct Look {
+    centre_luma: f64,
+    centre_blue_excess: f64,
+    corner_luma: f64,
+}
+
+fn look(path: &Path) -> Look {
+    let image = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
+    let (w, h) = image.dimensions();
+    let mean = |xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
+        let (mut n, mut rgb) = (0.0, [0.0f64; 3]);
+        for y in ys {
+            for x in xs.clone() {
+                let p = image.get_pixel(x, y);
+                for c in 0..3 {
+                    rgb[c] += f64::from(p[c]) / 255.0;
+                }
+                n += 1.0;
+            }
+        }
+        rgb.map(|c| c / n)
+    };
+    let luma = |rgb: [f64; 3]| 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    let centre = mean(w * 3 / 8..w * 5 / 8, h * 3 / 8..h * 5 / 8);
+    let corner = mean(0..w / 10, 0..h / 10);
+    Look {
+        centre_luma: luma(centre),
+        centre_blue_excess: centre[2] - centre[0],
+        corner_luma: luma(corner),
+    }
+}
+
+/// The PNG screenshots in `folder`.
+fn pngs(folder: &Path) -> Vec<PathBuf> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(folder)
+        .map(|dir| {
+            dir.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "png"))
+                .collect()
+        })
+        .unwrap_or_default();
+    found.sort();
+    found
+}
+
+struct Session<'a> {
+    x: &'a xvfb::Xvfb,
+    window: String,
+    screenshots: PathBuf,
+    dir: &'a TempDir,
+}
+
+impl Session<'_> {
+    fn run(&self, args: &[&str]) {
+        let out = xdotool(self.x, args);
+        assert!(
+            out.status.success(),
+            "xdotool {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+
+    fn focus(&self) {
+        self.run(&["windowfocus", "--sync", &self.window]);
+    }
+
+    fn click(&self, x: i32, y: i32) {
+        self.run(&["mousemove", &x.to_string(), &y.to_string(), "click", "1"]);
+        std::thread::sleep(Duration::from_millis(1500));
+    }
+
+    /// Presses F12 until a screenshot satisfies `wanted`, returning its
+    /// look; fails after [`STEP_TIMEOUT`] with the last look seen.
+    fn wait_for(&self, what: &str, wanted: impl Fn(&Look) -> bool) -> Look {
+        let start = Instant::now();
+        let mut last = None;
+        while start.elapsed() < STEP_TIMEOUT {
+            let before = pngs(&self.screenshots).len();
+            self.focus();
+            self.run(&["key", "F12"]);
+            let shot_start = Instant::now();
+            while pngs(&self.screenshots).len() == before
+                && shot_start.elapsed() < Duration::from_secs(20)
+            {
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            // The PNG is renamed into place once complete (atomic save).
+            if let Some(latest) = pngs(&self.screenshots).last() {
+                let seen = look(latest);
+                if wanted(&seen) {
+                    return seen;
+                }
+                last = Some(seen);
+            }
+            std::thread::sleep(Duration::from_millis(500));
+        }
+        panic!(
+            "{what}: not seen within {STEP_TIMEOUT:?}; last screenshot: {last:?}; marbre's log:\n{}",
+            marbre_log(self.dir)
+        );
+    }
+}
+
+#[test]
+fn typed_path_slider_and_undo_show_on_the_pixels() {
+    const TEST: &str = "typed_path_slider_and_undo_show_on_the_pixels";
+    let _serial = serial();
+    let dir = TempDir::new("e2e");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let cwd = dir.subdir("cwd");
+    let start = Path::new(REPO).join("tests/data/e2e/start.ron");
+    let lit = Path::new(REPO).join("tests/data/e2e/lit.ron");
+    let args: Vec<OsString> = vec!["--preset".into(), start.into()];
+    let _child = spawn_marbre(&x, &dir, &cwd, &args);
+    let found = xdotool(
+        &x,
+        &["search", "--sync", "--onlyvisible", "--name", "^marbre$"],
+    );
+    let window = String::from_utf8_lossy(&found.stdout)
+        .lines()
+        .next()
+        .unwrap_or_else(|| panic!("no marbre window; log:\n{}", marbre_log(&dir)))
+        .to_owned();
+    let session = Session {
+        x: &x,
+        window,
+        screenshots: cwd.join("screenshots"),
+        dir: &dir,
+    };
+
+    let first = session.wait_for("the start scene (blue sky)", |l| {
+        l.corner_luma > 0.2 && l.centre_blue_excess > 0.2
+    });
+
+    // The typed-path route: click the path field, replace its text, Enter.
+    session.focus();
+    session.click(PANEL_LEFT + 190, 34);
+    session.run(&["key", "ctrl+a"]);
+    session.run(&["type", "--delay", "20", &lit.display().to_string()]);
+    session.run(&["key", "Return"]);
+    let loaded = session.wait_for("lit.ron loaded (white ball on black)", |l| {
+        l.corner_luma < 0.02 && l.centre_luma > 0.6 && l.centre_blue_excess.abs() < 0.05
+    });
+
+    // Fold Preset, Materials and Environment; open Point light.
+    for header in 0..4 {
+        session.click(PANEL_LEFT + 50, 12 + header * HEADER_STEP);
+    }
+    // The intensity slider (logarithmic, 0 to 10 000) is the fourth row
+    // of the Point light section; drag its knob to the far left.
+    let (knob_x, knob_y) = (PANEL_LEFT + 79, 173);
+    session.run(&[
+        "mousemove",
+        &knob_x.to_string(),
+        &knob_y.to_string(),
+        "mousedown",
+        "1",
+    ]);
+    for x in [knob_x - 20, knob_x - 40, knob_x - 60, PANEL_LEFT + 5] {
+        std::thread::sleep(Duration::from_millis(400));
+        session.run(&["mousemove", &x.to_string(), &knob_y.to_string()]);
+    }
+    std::thread::sleep(Duration::from_millis(400));
+    session.run(&["mouseup", "1"]);
+    let dark = session.wait_for("the light's intensity dragged to 0 (black)", |l| {
+        l.centre_luma < 0.02
+    });
+
+    // Ctrl+Z undoes the whole drag in one step.
+    session.run(&["mousemove", "400", "300"]);
+    session.focus();
+    session.run(&["key", "ctrl+z"]);
+    let undone = session.wait_for("Ctrl+Z (the light back)", |l| {
+        l.centre_luma > 0.6 && l.corner_luma < 0.02
+    });
+    println!("start {first:?}\nloaded {loaded:?}\ndark {dark:?}\nundone {undone:?}");
+}
