@@ -278,7 +278,8 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_skipped_with_a_note_at_any_depth() {
-        let text = "(format_version: 2, colour_grading: 3, scene: (camera: (distance: 7.0, zoom: 2.0)))";
+        let text =
+            "(format_version: 2, colour_grading: 3, scene: (camera: (distance: 7.0, zoom: 2.0)))";
         let loaded = parse(text, Path::new("extra.ron")).unwrap();
         assert_eq!(loaded.preset.scene.camera.distance, 7.0);
         assert_eq!(
