@@ -550,12 +550,15 @@ fn choose_exr_channels(headers: &[exr::meta::header::Header], file: &str) -> Opt
                     .iter()
                     .zip(["R", "G", "B"])
                     .all(|(n, base)| n.to_string().ends_with(base));
-                let note = (layer_count > 1 || !exact).then(|| {
-                    format!(
-                        "{file}: {} of {layer_count} layers read (channels {r}, {g}, {b})",
+                let note = if layer_count > 1 {
+                    Some(format!(
+                        "{file}: read {} (channels {r}, {g}, {b}), one of the file's {layer_count} layers",
                         describe(part, prefix)
-                    )
-                });
+                    ))
+                } else {
+                    (!exact)
+                        .then(|| format!("{file}: channels {r}, {g}, {b} read as red, green, blue"))
+                };
                 return Some(ExrChoice {
                     part,
                     channels: ExrChannels::Rgb([r.clone(), g.clone(), b.clone()]),
@@ -711,15 +714,12 @@ fn exr_error(
 ) -> EnvMapError {
     use exr::compression::Compression;
 
-    let message = match &err {
+    let message = decode_message(&match &err {
         exr::error::Error::Aborted => "reading was aborted".to_string(),
         exr::error::Error::NotSupported(m) => format!("not supported: {m}"),
         exr::error::Error::Invalid(m) => format!("invalid file: {m}"),
-        exr::error::Error::Io(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
-            "the file is truncated (it ends before its last pixels)".to_string()
-        }
         exr::error::Error::Io(e) => format!("I/O error: {e}"),
-    };
+    });
     let named = match compression {
         Some(Compression::DWAA(_)) => Some(("DWAA", message.clone())),
         Some(Compression::DWAB(_)) => Some(("DWAB", message.clone())),
@@ -767,13 +767,20 @@ fn decode_with_image(
     };
     // The header first: an empty or absurdly large image is refused before
     // its pixels are allocated.
+    if let Some((width, height)) = declared_png_size(bytes).filter(|&(w, h)| w == 0 || h == 0) {
+        return Err(EnvMapError::Empty {
+            path: path.to_path_buf(),
+            width,
+            height,
+        });
+    }
     let (width, height) = reader()
         .into_dimensions()
-        .map_err(|e| decode_err(decode_message(&e)))?;
+        .map_err(|e| decode_err(decode_message(&e.to_string())))?;
     check_size(path, format_name, width.into(), height.into())?;
     let decoded = reader()
         .decode()
-        .map_err(|e| decode_err(decode_message(&e)))?;
+        .map_err(|e| decode_err(decode_message(&e.to_string())))?;
     let (width, height) = (decoded.width(), decoded.height());
 
     let pixels: Vec<[f32; 4]> = match &decoded {
@@ -830,25 +837,42 @@ fn decode_with_image(
     })
 }
 
-/// The decoder's reason, saying "truncated" where it means that the file
-/// ends early (the decoders' own words for it vary).
-fn decode_message(e: &image::ImageError) -> String {
-    let message = e.to_string();
+/// A decoder's reason, saying "truncated" where it means that the file
+/// ends early: the decoders' own words for it vary ("unexpected end of
+/// file", "not enough bytes", "failed to fill whole buffer", "reference to
+/// missing bytes").
+fn decode_message(message: &str) -> String {
+    let message = message.trim();
     let lower = message.to_ascii_lowercase();
     let cut_short = [
         "unexpected end",
         "unexpectedeof",
         "eof",
-        "truncated",
-        "no more data",
+        "not enough bytes",
+        "missing bytes",
+        "fill whole buffer",
     ]
     .iter()
     .any(|w| lower.contains(w));
     if cut_short && !lower.contains("truncated") {
         format!("the file is truncated ({message})")
     } else {
-        message
+        message.to_string()
     }
+}
+
+/// The size a PNG file's header declares, if it is a PNG file with a
+/// header: the `png` crate refuses a zero side as "invalid dimensions",
+/// which does not say that the image is empty.
+fn declared_png_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    let header = bytes.get(..24)?;
+    if !header.starts_with(b"\x89PNG\r\n\x1a\n") || &header[12..16] != b"IHDR" {
+        return None;
+    }
+    let side = |at: usize| {
+        u32::from_be_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]])
+    };
+    Some((side(16), side(20)))
 }
 
 fn grey(v: f32) -> [f32; 4] {

@@ -80,7 +80,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     // typo) are skipped with a note rather than refused: the rest of the
     // file is still worth loading.
     let mut unknown = Vec::new();
-    let mut note_unknown = |field: serde_ignored::Path| unknown.push(field.to_string());
+    let mut note_unknown = |field: serde_ignored::Path| unknown.push(field_path(&field));
     let tracked = serde_ignored::Deserializer::new(&mut de, &mut note_unknown);
     let parsed: Result<Preset, _> = serde_path_to_error::deserialize(tracked);
     let mut preset = match parsed {
@@ -133,6 +133,23 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         .collect();
     notes.extend(preset.scene.sanitize());
     Ok(Loaded { preset, notes })
+}
+
+/// A field's path as `serde_path_to_error` writes it in errors
+/// (`scene.spheres[0].radius`), so that notes and errors read alike.
+fn field_path(path: &serde_ignored::Path) -> String {
+    use serde_ignored::Path as P;
+    match path {
+        P::Root => String::new(),
+        P::Seq { parent, index } => format!("{}[{index}]", field_path(parent)),
+        P::Map { parent, key } => match field_path(parent) {
+            p if p.is_empty() => key.clone(),
+            p => format!("{p}.{key}"),
+        },
+        P::Some { parent } | P::NewtypeStruct { parent } | P::NewtypeVariant { parent } => {
+            field_path(parent)
+        }
+    }
 }
 
 fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> PresetError {
@@ -278,8 +295,8 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_skipped_with_a_note_at_any_depth() {
-        let text =
-            "(format_version: 2, colour_grading: 3, scene: (camera: (distance: 7.0, zoom: 2.0)))";
+        let text = "(format_version: 2, colour_grading: 3, \
+                    scene: (camera: (distance: 7.0, zoom: 2.0), spheres: [(radius: 2.0, glow: 1)]))";
         let loaded = parse(text, Path::new("extra.ron")).unwrap();
         assert_eq!(loaded.preset.scene.camera.distance, 7.0);
         assert_eq!(
@@ -287,6 +304,7 @@ mod tests {
             [
                 "extra.ron: unknown field `colour_grading` ignored (misspelt, or from a newer marbre)",
                 "extra.ron: unknown field `scene.camera.zoom` ignored (misspelt, or from a newer marbre)",
+                "extra.ron: unknown field `scene.spheres[0].glow` ignored (misspelt, or from a newer marbre)",
             ]
         );
     }
