@@ -17,7 +17,8 @@ pub const LUMINANCE: f32 = 0.375;
 pub const CODE16: u16 = 32768;
 /// The 8-bit code of `grey.png`.
 pub const GREY8: u8 = 100;
-/// The declared side of `huge_header.png`, far beyond `envmap::MAX_TEXELS`.
+/// The declared side of `huge_header.png` and `huge_header.exr`, far beyond
+/// `envmap::MAX_TEXELS`.
 pub const HUGE_SIDE: u32 = 100_000;
 
 pub fn write_all(bad: &Path) {
@@ -153,6 +154,20 @@ fn set_compression(bytes: &mut [u8], code: u8) {
     bytes[at] = code;
 }
 
+/// Sets the value of the `box2i` attribute `name` of an EXR file:
+/// x min, y min, x max, y max.
+fn set_box(bytes: &mut [u8], name: &str, value: [i32; 4]) {
+    let attribute = [name.as_bytes(), b"\0box2i\0\x10\0\0\0"].concat();
+    let at = bytes
+        .windows(attribute.len())
+        .position(|w| w == attribute)
+        .expect("a box2i attribute")
+        + attribute.len();
+    for (i, v) in value.iter().enumerate() {
+        bytes[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+    }
+}
+
 fn write_exr(dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
     let [r, g, b] = PICKED;
@@ -221,6 +236,13 @@ fn write_exr(dir: &Path) {
         set_compression(&mut bytes, code);
         std::fs::write(dir.join(name), bytes).unwrap();
     }
+    // The same line, its windows set to HUGE_SIDE × HUGE_SIDE.
+    let mut bytes = zip;
+    let last = HUGE_SIDE as i32 - 1;
+    for window in ["dataWindow", "displayWindow"] {
+        set_box(&mut bytes, window, [0, 0, last, last]);
+    }
+    std::fs::write(dir.join("huge_header.exr"), bytes).unwrap();
 
     // A depth part before the colour part.
     let depth = exr_layer("depth", 4, 2, Compression::ZIP1, &[("Z", DECOY)]);
