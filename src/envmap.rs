@@ -27,6 +27,7 @@
 //! sky), so the texture coordinate that addresses the image is
 //! `(u, 1 - v)`: [`uv_to_texel_uv`]. The shader must do the same two steps.
 
+use std::borrow::Cow;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -125,11 +126,12 @@ pub enum EnvMapError {
         format: &'static str,
         message: String,
     },
-    /// An OpenEXR file with DWAA/DWAB compression that the `exr` crate failed
-    /// to decode (older `exr` versions could not read DWA at all).
+    /// An OpenEXR file whose compression the `exr` crate does not implement
+    /// (HTJ2K), or DWAA/DWAB data it failed to decode (older `exr`
+    /// versions could not read DWA at all).
     #[error(
         "environment map {}: cannot decode OpenEXR with {compression} compression: {message}; \
-         re-save the file with ZIP or PIZ compression",
+         {EXR_RESAVE_HINT}",
         .path.display()
     )]
     ExrCompression {
@@ -225,6 +227,115 @@ impl EnvImage {
     }
 }
 
+/// The size of a `width` × `height` image shrunk, keeping its aspect ratio,
+/// until no side exceeds `max_side` (at least 1): the image's own size when
+/// it already fits.
+pub fn fitted_size(width: u32, height: u32, max_side: u32) -> (u32, u32) {
+    let max_side = max_side.max(1);
+    if width <= max_side && height <= max_side {
+        return (width, height);
+    }
+    let scale = f64::from(max_side) / f64::from(width.max(height));
+    let side = |s: u32| ((f64::from(s) * scale).round() as u32).clamp(1, max_side);
+    (side(width), side(height))
+}
+
+/// For each of `to` output texels along one axis, the input texels among
+/// `from` (`to ≤ from`) that its footprint covers and their weights, the
+/// covered fraction of each (summing to 1).
+fn box_taps(from: u32, to: u32) -> Vec<Vec<(u32, f32)>> {
+    let scale = f64::from(from) / f64::from(to);
+    (0..to)
+        .map(|i| {
+            let start = f64::from(i) * scale;
+            let end = f64::from(i + 1) * scale;
+            let first = start.floor() as u32;
+            let last = (end.ceil() as u32).min(from);
+            (first..last)
+                .map(|j| {
+                    let overlap = end.min(f64::from(j + 1)) - start.max(f64::from(j));
+                    (j, (overlap / scale) as f32)
+                })
+                .filter(|&(_, w)| w > 0.0)
+                .collect()
+        })
+        .collect()
+}
+
+/// `image` downscaled by [`EnvImage::downscaled`] so that no side exceeds
+/// `max_side`, or `image` itself when it fits.
+pub fn fit_within(image: &EnvImage, max_side: u32) -> Cow<'_, EnvImage> {
+    let (width, height) = fitted_size(image.width, image.height, max_side);
+    if (width, height) == (image.width, image.height) {
+        Cow::Borrowed(image)
+    } else {
+        Cow::Owned(image.downscaled(width, height))
+    }
+}
+
+impl EnvImage {
+    /// This image box-filtered down to `width` × `height` (neither larger
+    /// than now, neither 0): each output texel is the area-weighted average
+    /// of the input texels its footprint covers, so the mean radiance is
+    /// kept and no value leaves the range of its inputs.
+    pub fn downscaled(&self, width: u32, height: u32) -> EnvImage {
+        let columns = box_taps(self.width, width);
+        let rows = box_taps(self.height, height);
+        let wide: Vec<[f32; 4]> = (0..self.height)
+            .flat_map(|y| {
+                columns
+                    .iter()
+                    .map(move |taps| weighted_sum(taps.iter().map(|&(x, w)| (self.texel(x, y), w))))
+            })
+            .collect();
+        let pixels = rows
+            .iter()
+            .flat_map(|taps| {
+                let wide = &wide;
+                (0..width).map(move |x| {
+                    weighted_sum(
+                        taps.iter()
+                            .map(|&(y, w)| (wide[y as usize * width as usize + x as usize], w)),
+                    )
+                })
+            })
+            .collect();
+        EnvImage {
+            width,
+            height,
+            pixels,
+        }
+    }
+}
+
+fn weighted_sum(taps: impl Iterator<Item = ([f32; 4], f32)>) -> [f32; 4] {
+    let mut sum = [0.0f32; 4];
+    for (texel, w) in taps {
+        for (s, t) in sum.iter_mut().zip(texel) {
+            *s += t * w;
+        }
+    }
+    sum
+}
+
+impl EnvLoad {
+    /// Shrinks the image to fit a texture of at most `max_side` texels a
+    /// side (the GPU's `max_texture_dimension_2d`), with a note naming
+    /// `what` (the file) when it had to.
+    pub fn fit_within(mut self, max_side: u32, what: &str) -> EnvLoad {
+        let (width, height) = (self.image.width, self.image.height);
+        if let Cow::Owned(smaller) = fit_within(&self.image, max_side) {
+            self.notes.push(format!(
+                "{what} is {width}×{height}, larger than this GPU's max texture side {max_side}: \
+                 downscaled to {}×{} (area average, mean radiance kept)",
+                smaller.width, smaller.height
+            ));
+            self.image = smaller;
+        }
+        self
+    }
+}
+
 /// A uniform map; same as [`EnvImage::constant`].
 pub fn constant(width: u32, height: u32, rgb: [f32; 3]) -> EnvImage {
     EnvImage::constant(width, height, rgb)
@@ -289,8 +400,13 @@ pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapEr
         path: path.to_path_buf(),
         cause,
     })?;
+    let mut choice_note = None;
     let mut image = match extension.as_str() {
-        "exr" => decode_exr(path, &bytes)?,
+        "exr" => {
+            let (image, note) = decode_exr(path, &bytes)?;
+            choice_note = note;
+            image
+        }
         "hdr" => decode_with_image(
             path,
             &bytes,
@@ -315,101 +431,306 @@ pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapEr
         .unwrap_or_else(|| path.display().to_string());
     Ok(EnvLoad {
         image,
-        notes: counts.notes(&file_name),
+        notes: choice_note
+            .into_iter()
+            .chain(counts.notes(&file_name))
+            .collect(),
     })
 }
 
-fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvImage, EnvMapError> {
+/// The most texels an image may declare: 2²⁸ (16384×16384, or a
+/// 23170×11585 lat-long map), 4 GiB as f32 RGBA. The size is checked from
+/// the file's header before anything is allocated, so a hostile header
+/// cannot make the loader ask for terabytes.
+pub const MAX_TEXELS: u64 = 1 << 28;
+
+/// What to do about an OpenEXR file marbre's reader cannot decode.
+pub const EXR_RESAVE_HINT: &str = "re-save it with ZIP or PIZ compression or none, \
+     e.g. `oiiotool in.exr --compression zip -o out.exr`";
+
+/// An error unless a `width` × `height` image is one marbre loads: not
+/// empty, and at most [`MAX_TEXELS`].
+fn check_size(
+    path: &Path,
+    format: &'static str,
+    width: u64,
+    height: u64,
+) -> Result<(), EnvMapError> {
+    if width == 0 || height == 0 {
+        return Err(EnvMapError::Empty {
+            path: path.to_path_buf(),
+            width: width.min(u64::from(u32::MAX)) as u32,
+            height: height.min(u64::from(u32::MAX)) as u32,
+        });
+    }
+    if width.saturating_mul(height) > MAX_TEXELS {
+        return Err(EnvMapError::Decode {
+            path: path.to_path_buf(),
+            format,
+            message: format!(
+                "the file declares {width}x{height} texels, more than the {MAX_TEXELS} \
+                 (16384x16384) marbre loads"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The channels of an OpenEXR file that hold the picture: red, green and
+/// blue, or luminance alone.
+enum ExrChannels {
+    Rgb([exr::meta::attribute::Text; 3]),
+    Grey(exr::meta::attribute::Text),
+}
+
+/// Which part of an OpenEXR file and which of its channels [`decode_exr`]
+/// reads, and the note telling the user so when the file had a choice.
+struct ExrChoice {
+    part: usize,
+    channels: ExrChannels,
+    note: Option<String>,
+}
+
+/// Picks the picture in an OpenEXR file: the first part, and in it the
+/// first layer (`R` before `diffuse.R`), that has red, green and blue
+/// channels (names compared case-insensitively); failing that, the first
+/// with luminance `Y`, read as grey. `None` when no part has either.
+fn choose_exr_channels(headers: &[exr::meta::header::Header], file: &str) -> Option<ExrChoice> {
+    // Per part, its layers in order of appearance: (prefix, channel names).
+    let layers: Vec<Vec<(String, Vec<exr::meta::attribute::Text>)>> = headers
+        .iter()
+        .map(|header| {
+            let mut layers: Vec<(String, Vec<exr::meta::attribute::Text>)> = Vec::new();
+            for channel in &header.channels.list {
+                let name = channel.name.to_string();
+                let prefix = name.rfind('.').map_or("", |dot| &name[..dot]).to_string();
+                match layers.iter_mut().find(|(p, _)| *p == prefix) {
+                    Some((_, names)) => names.push(channel.name.clone()),
+                    None => layers.push((prefix, vec![channel.name.clone()])),
+                }
+            }
+            // The unnamed layer first: plain `R, G, B` are the picture.
+            layers.sort_by_key(|(prefix, _)| !prefix.is_empty());
+            layers
+        })
+        .collect();
+    fn find<'a>(
+        names: &'a [exr::meta::attribute::Text],
+        base: &str,
+    ) -> Option<&'a exr::meta::attribute::Text> {
+        names.iter().find(|n| {
+            let n = n.to_string();
+            n.rsplit('.')
+                .next()
+                .unwrap_or("")
+                .eq_ignore_ascii_case(base)
+        })
+    }
+    let layer_count: usize = layers.iter().map(Vec::len).sum();
+    let describe = |part: usize, prefix: &str| {
+        let part_name = headers[part]
+            .own_attributes
+            .layer_name
+            .as_ref()
+            .map(|n| format!(" (`{n}`)"))
+            .unwrap_or_default();
+        let layer = if prefix.is_empty() {
+            "the unnamed layer".to_string()
+        } else {
+            format!("layer `{prefix}`")
+        };
+        format!("{layer} of part {part}{part_name}")
+    };
+    let mut grey = None;
+    for (part, part_layers) in layers.iter().enumerate() {
+        for (prefix, names) in part_layers {
+            let rgb = ["R", "G", "B"].map(|base| find(names, base));
+            if let [Some(r), Some(g), Some(b)] = rgb {
+                let exact = [r, g, b]
+                    .iter()
+                    .zip(["R", "G", "B"])
+                    .all(|(n, base)| n.to_string().ends_with(base));
+                let note = if layer_count > 1 {
+                    Some(format!(
+                        "{file}: read {} (channels {r}, {g}, {b}), one of the file's {layer_count} layers",
+                        describe(part, prefix)
+                    ))
+                } else {
+                    (!exact)
+                        .then(|| format!("{file}: channels {r}, {g}, {b} read as red, green, blue"))
+                };
+                return Some(ExrChoice {
+                    part,
+                    channels: ExrChannels::Rgb([r.clone(), g.clone(), b.clone()]),
+                    note,
+                });
+            }
+            if grey.is_none()
+                && let Some(y) = find(names, "Y")
+            {
+                let note = format!(
+                    "{file}: luminance only: channel {y} of {} shown as grey",
+                    describe(part, prefix)
+                );
+                grey = Some(ExrChoice {
+                    part,
+                    channels: ExrChannels::Grey(y.clone()),
+                    note: Some(note),
+                });
+            }
+        }
+    }
+    grey
+}
+
+/// Every part of an OpenEXR file and its channels, for a message.
+fn exr_channel_list(headers: &[exr::meta::header::Header]) -> String {
+    headers
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            let names: Vec<String> = h.channels.list.iter().map(|c| c.name.to_string()).collect();
+            format!(
+                "part {i}: {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// The picture of an OpenEXR file ([`choose_exr_channels`]), and a note if
+/// it was chosen among others. The `exr` crate's panics on malformed files
+/// are caught and reported as a decode error.
+fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(EnvImage, Option<String>), EnvMapError> {
+    let decode_error = |message: String| EnvMapError::Decode {
+        path: path.to_path_buf(),
+        format: "OpenEXR",
+        message,
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+            .map_err(|e| exr_error(path, None, e))?;
+        let file = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| path.display().to_string());
+        let Some(choice) = choose_exr_channels(&meta.headers, &file) else {
+            return Err(decode_error(format!(
+                "no part has R, G, B or Y channels (found {}); \
+                 marbre reads a colour (R, G, B) or luminance (Y) image",
+                exr_channel_list(&meta.headers)
+            )));
+        };
+        let header = &meta.headers[choice.part];
+        let size = header.layer_size;
+        check_size(path, "OpenEXR", size.width() as u64, size.height() as u64)?;
+        let image = read_exr_channels(bytes, &choice.channels)
+            .map_err(|e| exr_error(path, Some(header.compression), e))?;
+        Ok((image, choice.note))
+    }))
+    .unwrap_or_else(|_| {
+        Err(decode_error(
+            "the OpenEXR reader failed on this file (a malformed file it does not check)".into(),
+        ))
+    })
+}
+
+/// Reads `channels` of the first part that has them, as linear RGBA.
+fn read_exr_channels(bytes: &[u8], channels: &ExrChannels) -> exr::error::Result<EnvImage> {
     use exr::prelude::*;
 
-    let rgba = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .rgba_channels(
-            |resolution, _| {
-                (
-                    resolution.width(),
-                    vec![[0.0f32, 0.0, 0.0, 1.0]; resolution.width() * resolution.height()],
-                )
-            },
-            |(w, px): &mut (usize, Vec<[f32; 4]>),
-             pos: Vec2<usize>,
-             (r, g, b, _a): (f32, f32, f32, f32)| {
-                px[pos.y() * *w + pos.x()] = [r, g, b, 1.0];
-            },
+    let storage = |resolution: Vec2<usize>| {
+        (
+            resolution.width(),
+            vec![[0.0f32, 0.0, 0.0, 1.0]; resolution.width() * resolution.height()],
         )
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(Cursor::new(bytes));
-
+    };
     let to_image = |size: Vec2<usize>, pixels: Vec<[f32; 4]>| EnvImage {
         width: size.width() as u32,
         height: size.height() as u32,
         pixels,
     };
-    match rgba {
-        Ok(img) => Ok(to_image(
-            img.layer_data.size,
-            img.layer_data.channel_data.pixels.1,
-        )),
-        Err(rgba_err) => {
-            // A luminance-only file has no R, G, B: read its Y channel.
-            let grey = read()
+    match channels {
+        ExrChannels::Rgb([r, g, b]) => {
+            let image = read()
                 .no_deep_data()
                 .largest_resolution_level()
                 .specific_channels()
-                .required("Y")
+                .required(r.clone())
+                .required(g.clone())
+                .required(b.clone())
                 .collect_pixels(
-                    |resolution, _| {
-                        (
-                            resolution.width(),
-                            vec![[0.0f32, 0.0, 0.0, 1.0]; resolution.width() * resolution.height()],
-                        )
+                    |resolution, _| storage(resolution),
+                    |(w, px): &mut (usize, Vec<[f32; 4]>),
+                     pos: Vec2<usize>,
+                     (r, g, b): (f32, f32, f32)| {
+                        px[pos.y() * *w + pos.x()] = [r, g, b, 1.0];
                     },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(Cursor::new(bytes))?;
+            Ok(to_image(
+                image.layer_data.size,
+                image.layer_data.channel_data.pixels.1,
+            ))
+        }
+        ExrChannels::Grey(y) => {
+            let image = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .specific_channels()
+                .required(y.clone())
+                .collect_pixels(
+                    |resolution, _| storage(resolution),
                     |(w, px): &mut (usize, Vec<[f32; 4]>), pos: Vec2<usize>, (y,): (f32,)| {
                         px[pos.y() * *w + pos.x()] = [y, y, y, 1.0];
                     },
                 )
                 .first_valid_layer()
                 .all_attributes()
-                .from_buffered(Cursor::new(bytes));
-            match grey {
-                Ok(img) => Ok(to_image(
-                    img.layer_data.size,
-                    img.layer_data.channel_data.pixels.1,
-                )),
-                Err(_) => Err(exr_error(path, bytes, rgba_err)),
-            }
+                .from_buffered(Cursor::new(bytes))?;
+            Ok(to_image(
+                image.layer_data.size,
+                image.layer_data.channel_data.pixels.1,
+            ))
         }
     }
 }
 
-/// Turns an `exr` failure into an [`EnvMapError`], pointing at DWA
-/// compression when the header declares it.
-fn exr_error(path: &Path, bytes: &[u8], err: exr::error::Error) -> EnvMapError {
+/// Turns an `exr` failure into an [`EnvMapError`]. A file whose
+/// `compression` the `exr` crate does not implement (HTJ2K), or whose DWAA
+/// or DWAB data it failed on, gets [`EnvMapError::ExrCompression`], which
+/// says what to do.
+fn exr_error(
+    path: &Path,
+    compression: Option<exr::compression::Compression>,
+    err: exr::error::Error,
+) -> EnvMapError {
     use exr::compression::Compression;
 
-    let message = match &err {
+    let message = decode_message(&match &err {
         exr::error::Error::Aborted => "reading was aborted".to_string(),
         exr::error::Error::NotSupported(m) => format!("not supported: {m}"),
         exr::error::Error::Invalid(m) => format!("invalid file: {m}"),
         exr::error::Error::Io(e) => format!("I/O error: {e}"),
+    });
+    let named = match compression {
+        Some(Compression::DWAA(_)) => Some(("DWAA", message.clone())),
+        Some(Compression::DWAB(_)) => Some(("DWAB", message.clone())),
+        Some(Compression::HTJ2K32 | Compression::HTJ2K256) => Some((
+            "HTJ2K",
+            "marbre's OpenEXR reader (the `exr` crate) does not support it".to_string(),
+        )),
+        _ => None,
     };
-    let dwa = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
-        .ok()
-        .and_then(|meta| {
-            meta.headers.iter().find_map(|h| match h.compression {
-                Compression::DWAA(_) => Some("DWAA"),
-                Compression::DWAB(_) => Some("DWAB"),
-                _ => None,
-            })
-        })
-        .or_else(|| {
-            let m = message.to_ascii_lowercase();
-            m.contains("dwa").then_some("DWA")
-        });
-    match dwa {
-        Some(compression) => EnvMapError::ExrCompression {
+    match named {
+        Some((compression, message)) => EnvMapError::ExrCompression {
             path: path.to_path_buf(),
             compression: compression.to_string(),
             message,
@@ -436,12 +757,30 @@ fn decode_with_image(
         format: format_name,
         message,
     };
-    let mut reader = image::ImageReader::with_format(Cursor::new(bytes), format);
-    // The default 512 MiB cap rejects 16k maps; stay bounded but roomier.
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(4 << 30);
-    reader.limits(limits);
-    let decoded = reader.decode().map_err(|e| decode_err(e.to_string()))?;
+    let reader = || {
+        let mut reader = image::ImageReader::with_format(Cursor::new(bytes), format);
+        // The default 512 MiB cap rejects 16k maps; stay bounded but roomier.
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(4 << 30);
+        reader.limits(limits);
+        reader
+    };
+    // The header first: an empty or absurdly large image is refused before
+    // its pixels are allocated.
+    if let Some((width, height)) = declared_png_size(bytes).filter(|&(w, h)| w == 0 || h == 0) {
+        return Err(EnvMapError::Empty {
+            path: path.to_path_buf(),
+            width,
+            height,
+        });
+    }
+    let (width, height) = reader()
+        .into_dimensions()
+        .map_err(|e| decode_err(decode_message(&e.to_string())))?;
+    check_size(path, format_name, width.into(), height.into())?;
+    let decoded = reader()
+        .decode()
+        .map_err(|e| decode_err(decode_message(&e.to_string())))?;
     let (width, height) = (decoded.width(), decoded.height());
 
     let pixels: Vec<[f32; 4]> = match &decoded {
@@ -496,6 +835,44 @@ fn decode_with_image(
         height,
         pixels,
     })
+}
+
+/// A decoder's reason, saying "truncated" where it means that the file
+/// ends early: the decoders' own words for it vary ("unexpected end of
+/// file", "not enough bytes", "failed to fill whole buffer", "reference to
+/// missing bytes").
+fn decode_message(message: &str) -> String {
+    let message = message.trim();
+    let lower = message.to_ascii_lowercase();
+    let cut_short = [
+        "unexpected end",
+        "unexpectedeof",
+        "eof",
+        "not enough bytes",
+        "missing bytes",
+        "fill whole buffer",
+    ]
+    .iter()
+    .any(|w| lower.contains(w));
+    if cut_short && !lower.contains("truncated") {
+        format!("the file is truncated ({message})")
+    } else {
+        message.to_string()
+    }
+}
+
+/// The size a PNG file's header declares, if it is a PNG file with a
+/// header: the `png` crate refuses a zero side as "invalid dimensions",
+/// which does not say that the image is empty.
+fn declared_png_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    let header = bytes.get(..24)?;
+    if !header.starts_with(b"\x89PNG\r\n\x1a\n") || &header[12..16] != b"IHDR" {
+        return None;
+    }
+    let side = |at: usize| {
+        u32::from_be_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]])
+    };
+    Some((side(16), side(20)))
 }
 
 fn grey(v: f32) -> [f32; 4] {
@@ -613,6 +990,80 @@ mod tests {
     fn u_dist(a: f32, b: f32) -> f32 {
         let d = (a - b).rem_euclid(1.0);
         d.min(1.0 - d)
+    }
+
+    #[test]
+    fn fitted_sizes_keep_the_aspect_ratio_within_the_limit() {
+        assert_eq!(fitted_size(16384, 8192, 8192), (8192, 4096));
+        assert_eq!(fitted_size(8192, 4096, 8192), (8192, 4096));
+        assert_eq!(fitted_size(1000, 3, 100), (100, 1));
+        assert_eq!(fitted_size(30, 70, 7), (3, 7));
+        assert_eq!(fitted_size(5, 5, 0), (1, 1));
+    }
+
+    /// Each output texel of a downscale is the mean of the input area it
+    /// covers: integer ratios average whole blocks, other ratios weigh
+    /// partly covered texels by their covered fraction; the image mean is
+    /// kept either way.
+    #[test]
+    fn downscaling_averages_areas_and_keeps_the_mean() {
+        let ramp = EnvImage {
+            width: 4,
+            height: 2,
+            pixels: (0..8).map(|i| [i as f32, 1.0, 0.0, 1.0]).collect(),
+        };
+        let half = ramp.downscaled(2, 1);
+        // Blocks {0, 1, 4, 5} and {2, 3, 6, 7}.
+        assert_eq!(half.pixels, [[2.5, 1.0, 0.0, 1.0], [4.5, 1.0, 0.0, 1.0]]);
+        // 3 → 2 columns: the middle texel is split half and half.
+        let row = EnvImage {
+            width: 3,
+            height: 1,
+            pixels: [3.0, 6.0, 9.0].map(|v| [v, v, v, 1.0]).to_vec(),
+        };
+        let two = row.downscaled(2, 1);
+        assert!(close(two.pixels[0][0], (3.0 * 1.0 + 6.0 * 0.5) / 1.5, 1e-5));
+        assert!(close(two.pixels[1][0], (6.0 * 0.5 + 9.0 * 1.0) / 1.5, 1e-5));
+        let mean = |img: &EnvImage| {
+            img.pixels.iter().map(|p| f64::from(p[0])).sum::<f64>() / img.pixels.len() as f64
+        };
+        let noisy = EnvImage {
+            width: 37,
+            height: 19,
+            pixels: (0..37 * 19)
+                .map(|i| {
+                    let v = ((i * 7919) % 1000) as f32 / 10.0;
+                    [v, v, v, 1.0]
+                })
+                .collect(),
+        };
+        for (w, h) in [(10, 5), (36, 18), (1, 1), (20, 19)] {
+            let small = noisy.downscaled(w, h);
+            assert_eq!((small.width, small.height), (w, h));
+            assert_eq!(small.pixels.len(), (w * h) as usize);
+            let (a, b) = (mean(&noisy), mean(&small));
+            assert!((a - b).abs() < 1e-4 * a, "{w}x{h}: mean {b} vs {a}");
+        }
+    }
+
+    #[test]
+    fn an_oversize_load_is_fitted_with_a_note_and_a_fitting_one_kept() {
+        let load = EnvLoad {
+            image: EnvImage::constant(64, 32, [2.0, 1.0, 0.5]),
+            notes: Vec::new(),
+        };
+        let fitted = load.clone().fit_within(16, "big.exr");
+        assert_eq!((fitted.image.width, fitted.image.height), (16, 8));
+        assert!(fitted.image.pixels.iter().all(|p| close(p[0], 2.0, 1e-6)));
+        assert_eq!(
+            fitted.notes,
+            [
+                "big.exr is 64×32, larger than this GPU's max texture side 16: \
+              downscaled to 16×8 (area average, mean radiance kept)"
+            ]
+        );
+        let kept = load.fit_within(64, "big.exr");
+        assert_eq!((kept.image.width, kept.notes.len()), (64, 0));
     }
 
     #[test]

@@ -76,7 +76,14 @@ pub struct Loaded {
 pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     let mut de =
         ron::Deserializer::from_str(text).map_err(|e| syntax_error(path, &e, String::new()))?;
-    let mut preset: Preset = match serde_path_to_error::deserialize(&mut de) {
+    // Fields this build does not know (from a newer minor version, or a
+    // typo) are skipped with a note rather than refused: the rest of the
+    // file is still worth loading.
+    let mut unknown = Vec::new();
+    let mut note_unknown = |field: serde_ignored::Path| unknown.push(field_path(&field));
+    let tracked = serde_ignored::Deserializer::new(&mut de, &mut note_unknown);
+    let parsed: Result<Preset, _> = serde_path_to_error::deserialize(tracked);
+    let mut preset = match parsed {
         Ok(p) => p,
         Err(e) => {
             let field = e.path().to_string();
@@ -115,8 +122,34 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
             mesh.obj = folder.join(&mesh.obj);
         }
     }
-    let notes = preset.scene.sanitize();
+    let mut notes: Vec<String> = unknown
+        .into_iter()
+        .map(|field| {
+            format!(
+                "{}: unknown field `{field}` ignored (misspelt, or from a newer marbre)",
+                path.display()
+            )
+        })
+        .collect();
+    notes.extend(preset.scene.sanitize());
     Ok(Loaded { preset, notes })
+}
+
+/// A field's path as `serde_path_to_error` writes it in errors
+/// (`scene.spheres[0].radius`), so that notes and errors read alike.
+fn field_path(path: &serde_ignored::Path) -> String {
+    use serde_ignored::Path as P;
+    match path {
+        P::Root => String::new(),
+        P::Seq { parent, index } => format!("{}[{index}]", field_path(parent)),
+        P::Map { parent, key } => match field_path(parent) {
+            p if p.is_empty() => key.clone(),
+            p => format!("{p}.{key}"),
+        },
+        P::Some { parent } | P::NewtypeStruct { parent } | P::NewtypeVariant { parent } => {
+            field_path(parent)
+        }
+    }
 }
 
 fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> PresetError {
@@ -258,6 +291,22 @@ mod tests {
     fn a_future_version_is_refused() {
         let err = parse("(format_version: 99)", Path::new("new.ron")).unwrap_err();
         assert!(matches!(err, PresetError::FutureVersion { found: 99, .. }));
+    }
+
+    #[test]
+    fn unknown_fields_are_skipped_with_a_note_at_any_depth() {
+        let text = "(format_version: 2, colour_grading: 3, \
+                    scene: (camera: (distance: 7.0, zoom: 2.0), spheres: [(radius: 2.0, glow: 1)]))";
+        let loaded = parse(text, Path::new("extra.ron")).unwrap();
+        assert_eq!(loaded.preset.scene.camera.distance, 7.0);
+        assert_eq!(
+            loaded.notes,
+            [
+                "extra.ron: unknown field `colour_grading` ignored (misspelt, or from a newer marbre)",
+                "extra.ron: unknown field `scene.camera.zoom` ignored (misspelt, or from a newer marbre)",
+                "extra.ron: unknown field `scene.spheres[0].glow` ignored (misspelt, or from a newer marbre)",
+            ]
+        );
     }
 
     #[test]

@@ -97,7 +97,7 @@ fn existing_file(path: &std::path::Path) -> PathBuf {
 }
 
 fn bad(name: &str) -> PathBuf {
-    root().join("tests/data/bad_presets").join(name)
+    root().join("tests/data/bad/presets").join(name)
 }
 
 fn load_err(name: &str) -> (PresetError, String) {

@@ -1,6 +1,6 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
-use super::session::{accumulate, load_scene, renderer_for, trace_frame};
+use super::session::{accumulate, load_scene, max_texture_side, renderer_for, trace_frame};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::{GpuContext, Renderer};
@@ -77,10 +77,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.auto_exposure {
         loaded.scene.render.auto_exposure = true;
     }
+    let ctx = GpuContext::headless()?;
+    let loaded = loaded.fit_environment(max_texture_side(&ctx));
     for note in &loaded.notes {
         eprintln!("note: {note}");
     }
-    let ctx = GpuContext::headless()?;
     let mut renderer = renderer_for(&ctx, &loaded, args.size)?;
     let bar = indicatif::ProgressBar::new(u64::from(spp));
     bar.set_style(

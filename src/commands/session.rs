@@ -2,7 +2,7 @@
 //! viewer, `render` and `bench`, so they all see the same scene.
 
 use crate::cubemap;
-use crate::envmap::EnvImage;
+use crate::envmap::{EnvImage, EnvLoad};
 use crate::gpu::{GpuContext, Renderer};
 use crate::preset;
 use crate::scene::{EnvSource, Scene};
@@ -54,6 +54,51 @@ pub fn prepare_scene(mut scene: Scene, mut notes: Vec<String>) -> Result<LoadedS
         images,
         notes,
     })
+}
+
+impl LoadedScene {
+    /// Shrinks the environment image to fit a texture of at most `max_side`
+    /// texels a side (the GPU's `max_texture_dimension_2d`), with a note
+    /// when it had to.
+    pub fn fit_environment(mut self, max_side: u32) -> LoadedScene {
+        if let Some(image) = self.env.take() {
+            let fitted = EnvLoad {
+                image,
+                notes: Vec::new(),
+            }
+            .fit_within(max_side, &source_name(&self.scene.environment.source));
+            self.notes.extend(fitted.notes);
+            self.env = Some(fitted.image);
+        }
+        self
+    }
+}
+
+/// The environment `source` stands for, as `cubemap::load_source` loads it,
+/// shrunk to fit a texture of at most `max_side` texels a side (the GPU's
+/// `max_texture_dimension_2d`, [`max_texture_side`]) with a note when it
+/// had to.
+pub fn load_environment(
+    source: &EnvSource,
+    max_side: u32,
+) -> Result<Option<EnvLoad>, cubemap::CubeMapError> {
+    let name = source_name(source);
+    Ok(cubemap::load_source(source)?.map(|l| l.fit_within(max_side, &name)))
+}
+
+/// The largest texture side `ctx`'s device takes.
+pub fn max_texture_side(ctx: &GpuContext) -> u32 {
+    ctx.device.limits().max_texture_dimension_2d
+}
+
+/// The files of an environment source, for notes.
+fn source_name(source: &EnvSource) -> String {
+    source
+        .paths()
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The largest image atlas the renderer asks for: wgpu's default limit of

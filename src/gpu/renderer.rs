@@ -21,7 +21,7 @@ use super::scene_gpu::{self, FrameUniform};
 use super::shader_source::{Program, assemble, sources_generation};
 use super::texture_codegen;
 use crate::env_sampling::EnvDistribution;
-use crate::envmap::EnvImage;
+use crate::envmap::{self, EnvImage};
 use crate::scene::{Scene, ToneMap};
 use crate::texture::ImageSet;
 use anyhow::Result;
@@ -268,8 +268,9 @@ impl Renderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let env_view = upload_env(ctx, env);
-        let env_distribution = upload_env_distribution(ctx, env);
+        let env = env.map(|e| envmap::fit_within(e, ctx.device.limits().max_texture_dimension_2d));
+        let env_view = upload_env(ctx, env.as_deref());
+        let env_distribution = upload_env_distribution(ctx, env.as_deref());
         let image_atlas_view = upload_atlas(ctx, images.atlas());
         let accumulation = Accumulation::new(device, size);
         let error_meter = ErrorMeter::new(device)?;
@@ -643,10 +644,13 @@ impl Renderer {
         Ok(())
     }
 
-    /// Replaces the environment image (None: a black 1×1 placeholder).
+    /// Replaces the environment image (None: a black 1×1 placeholder). One
+    /// larger than the GPU's textures is downscaled to fit (as
+    /// `session::load_environment` does with a note), never refused.
     pub fn set_environment(&mut self, ctx: &GpuContext, env: Option<&EnvImage>) {
-        self.env_view = upload_env(ctx, env);
-        self.env_distribution = upload_env_distribution(ctx, env);
+        let env = env.map(|e| envmap::fit_within(e, ctx.device.limits().max_texture_dimension_2d));
+        self.env_view = upload_env(ctx, env.as_deref());
+        self.env_distribution = upload_env_distribution(ctx, env.as_deref());
         self.reset_accumulation();
     }
 

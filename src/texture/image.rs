@@ -176,7 +176,8 @@ impl From<EnvMapError> for ImageError {
                 path,
                 format: "OpenEXR",
                 message: format!(
-                    "{compression} compression: {message}; re-save the file with ZIP or PIZ compression"
+                    "{compression} compression: {message}; {}",
+                    envmap::EXR_RESAVE_HINT
                 ),
             },
             EnvMapError::Empty {

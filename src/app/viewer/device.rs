@@ -4,8 +4,7 @@
 //! made is lost; the accumulated samples start over).
 
 use super::{Viewer, surface_config};
-use crate::commands::session::{LoadedScene, renderer_for};
-use crate::cubemap;
+use crate::commands::session::{LoadedScene, load_environment, max_texture_side, renderer_for};
 use crate::gpu::GpuContext;
 use crate::gpu::pass_timer::PassTimer;
 use anyhow::{Context as _, Result};
@@ -22,7 +21,7 @@ impl Viewer {
         // The environment's pixels live only on the GPU: read the file
         // again (a source that no longer loads falls back to none).
         let mut notes = Vec::new();
-        let env = match cubemap::load_source(&self.scene.environment.source) {
+        let env = match load_environment(&self.scene.environment.source, max_texture_side(&ctx)) {
             Ok(loaded) => loaded.map(|l| l.image),
             Err(e) => {
                 notes.push(format!("{e:#}"));

@@ -12,8 +12,7 @@ use crate::app::file_dialogs::{DialogPurpose, OpenDialog, dialogs_available};
 use crate::app::file_watch::{FileWatch, is_same_file};
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
-use crate::commands::session::{load_images, load_scene};
-use crate::cubemap;
+use crate::commands::session::{load_environment, load_images, load_scene, max_texture_side};
 use crate::envmap;
 use crate::gpu::shader_source;
 use crate::preset;
@@ -48,7 +47,8 @@ impl Viewer {
     /// Replaces the scene with the preset at `path`; on failure the scene
     /// stays as it was and the panel says why. Returns whether it loaded.
     fn load_preset(&mut self, path: &Path) -> bool {
-        let loaded = match load_scene(path, None) {
+        let max_side = max_texture_side(&self.ctx);
+        let loaded = match load_scene(path, None).map(|l| l.fit_environment(max_side)) {
             Ok(loaded) => loaded,
             Err(e) => {
                 self.panel.error(format!("{e:#}"));
@@ -103,7 +103,7 @@ impl Viewer {
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(", ");
-        match cubemap::load_source(&source) {
+        match load_environment(&source, max_texture_side(&self.ctx)) {
             Ok(Some(l)) => {
                 let mut scene = self.scene.clone();
                 scene.environment.source = source;
@@ -259,7 +259,8 @@ impl Viewer {
     /// Reopens the scene a crashed run autosaved, as unsaved edits of the
     /// preset it came from.
     fn recover(&mut self, offer: &recovery::RecoveryOffer) {
-        let loaded = match load_scene(&offer.preset, None) {
+        let max_side = max_texture_side(&self.ctx);
+        let loaded = match load_scene(&offer.preset, None).map(|l| l.fit_environment(max_side)) {
             Ok(loaded) => loaded,
             Err(e) => {
                 self.panel.error(format!("cannot recover: {e:#}"));

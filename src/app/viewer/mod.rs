@@ -22,7 +22,7 @@ use super::recovery::{self, Autosave};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::{ViewerOptions, camera_input};
-use crate::commands::session::{DEFAULT_PRESET, load_scene, renderer_for};
+use crate::commands::session::{DEFAULT_PRESET, load_scene, max_texture_side, renderer_for};
 use crate::gpu::pass_timer::PassTimer;
 use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
 use crate::panel::{self, PanelAction, PanelState};
@@ -142,6 +142,7 @@ impl Viewer {
         let size = window.inner_size();
         let config = surface_config(&surface, &ctx, size);
         surface.configure(&ctx.device, &config);
+        let loaded = loaded.fit_environment(max_texture_side(&ctx));
         let renderer = renderer_for(&ctx, &loaded, (config.width, config.height))?;
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
