@@ -15,6 +15,7 @@ mod file_watch;
 mod history;
 mod prompts;
 mod recovery;
+mod scene_loader;
 mod screenshots;
 mod settings;
 mod shortcuts;

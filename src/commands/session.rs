@@ -24,6 +24,42 @@ pub struct LoadedScene {
 }
 
 pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<LoadedScene> {
+    load_scene_reporting(preset_path, env_override, &mut |_| {})
+}
+
+/// The steps of loading a preset, in order, for a progress bar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadStage {
+    Preset,
+    Environment,
+    Meshes,
+    Images,
+}
+
+impl LoadStage {
+    pub const COUNT: usize = 4;
+
+    pub fn label(self) -> &'static str {
+        match self {
+            LoadStage::Preset => "reading the preset",
+            LoadStage::Environment => "loading the environment map",
+            LoadStage::Meshes => "loading the OBJ meshes",
+            LoadStage::Images => "loading the image textures",
+        }
+    }
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// [`load_scene`], calling `report` as each stage starts.
+pub fn load_scene_reporting(
+    preset_path: &Path,
+    env_override: Option<&Path>,
+    report: &mut dyn FnMut(LoadStage),
+) -> Result<LoadedScene> {
+    report(LoadStage::Preset);
     let loaded = preset::load(preset_path)?;
     let mut scene = loaded.preset.scene;
     if let Some(env) = env_override {
@@ -31,22 +67,33 @@ pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<Loa
             path: env.to_owned(),
         };
     }
-    prepare_scene(scene, loaded.notes)
+    prepare_scene_reporting(scene, loaded.notes, report)
 }
 
 /// Loads what `scene` reads (its environment, meshes and images) and
 /// clamps what they bring, adding to `notes`: a scene built in code gets
 /// exactly what a preset's would.
-pub fn prepare_scene(mut scene: Scene, mut notes: Vec<String>) -> Result<LoadedScene> {
+pub fn prepare_scene(scene: Scene, notes: Vec<String>) -> Result<LoadedScene> {
+    prepare_scene_reporting(scene, notes, &mut |_| {})
+}
+
+fn prepare_scene_reporting(
+    mut scene: Scene,
+    mut notes: Vec<String>,
+    report: &mut dyn FnMut(LoadStage),
+) -> Result<LoadedScene> {
+    report(LoadStage::Environment);
     // A cube map arrives resampled to lat-long (`cubemap::load_source`).
     let env = cubemap::load_source(&scene.environment.source)?.map(|l| {
         notes.extend(l.notes);
         l.image
     });
+    report(LoadStage::Meshes);
     crate::obj_loader::load_meshes(&mut scene, &mut notes)?;
     // The meshes' materials arrive with their files: clamp them as the
     // preset's own were.
     notes.extend(scene.sanitize());
+    report(LoadStage::Images);
     let images = load_images(&scene, &mut notes)?;
     Ok(LoadedScene {
         scene,

@@ -74,6 +74,8 @@ pub struct MeshBuffers {
     /// without walking a million triangles again.
     light_key: Option<LightKey>,
     stats: MeshStats,
+    /// Geometry a loader thread prepared for the next scene.
+    provided: Option<PreparedGeometry>,
 }
 
 /// Everything besides the triangles that the light table reads.
@@ -108,36 +110,22 @@ fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::
     })
 }
 
-impl MeshBuffers {
-    pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
-        let mut out = Self {
-            key: GeometryKey::default(),
-            nodes: storage_buffer(device, "bvh nodes", &[]),
-            triangles: storage_buffer(device, "mesh triangles", &[]),
-            attributes: storage_buffer(device, "mesh attributes", &[]),
-            lights: storage_buffer(device, "lights", &[]),
-            emitters: Vec::new(),
-            table: LightTable::default(),
-            light_key: None,
-            stats: MeshStats::default(),
-        };
-        out.rebuild_geometry(device, scene);
-        out.rebuild_lights(device, scene);
-        out
-    }
+/// The CPU half of a geometry upload: the BVH over every mesh triangle in
+/// world space, the triangles and their attributes in BVH order, and the
+/// emissive ones. Building it is the slow part of loading a big mesh (the
+/// BVH), so a loader thread can do it ([`MeshBuffers::provide`]) while the
+/// window keeps drawing.
+pub struct PreparedGeometry {
+    key: GeometryKey,
+    bvh: Bvh,
+    verts: Vec<TriangleVerts>,
+    attributes: Vec<TriangleAttributesGpu>,
+    emitters: Vec<EmitterTriangle>,
+}
 
-    /// Brings the buffers up to `scene`: the BVH if its geometry moved, the
-    /// light table if the geometry or anything else it reads changed.
-    pub fn update(&mut self, device: &wgpu::Device, scene: &Scene) {
-        if GeometryKey::of(scene) != self.key {
-            self.rebuild_geometry(device, scene);
-            self.light_key = None;
-        }
-        self.rebuild_lights(device, scene);
-    }
-
-    fn rebuild_geometry(&mut self, device: &wgpu::Device, scene: &Scene) {
-        self.key = GeometryKey::of(scene);
+impl PreparedGeometry {
+    pub fn of(scene: &Scene) -> Self {
+        let key = GeometryKey::of(scene);
         let bases = scene.mesh_material_bases();
         let mut positions: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
         let mut attributes = Vec::with_capacity(scene.triangle_count());
@@ -157,7 +145,7 @@ impl MeshBuffers {
         let positions = bvh.reorder(&positions);
         let attributes = bvh.reorder(&attributes);
         let verts: Vec<TriangleVerts> = positions.iter().map(TriangleVerts::new).collect();
-        self.emitters = positions
+        let emitters = positions
             .iter()
             .zip(&attributes)
             .map(|(&vertices, a)| EmitterTriangle {
@@ -165,13 +153,74 @@ impl MeshBuffers {
                 material: a.material,
             })
             .collect();
-        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&bvh.nodes));
-        self.triangles = storage_buffer(device, "mesh triangles", bytemuck::cast_slice(&verts));
-        self.attributes =
-            storage_buffer(device, "mesh attributes", bytemuck::cast_slice(&attributes));
-        self.stats.triangles = verts.len();
-        self.stats.bvh_nodes = bvh.nodes.len();
-        self.stats.bvh_build = bvh.stats.build_time;
+        Self {
+            key,
+            bvh,
+            verts,
+            attributes,
+            emitters,
+        }
+    }
+}
+
+impl MeshBuffers {
+    pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
+        let mut out = Self {
+            key: GeometryKey::default(),
+            nodes: storage_buffer(device, "bvh nodes", &[]),
+            triangles: storage_buffer(device, "mesh triangles", &[]),
+            attributes: storage_buffer(device, "mesh attributes", &[]),
+            lights: storage_buffer(device, "lights", &[]),
+            emitters: Vec::new(),
+            table: LightTable::default(),
+            light_key: None,
+            stats: MeshStats::default(),
+            provided: None,
+        };
+        out.rebuild_geometry(device, scene);
+        out.rebuild_lights(device, scene);
+        out
+    }
+
+    /// Brings the buffers up to `scene`: the BVH if its geometry moved, the
+    /// light table if the geometry or anything else it reads changed.
+    pub fn update(&mut self, device: &wgpu::Device, scene: &Scene) {
+        if GeometryKey::of(scene) != self.key {
+            self.rebuild_geometry(device, scene);
+            self.light_key = None;
+        }
+        self.rebuild_lights(device, scene);
+    }
+
+    fn rebuild_geometry(&mut self, device: &wgpu::Device, scene: &Scene) {
+        let key = GeometryKey::of(scene);
+        let prepared = match self.provided.take() {
+            Some(p) if p.key == key => p,
+            _ => PreparedGeometry::of(scene),
+        };
+        self.key = prepared.key;
+        self.emitters = prepared.emitters;
+        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&prepared.bvh.nodes));
+        self.triangles = storage_buffer(
+            device,
+            "mesh triangles",
+            bytemuck::cast_slice(&prepared.verts),
+        );
+        self.attributes = storage_buffer(
+            device,
+            "mesh attributes",
+            bytemuck::cast_slice(&prepared.attributes),
+        );
+        self.stats.triangles = prepared.verts.len();
+        self.stats.bvh_nodes = prepared.bvh.nodes.len();
+        self.stats.bvh_build = prepared.bvh.stats.build_time;
+    }
+
+    /// Hands over geometry prepared off the render thread (a loader
+    /// thread): the next update whose scene has this geometry uploads it
+    /// instead of building the BVH again.
+    pub fn provide(&mut self, prepared: PreparedGeometry) {
+        self.provided = Some(prepared);
     }
 
     fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {

@@ -8,7 +8,7 @@ use super::context::GpuContext;
 use super::error_meter::{self, ErrorEstimate, ErrorMeter};
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
-use super::mesh_buffers::{MeshBuffers, MeshStats};
+use super::mesh_buffers::{MeshBuffers, MeshStats, PreparedGeometry};
 use super::non_finite::{self, NonFiniteCounter, NonFiniteCounts};
 use super::pass_timer::{Pass, PassTimer};
 use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
@@ -377,6 +377,12 @@ impl Renderer {
     pub fn render_size(&self) -> (u32, u32) {
         let s = |v: u32| ((v as f32 * self.render_scale).ceil() as u32).clamp(1, v.max(1));
         (s(self.size.0), s(self.size.1))
+    }
+
+    /// Geometry prepared off the render thread for the next scene set
+    /// (see [`PreparedGeometry`]): that scene's BVH is not built again.
+    pub fn provide_geometry(&mut self, prepared: PreparedGeometry) {
+        self.meshes.provide(prepared);
     }
 
     /// Applies an edited scene and waits for any shader it needs: for

@@ -89,6 +89,14 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
                 );
         }
     });
+    if let Some((stage, fraction)) = &state.progress {
+        ui.add(
+            egui::ProgressBar::new(*fraction)
+                .text(stage.as_str())
+                .animate(true),
+        )
+        .on_hover_text("The scene on screen stays until the new one has loaded");
+    }
     let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
     for message in &state.messages[first..] {
         if message.is_error {

@@ -86,6 +86,9 @@ pub struct PanelState {
     /// (where no file dialog can open); cleared once done.
     pub focus_preset_path: bool,
     pub focus_env_path: bool,
+    /// A preset loading in the background: what it is doing, and the
+    /// fraction done.
+    pub progress: Option<(String, f32)>,
 }
 
 impl PanelState {
@@ -106,6 +109,7 @@ impl PanelState {
             recent_files: Vec::new(),
             focus_preset_path: false,
             focus_env_path: false,
+            progress: None,
         }
     }
 

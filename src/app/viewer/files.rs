@@ -12,11 +12,12 @@ use crate::app::file_dialogs::{DialogPurpose, OpenDialog, dialogs_available};
 use crate::app::file_watch::{FileWatch, is_same_file};
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
+use crate::app::scene_loader::{ReadyScene, SceneLoad};
 use crate::commands::session::{load_environment, load_images, load_scene, max_texture_side};
 use crate::envmap;
 use crate::gpu::shader_source;
 use crate::preset;
-use crate::scene::{EnvSource, Scene};
+use crate::scene::{EnvSource, OrbitCamera, Scene};
 use crate::texture::ImageSet;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
@@ -44,26 +45,56 @@ impl Viewer {
         }
     }
 
-    /// Replaces the scene with the preset at `path`; on failure the scene
-    /// stays as it was and the panel says why. Returns whether it loaded.
-    fn load_preset(&mut self, path: &Path) -> bool {
-        let max_side = max_texture_side(&self.ctx);
-        let loaded = match load_scene(path, None).map(|l| l.fit_environment(max_side)) {
-            Ok(loaded) => loaded,
-            Err(e) => {
-                self.panel.error(format!("{e:#}"));
-                return false;
-            }
+    /// Starts loading the preset at `path` on a worker thread; the scene
+    /// on screen stays until it has all loaded ([`Viewer::poll_loading`]).
+    fn load_preset(&mut self, path: &Path) {
+        self.start_loading(path, None);
+    }
+
+    /// Starts a load; `keep_view` is the camera to keep if the file's own
+    /// camera is the one the preset had (a reload after an outside edit).
+    fn start_loading(&mut self, path: &Path, keep_view: Option<KeepView>) {
+        let load = SceneLoad::start(path, max_texture_side(&self.ctx));
+        self.loading = Some((load, keep_view));
+    }
+
+    /// Installs a finished load, or says why it failed (the scene on
+    /// screen then stays as it was); shows the progress meanwhile.
+    pub(super) fn poll_loading(&mut self) {
+        let Some((load, _)) = &self.loading else {
+            self.panel.progress = None;
+            return;
         };
+        let Some(result) = load.poll() else {
+            let (stage, fraction) = load.progress();
+            self.panel.progress = Some((format!("{}: {stage}", load.path().display()), fraction));
+            return;
+        };
+        let (load, keep_view) = self.loading.take().expect("a load is under way");
+        self.panel.progress = None;
+        match result {
+            Ok(ready) => self.install_loaded(load.path(), ready, keep_view),
+            Err(e) => self.panel.error(format!("{e:#}")),
+        }
+    }
+
+    fn install_loaded(&mut self, path: &Path, ready: ReadyScene, keep_view: Option<KeepView>) {
+        let loaded = ready.loaded;
+        self.renderer.provide_geometry(ready.geometry);
         if let Err(e) = self.apply_scene(
             loaded.scene.clone(),
             loaded.env.as_ref(),
             Some(loaded.images.clone()),
         ) {
             self.panel.error(format!("{}: {e:#}", path.display()));
-            return false;
+            return;
         }
-        self.preset_camera = self.scene.camera;
+        if let Some(keep) = keep_view
+            && self.scene.camera == keep.preset_camera
+        {
+            self.scene.camera = keep.camera;
+        }
+        self.preset_camera = loaded.scene.camera;
         let description = preset::load(path)
             .map(|l| l.preset.description)
             .unwrap_or_default();
@@ -78,7 +109,6 @@ impl Viewer {
         }
         self.opened(path);
         self.start_watching();
-        true
     }
 
     /// Remembers `path` in the recent files (saved at once, so a crash
@@ -233,9 +263,7 @@ impl Viewer {
                     self.load_preset(&next);
                 }
             }
-            (Prompt::LoadPreset(next), Answer::Proceed) => {
-                self.load_preset(&next);
-            }
+            (Prompt::LoadPreset(next), Answer::Proceed) => self.load_preset(&next),
             (Prompt::Quit, Answer::SaveFirst) => {
                 if self.save_preset(&path) {
                     self.quit();
@@ -356,11 +384,12 @@ impl Viewer {
     /// Loads the preset file again after an outside edit, keeping the
     /// user's view unless the edit moved the camera.
     fn reload_from_disk(&mut self) {
-        let (camera, preset_camera) = (self.scene.camera, self.preset_camera);
+        let keep = KeepView {
+            camera: self.scene.camera,
+            preset_camera: self.preset_camera,
+        };
         let path = self.document.path.clone();
-        if self.load_preset(&path) && self.scene.camera == preset_camera {
-            self.scene.camera = camera;
-        }
+        self.start_loading(&path, Some(keep));
     }
 
     fn reload_shaders(&mut self) {
@@ -381,4 +410,13 @@ impl Viewer {
 /// The `shaders/` folder `--dev` reads: the source tree's.
 fn dev_shader_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")
+}
+
+/// The view to keep across a reload, unless the file moved the camera.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct KeepView {
+    /// The user's camera now.
+    camera: OrbitCamera,
+    /// The camera the preset had when loaded.
+    preset_camera: OrbitCamera,
 }

@@ -19,6 +19,7 @@ use super::file_watch::FileWatch;
 use super::history::History;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
+use super::scene_loader::SceneLoad;
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::{ViewerOptions, camera_input};
@@ -81,6 +82,8 @@ pub struct Viewer {
     prompt: Option<Prompt>,
     /// A native file dialog open on its thread.
     dialog: Option<OpenDialog>,
+    /// A preset loading on its thread, and the view to keep when it lands.
+    loading: Option<(SceneLoad, Option<files::KeepView>)>,
     /// The preset's folder, and `shaders/` in `--dev` mode, for hot reload.
     watch: Option<FileWatch>,
     shader_watch: Option<FileWatch>,
@@ -203,6 +206,7 @@ impl Viewer {
             autosave,
             prompt,
             dialog: None,
+            loading: None,
             watch: None,
             shader_watch: None,
             show_help: false,
@@ -444,6 +448,7 @@ impl Viewer {
         }
         self.poll_dialog();
         self.poll_file_watch();
+        self.poll_loading();
         let now = Instant::now();
         let dt = now.duration_since(self.last_frame).as_secs_f32();
         self.last_frame = now;

@@ -1,0 +1,110 @@
+//! Loading a preset on a worker thread, so that the window keeps drawing
+//! (the old scene, and a progress bar) while a big OBJ is parsed and its
+//! BVH built.
+//!
+//! The worker does everything that needs no GPU: the preset, the
+//! environment map (fitted to the GPU's largest texture), the meshes, the
+//! images, and the BVH ([`PreparedGeometry`]). The viewer then installs the
+//! result on the render thread in one go, or shows why it failed.
+
+use crate::commands::session::{LoadStage, LoadedScene, load_scene_reporting};
+use crate::gpu::mesh_buffers::PreparedGeometry;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, mpsc};
+
+/// A loaded scene with its BVH already built.
+pub struct ReadyScene {
+    pub loaded: LoadedScene,
+    pub geometry: PreparedGeometry,
+}
+
+/// The stage a worker is at: 0..LoadStage::COUNT for the loading stages,
+/// then the BVH.
+const BVH_STAGE: usize = LoadStage::COUNT;
+
+pub struct SceneLoad {
+    path: PathBuf,
+    stage: Arc<AtomicUsize>,
+    receiver: mpsc::Receiver<anyhow::Result<ReadyScene>>,
+}
+
+impl SceneLoad {
+    /// Starts loading `path`; the environment is fitted to `max_side`.
+    pub fn start(path: &Path, max_side: u32) -> Self {
+        let (sender, receiver) = mpsc::channel();
+        let stage = Arc::new(AtomicUsize::new(0));
+        let (worker_path, worker_stage) = (path.to_owned(), stage.clone());
+        std::thread::spawn(move || {
+            let result = load_scene_reporting(&worker_path, None, &mut |s| {
+                worker_stage.store(s.index(), Ordering::Relaxed);
+            })
+            .map(|loaded| {
+                let loaded = loaded.fit_environment(max_side);
+                worker_stage.store(BVH_STAGE, Ordering::Relaxed);
+                let geometry = PreparedGeometry::of(&loaded.scene);
+                ReadyScene { loaded, geometry }
+            });
+            // The viewer may have given up on this load: then nobody listens.
+            let _ = sender.send(result);
+        });
+        Self {
+            path: path.to_owned(),
+            stage,
+            receiver,
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// What the worker is doing, and the fraction of the stages done.
+    pub fn progress(&self) -> (&'static str, f32) {
+        let stage = self.stage.load(Ordering::Relaxed);
+        let label = match stage {
+            0 => LoadStage::Preset.label(),
+            1 => LoadStage::Environment.label(),
+            2 => LoadStage::Meshes.label(),
+            3 => LoadStage::Images.label(),
+            _ => "building the BVH",
+        };
+        (label, stage as f32 / (BVH_STAGE + 1) as f32)
+    }
+
+    /// The result once the worker is done.
+    pub fn poll(&self) -> Option<anyhow::Result<ReadyScene>> {
+        match self.receiver.try_recv() {
+            Ok(result) => Some(result),
+            Err(mpsc::TryRecvError::Empty) => None,
+            Err(mpsc::TryRecvError::Disconnected) => Some(Err(anyhow::anyhow!(
+                "{}: the loading thread stopped",
+                self.path.display()
+            ))),
+        }
+    }
+
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wait(load: SceneLoad) -> anyhow::Result<ReadyScene> {
+        load.receiver.recv().expect("the worker sends a result")
+    }
+
+    #[test]
+    fn loads_a_preset_with_its_meshes_off_the_thread() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/cornell.ron");
+        let ready = wait(SceneLoad::start(&path, 8192)).expect("cornell loads");
+        assert!(ready.loaded.scene.triangle_count() > 0);
+    }
+
+    #[test]
+    fn a_broken_preset_reports_the_file() {
+        let path = Path::new("no/such/preset.ron");
+        let error = wait(SceneLoad::start(path, 8192)).err().expect("fails");
+        assert!(format!("{error:#}").contains("no/such/preset.ron"), "{error:#}");
+    }
+}
