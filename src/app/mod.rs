@@ -65,7 +65,9 @@ impl ApplicationHandler for App {
         let (width, height) = settings.window_size.unwrap_or((1280, 720));
         let attributes = Window::default_attributes()
             .with_title("marbre")
-            .with_inner_size(winit::dpi::PhysicalSize::new(width.max(320), height.max(240)));
+            .with_inner_size(winit::dpi::PhysicalSize::new(width.max(320), height.max(240)))
+            // Room for the side panel, the Quality strip and some image.
+            .with_min_inner_size(winit::dpi::LogicalSize::new(640, 400));
         let options = self.options.clone();
         let result = event_loop
             .create_window(attributes)

@@ -42,6 +42,10 @@ const PANEL_WIDTH: f32 = 380.0;
 /// Height of the Quality strip under the image, in points, when the window
 /// opens.
 const QUALITY_HEIGHT: f32 = 190.0;
+/// The smallest window, in points, that shows the panels; a smaller one
+/// (shrunk by hand, or by a window manager ignoring the minimum size)
+/// shows the image alone.
+const MIN_UI_SIZE: egui::Vec2 = egui::vec2(PANEL_WIDTH + 240.0, QUALITY_HEIGHT + 160.0);
 
 pub struct Viewer {
     window: Arc<Window>,
@@ -403,7 +407,11 @@ impl Viewer {
         let mut answer = None;
         let output = self.egui_ctx.run_ui(raw_input, |ui| {
             pressed = shortcuts::pressed(ui.ctx());
-            if !ui_hidden {
+            // Too small a window for the panels (egui's layouts need room):
+            // show the image alone until it grows again.
+            let room = ui.max_rect().size();
+            let roomy = room.x >= MIN_UI_SIZE.x && room.y >= MIN_UI_SIZE.y;
+            if !ui_hidden && roomy {
                 egui::Panel::right("marbre-panel")
                     .default_size(PANEL_WIDTH)
                     .show(ui, |ui| {
