@@ -142,6 +142,34 @@ impl Session<'_> {
     }
 }
 
+/// Starts the viewer on `preset` and finds its window.
+fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard, Session<'a>) {
+    let cwd = dir.subdir("cwd");
+    let args: Vec<OsString> = vec!["--preset".into(), preset.into()];
+    let child = spawn_marbre(x, dir, &cwd, &args);
+    let found = xdotool(x, &["search", "--sync", "--onlyvisible", "--name", "^marbre$"]);
+    let window = String::from_utf8_lossy(&found.stdout)
+        .lines()
+        .next()
+        .unwrap_or_else(|| panic!("no marbre window; log:\n{}", marbre_log(dir)))
+        .to_owned();
+    let session = Session {
+        x,
+        window,
+        screenshots: cwd.join("screenshots"),
+        dir,
+    };
+    (child, session)
+}
+
+/// Neither a panic nor a GPU error the viewer did not catch in its log.
+fn assert_clean_log(dir: &TempDir) {
+    let log = marbre_log(dir);
+    for bad in ["panicked", "uncaptured GPU error", "Validation Error"] {
+        assert!(!log.contains(bad), "marbre's log has {bad:?}:\n{log}");
+    }
+}
+
 #[test]
 fn typed_path_slider_and_undo_show_on_the_pixels() {
     const TEST: &str = "typed_path_slider_and_undo_show_on_the_pixels";
@@ -150,26 +178,9 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
     let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
         return;
     };
-    let cwd = dir.subdir("cwd");
     let start = Path::new(REPO).join("tests/data/e2e/start.ron");
     let lit = Path::new(REPO).join("tests/data/e2e/lit.ron");
-    let args: Vec<OsString> = vec!["--preset".into(), start.into()];
-    let _child = spawn_marbre(&x, &dir, &cwd, &args);
-    let found = xdotool(
-        &x,
-        &["search", "--sync", "--onlyvisible", "--name", "^marbre$"],
-    );
-    let window = String::from_utf8_lossy(&found.stdout)
-        .lines()
-        .next()
-        .unwrap_or_else(|| panic!("no marbre window; log:\n{}", marbre_log(&dir)))
-        .to_owned();
-    let session = Session {
-        x: &x,
-        window,
-        screenshots: cwd.join("screenshots"),
-        dir: &dir,
-    };
+    let (_child, session) = open(&x, &dir, &start);
 
     let first = session.wait_for("the start scene (blue sky)", |l| {
         l.corner_luma > 0.2 && l.centre_blue_excess > 0.2
@@ -217,4 +228,28 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
         l.centre_luma > 0.6 && l.corner_luma < 0.02
     });
     println!("start {first:?}\nloaded {loaded:?}\ndark {dark:?}\nundone {undone:?}");
+    assert_clean_log(&dir);
+}
+
+/// Shrunk to 1×1 (as small as X allows; a minimised window reports 0×0,
+/// which the viewer skips the same way) and grown back, the window keeps
+/// rendering: no panic, no GPU validation error, the scene as before.
+#[test]
+fn shrinking_the_window_to_a_pixel_and_back_keeps_rendering() {
+    const TEST: &str = "shrinking_the_window_to_a_pixel_and_back_keeps_rendering";
+    let _serial = serial();
+    let dir = TempDir::new("e2e-resize");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let lit = Path::new(REPO).join("tests/data/e2e/lit.ron");
+    let (_child, session) = open(&x, &dir, &lit);
+    let lit_look = |l: &Look| l.corner_luma < 0.02 && l.centre_luma > 0.6;
+    session.wait_for("lit.ron", lit_look);
+    for (w, h) in [(1, 1), (200, 100), (1, 1), (1280, 720)] {
+        session.run(&["windowsize", &session.window, &w.to_string(), &h.to_string()]);
+        std::thread::sleep(Duration::from_secs(3));
+    }
+    session.wait_for("lit.ron after the resizes", lit_look);
+    assert_clean_log(&dir);
 }
