@@ -10,6 +10,7 @@ mod convergence;
 mod feature_costs;
 mod history;
 mod screenshots;
+pub mod soak;
 mod viewer;
 
 use anyhow::Result;
@@ -28,6 +29,9 @@ pub struct ViewerOptions {
     pub env: Option<PathBuf>,
     pub exit_after_frames: Option<u64>,
     pub window_screenshot: Option<PathBuf>,
+    /// Run as `marbre soak`: random edits driven frame by frame, memory
+    /// judged at the end.
+    pub soak: Option<soak::SoakOptions>,
 }
 
 struct App {
@@ -42,9 +46,17 @@ impl ApplicationHandler for App {
         if self.viewer.is_some() {
             return;
         }
+        // A soak is about what frames leave behind, not what they show: a
+        // smaller window keeps its many frames quick on a software
+        // rasteriser.
+        let (width, height) = if self.options.soak.is_some() {
+            (800, 500)
+        } else {
+            (1280, 720)
+        };
         let attributes = Window::default_attributes()
             .with_title("marbre")
-            .with_inner_size(winit::dpi::PhysicalSize::new(1280, 720));
+            .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
         let result = event_loop
             .create_window(attributes)
             .map_err(anyhow::Error::from)
