@@ -55,7 +55,7 @@ impl SoakOptions {
     /// A fifth of the run, at least 50 frames, at most 2000 and never more
     /// than half the run (the other half is what is judged).
     pub fn default_warm_up(frames: u64) -> u64 {
-        (frames / 5).max(50).min(2000).min(frames / 2)
+        (frames / 5).clamp(50, 2000).min(frames / 2)
     }
 
     /// Preset files from the command line: each argument a `.ron` file, or
@@ -149,7 +149,8 @@ impl SoakDriver {
             self.losses += 1;
             return SoakAction::LoseDevice;
         }
-        if !self.options.presets.is_empty() && frame > 0 && frame % self.load_interval == 0 {
+        if !self.options.presets.is_empty() && frame > 0 && frame.is_multiple_of(self.load_interval)
+        {
             let index = (self.loads % self.options.presets.len() as u64) as usize;
             self.loads += 1;
             self.env_map = None;

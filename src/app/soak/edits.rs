@@ -397,8 +397,10 @@ fn add_or_remove_sphere(rng: &mut Pcg32, scene: &mut Scene) -> bool {
     if scene.spheres.len() >= MAX_SPHERES || scene.materials().count() >= MAX_MATERIALS {
         return false;
     }
-    let mut material = Material::default();
-    material.diffuse = Texture::color(Vec3::new(rng.unit(), rng.unit(), rng.unit()));
+    let material = Material {
+        diffuse: Texture::color(Vec3::new(rng.unit(), rng.unit(), rng.unit())),
+        ..Material::default()
+    };
     scene.spheres.push(Sphere {
         name: SOAK_SPHERE.into(),
         center: Vec3::new(

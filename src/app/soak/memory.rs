@@ -80,4 +80,36 @@ mod tests {
         let rss = resident_set_bytes().expect("/proc/self/status has VmRSS");
         assert!(rss > 1 << 20, "RSS {rss} bytes");
     }
+
+    /// A new 16 MiB buffer is one more live object and at least 16 MiB
+    /// more allocated (lavapipe's Vulkan reports its allocator); dropping
+    /// it gives both back.
+    #[test]
+    fn a_buffer_shows_in_the_gpu_figures() {
+        let Some(ctx) = crate::gpu::testing::gpu_or_skip("a_buffer_shows_in_the_gpu_figures")
+        else {
+            return;
+        };
+        let settle = || {
+            let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+            sample_memory(&ctx)
+        };
+        let before = settle();
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("soak memory probe"),
+            size: 16 << 20,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let with = settle();
+        let resources = |s: MemorySample| s.gpu_resources.expect("wgpu-core reports its hub");
+        assert_eq!(resources(with), resources(before) + 1);
+        if let (Some(b), Some(w)) = (before.gpu_allocated_bytes, with.gpu_allocated_bytes) {
+            assert!(w >= b + (16 << 20), "allocated {b} → {w} bytes");
+        }
+        drop(buffer);
+        let after = settle();
+        assert_eq!(resources(after), resources(before));
+        assert_eq!(after.gpu_allocated_bytes, before.gpu_allocated_bytes);
+    }
 }

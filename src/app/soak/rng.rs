@@ -53,7 +53,7 @@ impl Pcg32 {
         if n == 0 {
             return 0;
         }
-        (u64::from(self.next_u32()) * n as u64 >> 32) as usize
+        ((u64::from(self.next_u32()) * n as u64) >> 32) as usize
     }
 
     /// True with probability `p`.
