@@ -116,6 +116,8 @@ pub struct SoakDriver {
     /// The current preset's environment map while the soak shows a
     /// constant sky instead.
     env_map: Option<EnvSource>,
+    /// The frame of the last call to `step`.
+    last_step: Option<u64>,
     samples: Vec<(u64, MemorySample)>,
 }
 
@@ -135,6 +137,7 @@ impl SoakDriver {
             parameter_edits: 0,
             structural_edits: [0; Structural::ALL.len()],
             env_map: None,
+            last_step: None,
             samples: Vec::new(),
         }
     }
@@ -145,6 +148,11 @@ impl SoakDriver {
     /// simulated device loss. An edit the renderer refuses is put back by
     /// the viewer, as any refused panel edit is.
     pub fn step(&mut self, frame: u64, scene: &mut Scene) -> SoakAction {
+        // A frame the viewer could not present (an outdated surface) comes
+        // round again with the same number: it gets no second action.
+        if self.last_step.replace(frame) == Some(frame) {
+            return SoakAction::Nothing;
+        }
         if frame == self.loss_frame {
             self.losses += 1;
             return SoakAction::LoseDevice;

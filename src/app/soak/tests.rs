@@ -199,6 +199,7 @@ fn step_is_deterministic_for_a_seed() {
             .collect::<Vec<_>>()
     };
     let (a, b, other) = (run(5), run(5), run(6));
+    assert!(a.iter().any(|(action, _)| *action != SoakAction::Nothing));
     assert!(a == b, "two runs with seed 5 differ");
     assert!(a != other, "seeds 5 and 6 made the same edits");
     assert!(a.iter().any(|(_, scene)| *scene != start));
@@ -254,4 +255,35 @@ fn ten_thousand_steps_make_every_edit_and_keep_the_scene_valid() {
             driver.structural_edits
         );
     }
+}
+
+/// A frame asked for twice (the viewer could not present it) gets its
+/// action once: a preset is not loaded twice, the device not lost twice.
+#[test]
+fn a_repeated_frame_gets_no_second_action() {
+    let options = SoakOptions {
+        presets: repo_presets(),
+        ..options(300, 100)
+    };
+    let mut driver = SoakDriver::new(&options);
+    let mut scene = Scene::default();
+    let mut actions = Vec::new();
+    for frame in 0..300 {
+        for _ in 0..2 {
+            let action = driver.step(frame, &mut scene);
+            if action != SoakAction::Nothing {
+                actions.push((frame, action));
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert_eq!(
+        actions,
+        [
+            (75, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[0]))),
+            (150, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[1]))),
+            (187, SoakAction::LoseDevice),
+            (225, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[2]))),
+        ]
+    );
 }
