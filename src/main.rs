@@ -4,7 +4,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use marbre::commands::{
-    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render,
+    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render, soak,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -61,6 +61,11 @@ enum Command {
     /// Time and error at increasing samples per pixel against a cached
     /// high-spp reference (default: the Cornell box at 512x512).
     BenchConvergence(convergence_bench::ConvergenceBenchArgs),
+    /// Run the viewer for many frames under seeded random edits, preset
+    /// loads and a simulated device loss; fail if memory (RSS, GPU bytes,
+    /// GPU objects) grows beyond a bound after the warm-up or wgpu reports
+    /// a validation error.
+    Soak(soak::SoakArgs),
 }
 
 fn main() -> ExitCode {
@@ -73,12 +78,14 @@ fn main() -> ExitCode {
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),
         Some(Command::BenchConvergence(args)) => convergence_bench::run(&args),
+        Some(Command::Soak(args)) => soak::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {
             preset: cli.viewer.preset,
             env: cli.viewer.env,
             exit_after_frames: cli.viewer.exit_after_frames,
             window_screenshot: cli.viewer.window_screenshot,
             dev: cli.viewer.dev,
+            soak: None,
         }),
     };
     match result {

@@ -19,6 +19,7 @@ mod scene_loader;
 mod screenshots;
 mod settings;
 mod shortcuts;
+pub mod soak;
 mod viewer;
 
 use anyhow::Result;
@@ -41,6 +42,9 @@ pub struct ViewerOptions {
     /// Read `shaders/` from the source tree and rebuild the trace pipeline
     /// when a file there changes.
     pub dev: bool,
+    /// Run as `marbre soak`: random edits driven frame by frame, memory
+    /// judged at the end.
+    pub soak: Option<soak::SoakOptions>,
 }
 
 struct App {
@@ -62,7 +66,14 @@ impl ApplicationHandler for App {
         if let Some(note) = note {
             log::warn!("{note}");
         }
-        let (width, height) = settings.window_size.unwrap_or((1280, 720));
+        // A soak is about what frames leave behind, not what they show: a
+        // smaller window keeps its many frames quick on a software
+        // rasteriser.
+        let (width, height) = if self.options.soak.is_some() {
+            (800, 500)
+        } else {
+            settings.window_size.unwrap_or((1280, 720))
+        };
         let attributes = Window::default_attributes()
             .with_title("marbre")
             .with_inner_size(winit::dpi::PhysicalSize::new(width.max(320), height.max(240)))

@@ -10,3 +10,4 @@ pub mod presets_bench;
 pub mod references;
 pub mod render;
 pub mod session;
+pub mod soak;

@@ -18,7 +18,7 @@ use super::renderer::Renderer;
 use crate::scene::Scene;
 use crate::texture::ImageSet;
 use anyhow::{Result, anyhow};
-use std::sync::{Arc, mpsc};
+use std::sync::{Arc, Condvar, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
 /// A built trace pipeline and the size of its WGSL.
@@ -52,46 +52,132 @@ impl WarmUp {
     }
 }
 
-/// A trace pipeline being built on a worker thread.
+/// The work of one build: an optional warm-up, then creating the pipeline.
+type BuildFn = Box<dyn FnOnce() -> Result<(wgpu::RenderPipeline, usize)> + Send>;
+
+/// A build waiting for the worker, and where its result goes.
+struct Job {
+    warm_up: Option<WarmUp>,
+    build: BuildFn,
+    sender: mpsc::Sender<Result<BuiltPipeline>>,
+    requested: Instant,
+}
+
+impl Job {
+    fn run(self) {
+        let result = (|| {
+            if let Some(warm_up) = self.warm_up {
+                warm_up.run()?;
+            }
+            let (pipeline, shader_bytes) = (self.build)()?;
+            Ok(BuiltPipeline {
+                pipeline,
+                shader_bytes,
+                took: self.requested.elapsed(),
+            })
+        })();
+        // The renderer may have moved on to another build: then nobody
+        // listens, and the result is dropped.
+        let _ = self.sender.send(result);
+    }
+}
+
+/// The next job for the worker, and whether its owner is gone.
+#[derive(Default)]
+struct Queue {
+    next: Option<Job>,
+    closed: bool,
+}
+
+/// One worker thread that builds trace pipelines one at a time, always the
+/// latest request: a request made while another waits replaces it (that
+/// one's result would be superseded anyway). A thread per request instead
+/// piled up threads, each with its own allocator arena, during a slider
+/// drag over a structural setting: the soak test measured RSS growing from
+/// 265 MiB to 1.1 GiB in 300 frames.
+pub struct PipelineBuilder {
+    queue: Arc<(Mutex<Queue>, Condvar)>,
+    worker_started: bool,
+}
+
+impl Default for PipelineBuilder {
+    fn default() -> Self {
+        Self {
+            queue: Arc::new((Mutex::new(Queue::default()), Condvar::new())),
+            worker_started: false,
+        }
+    }
+}
+
+impl PipelineBuilder {
+    /// Queues a build with `build` (which creates the pipeline on the
+    /// render device) after the optional warm-up, replacing any build not
+    /// yet started.
+    pub fn start(
+        &mut self,
+        warm_up: Option<WarmUp>,
+        build: impl FnOnce() -> Result<(wgpu::RenderPipeline, usize)> + Send + 'static,
+    ) -> PipelineBuild {
+        let (sender, receiver) = mpsc::channel();
+        let job = Job {
+            warm_up,
+            build: Box::new(build),
+            sender,
+            requested: Instant::now(),
+        };
+        let (lock, ready) = &*self.queue;
+        lock.lock().unwrap_or_else(|e| e.into_inner()).next = Some(job);
+        ready.notify_one();
+        if !self.worker_started {
+            self.worker_started = true;
+            let queue = self.queue.clone();
+            std::thread::spawn(move || work(&queue));
+        }
+        PipelineBuild { receiver }
+    }
+}
+
+impl Drop for PipelineBuilder {
+    fn drop(&mut self) {
+        let (lock, ready) = &*self.queue;
+        lock.lock().unwrap_or_else(|e| e.into_inner()).closed = true;
+        ready.notify_one();
+    }
+}
+
+/// The worker: runs the latest job until the builder is dropped.
+fn work(queue: &(Mutex<Queue>, Condvar)) {
+    let (lock, ready) = queue;
+    loop {
+        let job = {
+            let mut queue = lock.lock().unwrap_or_else(|e| e.into_inner());
+            loop {
+                if let Some(job) = queue.next.take() {
+                    break job;
+                }
+                if queue.closed {
+                    return;
+                }
+                queue = ready.wait(queue).unwrap_or_else(|e| e.into_inner());
+            }
+        };
+        job.run();
+    }
+}
+
+/// A trace pipeline being built on the builder's worker thread.
 pub struct PipelineBuild {
     receiver: mpsc::Receiver<Result<BuiltPipeline>>,
 }
 
 impl PipelineBuild {
-    /// Starts building, with `build` (which creates the pipeline on the
-    /// render device) after the optional warm-up.
-    pub fn start(
-        warm_up: Option<WarmUp>,
-        build: impl FnOnce() -> Result<(wgpu::RenderPipeline, usize)> + Send + 'static,
-    ) -> Self {
-        let (sender, receiver) = mpsc::channel();
-        let started = Instant::now();
-        std::thread::spawn(move || {
-            let result = (|| {
-                if let Some(warm_up) = warm_up {
-                    warm_up.run()?;
-                }
-                let (pipeline, shader_bytes) = build()?;
-                Ok(BuiltPipeline {
-                    pipeline,
-                    shader_bytes,
-                    took: started.elapsed(),
-                })
-            })();
-            // The renderer may have moved on to another build: then nobody
-            // listens, and the result is dropped.
-            let _ = sender.send(result);
-        });
-        Self { receiver }
-    }
-
     /// The result, if the build has finished.
     pub fn poll(&self) -> Option<Result<BuiltPipeline>> {
         match self.receiver.try_recv() {
             Ok(result) => Some(result),
             Err(mpsc::TryRecvError::Empty) => None,
             Err(mpsc::TryRecvError::Disconnected) => {
-                Some(Err(anyhow!("the shader build thread stopped")))
+                Some(Err(anyhow!("the shader build was dropped before it ran")))
             }
         }
     }
@@ -100,7 +186,7 @@ impl PipelineBuild {
     pub fn wait(&self) -> Result<BuiltPipeline> {
         self.receiver
             .recv()
-            .map_err(|_| anyhow!("the shader build thread stopped"))?
+            .map_err(|_| anyhow!("the shader build was dropped before it ran"))?
     }
 }
 
@@ -110,16 +196,52 @@ mod tests {
 
     /// A failed build reports its error through `poll` (the renderer then
     /// keeps its old pipeline); it never panics the render thread.
-    #[test]
-    fn a_failed_build_reports_its_error() {
-        let build = PipelineBuild::start(None, || Err(anyhow!("trace shader: no such function")));
-        let result = loop {
+    fn result_of(build: &PipelineBuild) -> Result<BuiltPipeline> {
+        loop {
             if let Some(result) = build.poll() {
                 break result;
             }
             std::thread::sleep(Duration::from_millis(1));
-        };
-        let message = format!("{:#}", result.err().expect("the build failed"));
+        }
+    }
+
+    /// A failed build reports its error through `poll` (the renderer then
+    /// keeps its old pipeline); it never panics the render thread.
+    #[test]
+    fn a_failed_build_reports_its_error() {
+        let mut builder = PipelineBuilder::default();
+        let build = builder.start(None, || Err(anyhow!("trace shader: no such function")));
+        let message = format!("{:#}", result_of(&build).err().expect("the build failed"));
         assert!(message.contains("no such function"), "{message}");
+    }
+
+    /// Requests made while one build runs: only the latest runs after it,
+    /// the ones in between are dropped unrun, and no thread is added.
+    #[test]
+    fn a_waiting_build_is_replaced_by_the_next_request() {
+        let mut builder = PipelineBuilder::default();
+        let (release, hold) = mpsc::channel::<()>();
+        let first = builder.start(None, move || {
+            hold.recv().ok();
+            Err(anyhow!("first"))
+        });
+        // Let the worker take the first job before queueing the others.
+        std::thread::sleep(Duration::from_millis(50));
+        let ran = Arc::new(Mutex::new(Vec::new()));
+        let job = |name: &'static str| {
+            let ran = ran.clone();
+            move || {
+                ran.lock().unwrap().push(name);
+                Err(anyhow!(name))
+            }
+        };
+        let second = builder.start(None, job("second"));
+        let third = builder.start(None, job("third"));
+        release.send(()).unwrap();
+        assert!(format!("{:#}", result_of(&first).err().unwrap()).contains("first"));
+        assert!(format!("{:#}", result_of(&third).err().unwrap()).contains("third"));
+        let dropped = format!("{:#}", result_of(&second).err().unwrap());
+        assert!(dropped.contains("dropped before it ran"), "{dropped}");
+        assert_eq!(*ran.lock().unwrap(), ["third"]);
     }
 }

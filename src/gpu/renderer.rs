@@ -11,7 +11,7 @@ use super::geometry_buffers::GeometryBuffers;
 use super::mesh_buffers::{MeshBuffers, MeshStats, PreparedGeometry};
 use super::non_finite::{self, NonFiniteCounter, NonFiniteCounts};
 use super::pass_timer::{Pass, PassTimer};
-use super::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
+use super::pipeline_build::{BuiltPipeline, PipelineBuild, PipelineBuilder, WarmUp};
 use super::pipelines::{
     compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
     storage, uniform, upload_atlas, upload_rgba16f, validate,
@@ -127,6 +127,8 @@ pub struct Renderer {
     scene: Scene,
     /// A structural edit whose pipeline is being built.
     pending: Option<PendingScene>,
+    /// The worker thread that builds trace pipelines, latest request first.
+    builder: PipelineBuilder,
     /// The device that warms the shader cache for builds (CPU adapters).
     warm_up: Option<Arc<GpuContext>>,
     last_build: Option<Duration>,
@@ -185,7 +187,8 @@ impl Renderer {
         let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace"),
             entries: &[
-                entry(0, uniform()),
+                // Storage, not uniform: see `frame` in shaders/scene.wgsl.
+                entry(0, storage(true)),
                 entry(GeometryBuffers::BINDINGS[0], uniform()),
                 entry(GeometryBuffers::BINDINGS[1], uniform()),
                 entry(GeometryBuffers::BINDINGS[2], uniform()),
@@ -197,7 +200,7 @@ impl Renderer {
                 ),
                 entry(5, float_texture(false)),
                 entry(6, uniform()),
-                entry(7, uniform()),
+                entry(7, storage(true)),
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
                 entry(16, float_texture(false)),
@@ -240,7 +243,7 @@ impl Renderer {
         let frame_buffer = buffer(
             "frame",
             bytemuck::bytes_of(&scene_gpu::frame_uniform(scene, size, 0, 0)),
-            wgpu::BufferUsages::UNIFORM,
+            wgpu::BufferUsages::STORAGE,
         );
         let display_buffer = buffer(
             "display",
@@ -257,7 +260,7 @@ impl Renderer {
         let texture_param_buffer = buffer(
             "texture parameters",
             bytemuck::cast_slice(&textures.params),
-            wgpu::BufferUsages::UNIFORM,
+            wgpu::BufferUsages::STORAGE,
         );
         let env_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
@@ -278,6 +281,7 @@ impl Renderer {
         Ok(Self {
             scene: scene.clone(),
             pending: None,
+            builder: PipelineBuilder::default(),
             warm_up: None,
             last_build: None,
             key,
@@ -473,7 +477,7 @@ impl Renderer {
         });
         let (device, layout) = (ctx.device.clone(), self.trace_layout.clone());
         let build_key = key.clone();
-        let build = PipelineBuild::start(warm_up, move || {
+        let build = self.builder.start(warm_up, move || {
             Self::build_trace_pipeline(&device, &layout, &build_key)
         });
         self.pending = Some(PendingScene { build, key, target });

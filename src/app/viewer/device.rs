@@ -39,9 +39,21 @@ impl Viewer {
         self.timer = PassTimer::new(&ctx);
         self.egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());
-        // The new egui renderer has no font atlas: rebuilding the fonts
-        // sends the whole atlas again with the next frame.
-        self.egui_ctx.set_fonts(egui::FontDefinitions::default());
+        // The new egui renderer has no textures, and egui only sends what
+        // changed: a new context (with the old one's memory: open
+        // sections, scroll, focus) sends the whole font atlas again.
+        let memory = self.egui_ctx.memory(|m| m.clone());
+        let egui_ctx = egui::Context::default();
+        egui_ctx.memory_mut(|m| *m = memory);
+        self.egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &self.window,
+            Some(self.window.scale_factor() as f32),
+            None,
+            Some(max_texture_side(&ctx) as usize),
+        );
+        self.egui_ctx = egui_ctx;
         self.ctx = ctx;
         self.panel.error(format!(
             "the GPU device was lost ({reason}); recreated it and every GPU resource from the scene"

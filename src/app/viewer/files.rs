@@ -47,7 +47,7 @@ impl Viewer {
 
     /// Starts loading the preset at `path` on a worker thread; the scene
     /// on screen stays until it has all loaded ([`Viewer::poll_loading`]).
-    fn load_preset(&mut self, path: &Path) {
+    pub(super) fn load_preset(&mut self, path: &Path) {
         self.start_loading(path, None);
     }
 

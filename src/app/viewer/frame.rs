@@ -253,6 +253,7 @@ impl Viewer {
         self.renderer.after_submit();
         self.record_feature_cost();
         self.ctx.queue.present(frame);
+        let soak_goes_on = self.soak_record()?;
         self.frames += 1;
         let controls = &self.panel.quality;
         if controls.screenshot_at_target
@@ -273,7 +274,7 @@ impl Viewer {
         if is_last {
             self.report_quality();
         }
-        Ok(!is_last)
+        Ok(!is_last && soak_goes_on)
     }
 
     fn take_screenshot(&mut self) {

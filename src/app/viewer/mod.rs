@@ -20,6 +20,7 @@ use super::history::History;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
 use super::scene_loader::SceneLoad;
+use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::{ViewerOptions, camera_input};
@@ -91,6 +92,8 @@ pub struct Viewer {
     /// The preset's folder, and `shaders/` in `--dev` mode, for hot reload.
     watch: Option<FileWatch>,
     shader_watch: Option<FileWatch>,
+    /// `marbre soak`: random edits each frame, memory judged at the end.
+    soak: Option<SoakDriver>,
     show_help: bool,
     ui_hidden: bool,
     /// The user chose to quit: the loop exits after this frame.
@@ -177,7 +180,10 @@ impl Viewer {
         let preset_camera = loaded.scene.camera;
         let history = History::new(&loaded.scene);
         let document = Document::new(&preset_path, description, &loaded.scene);
-        let scripted = options.exit_after_frames.is_some();
+        let scripted = options.exit_after_frames.is_some() || options.soak.is_some();
+        // A soak's thousands of edits are not the user's work: nothing of
+        // it is autosaved or remembered.
+        let config_dir = config_dir.filter(|_| options.soak.is_none());
         // A run that crashed left its unsaved edits: offer them first.
         let prompt = config_dir
             .as_deref()
@@ -185,6 +191,7 @@ impl Viewer {
             .and_then(recovery::pending_offer)
             .map(Prompt::Recover);
         let autosave = config_dir.clone().map(Autosave::new);
+        let soak = options.soak.as_ref().map(SoakDriver::new);
         let mut viewer = Self {
             history,
             timer,
@@ -213,6 +220,7 @@ impl Viewer {
             loading: None,
             watch: None,
             shader_watch: None,
+            soak,
             show_help: false,
             ui_hidden: false,
             quitting: false,
@@ -457,6 +465,7 @@ impl Viewer {
         self.poll_dialog();
         self.poll_file_watch();
         self.poll_loading();
+        self.soak_step()?;
         let now = Instant::now();
         let dt = now.duration_since(self.last_frame).as_secs_f32();
         self.last_frame = now;
@@ -480,7 +489,57 @@ impl Viewer {
             self.egui_renderer.free_texture(id);
         }
         self.autosave();
-        result.map(|go_on| go_on && !self.quitting)
+        let go_on = result? && !self.quitting;
+        if !go_on && !self.quitting {
+            // A scripted run's last frame: end as a quit would.
+            self.quit();
+        }
+        Ok(go_on)
+    }
+
+    /// Applies this frame's soak edit or action, if soaking.
+    fn soak_step(&mut self) -> Result<()> {
+        let Some(driver) = &mut self.soak else {
+            return Ok(());
+        };
+        match driver.step(self.frames, &mut self.scene) {
+            SoakAction::Nothing => {}
+            SoakAction::LoadPreset(path) => self.load_preset(&path),
+            SoakAction::LoseDevice => {
+                // As a driver reset would: the device goes, its loss is
+                // reported on the next poll, and the viewer recovers.
+                self.ctx.device.destroy();
+                let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+                let reason = self
+                    .device_watch
+                    .take_lost()
+                    .unwrap_or_else(|| "destroyed by the soak".to_owned());
+                self.recover_device(&reason)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// After a presented frame of a soak: its memory sample, and at the
+    /// end the verdict (an error fails the run). Whether to go on.
+    fn soak_record(&mut self) -> Result<bool> {
+        let Some(driver) = &mut self.soak else {
+            return Ok(true);
+        };
+        driver.record(self.frames, sample_memory(&self.ctx));
+        if !driver.finished(self.frames) {
+            return Ok(true);
+        }
+        match driver.verdict(self.device_watch.validation_errors()) {
+            Ok(report) => {
+                eprintln!("{report}");
+                Ok(false)
+            }
+            Err(report) => {
+                eprintln!("{report}");
+                anyhow::bail!("the soak failed (see above)")
+            }
+        }
     }
 
     /// Copies unsaved edits to the recovery file when it is time.
