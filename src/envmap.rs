@@ -41,6 +41,11 @@ pub const F16_MAX: f32 = 65504.0;
 /// The extensions [`load`] understands (lower case, without the dot).
 pub const SUPPORTED_EXTENSIONS: [&str; 5] = ["exr", "hdr", "png", "jpg", "jpeg"];
 
+/// The most texels [`load`] decodes: a 16k lat-long map (16384 x 8192,
+/// 2 GiB as RGBA f32). A header declaring more is refused before anything
+/// is allocated, so a corrupt file cannot exhaust memory.
+pub const MAX_TEXELS: u64 = 16384 * 8192;
+
 /// A lat-long environment map in linear radiance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvImage {
@@ -275,31 +280,29 @@ pub fn load(path: &Path) -> Result<EnvLoad, EnvMapError> {
 /// `decode` says: image textures holding data rather than colour are read
 /// with [`IntegerDecode::Linear`].
 pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapError> {
-    let extension = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if !SUPPORTED_EXTENSIONS.contains(&extension.as_str()) {
-        return Err(EnvMapError::UnsupportedExtension {
-            path: path.to_path_buf(),
-            extension,
-        });
-    }
+    // An unsupported type is refused before the file is read.
+    supported_extension(path)?;
     let bytes = std::fs::read(path).map_err(|cause| EnvMapError::Io {
         path: path.to_path_buf(),
         cause,
     })?;
+    decode_bytes(&bytes, path, decode)
+}
+
+/// [`load_with`] on the bytes of a file already read: `path` chooses the
+/// format by its extension and names the file in messages. The fuzz target
+/// and its regression tests decode through it without a file.
+pub fn decode_bytes(
+    bytes: &[u8],
+    path: &Path,
+    decode: IntegerDecode,
+) -> Result<EnvLoad, EnvMapError> {
+    let extension = supported_extension(path)?;
     let mut image = match extension.as_str() {
-        "exr" => decode_exr(path, &bytes)?,
-        "hdr" => decode_with_image(
-            path,
-            &bytes,
-            image::ImageFormat::Hdr,
-            "Radiance HDR",
-            decode,
-        )?,
-        "png" => decode_with_image(path, &bytes, image::ImageFormat::Png, "PNG", decode)?,
-        _ => decode_with_image(path, &bytes, image::ImageFormat::Jpeg, "JPEG", decode)?,
+        "exr" => decode_exr(path, bytes)?,
+        "hdr" => decode_with_image(path, bytes, image::ImageFormat::Hdr, "Radiance HDR", decode)?,
+        "png" => decode_with_image(path, bytes, image::ImageFormat::Png, "PNG", decode)?,
+        _ => decode_with_image(path, bytes, image::ImageFormat::Jpeg, "JPEG", decode)?,
     };
     if image.width == 0 || image.height == 0 || image.pixels.is_empty() {
         return Err(EnvMapError::Empty {
@@ -319,8 +322,52 @@ pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapEr
     })
 }
 
+/// The lower-case extension of `path`, if [`load`] reads it.
+fn supported_extension(path: &Path) -> Result<String, EnvMapError> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if SUPPORTED_EXTENSIONS.contains(&extension.as_str()) {
+        Ok(extension)
+    } else {
+        Err(EnvMapError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            extension,
+        })
+    }
+}
+
+/// Refuses an image of more than [`MAX_TEXELS`] texels.
+fn check_size(
+    path: &Path,
+    format: &'static str,
+    width: u64,
+    height: u64,
+) -> Result<(), EnvMapError> {
+    if width.saturating_mul(height) <= MAX_TEXELS {
+        return Ok(());
+    }
+    Err(EnvMapError::Decode {
+        path: path.to_path_buf(),
+        format,
+        message: format!(
+            "the image is {width}x{height}, more than the {MAX_TEXELS} texels (16384x8192) an environment map may have"
+        ),
+    })
+}
+
 fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvImage, EnvMapError> {
     use exr::prelude::*;
+
+    // Every layer's size, checked before the reader allocates for one; a
+    // header that does not parse is left to the reader to report.
+    if let Ok(meta) = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false) {
+        for header in &meta.headers {
+            let size = header.layer_size;
+            check_size(path, "OpenEXR", size.width() as u64, size.height() as u64)?;
+        }
+    }
 
     let rgba = read()
         .no_deep_data()
@@ -441,8 +488,12 @@ fn decode_with_image(
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(4 << 30);
     reader.limits(limits);
-    let decoded = reader.decode().map_err(|e| decode_err(e.to_string()))?;
-    let (width, height) = (decoded.width(), decoded.height());
+    let decoder = reader
+        .into_decoder()
+        .map_err(|e| decode_err(e.to_string()))?;
+    let (width, height) = image::ImageDecoder::dimensions(&decoder);
+    check_size(path, format_name, width.into(), height.into())?;
+    let decoded = D::from_decoder(decoder).map_err(|e| decode_err(e.to_string()))?;
 
     let pixels: Vec<[f32; 4]> = match &decoded {
         // Radiance HDR (and any other float source) is already linear.
