@@ -58,7 +58,19 @@ pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
         path: path.to_owned(),
         cause,
     })?;
-    let text = String::from_utf8_lossy(&bytes);
+    parse_bytes(&bytes, path, |library| std::fs::read(library))
+}
+
+/// Reads the bytes of an OBJ file. `path` names it in messages, and its
+/// folder resolves the material libraries (whose bytes `read_library`
+/// returns: the file system for [`load`], memory for the fuzz target and
+/// its regression tests) and their textures.
+pub fn parse_bytes(
+    bytes: &[u8],
+    path: &Path,
+    read_library: impl Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<LoadedObj, ObjError> {
+    let text = String::from_utf8_lossy(bytes);
     // tobj says what is wrong but not where, and panics on some malformed
     // statements: the syntax check runs first and names the line.
     if let Some((line, statement)) = obj_syntax::first_bad_obj_line(&text) {
@@ -79,7 +91,7 @@ pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
     let library_problem = std::cell::RefCell::new(None);
     let load_library = |name: &Path| {
         let mtl = mtl_folder.join(name);
-        let text = match std::fs::read(&mtl) {
+        let text = match read_library(&mtl) {
             Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
             Err(e) => {
                 *library_problem.borrow_mut() = Some(format!(

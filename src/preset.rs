@@ -168,11 +168,18 @@ pub fn load(path: &Path) -> Result<Loaded, PresetError> {
         path: path.to_owned(),
         cause,
     })?;
-    let text = String::from_utf8(bytes).map_err(|e| PresetError::NotText {
+    parse_bytes(&bytes, path)
+}
+
+/// Parses the bytes of a preset file: [`parse`] after the UTF-8 check that
+/// [`load`] makes, so the fuzz target and the regression tests reach it
+/// without a file.
+pub fn parse_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, PresetError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| PresetError::NotText {
         path: path.to_owned(),
-        offset: e.utf8_error().valid_up_to(),
+        offset: e.valid_up_to(),
     })?;
-    parse(&text, path)
+    parse(text, path)
 }
 
 /// Serialises a preset as it would be saved at `path`: paths inside it are

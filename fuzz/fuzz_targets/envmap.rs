@@ -1,0 +1,30 @@
+//! Environment maps: the first byte picks the file type (its low seven bits
+//! index `SUPPORTED_EXTENSIONS`, modulo its length) and, by its top bit, how
+//! 8- and 16-bit codes decode; the rest is the file. Decoded through
+//! `envmap::decode_bytes`, the decoder `envmap::load_with` uses, then the
+//! importance-sampling table the renderer builds from every map, and one
+//! sample drawn from it.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use marbre::env_sampling::EnvDistribution;
+use marbre::envmap::{IntegerDecode, SUPPORTED_EXTENSIONS, decode_bytes};
+use std::path::PathBuf;
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&selector, file)) = data.split_first() else {
+        return;
+    };
+    let extension = SUPPORTED_EXTENSIONS[usize::from(selector & 0x7f) % SUPPORTED_EXTENSIONS.len()];
+    let decode = if selector & 0x80 == 0 {
+        IntegerDecode::Srgb
+    } else {
+        IntegerDecode::Linear
+    };
+    let path = PathBuf::from(format!("/fuzz/envmaps/input.{extension}"));
+    if let Ok(loaded) = decode_bytes(file, &path, decode) {
+        let distribution = EnvDistribution::new(&loaded.image);
+        let (t, _) = distribution.sample(0.5, 0.5);
+        distribution.pdf_texel_uv(t);
+    }
+});
