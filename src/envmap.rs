@@ -427,13 +427,7 @@ pub fn decode_bytes(
             choice_note = note;
             image
         }
-        "hdr" => decode_with_image(
-            path,
-            bytes,
-            image::ImageFormat::Hdr,
-            "Radiance HDR",
-            decode,
-        )?,
+        "hdr" => decode_with_image(path, bytes, image::ImageFormat::Hdr, "Radiance HDR", decode)?,
         "png" => decode_with_image(path, bytes, image::ImageFormat::Png, "PNG", decode)?,
         _ => decode_with_image(path, bytes, image::ImageFormat::Jpeg, "JPEG", decode)?,
     };

@@ -21,8 +21,8 @@ mod xvfb;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 use std::sync::Mutex;
+use std::time::{Duration, Instant};
 use xvfb::{TempDir, display_or_skip, marbre_log, spawn_marbre, xdotool};
 
 /// One window at a time: on a software rasteriser two would only slow
@@ -157,7 +157,10 @@ fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard,
     let cwd = dir.subdir("cwd");
     let args: Vec<OsString> = vec!["--preset".into(), preset.into()];
     let child = spawn_marbre(x, dir, &cwd, &args);
-    let found = xdotool(x, &["search", "--sync", "--onlyvisible", "--name", "^marbre$"]);
+    let found = xdotool(
+        x,
+        &["search", "--sync", "--onlyvisible", "--name", "^marbre$"],
+    );
     let window = String::from_utf8_lossy(&found.stdout)
         .lines()
         .next()
@@ -257,7 +260,12 @@ fn shrinking_the_window_to_a_pixel_and_back_keeps_rendering() {
     let lit_look = |l: &Look| l.corner_luma < 0.02 && l.centre_luma > 0.6;
     session.wait_for("lit.ron", lit_look);
     for (w, h) in [(1, 1), (200, 100), (1, 1), (1280, 720)] {
-        session.run(&["windowsize", &session.window, &w.to_string(), &h.to_string()]);
+        session.run(&[
+            "windowsize",
+            &session.window,
+            &w.to_string(),
+            &h.to_string(),
+        ]);
         std::thread::sleep(Duration::from_secs(3));
     }
     session.wait_for("lit.ron after the resizes", lit_look);

@@ -23,9 +23,9 @@ pub mod soak;
 mod viewer;
 
 use anyhow::Result;
+use settings::Settings;
 use std::path::PathBuf;
 use std::sync::Arc;
-use settings::Settings;
 use viewer::Viewer;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -76,7 +76,10 @@ impl ApplicationHandler for App {
         };
         let attributes = Window::default_attributes()
             .with_title("marbre")
-            .with_inner_size(winit::dpi::PhysicalSize::new(width.max(320), height.max(240)))
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                width.max(320),
+                height.max(240),
+            ))
             // Room for the side panel, the Quality strip and some image.
             .with_min_inner_size(winit::dpi::LogicalSize::new(640, 400));
         let options = self.options.clone();

@@ -93,7 +93,12 @@ impl Autosave {
     /// Called every frame: writes `preset` (the scene with unsaved edits,
     /// from `source`) when the interval has passed and it changed since
     /// the last write; removes the file when there is nothing unsaved.
-    pub fn tick(&mut self, dirty: bool, source: &Path, preset: impl FnOnce() -> Preset) -> anyhow::Result<()> {
+    pub fn tick(
+        &mut self,
+        dirty: bool,
+        source: &Path,
+        preset: impl FnOnce() -> Preset,
+    ) -> anyhow::Result<()> {
         if !dirty {
             if self.written.take().is_some() {
                 discard(&self.dir);
@@ -168,13 +173,19 @@ mod tests {
         let mut autosave = Autosave::new(dir.root().to_owned());
         let mut edited = Preset::default();
         edited.scene.render.exposure = 3.0;
-        autosave.tick(true, Path::new("a.ron"), || edited.clone()).unwrap();
+        autosave
+            .tick(true, Path::new("a.ron"), || edited.clone())
+            .unwrap();
         assert!(!preset_file(dir.root()).exists(), "not before the interval");
         autosave.last_write -= AUTOSAVE_INTERVAL;
-        autosave.tick(true, Path::new("a.ron"), || edited.clone()).unwrap();
+        autosave
+            .tick(true, Path::new("a.ron"), || edited.clone())
+            .unwrap();
         let saved = preset::load(&preset_file(dir.root())).unwrap().preset;
         assert_eq!(saved.scene.render.exposure, 3.0);
-        autosave.tick(false, Path::new("a.ron"), || unreachable!()).unwrap();
+        autosave
+            .tick(false, Path::new("a.ron"), || unreachable!())
+            .unwrap();
         assert!(!preset_file(dir.root()).exists(), "clean again: removed");
     }
 }

@@ -83,7 +83,6 @@ impl SceneLoad {
             ))),
         }
     }
-
 }
 
 #[cfg(test)]
@@ -105,6 +104,9 @@ mod tests {
     fn a_broken_preset_reports_the_file() {
         let path = Path::new("no/such/preset.ron");
         let error = wait(SceneLoad::start(path, 8192)).err().expect("fails");
-        assert!(format!("{error:#}").contains("no/such/preset.ron"), "{error:#}");
+        assert!(
+            format!("{error:#}").contains("no/such/preset.ron"),
+            "{error:#}"
+        );
     }
 }

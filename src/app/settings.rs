@@ -49,7 +49,9 @@ impl Settings {
         let path = Self::file(dir);
         let text = match std::fs::read_to_string(&path) {
             Ok(text) => text,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return (Settings::default(), None),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return (Settings::default(), None);
+            }
             Err(e) => {
                 let note = format!("{}: {e}; using default settings", path.display());
                 return (Settings::default(), Some(note));
@@ -71,8 +73,7 @@ impl Settings {
     pub fn save(&self, dir: &Path) -> anyhow::Result<()> {
         let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())?;
         let path = Self::file(dir);
-        write_atomic(&path, text.as_bytes())
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+        write_atomic(&path, text.as_bytes()).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
     }
 
     /// Puts `path` first in the recent files (once), forgetting the oldest

@@ -38,12 +38,20 @@ pub fn pressed(ctx: &egui::Context) -> Vec<Shortcut> {
         take(Modifiers::NONE, Key::Escape, Shortcut::Close);
         take(Modifiers::NONE, Key::F12, Shortcut::Screenshot);
         // The shifted shortcuts first: Ctrl+S would also match Ctrl+Shift+S.
-        take(Modifiers::COMMAND | Modifiers::SHIFT, Key::S, Shortcut::SaveAs);
+        take(
+            Modifiers::COMMAND | Modifiers::SHIFT,
+            Key::S,
+            Shortcut::SaveAs,
+        );
         take(Modifiers::COMMAND, Key::S, Shortcut::Save);
         if typing {
             return pressed;
         }
-        take(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z, Shortcut::Redo);
+        take(
+            Modifiers::COMMAND | Modifiers::SHIFT,
+            Key::Z,
+            Shortcut::Redo,
+        );
         take(Modifiers::COMMAND, Key::Y, Shortcut::Redo);
         take(Modifiers::COMMAND, Key::Z, Shortcut::Undo);
         take(Modifiers::COMMAND, Key::O, Shortcut::Open);

@@ -200,7 +200,11 @@ impl MeshBuffers {
         };
         self.key = prepared.key;
         self.emitters = prepared.emitters;
-        self.nodes = storage_buffer(device, "bvh nodes", bytemuck::cast_slice(&prepared.bvh.nodes));
+        self.nodes = storage_buffer(
+            device,
+            "bvh nodes",
+            bytemuck::cast_slice(&prepared.bvh.nodes),
+        );
         self.triangles = storage_buffer(
             device,
             "mesh triangles",

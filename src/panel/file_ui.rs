@@ -46,7 +46,9 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
     ui.horizontal(|ui| {
         if ui
             .button("Save")
-            .on_hover_text("Overwrite the preset file the scene was loaded from or last saved to (Ctrl+S)")
+            .on_hover_text(
+                "Overwrite the preset file the scene was loaded from or last saved to (Ctrl+S)",
+            )
             .clicked()
         {
             actions.push(PanelAction::SavePreset);
@@ -112,9 +114,10 @@ fn recent_menu(ui: &mut Ui, state: &PanelState, actions: &mut Vec<PanelAction>) 
     ui.add_enabled_ui(!state.recent_files.is_empty(), |ui| {
         ui.menu_button("Recent", |ui| {
             for path in &state.recent_files {
-                let name = path
-                    .file_name()
-                    .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into());
+                let name = path.file_name().map_or_else(
+                    || path.display().to_string(),
+                    |n| n.to_string_lossy().into(),
+                );
                 if ui
                     .button(name)
                     .on_hover_text(path.display().to_string())

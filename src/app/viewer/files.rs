@@ -277,7 +277,7 @@ impl Viewer {
         // Declining a recovery deletes it; so does accepting it once the
         // scene is back (it is autosaved again while unsaved).
         if let Some(dir) = &self.config_dir
-            && matches!(self.prompt, None)
+            && self.prompt.is_none()
             && recovery::pending_offer(dir).is_some()
         {
             recovery::discard(dir);
@@ -396,8 +396,10 @@ impl Viewer {
         let dir = dev_shader_dir();
         match shader_source::load_dev_sources(&dir) {
             Ok(generation) => {
-                self.panel
-                    .info(format!("shaders reloaded from {} (#{generation})", dir.display()));
+                self.panel.info(format!(
+                    "shaders reloaded from {} (#{generation})",
+                    dir.display()
+                ));
                 if let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
                     self.panel.error(format!("{e:#}"));
                 }

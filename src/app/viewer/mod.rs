@@ -20,9 +20,9 @@ use super::history::History;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
 use super::scene_loader::SceneLoad;
-use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
+use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::{ViewerOptions, camera_input};
 use crate::commands::session::{DEFAULT_PRESET, load_scene, max_texture_side, renderer_for};
 use crate::gpu::pass_timer::PassTimer;
@@ -163,7 +163,8 @@ impl Viewer {
             None,
             Some(ctx.device.limits().max_texture_dimension_2d as usize),
         );
-        let egui_renderer = egui_wgpu::Renderer::new(&ctx.device, config.format, Default::default());
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&ctx.device, config.format, Default::default());
         let env_path = match &loaded.scene.environment.source {
             EnvSource::LatLong { path } => path.display().to_string(),
             _ => String::new(),
@@ -247,14 +248,12 @@ impl Viewer {
             .consumed;
         match event {
             WindowEvent::CloseRequested => self.request_quit(),
-            WindowEvent::Resized(size) => {
-                // A minimised window has zero size: keep the last valid
-                // configuration, and draw nothing until it comes back.
-                if size.width > 0 && size.height > 0 {
-                    self.config.width = size.width;
-                    self.config.height = size.height;
-                    self.surface.configure(&self.ctx.device, &self.config);
-                }
+            // A minimised window has zero size: keep the last valid
+            // configuration, and draw nothing until it comes back.
+            WindowEvent::Resized(size) if size.width > 0 && size.height > 0 => {
+                self.config.width = size.width;
+                self.config.height = size.height;
+                self.surface.configure(&self.ctx.device, &self.config);
             }
             WindowEvent::DroppedFile(path) => self.load_dropped(path),
             WindowEvent::KeyboardInput {
@@ -293,7 +292,7 @@ impl Viewer {
         if let Some(autosave) = &mut self.autosave {
             autosave.finish();
         }
-        if !self.window.fullscreen().is_some() {
+        if self.window.fullscreen().is_none() {
             let size = self.window.inner_size();
             self.settings.window_size = Some((size.width, size.height));
         }
@@ -321,9 +320,11 @@ impl Viewer {
         };
         match restored {
             Some(scene) => self.scene = scene,
-            None => self
-                .panel
-                .info(if undo { "nothing to undo" } else { "nothing to redo" }),
+            None => self.panel.info(if undo {
+                "nothing to undo"
+            } else {
+                "nothing to redo"
+            }),
         }
     }
 
@@ -337,7 +338,9 @@ impl Viewer {
                 PanelAction::SavePresetAs(p) => {
                     self.save_preset(&p);
                 }
-                PanelAction::BrowsePreset => self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset),
+                PanelAction::BrowsePreset => {
+                    self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset)
+                }
                 PanelAction::BrowseSavePresetAs => {
                     self.open_dialog(super::file_dialogs::DialogPurpose::SavePresetAs)
                 }
@@ -406,7 +409,9 @@ impl Viewer {
         self.panel.can_undo = self.history.can_undo();
         self.panel.can_redo = self.history.can_redo();
         self.panel.unsaved = self.document.is_dirty(&self.scene);
-        self.panel.recent_files.clone_from(&self.settings.recent_files);
+        self.panel
+            .recent_files
+            .clone_from(&self.settings.recent_files);
         let preset_name = self.document_name();
         let (scene, panel_state) = (&mut self.scene, &mut self.panel);
         let (prompt, ui_hidden) = (&self.prompt, self.ui_hidden);
@@ -428,8 +433,8 @@ impl Viewer {
                         egui::ScrollArea::vertical()
                             .auto_shrink([false; 2])
                             .show(ui, |ui| {
-                            actions = panel::draw(ui, scene, panel_state, &stats);
-                        });
+                                actions = panel::draw(ui, scene, panel_state, &stats);
+                            });
                     });
                 egui::Panel::bottom("marbre-quality")
                     .resizable(true)
@@ -556,10 +561,10 @@ impl Viewer {
 
     /// The preset's file name, for prompts.
     fn document_name(&self) -> String {
-        self.document
-            .path
-            .file_name()
-            .map_or_else(|| "The scene".to_owned(), |n| n.to_string_lossy().into_owned())
+        self.document.path.file_name().map_or_else(
+            || "The scene".to_owned(),
+            |n| n.to_string_lossy().into_owned(),
+        )
     }
 }
 
