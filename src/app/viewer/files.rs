@@ -111,10 +111,16 @@ impl Viewer {
         self.start_watching();
     }
 
-    /// Remembers `path` in the recent files (saved at once, so a crash
-    /// keeps the list).
+    /// Remembers `path` in the recent files, and a preset as the one to
+    /// open next time (saved at once, so a crash keeps them).
     pub(super) fn opened(&mut self, path: &Path) {
         self.settings.remember(path);
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ron"))
+        {
+            self.settings.last_preset = self.settings.recent_files.first().cloned();
+        }
         self.save_settings();
     }
 

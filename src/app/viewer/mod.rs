@@ -115,7 +115,17 @@ fn startup_preset(options: &ViewerOptions, settings: &Settings) -> PathBuf {
         .last_preset
         .clone()
         .filter(|p| p.is_file())
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_PRESET))
+        .unwrap_or_else(default_preset)
+}
+
+/// The default preset: in the working folder (a checkout, as the README
+/// runs it), else in the source tree this binary was built from.
+fn default_preset() -> PathBuf {
+    let local = PathBuf::from(DEFAULT_PRESET);
+    if local.is_file() {
+        return local;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_PRESET)
 }
 
 impl Viewer {
@@ -131,9 +141,9 @@ impl Viewer {
             Ok(loaded) => loaded,
             // The last session's preset no longer loads: say why, and
             // start on the default one rather than not at all.
-            Err(e) if options.preset.is_none() && preset_path != Path::new(DEFAULT_PRESET) => {
+            Err(e) if options.preset.is_none() && preset_path != default_preset() => {
                 startup_notes.push(format!("{e:#}; opened the default preset instead"));
-                preset_path = PathBuf::from(DEFAULT_PRESET);
+                preset_path = default_preset();
                 load_scene(&preset_path, options.env.as_deref())?
             }
             Err(e) => return Err(e),
