@@ -95,15 +95,24 @@ struct Polygon {
     uv_v: vec3f,
 }
 
-// The frame's settings and the texture parameters below are read at
-// constant offsets, many in branch and loop conditions: from a uniform
-// buffer, Mesa 22's lavapipe inlines such values into the shader and
-// compiles a new variant at every draw after a buffer changed, never
-// freeing the old ones (measured: 5 MB of JIT code a frame, RSS past 1 GiB
-// in 300 frames of the soak test, on any scene whose shader is small
-// enough to qualify). Storage buffers are never inlined; a constant offset
-// is one broadcast load from either.
-@group(0) @binding(0) var<storage, read> frame: Frame;
+// The frame's settings, in a uniform buffer of two slots (the second a
+// copy of the first), read through an index that is 0 at run time but not
+// a constant to the compiler (`frame_slot`). Mesa 22's lavapipe inlines
+// uniform values read at constant offsets in loop and branch conditions
+// into the shader and compiles a new variant for every command buffer,
+// never freeing the old ones: 5 MB of JIT code a frame (RSS past 1 GiB in
+// 300 frames of the soak test) on any scene whose shader it picks. Read at
+// a uniform but non-constant offset they are not inlined, and still
+// uniform to llvmpipe (a storage buffer stopped the leak too, but made
+// loops on them divergent: frames 1.4x slower).
+@group(0) @binding(0) var<uniform> frame_slots: array<Frame, 2>;
+// The settings, copied from `frame_slots` once per invocation (`fs_trace`).
+var<private> frame: Frame;
+
+// The slot holding the frame's settings: 0, computed from a uniform.
+fn frame_slot() -> u32 {
+    return u32(frame_slots[0].opaque_one) - 1u;
+}
 // Uniform arrays of fixed size (Rust: scene::MAX_SPHERES). Lanes of one SIMD
 // group read different elements; lavapipe does that far faster from a
 // uniform buffer than from a storage buffer (measured: 14 % of the frame).
@@ -115,9 +124,8 @@ const MAX_SPHERES: u32 = 63u;
 @group(0) @binding(9) var<uniform> cylinders: array<Cylinder, 8>;
 @group(0) @binding(10) var<uniform> polygons: array<Polygon, 16>;
 // The numbers of the scene's texture trees, read at constant indices by the
-// generated texture functions (Rust: gpu::texture_codegen); a storage
-// buffer, like `frame`, so that lavapipe does not inline them.
-@group(0) @binding(7) var<storage, read> texture_params: array<vec4f, 1024>;
+// generated texture functions (Rust: gpu::texture_codegen).
+@group(0) @binding(7) var<uniform> texture_params: array<vec4f, 1024>;
 
 #if IMAGE
 // Every image of the scene with its mip levels (Rust: texture::ImageAtlas),

@@ -258,6 +258,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
 
 @fragment
 fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
+    frame = frame_slots[frame_slot()];
     let pixel = vec2u(position.xy);
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);

@@ -187,8 +187,8 @@ impl Renderer {
         let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace"),
             entries: &[
-                // Storage, not uniform: see `frame` in shaders/scene.wgsl.
-                entry(0, storage(true)),
+                // Two slots: see `frame_slots` in shaders/scene.wgsl.
+                entry(0, uniform()),
                 entry(GeometryBuffers::BINDINGS[0], uniform()),
                 entry(GeometryBuffers::BINDINGS[1], uniform()),
                 entry(GeometryBuffers::BINDINGS[2], uniform()),
@@ -200,7 +200,7 @@ impl Renderer {
                 ),
                 entry(5, float_texture(false)),
                 entry(6, uniform()),
-                entry(7, storage(true)),
+                entry(7, uniform()),
                 entry(8, float_texture(false)),
                 entry(11, storage(true)),
                 entry(16, float_texture(false)),
@@ -242,8 +242,8 @@ impl Renderer {
         };
         let frame_buffer = buffer(
             "frame",
-            bytemuck::bytes_of(&scene_gpu::frame_uniform(scene, size, 0, 0)),
-            wgpu::BufferUsages::STORAGE,
+            bytemuck::cast_slice(&[scene_gpu::frame_uniform(scene, size, 0, 0); 2]),
+            wgpu::BufferUsages::UNIFORM,
         );
         let display_buffer = buffer(
             "display",
@@ -260,7 +260,7 @@ impl Renderer {
         let texture_param_buffer = buffer(
             "texture parameters",
             bytemuck::cast_slice(&textures.params),
-            wgpu::BufferUsages::STORAGE,
+            wgpu::BufferUsages::UNIFORM,
         );
         let env_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
@@ -711,7 +711,7 @@ impl Renderer {
         uniform.light_total_power = table.total_power;
         uniform.triangle_count = self.meshes.stats().triangles as u32;
         ctx.queue
-            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
+            .write_buffer(&self.frame_buffer, 0, bytemuck::cast_slice(&[uniform; 2]));
         let (previous_mean, previous_spread) = self.accumulation.latest_views();
         let mut entries = vec![
             bind(0, self.frame_buffer.as_entire_binding()),
