@@ -21,18 +21,8 @@ mod xvfb;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
-use xvfb::{TempDir, display_or_skip, marbre_log, spawn_marbre, xdotool};
-
-/// One window at a time: on a software rasteriser two would only slow
-/// each other past the timeouts.
-static SERIAL: Mutex<()> = Mutex::new(());
-
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    // A failed test poisons the lock; the next one may still run.
-    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
-}
+use xvfb::{TempDir, display_or_skip, marbre_log, serial, spawn_marbre, xdotool};
 
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 

@@ -15,18 +15,17 @@
 //! Each test starts its own Xvfb and skips loudly without it, `xdotool` or
 //! a GPU adapter (see `xvfb`).
 //!
-//! The tests run one at a time (see `SERIAL`): on a software rasteriser each
+//! The tests run one at a time (`xvfb::serial`): on a software rasteriser each
 //! frame takes about a second of every core, and two windows at once would
 //! only make both slower and the timeouts less meaningful.
 
 mod xvfb;
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use xvfb::{
-    Guard, TempDir, Xvfb, assert_success, display_or_skip, marbre_log, spawn_marbre, wait_for_exit,
-    xdotool,
+    Guard, TempDir, Xvfb, assert_success, display_or_skip, marbre_log, serial, spawn_marbre,
+    wait_for_exit, xdotool,
 };
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -34,13 +33,6 @@ const REPO: &str = env!("CARGO_MANIFEST_DIR");
 /// on lavapipe with two cores (first frame a few seconds more for shader
 /// compilation); this leaves several times that.
 const CHILD_TIMEOUT: Duration = Duration::from_secs(120);
-
-static SERIAL: Mutex<()> = Mutex::new(());
-
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    // A failed test poisons the lock; the next one may still run.
-    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 // ---------------------------------------------------------------------------
 // Pixel statistics.

@@ -259,8 +259,10 @@ static DEV_SOURCES: std::sync::RwLock<Option<DevSources>> = std::sync::RwLock::n
 
 /// Reads every shader file from `dir` (the repository's `shaders/`), to be
 /// used instead of the embedded copies from now on; returns the new
-/// generation. On error nothing changes.
-pub fn load_dev_sources(dir: &std::path::Path) -> anyhow::Result<u64> {
+/// generation, or `None` when the text is what was loaded last (reading
+/// the files is itself a file event to a watcher). On error nothing
+/// changes.
+pub fn load_dev_sources(dir: &std::path::Path) -> anyhow::Result<Option<u64>> {
     let mut files = Vec::with_capacity(SOURCES.len());
     for (name, _) in SOURCES {
         let path = dir.join(name);
@@ -269,9 +271,12 @@ pub fn load_dev_sources(dir: &std::path::Path) -> anyhow::Result<u64> {
         files.push((*name, text));
     }
     let mut dev = DEV_SOURCES.write().unwrap_or_else(|e| e.into_inner());
+    if dev.as_ref().is_some_and(|d| d.files == files) {
+        return Ok(None);
+    }
     let generation = dev.as_ref().map_or(1, |d| d.generation + 1);
     *dev = Some(DevSources { files, generation });
-    Ok(generation)
+    Ok(Some(generation))
 }
 
 /// Which sources [`assemble`] reads: 0 for the embedded ones, else the

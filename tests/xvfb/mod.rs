@@ -18,10 +18,20 @@ use std::io::{BufRead, BufReader};
 use std::os::unix::fs::DirBuilderExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::mpsc;
+use std::sync::{Mutex, MutexGuard, mpsc};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 const BIN: &str = env!("CARGO_BIN_EXE_marbre");
+
+static SERIAL: Mutex<()> = Mutex::new(());
+
+/// One window at a time within a test binary: on a software rasteriser
+/// each frame takes about a second of every core, and two windows at once
+/// would only make both slower and the timeouts less meaningful.
+pub fn serial() -> MutexGuard<'static, ()> {
+    // A failed test poisons the lock; the next one may still run.
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 /// A private temporary folder, removed on drop unless the test failed (then
 /// its path is printed so the logs and images can be inspected).

@@ -353,6 +353,8 @@ impl Viewer {
                         "--dev: editing a shader in {} rebuilds the trace pipeline",
                         shaders.display()
                     ));
+                    // The source tree may differ from what was built in.
+                    self.reload_shaders();
                 }
                 Err(e) => self.panel.error(format!("shader hot reload is off: {e:#}")),
             }
@@ -401,7 +403,8 @@ impl Viewer {
     fn reload_shaders(&mut self) {
         let dir = dev_shader_dir();
         match shader_source::load_dev_sources(&dir) {
-            Ok(generation) => {
+            Ok(None) => {}
+            Ok(Some(generation)) => {
                 self.panel.info(format!(
                     "shaders reloaded from {} (#{generation})",
                     dir.display()
