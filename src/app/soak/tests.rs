@@ -287,3 +287,38 @@ fn a_repeated_frame_gets_no_second_action() {
         ]
     );
 }
+
+#[test]
+fn progress_is_printed_after_each_tenth_but_not_at_the_end() {
+    let driver = SoakDriver::new(&options(1000, 200));
+    let lines: Vec<(u64, String)> = (0..1000)
+        .filter_map(|frame| {
+            driver
+                .progress_line(frame, &flat(frame))
+                .map(|l| (frame, l))
+        })
+        .collect();
+    let frames: Vec<u64> = lines.iter().map(|(f, _)| *f).collect();
+    assert_eq!(frames, [99, 199, 299, 399, 499, 599, 699, 799, 899]);
+    assert_eq!(
+        lines[0].1,
+        "soak: frame 100 of 1000: RSS 300.0 MiB, GPU 100.0 MiB in 200 objects"
+    );
+    let unmeasured = MemorySample {
+        rss_bytes: 0,
+        gpu_allocated_bytes: None,
+        gpu_resources: Some(7),
+    };
+    assert_eq!(
+        driver.progress_line(499, &unmeasured).as_deref(),
+        Some("soak: frame 500 of 1000: RSS 0.0 MiB, 7 GPU objects")
+    );
+    let tiny = SoakDriver::new(&options(5, 2));
+    assert_eq!(
+        (0..5)
+            .filter(|&f| tiny.progress_line(f, &flat(f)).is_some())
+            .count(),
+        4,
+        "a run shorter than ten frames reports every frame but the last"
+    );
+}
