@@ -11,6 +11,9 @@
 //!    the left end: the image goes black;
 //! 4. Ctrl+Z: the light is back, the ball white again.
 //!
+//! Also: a crashed run's autosave offered, kept for later by Esc, and
+//! recovered; and a window shrunk to a pixel and back.
+//!
 //! The panel is found by its layout: a 1280×720 window (the default size,
 //! with a fresh settings folder), the side panel its default 380 points
 //! wide on the right at scale 1, and the sections folded from the top so
@@ -231,6 +234,69 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
         l.centre_luma > 0.6 && l.corner_luma < 0.02
     });
     println!("start {first:?}\nloaded {loaded:?}\ndark {dark:?}\nundone {undone:?}");
+    assert_clean_log(&dir);
+}
+
+/// A run that crashed with unsaved edits left its autosave (written here
+/// as the viewer writes it: a preset and an info file named by the dead
+/// process's pid). The next start offers it; Esc closes the offer and keeps
+/// the files for later; the start after that offers it again, and Recover
+/// (reached with Tab, Enter) brings the edits back and removes the files.
+#[test]
+fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
+    const TEST: &str = "a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered";
+    let _serial = serial();
+    let dir = TempDir::new("e2e-recovery");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let start = Path::new(REPO).join("tests/data/e2e/start.ron");
+    let lit = Path::new(REPO).join("tests/data/e2e/lit.ron");
+    // Beyond Linux's pid_max (2^22): a writer that is surely gone.
+    let dead_pid = 1u32 << 23;
+    let config = dir.subdir("config");
+    let recovered = config.join(format!("recovery-{dead_pid}.ron"));
+    let info = config.join(format!("recovery-{dead_pid}-info.ron"));
+    std::fs::copy(&lit, &recovered).unwrap();
+    std::fs::write(
+        &info,
+        format!(
+            "(source: {:?}, saved_at: \"2026-11-22 18:00:00\", pid: {dead_pid})",
+            start.display().to_string()
+        ),
+    )
+    .unwrap();
+    let start_look = |l: &Look| l.corner_luma > 0.2 && l.centre_blue_excess > 0.2;
+    let lit_look = |l: &Look| l.corner_luma < 0.02 && l.centre_luma > 0.6;
+
+    {
+        let (_child, session) = open(&x, &dir, &start);
+        session.wait_for("the start scene behind the offer", start_look);
+        session.focus();
+        session.run(&["key", "Escape"]);
+        std::thread::sleep(Duration::from_secs(2));
+        // Had Esc left the offer open, this would press its Recover button.
+        session.run(&["key", "Tab", "Return"]);
+        std::thread::sleep(Duration::from_secs(5));
+        session.wait_for("the start scene after Esc", start_look);
+        assert!(
+            recovered.is_file() && info.is_file(),
+            "Esc must keep the autosave for the next start; log:\n{}",
+            marbre_log(&dir)
+        );
+        assert_clean_log(&dir);
+    }
+
+    let (_child, session) = open(&x, &dir, &start);
+    session.wait_for("the start scene behind the second offer", start_look);
+    session.focus();
+    session.run(&["key", "Tab", "Return"]);
+    session.wait_for("the recovered edits (lit.ron's white ball)", lit_look);
+    assert!(
+        !recovered.exists() && !info.exists(),
+        "a recovered autosave is removed; log:\n{}",
+        marbre_log(&dir)
+    );
     assert_clean_log(&dir);
 }
 

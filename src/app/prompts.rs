@@ -28,8 +28,11 @@ pub enum Answer {
     SaveFirst,
     /// Go on and lose the edits (load, quit, reload from disk, recover).
     Proceed,
-    /// Do nothing: keep the scene as it is.
+    /// Do nothing: keep the scene as it is (and an offered recovery for
+    /// the next start).
     Cancel,
+    /// Throw the offered recovery away.
+    Discard,
 }
 
 /// Draws `prompt` as a modal dialog; the answer once given.
@@ -72,11 +75,15 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
             "Recover unsaved changes",
             format!(
                 "marbre did not close cleanly last time. Unsaved changes to {} were autosaved \
-                 at {}. Recover them?",
+                 at {}. Recover them? (Later keeps them for the next start.)",
                 offer.source.display(),
                 offer.saved_at
             ),
-            &[("Recover", Answer::Proceed), ("Discard", Answer::Cancel)],
+            &[
+                ("Recover", Answer::Proceed),
+                ("Later", Answer::Cancel),
+                ("Discard", Answer::Discard),
+            ],
         ),
     };
     let mut answer = None;

@@ -1,13 +1,15 @@
 //! Autosave: while the scene has unsaved edits, a copy goes to a recovery
 //! file every [`AUTOSAVE_INTERVAL`]; a clean exit, a save or a discard
-//! removes it. A recovery file found at start-up means the last run ended
-//! without that (a crash, a kill, a power cut), and the viewer offers it.
+//! removes it. A recovery file found at start-up means the run that wrote
+//! it ended without that (a crash, a kill, a power cut), and the viewer
+//! offers it.
 //!
 //! The copy is a preset (written by `preset::save`, so its paths are made
 //! relative to the recovery folder and it loads like any other), beside a
 //! small info file naming the preset it was edited from, when, and the
-//! process that wrote it: a recovery file of a marbre still running is
-//! not offered to a second one.
+//! process that wrote it. Each process writes its own pair of files, named
+//! by its pid, so two marbres open at once never overwrite each other's
+//! edits, and a file whose writer is still running is not offered.
 
 use crate::atomic_write::write_atomic;
 use crate::preset::{self, Preset};
@@ -23,7 +25,8 @@ pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(20);
 struct RecoveryInfo {
     /// The preset the scene was loaded from (Save writes there).
     source: PathBuf,
-    /// Local time of the autosave, for the offer's text.
+    /// Local time of the autosave, for the offer's text; as
+    /// "YYYY-MM-DD HH:MM:SS" it also sorts in time order.
     saved_at: String,
     /// The marbre process that wrote it.
     pid: u32,
@@ -37,54 +40,86 @@ pub struct RecoveryOffer {
     /// The preset it was edited from.
     pub source: PathBuf,
     pub saved_at: String,
+    /// The folder and the writer's pid, which name the files.
+    dir: PathBuf,
+    pid: u32,
 }
 
 pub struct Autosave {
     dir: PathBuf,
+    /// Names this process's files.
+    pid: u32,
     /// The scene last written, so that an unchanged scene is not written
     /// again.
     written: Option<Scene>,
     last_write: Instant,
 }
 
-fn preset_file(dir: &Path) -> PathBuf {
-    dir.join("recovery.ron")
+fn preset_file(dir: &Path, pid: u32) -> PathBuf {
+    dir.join(format!("recovery-{pid}.ron"))
 }
 
-fn info_file(dir: &Path) -> PathBuf {
-    dir.join("recovery-info.ron")
+fn info_file(dir: &Path, pid: u32) -> PathBuf {
+    dir.join(format!("recovery-{pid}-info.ron"))
 }
 
-/// Whether process `pid` is running (Linux: its /proc entry exists;
-/// elsewhere every writer counts as gone, so the file is offered).
+/// The writer's pid in an info file's name, None for any other file.
+fn info_file_pid(name: &str) -> Option<u32> {
+    name.strip_prefix("recovery-")?
+        .strip_suffix("-info.ron")?
+        .parse()
+        .ok()
+}
+
+/// Whether process `pid` is a marbre still running: on Linux, its /proc
+/// entry has the same command name as this process (after a reboot the pid
+/// may belong to another program, which does not count). Elsewhere every
+/// other writer counts as gone, so its file is offered.
 fn process_alive(pid: u32) -> bool {
-    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
-}
-
-/// The recovery file in `dir` if a run that has ended left one.
-pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
-    let preset = preset_file(dir);
-    let info: RecoveryInfo = ron::from_str(&std::fs::read_to_string(info_file(dir)).ok()?).ok()?;
-    if !preset.exists() || process_alive(info.pid) {
-        return None;
+    if pid == std::process::id() {
+        return true;
     }
-    Some(RecoveryOffer {
-        preset,
-        source: info.source,
-        saved_at: info.saved_at,
-    })
+    let command = |process: &str| std::fs::read_to_string(format!("/proc/{process}/comm")).ok();
+    matches!((command(&pid.to_string()), command("self")), (Some(a), Some(b)) if a == b)
 }
 
-/// Removes the recovery file in `dir` (after it was recovered or declined).
-pub fn discard(dir: &Path) {
-    let _ = std::fs::remove_file(info_file(dir));
-    let _ = std::fs::remove_file(preset_file(dir));
+/// The newest recovery file in `dir` whose writer has ended, if any (the
+/// others are offered at later starts, one at a time).
+pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
+    std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|entry| info_file_pid(entry.ok()?.file_name().to_str()?))
+        .filter(|&pid| !process_alive(pid))
+        .filter_map(|pid| {
+            let text = std::fs::read_to_string(info_file(dir, pid)).ok()?;
+            let info: RecoveryInfo = ron::from_str(&text).ok()?;
+            let preset = preset_file(dir, pid);
+            preset.exists().then(|| RecoveryOffer {
+                preset,
+                source: info.source,
+                saved_at: info.saved_at,
+                dir: dir.to_owned(),
+                pid,
+            })
+        })
+        .max_by(|a, b| a.saved_at.cmp(&b.saved_at))
+}
+
+/// Removes a recovery file once it was recovered or declined.
+pub fn discard(offer: &RecoveryOffer) {
+    remove_files(&offer.dir, offer.pid);
+}
+
+fn remove_files(dir: &Path, pid: u32) {
+    let _ = std::fs::remove_file(info_file(dir, pid));
+    let _ = std::fs::remove_file(preset_file(dir, pid));
 }
 
 impl Autosave {
     pub fn new(dir: PathBuf) -> Self {
         Self {
             dir,
+            pid: std::process::id(),
             written: None,
             last_write: Instant::now(),
         }
@@ -101,7 +136,7 @@ impl Autosave {
     ) -> anyhow::Result<()> {
         if !dirty {
             if self.written.take().is_some() {
-                discard(&self.dir);
+                remove_files(&self.dir, self.pid);
             }
             self.last_write = Instant::now();
             return Ok(());
@@ -119,22 +154,24 @@ impl Autosave {
         Ok(())
     }
 
+    /// The preset first, then the info that makes it an offer: a crash
+    /// between the two leaves the previous autosave's pair, or none.
     fn write(&self, preset: &Preset, source: &Path) -> anyhow::Result<()> {
-        preset::save(preset, &preset_file(&self.dir))?;
+        preset::save(preset, &preset_file(&self.dir, self.pid))?;
         let info = RecoveryInfo {
             source: std::path::absolute(source).unwrap_or_else(|_| source.to_owned()),
             saved_at: chrono::Local::now().format("%Y-%m-%d %H:%M:%S").to_string(),
-            pid: std::process::id(),
+            pid: self.pid,
         };
         let text = ron::ser::to_string_pretty(&info, ron::ser::PrettyConfig::default())?;
-        let path = info_file(&self.dir);
+        let path = info_file(&self.dir, self.pid);
         write_atomic(&path, text.as_bytes()).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
     }
 
     /// A clean exit: the edits were saved or knowingly discarded.
     pub fn finish(&mut self) {
         self.written = None;
-        discard(&self.dir);
+        remove_files(&self.dir, self.pid);
     }
 }
 
@@ -143,49 +180,120 @@ mod tests {
     use super::*;
     use crate::test_dir::TempDir;
 
-    fn info(dir: &Path, pid: u32) {
+    /// A recovery file as process `pid` would leave it.
+    fn left_by(dir: &Path, pid: u32, saved_at: &str, exposure: f32) {
+        let mut preset = Preset::default();
+        preset.scene.render.exposure = exposure;
+        preset::save(&preset, &preset_file(dir, pid)).unwrap();
         let info = RecoveryInfo {
-            source: PathBuf::from("/presets/a.ron"),
-            saved_at: "2026-11-22 19:00:00".into(),
+            source: PathBuf::from(format!("/presets/{pid}.ron")),
+            saved_at: saved_at.into(),
             pid,
         };
-        std::fs::write(info_file(dir), ron::to_string(&info).unwrap()).unwrap();
+        std::fs::write(info_file(dir, pid), ron::to_string(&info).unwrap()).unwrap();
     }
+
+    /// Pids beyond Linux's pid_max (2^22): no such process.
+    const GONE: u32 = 1 << 23;
 
     #[test]
     fn a_dead_writers_file_is_offered_and_a_live_ones_is_not() {
         let dir = TempDir::new("recovery-offer");
-        preset::save(&Preset::default(), &preset_file(dir.root())).unwrap();
-        info(dir.root(), std::process::id());
+        left_by(dir.root(), std::process::id(), "2026-11-22 19:00:00", 2.0);
         assert_eq!(pending_offer(dir.root()), None, "this process is alive");
-        // Beyond Linux's pid_max (2^22): no such process.
-        info(dir.root(), 1 << 23);
+        left_by(dir.root(), GONE, "2026-11-22 18:00:00", 3.0);
         let offer = pending_offer(dir.root()).expect("an offer");
-        assert_eq!(offer.source, Path::new("/presets/a.ron"));
-        assert!(preset::load(&offer.preset).is_ok());
-        discard(dir.root());
+        assert_eq!(offer.source, Path::new(&format!("/presets/{GONE}.ron")));
+        let recovered = preset::load(&offer.preset).unwrap().preset;
+        assert_eq!(recovered.scene.render.exposure, 3.0);
+        discard(&offer);
         assert_eq!(pending_offer(dir.root()), None);
+        assert!(
+            preset_file(dir.root(), std::process::id()).exists(),
+            "the live writer's file is left alone"
+        );
+    }
+
+    #[test]
+    fn the_newest_of_several_is_offered_first_and_the_rest_later() {
+        let dir = TempDir::new("recovery-several");
+        left_by(dir.root(), GONE, "2026-11-22 18:00:00", 3.0);
+        left_by(dir.root(), GONE + 1, "2026-11-22 18:30:00", 4.0);
+        let newest = pending_offer(dir.root()).unwrap();
+        assert_eq!(newest.saved_at, "2026-11-22 18:30:00");
+        discard(&newest);
+        assert_eq!(
+            pending_offer(dir.root()).unwrap().saved_at,
+            "2026-11-22 18:00:00"
+        );
+    }
+
+    /// After a reboot a dead marbre's pid may be another program's.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_pid_now_held_by_another_program_counts_as_ended() {
+        let dir = TempDir::new("recovery-reused-pid");
+        let mut other = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .expect("spawn sleep");
+        left_by(dir.root(), other.id(), "2026-11-22 18:00:00", 3.0);
+        let offer = pending_offer(dir.root());
+        other.kill().unwrap();
+        other.wait().unwrap();
+        assert!(offer.is_some(), "sleep is not marbre: the file is offered");
     }
 
     #[test]
     fn autosave_writes_unsaved_edits_after_the_interval_and_removes_them_when_clean() {
         let dir = TempDir::new("recovery-autosave");
         let mut autosave = Autosave::new(dir.root().to_owned());
+        let mine = preset_file(dir.root(), std::process::id());
         let mut edited = Preset::default();
         edited.scene.render.exposure = 3.0;
         autosave
             .tick(true, Path::new("a.ron"), || edited.clone())
             .unwrap();
-        assert!(!preset_file(dir.root()).exists(), "not before the interval");
+        assert!(!mine.exists(), "not before the interval");
         autosave.last_write -= AUTOSAVE_INTERVAL;
         autosave
             .tick(true, Path::new("a.ron"), || edited.clone())
             .unwrap();
-        let saved = preset::load(&preset_file(dir.root())).unwrap().preset;
+        let saved = preset::load(&mine).unwrap().preset;
         assert_eq!(saved.scene.render.exposure, 3.0);
         autosave
             .tick(false, Path::new("a.ron"), || unreachable!())
             .unwrap();
-        assert!(!preset_file(dir.root()).exists(), "clean again: removed");
+        assert!(!mine.exists(), "clean again: removed");
+    }
+
+    #[test]
+    fn two_processes_autosave_to_their_own_files() {
+        let dir = TempDir::new("recovery-two");
+        let mut first = Autosave::new(dir.root().to_owned());
+        let mut second = Autosave::new(dir.root().to_owned());
+        second.pid = GONE;
+        for (autosave, exposure) in [(&mut first, 1.5), (&mut second, 2.5)] {
+            let mut edited = Preset::default();
+            edited.scene.render.exposure = exposure;
+            autosave.last_write -= AUTOSAVE_INTERVAL;
+            autosave.tick(true, Path::new("a.ron"), || edited).unwrap();
+        }
+        let exposure = |pid| {
+            preset::load(&preset_file(dir.root(), pid))
+                .unwrap()
+                .preset
+                .scene
+                .render
+                .exposure
+        };
+        assert_eq!(exposure(std::process::id()), 1.5);
+        assert_eq!(exposure(GONE), 2.5);
+        first.finish();
+        assert!(!preset_file(dir.root(), std::process::id()).exists());
+        assert!(
+            preset_file(dir.root(), GONE).exists(),
+            "the other's edits stay"
+        );
     }
 }

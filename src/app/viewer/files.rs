@@ -277,28 +277,29 @@ impl Viewer {
             }
             (Prompt::Quit, Answer::Proceed) => self.quit(),
             (Prompt::ReloadFromDisk, Answer::Proceed) => self.reload_from_disk(),
-            (Prompt::Recover(offer), Answer::Proceed) => self.recover(&offer),
+            // Once the scene is back it is autosaved again, to this
+            // process's own file, while it stays unsaved.
+            (Prompt::Recover(offer), Answer::Proceed) => {
+                if self.recover(&offer) {
+                    recovery::discard(&offer);
+                }
+            }
+            (Prompt::Recover(offer), Answer::Discard) => recovery::discard(&offer),
             (Prompt::Recover(_), Answer::SaveFirst) => {}
-        }
-        // Declining a recovery deletes it; so does accepting it once the
-        // scene is back (it is autosaved again while unsaved).
-        if let Some(dir) = &self.config_dir
-            && self.prompt.is_none()
-            && recovery::pending_offer(dir).is_some()
-        {
-            recovery::discard(dir);
+            (_, Answer::Discard) => {}
         }
     }
 
     /// Reopens the scene a crashed run autosaved, as unsaved edits of the
-    /// preset it came from.
-    fn recover(&mut self, offer: &recovery::RecoveryOffer) {
+    /// preset it came from. False (with the reason in the panel) if the
+    /// file could not be read back: it is kept, to be offered again.
+    fn recover(&mut self, offer: &recovery::RecoveryOffer) -> bool {
         let max_side = max_texture_side(&self.ctx);
         let loaded = match load_scene(&offer.preset, None).map(|l| l.fit_environment(max_side)) {
             Ok(loaded) => loaded,
             Err(e) => {
                 self.panel.error(format!("cannot recover: {e:#}"));
-                return;
+                return false;
             }
         };
         if let Err(e) = self.apply_scene(
@@ -307,7 +308,7 @@ impl Viewer {
             Some(loaded.images.clone()),
         ) {
             self.panel.error(format!("cannot recover: {e:#}"));
-            return;
+            return false;
         }
         // The document is the original preset (Save writes there), compared
         // with what that file holds, so the recovered edits show unsaved.
@@ -325,6 +326,7 @@ impl Viewer {
             offer.saved_at
         ));
         self.start_watching();
+        true
     }
 
     /// Watches the preset's folder, and `shaders/` in `--dev` mode.

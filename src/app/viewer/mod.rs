@@ -371,6 +371,24 @@ impl Viewer {
     fn handle_shortcuts(&mut self, pressed: Vec<Shortcut>) {
         use super::file_dialogs::DialogPurpose;
         for shortcut in pressed {
+            // A prompt waits for its answer: Esc is Cancel (which keeps an
+            // offered recovery for later), and shortcuts that would change
+            // the scene or open files behind it wait too.
+            if self.prompt.is_some() {
+                match shortcut {
+                    Shortcut::Close if !self.show_help => {
+                        self.answer_prompt(prompts::Answer::Cancel);
+                        continue;
+                    }
+                    Shortcut::Undo
+                    | Shortcut::Redo
+                    | Shortcut::Save
+                    | Shortcut::SaveAs
+                    | Shortcut::Open
+                    | Shortcut::HideUi => continue,
+                    _ => {}
+                }
+            }
             match shortcut {
                 Shortcut::Undo => self.step_history(true),
                 Shortcut::Redo => self.step_history(false),
