@@ -73,14 +73,28 @@ pub fn compile_wgsl(
 
 /// Parses and validates WGSL with naga, as the device will.
 pub fn validate(source: &str) -> Result<(), String> {
-    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| located(source, e.location(source), e.emit_to_string(source)))?;
     naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
     .validate(&module)
-    .map_err(|e| e.emit_to_string(source))?;
+    .map_err(|e| located(source, e.location(source), e.emit_to_string(source)))?;
     Ok(())
+}
+
+/// naga's report headed by the file and line the error is at in `shaders/`:
+/// naga counts lines in the assembled module, which no one edits.
+fn located(source: &str, location: Option<naga::SourceLocation>, report: String) -> String {
+    let position = location.and_then(|at| {
+        super::shader_source::source_position(source, at.line_number)
+            .map(|(file, line)| format!("{file}:{line}:{}", at.line_position))
+    });
+    match position {
+        Some(position) => format!("at {position}\n{report}"),
+        None => report,
+    }
 }
 
 /// Runs `create` inside a validation error scope.
@@ -222,4 +236,20 @@ pub fn upload_rgba16f(
         bytes,
     );
     texture.create_view(&Default::default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wgsl_error_names_the_shader_file_and_its_own_line() {
+        let module = "// ---- a.wgsl\nfn ok() {}\n// ---- b.wgsl\n\nfn broken( {\n";
+        let error = validate(module).unwrap_err();
+        assert!(error.starts_with("at b.wgsl:2:12\n"), "{error}");
+        assert!(error.contains("expected identifier"), "{error}");
+        let invalid = "// ---- c.wgsl\nfn f() -> f32 {\n    return 1u;\n}\n";
+        let error = validate(invalid).unwrap_err();
+        assert!(error.starts_with("at c.wgsl:"), "{error}");
+    }
 }

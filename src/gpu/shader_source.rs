@@ -325,12 +325,63 @@ pub fn assemble(
     let defines = features.defines();
     let mut module = String::new();
     for name in program.files(features) {
-        module.push_str(&format!("// ---- {name}\n"));
+        module.push_str(&format!("{SECTION_HEADER}{name}\n"));
         module.push_str(&preprocess(&source_text(name), name, &defines)?);
     }
     if program == Program::Trace {
-        module.push_str("// ---- generated textures\n");
+        module.push_str(&format!("{SECTION_HEADER}generated textures\n"));
         module.push_str(generated_textures);
     }
     Ok(module)
+}
+
+/// The line [`assemble`] puts before each file's text, followed by its name.
+const SECTION_HEADER: &str = "// ---- ";
+
+/// Where line `line` (1-based) of an [`assemble`]d module comes from: the
+/// file's name and its own line number. Preprocessing keeps every line
+/// (a dropped one is left empty), so the offset from the file's header is
+/// its line in the file. None before the first header or past the end.
+pub fn source_position(module: &str, line: u32) -> Option<(String, u32)> {
+    let mut section = None;
+    for (index, text) in module.lines().enumerate().take(line as usize) {
+        if let Some(name) = text.strip_prefix(SECTION_HEADER) {
+            section = Some((name.to_owned(), index as u32 + 1));
+        }
+        if index as u32 + 1 == line {
+            return section.map(|(name, header)| (name, line - header));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_module_line_maps_back_to_its_file_and_line() {
+        let module = assemble(Program::Trace, &FeatureSet::all(), "fn generated() {}\n").unwrap();
+        let module_line = module
+            .lines()
+            .position(|l| l.starts_with("fn fs_trace("))
+            .unwrap() as u32
+            + 1;
+        let file_line = source_text("trace.wgsl")
+            .lines()
+            .position(|l| l.starts_with("fn fs_trace("))
+            .unwrap() as u32
+            + 1;
+        assert_eq!(
+            source_position(&module, module_line),
+            Some(("trace.wgsl".to_owned(), file_line))
+        );
+        let last = module.lines().count() as u32;
+        assert_eq!(
+            source_position(&module, last),
+            Some(("generated textures".to_owned(), 1))
+        );
+        assert_eq!(source_position(&module, last + 1), None);
+        assert_eq!(source_position("fn f() {}\n", 1), None, "no header");
+    }
 }

@@ -101,11 +101,18 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
     }
     let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
     for message in &state.messages[first..] {
-        if message.is_error {
-            ui.colored_label(ui.visuals().error_fg_color, &message.text);
-        } else {
-            ui.label(&message.text);
+        // A message of several lines is a compiler's diagnostic or a
+        // report: monospace keeps its carets under the columns they point
+        // at, and egui's monospace font (Hack) has the box-drawing glyphs
+        // naga frames source lines with, which the proportional one lacks.
+        let mut text = egui::RichText::new(&message.text);
+        if message.text.contains('\n') {
+            text = text.monospace();
         }
+        if message.is_error {
+            text = text.color(ui.visuals().error_fg_color);
+        }
+        ui.label(text);
     }
 }
 
