@@ -10,6 +10,7 @@ pub mod env_sampling;
 pub mod envmap;
 pub mod geometry;
 pub mod gpu;
+pub mod heap;
 pub mod image_io;
 pub mod lights;
 pub mod mis;

@@ -68,28 +68,8 @@ enum Command {
     Soak(soak::SoakArgs),
 }
 
-/// At most two glibc malloc arenas. glibc gives each thread that allocates
-/// its own arena and never returns one; llvmpipe's rasteriser threads (made
-/// again with a recreated device), the shader-build and loading threads
-/// each leave one behind, and RSS crept up by steps: a 3000-frame soak grew
-/// 417 -> 549 MiB after its warm-up, 348 -> 372 MiB with two arenas (the
-/// same as `MALLOC_ARENA_MAX=2`, which still overrides this).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn limit_malloc_arenas() {
-    if std::env::var_os("MALLOC_ARENA_MAX").is_none() {
-        // SAFETY: mallopt only sets an allocator parameter; it is called
-        // before any other thread exists.
-        unsafe {
-            libc::mallopt(libc::M_ARENA_MAX, 2);
-        }
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn limit_malloc_arenas() {}
-
 fn main() -> ExitCode {
-    limit_malloc_arenas();
+    marbre::heap::limit_arenas();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {

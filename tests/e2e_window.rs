@@ -11,7 +11,8 @@
 //!    the left end: the image goes black;
 //! 4. Ctrl+Z: the light is back, the ball white again.
 //!
-//! Also: a crashed run's autosave offered, kept for later by Esc, and
+//! Also: closing the window with an unsaved edit (asked, Esc, then Save);
+//! a crashed run's autosave offered, kept for later by Esc, and
 //! recovered; and a window shrunk to a pixel and back.
 //!
 //! The panel is found by its layout: a 1280×720 window (the default size,
@@ -25,7 +26,10 @@ mod xvfb;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use xvfb::{TempDir, display_or_skip, marbre_log, serial, spawn_marbre, xdotool};
+use xvfb::{
+    TempDir, assert_success, display_or_skip, marbre_log, request_close, serial, spawn_marbre,
+    wait_for_exit, xdotool,
+};
 
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -111,6 +115,31 @@ impl Session<'_> {
     fn click(&self, x: i32, y: i32) {
         self.run(&["mousemove", &x.to_string(), &y.to_string(), "click", "1"]);
         std::thread::sleep(Duration::from_millis(1500));
+    }
+
+    /// Folds the Preset, Materials and Environment sections, opens Point
+    /// light and drags its intensity slider (logarithmic, 0 to 10 000, the
+    /// fourth row of the section) from its knob to the far left. Each step
+    /// waits a second: egui reads the pointer once per frame, and a press,
+    /// moves and release within one slow frame would be a click on the knob.
+    fn drag_light_intensity_to_zero(&self) {
+        for header in 0..4 {
+            self.click(PANEL_LEFT + 50, 12 + header * HEADER_STEP);
+        }
+        let (knob_x, knob_y) = (PANEL_LEFT + 79, 173);
+        self.run(&[
+            "mousemove",
+            &knob_x.to_string(),
+            &knob_y.to_string(),
+            "mousedown",
+            "1",
+        ]);
+        for x in [knob_x - 20, knob_x - 40, knob_x - 60, PANEL_LEFT + 5] {
+            std::thread::sleep(Duration::from_secs(1));
+            self.run(&["mousemove", &x.to_string(), &knob_y.to_string()]);
+        }
+        std::thread::sleep(Duration::from_secs(1));
+        self.run(&["mouseup", "1"]);
     }
 
     /// Presses F12 until a screenshot satisfies `wanted`, returning its
@@ -202,26 +231,7 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
         l.corner_luma < 0.02 && l.centre_luma > 0.6 && l.centre_blue_excess.abs() < 0.05
     });
 
-    // Fold Preset, Materials and Environment; open Point light.
-    for header in 0..4 {
-        session.click(PANEL_LEFT + 50, 12 + header * HEADER_STEP);
-    }
-    // The intensity slider (logarithmic, 0 to 10 000) is the fourth row
-    // of the Point light section; drag its knob to the far left.
-    let (knob_x, knob_y) = (PANEL_LEFT + 79, 173);
-    session.run(&[
-        "mousemove",
-        &knob_x.to_string(),
-        &knob_y.to_string(),
-        "mousedown",
-        "1",
-    ]);
-    for x in [knob_x - 20, knob_x - 40, knob_x - 60, PANEL_LEFT + 5] {
-        std::thread::sleep(Duration::from_millis(400));
-        session.run(&["mousemove", &x.to_string(), &knob_y.to_string()]);
-    }
-    std::thread::sleep(Duration::from_millis(400));
-    session.run(&["mouseup", "1"]);
+    session.drag_light_intensity_to_zero();
     let dark = session.wait_for("the light's intensity dragged to 0 (black)", |l| {
         l.centre_luma < 0.02
     });
@@ -234,6 +244,66 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
         l.centre_luma > 0.6 && l.corner_luma < 0.02
     });
     println!("start {first:?}\nloaded {loaded:?}\ndark {dark:?}\nundone {undone:?}");
+    assert_clean_log(&dir);
+}
+
+/// Closing the window (the window manager's close request) with unsaved
+/// edits asks first: Esc cancels and the viewer goes on; closing again and
+/// choosing Save (Tab, Enter) writes the edit to the preset file and quits.
+#[test]
+fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
+    const TEST: &str = "closing_with_unsaved_edits_asks_and_save_writes_the_preset";
+    let _serial = serial();
+    let dir = TempDir::new("e2e-quit");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let preset = dir.path().join("lit.ron");
+    std::fs::copy(Path::new(REPO).join("tests/data/e2e/lit.ron"), &preset).unwrap();
+    let intensity = || {
+        marbre::preset::load(&preset)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .preset
+            .scene
+            .point_light
+            .expect("lit.ron has a point light")
+            .intensity
+    };
+    assert_eq!(intensity(), 40.0);
+    let (mut child, session) = open(&x, &dir, &preset);
+    session.wait_for("lit.ron", |l| l.corner_luma < 0.02 && l.centre_luma > 0.6);
+    session.drag_light_intensity_to_zero();
+    session.wait_for("the light's intensity dragged to 0", |l| {
+        l.centre_luma < 0.02
+    });
+
+    request_close(&x, &session.window);
+    std::thread::sleep(Duration::from_secs(4));
+    assert!(
+        child.0.try_wait().unwrap().is_none(),
+        "closed without asking about the unsaved edit; log:\n{}",
+        marbre_log(&dir)
+    );
+    session.focus();
+    session.run(&["key", "Escape"]);
+    std::thread::sleep(Duration::from_secs(3));
+    assert!(
+        child.0.try_wait().unwrap().is_none(),
+        "Esc must cancel the quit"
+    );
+    assert_eq!(intensity(), 40.0, "nothing saved yet");
+
+    request_close(&x, &session.window);
+    std::thread::sleep(Duration::from_secs(4));
+    session.focus();
+    session.run(&["key", "Tab", "Return"]);
+    let status = wait_for_exit(&mut child, &dir, STEP_TIMEOUT);
+    assert_success(status, &dir);
+    assert!(
+        intensity() < 1e-3,
+        "Save then quit: the file holds the edit, intensity {}",
+        intensity()
+    );
     assert_clean_log(&dir);
 }
 

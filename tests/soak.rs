@@ -33,25 +33,27 @@ struct Row {
     rss_bytes: u64,
     gpu_allocated_bytes: Option<u64>,
     gpu_resources: Option<u64>,
+    heap_in_use_bytes: Option<u64>,
 }
 
 fn parse_rows(csv: &str) -> Vec<Row> {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next(),
-        Some("frame,rss_bytes,gpu_allocated_bytes,gpu_resources"),
+        Some("frame,rss_bytes,gpu_allocated_bytes,gpu_resources,heap_in_use_bytes,heap_free_bytes"),
         "the CSV header"
     );
     lines
         .map(|line| {
             let fields: Vec<&str> = line.split(',').collect();
-            assert_eq!(fields.len(), 4, "CSV row `{line}`");
+            assert_eq!(fields.len(), 6, "CSV row `{line}`");
             let optional = |s: &str| (!s.is_empty()).then(|| s.parse().unwrap());
             Row {
                 frame: fields[0].parse().unwrap(),
                 rss_bytes: fields[1].parse().unwrap(),
                 gpu_allocated_bytes: optional(fields[2]),
                 gpu_resources: optional(fields[3]),
+                heap_in_use_bytes: optional(fields[4]),
             }
         })
         .collect()
@@ -114,6 +116,14 @@ fn a_short_soak_passes_and_writes_its_report() {
         assert!(row.rss_bytes > 32 << 20, "{row:?}");
         assert!(row.gpu_resources.is_some_and(|n| n > 10), "{row:?}");
         assert!(row.gpu_allocated_bytes.is_some_and(|b| b > 0), "{row:?}");
+        // glibc reports its heap; what it holds is part of the resident set.
+        if cfg!(all(target_os = "linux", target_env = "gnu")) {
+            assert!(
+                row.heap_in_use_bytes
+                    .is_some_and(|b| b > 1 << 20 && b < row.rss_bytes * 4),
+                "{row:?}"
+            );
+        }
     }
 }
 

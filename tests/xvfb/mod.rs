@@ -229,3 +229,23 @@ pub fn xdotool(x: &Xvfb, args: &[&str]) -> std::process::Output {
         .output()
         .unwrap_or_else(|e| panic!("cannot run xdotool: {e}"))
 }
+
+/// Asks window `window` (an id as xdotool prints it) to close, as a window
+/// manager's close button does: a `WM_PROTOCOLS` client message carrying
+/// `WM_DELETE_WINDOW` (winit's `CloseRequested`).
+pub fn request_close(x: &Xvfb, window: &str) {
+    use x11rb::connection::Connection;
+    use x11rb::protocol::xproto::{ClientMessageEvent, ConnectionExt, EventMask};
+
+    let send = || -> Result<(), Box<dyn std::error::Error>> {
+        let window: u32 = window.trim().parse()?;
+        let (conn, _) = x11rb::connect(Some(&x.display))?;
+        let protocols = conn.intern_atom(false, b"WM_PROTOCOLS")?.reply()?.atom;
+        let delete = conn.intern_atom(false, b"WM_DELETE_WINDOW")?.reply()?.atom;
+        let message = ClientMessageEvent::new(32, window, protocols, [delete, 0, 0, 0, 0]);
+        conn.send_event(false, window, EventMask::NO_EVENT, message)?;
+        conn.flush()?;
+        Ok(())
+    };
+    send().unwrap_or_else(|e| panic!("sending WM_DELETE_WINDOW to window {window}: {e}"));
+}

@@ -16,6 +16,10 @@ pub struct MemorySample {
     /// shader modules, query sets and samplers (None where wgpu has no
     /// report, i.e. on WebGPU).
     pub gpu_resources: Option<u64>,
+    /// The C heap: bytes held, and bytes free but kept (None where the
+    /// allocator does not say). RSS growing while bytes held do not is
+    /// memory left resident by the allocator, not a leak.
+    pub heap: Option<crate::heap::HeapUsage>,
 }
 
 /// The process's and the device's memory now.
@@ -43,6 +47,7 @@ pub fn sample_memory(ctx: &GpuContext) -> MemorySample {
             .map(|r| r.num_allocated as u64)
             .sum()
         }),
+        heap: crate::heap::usage(),
     }
 }
 

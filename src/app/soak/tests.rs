@@ -29,6 +29,10 @@ fn flat(_: u64) -> MemorySample {
         rss_bytes: 300 * MIB,
         gpu_allocated_bytes: Some(100 * MIB),
         gpu_resources: Some(200),
+        heap: Some(crate::heap::HeapUsage {
+            in_use_bytes: 120 * MIB,
+            free_bytes: 4 * MIB,
+        }),
     }
 }
 
@@ -107,6 +111,7 @@ fn unmeasured_figures_are_reported_as_such() {
         rss_bytes: 0,
         gpu_allocated_bytes: None,
         gpu_resources: Some(50),
+        heap: None,
     });
     let report = driver.verdict(0).expect("nothing grew");
     assert!(
@@ -125,6 +130,7 @@ fn the_report_csv_has_one_row_per_recorded_frame() {
     };
     let driver = recorded(&options, |f| MemorySample {
         gpu_allocated_bytes: (f != 7).then_some(100 * MIB),
+        heap: (f != 9).then_some(flat(f).heap.unwrap()),
         ..flat(f)
     });
     driver.verdict(0).expect("flat memory passes");
@@ -133,10 +139,11 @@ fn the_report_csv_has_one_row_per_recorded_frame() {
     assert_eq!(lines.len(), 301);
     assert_eq!(
         lines[0],
-        "frame,rss_bytes,gpu_allocated_bytes,gpu_resources"
+        "frame,rss_bytes,gpu_allocated_bytes,gpu_resources,heap_in_use_bytes,heap_free_bytes"
     );
-    assert_eq!(lines[1], "0,314572800,104857600,200");
-    assert_eq!(lines[8], "7,314572800,,200");
+    assert_eq!(lines[1], "0,314572800,104857600,200,125829120,4194304");
+    assert_eq!(lines[8], "7,314572800,,200,125829120,4194304");
+    assert_eq!(lines[10], "9,314572800,104857600,200,,");
 }
 
 #[test]
@@ -302,12 +309,14 @@ fn progress_is_printed_after_each_tenth_but_not_at_the_end() {
     assert_eq!(frames, [99, 199, 299, 399, 499, 599, 699, 799, 899]);
     assert_eq!(
         lines[0].1,
-        "soak: frame 100 of 1000: RSS 300.0 MiB, GPU 100.0 MiB in 200 objects"
+        "soak: frame 100 of 1000: RSS 300.0 MiB, GPU 100.0 MiB in 200 objects, \
+         heap 120.0 MiB held + 4.0 MiB free"
     );
     let unmeasured = MemorySample {
         rss_bytes: 0,
         gpu_allocated_bytes: None,
         gpu_resources: Some(7),
+        heap: None,
     };
     assert_eq!(
         driver.progress_line(499, &unmeasured).as_deref(),
