@@ -97,14 +97,15 @@ struct Queue {
 /// 265 MiB to 1.1 GiB in 300 frames.
 pub struct PipelineBuilder {
     queue: Arc<(Mutex<Queue>, Condvar)>,
-    worker_started: bool,
+    /// The worker, once the first build starts; joined on drop.
+    worker: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Default for PipelineBuilder {
     fn default() -> Self {
         Self {
             queue: Arc::new((Mutex::new(Queue::default()), Condvar::new())),
-            worker_started: false,
+            worker: None,
         }
     }
 }
@@ -128,20 +129,31 @@ impl PipelineBuilder {
         let (lock, ready) = &*self.queue;
         lock.lock().unwrap_or_else(|e| e.into_inner()).next = Some(job);
         ready.notify_one();
-        if !self.worker_started {
-            self.worker_started = true;
+        if self.worker.is_none() {
             let queue = self.queue.clone();
-            std::thread::spawn(move || work(&queue));
+            self.worker = Some(std::thread::spawn(move || work(&queue)));
         }
         PipelineBuild { receiver }
     }
 }
 
+/// Drops a waiting build and waits for the one in progress (at most one
+/// shader compile). Left running, a build could still be inside the
+/// driver's compiler when the process exits and the compiler's global
+/// state is destroyed: a 10,000-frame soak ended in LLVM aborting
+/// ("Cannot select", signal 6) after its verdict.
 impl Drop for PipelineBuilder {
     fn drop(&mut self) {
         let (lock, ready) = &*self.queue;
-        lock.lock().unwrap_or_else(|e| e.into_inner()).closed = true;
+        {
+            let mut queue = lock.lock().unwrap_or_else(|e| e.into_inner());
+            queue.closed = true;
+            queue.next = None;
+        }
         ready.notify_one();
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
     }
 }
 
@@ -243,5 +255,28 @@ mod tests {
         let dropped = format!("{:#}", result_of(&second).err().unwrap());
         assert!(dropped.contains("dropped before it ran"), "{dropped}");
         assert_eq!(*ran.lock().unwrap(), ["third"]);
+    }
+
+    /// Dropping the builder waits for the build in progress and drops the
+    /// one waiting: nothing is left compiling when the process exits.
+    #[test]
+    fn dropping_the_builder_finishes_the_running_build_and_drops_the_waiting_one() {
+        let mut builder = PipelineBuilder::default();
+        let finished = Arc::new(Mutex::new(Vec::new()));
+        let job = |name: &'static str, millis: u64| {
+            let finished = finished.clone();
+            move || {
+                std::thread::sleep(Duration::from_millis(millis));
+                finished.lock().unwrap().push(name);
+                Err(anyhow!(name))
+            }
+        };
+        let _running = builder.start(None, job("running", 300));
+        std::thread::sleep(Duration::from_millis(50));
+        let waiting = builder.start(None, job("waiting", 0));
+        drop(builder);
+        assert_eq!(*finished.lock().unwrap(), ["running"]);
+        let dropped = format!("{:#}", result_of(&waiting).err().unwrap());
+        assert!(dropped.contains("dropped before it ran"), "{dropped}");
     }
 }

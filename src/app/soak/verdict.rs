@@ -1,16 +1,24 @@
 //! Whether memory stayed bounded: each series (RSS, GPU bytes, GPU
 //! resources) against its baseline at the end of the warm-up.
 //!
-//! The baseline is the series' maximum over the second half of the
-//! warm-up, once the first frames' one-off allocations (pipelines, the
-//! font atlas, the allocator's first blocks) are made. What the check
-//! looks at is the end of the run, its last quarter: a leak grows until
-//! the last frame, while what a preset load, a shader build or a device
-//! loss takes for a moment is given back. Byte series compare their
-//! largest value there (a leak that has settled still shows); the resource
-//! count compares its smallest (objects of a shader build in flight come
-//! and go, and a count that never drops back is exactly what a leak of
-//! one object per frame or per edit looks like).
+//! The baseline is taken over the second half of the warm-up, once the
+//! first frames' one-off allocations (pipelines, the font atlas, the
+//! allocator's first blocks) are made. What the check looks at is the end
+//! of the run, its last quarter: a leak grows until the last frame, while
+//! what a preset load, a shader build or a device loss takes for a moment
+//! is given back.
+//!
+//! - RSS compares medians: the level held for at least half the frames.
+//!   On lavapipe, compiling a heavy shader variant holds 150 MiB more for
+//!   a few hundred frames (a 10,000-frame soak: median 204 -> 214 MiB,
+//!   peaks to 415 MiB that fell back), which is work, not growth; a leak,
+//!   steady or settled, moves the median.
+//! - GPU bytes compare maxima (the allocator's blocks do not come and go
+//!   with builds: a leak that has settled still shows).
+//! - The resource count compares its smallest value with the baseline's
+//!   largest (objects of a shader build in flight come and go, and a count
+//!   that never drops back is exactly what a leak of one object per frame
+//!   or per edit looks like).
 
 /// How far a series may rise above its baseline: the larger of an
 /// absolute amount and a fraction of the baseline.
@@ -45,13 +53,22 @@ pub const RESOURCE_ALLOWANCE: Allowance = Allowance {
     fraction: 0.10,
 };
 
-/// Which end-of-run value is held to the limit (see the module comment).
+/// Which value of the last quarter is held to the limit, and against
+/// which baseline (see the module comment).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Rule {
-    /// The largest value of the last quarter.
-    LastQuarterMax,
-    /// The smallest value of the last quarter.
-    LastQuarterMin,
+    /// The last quarter's median against the baseline window's median.
+    Median,
+    /// The last quarter's largest value against the baseline's largest.
+    Max,
+    /// The last quarter's smallest value against the baseline's largest.
+    Min,
+}
+
+/// The median of `values` (the upper one of an even count); None if empty.
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied()
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,18 +126,27 @@ pub fn judge(metric: &Metric, points: &[(u64, u64)], warm_up: u64) -> Judged {
         };
     }
     let window_start = warm_up / 2;
-    let baseline = points
+    let window: Vec<f64> = points
         .iter()
         .filter(|(f, _)| (window_start..warm_up).contains(f))
         .map(|&(_, v)| v as f64)
-        .reduce(f64::max)
-        // No warm-up sample (a warm-up of 0): the first sample after it.
-        .unwrap_or(after[0].1);
+        .collect();
+    let baseline = match metric.rule {
+        Rule::Median => median(window),
+        Rule::Max | Rule::Min => window.into_iter().reduce(f64::max),
+    }
+    // No warm-up sample (a warm-up of 0): the first sample after it.
+    .unwrap_or(after[0].1);
     let tail_start = warm_up + (last_frame.saturating_sub(warm_up) * 3) / 4;
-    let tail = after.iter().filter(|(f, _)| *f >= tail_start).map(|p| p.1);
+    let tail: Vec<f64> = after
+        .iter()
+        .filter(|(f, _)| *f >= tail_start)
+        .map(|p| p.1)
+        .collect();
     let (judged, what) = match metric.rule {
-        Rule::LastQuarterMax => (tail.reduce(f64::max), "last-quarter max"),
-        Rule::LastQuarterMin => (tail.reduce(f64::min), "last-quarter min"),
+        Rule::Median => (median(tail), "last-quarter median"),
+        Rule::Max => (tail.into_iter().reduce(f64::max), "last-quarter max"),
+        Rule::Min => (tail.into_iter().reduce(f64::min), "last-quarter min"),
     };
     // The last sample is always in the tail, so it is never empty.
     let judged = judged.unwrap_or(after[after.len() - 1].1);
@@ -173,13 +199,19 @@ mod tests {
         name: "RSS",
         unit: Unit::Bytes,
         allowance: RSS_ALLOWANCE,
-        rule: Rule::LastQuarterMax,
+        rule: Rule::Median,
+    };
+    const GPU_BYTES: Metric = Metric {
+        name: "GPU allocated",
+        unit: Unit::Bytes,
+        allowance: GPU_BYTES_ALLOWANCE,
+        rule: Rule::Max,
     };
     const RESOURCES: Metric = Metric {
         name: "GPU resources",
         unit: Unit::Count,
         allowance: RESOURCE_ALLOWANCE,
-        rule: Rule::LastQuarterMin,
+        rule: Rule::Min,
     };
 
     #[test]
@@ -203,10 +235,40 @@ mod tests {
                 })
                 .collect()
         };
-        let transient = judge(&RSS, &spike(false), 200);
-        assert!(transient.failure.is_none(), "{transient:?}");
-        let held = judge(&RSS, &spike(true), 200);
-        assert!(held.failure.is_some(), "{held:?}");
+        for metric in [&RSS, &GPU_BYTES] {
+            let transient = judge(metric, &spike(false), 200);
+            assert!(transient.failure.is_none(), "{transient:?}");
+            let held = judge(metric, &spike(true), 200);
+            assert!(held.failure.is_some(), "{held:?}");
+        }
+    }
+
+    /// RSS: peaks in the last quarter (frames 799 to 999 of 1000 after a
+    /// 200-frame warm-up) that cover less than half of it pass, a level held over more
+    /// than half fails; GPU bytes fail on any peak held there.
+    #[test]
+    fn rss_is_judged_on_the_level_held_for_half_the_last_quarter() {
+        let base = 300u64 << 20;
+        let peaks = |high_frames: u64| -> Vec<(u64, u64)> {
+            (0..1000)
+                .map(|f| {
+                    let high = f >= 1000 - high_frames;
+                    (f, if high { base * 2 } else { base })
+                })
+                .collect()
+        };
+        assert!(judge(&RSS, &peaks(80), 200).failure.is_none());
+        let held = judge(&RSS, &peaks(120), 200);
+        let why = held.failure.expect("held over most of the last quarter");
+        assert!(why.contains("last-quarter median"), "{why}");
+        assert!(judge(&GPU_BYTES, &peaks(80), 200).failure.is_some());
+    }
+
+    #[test]
+    fn median_takes_the_middle_value() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), Some(3.0));
+        assert_eq!(median(Vec::new()), None);
     }
 
     /// Objects of a shader build in flight come and go; one object per
