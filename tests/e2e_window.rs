@@ -249,7 +249,8 @@ fn typed_path_slider_and_undo_show_on_the_pixels() {
 
 /// Closing the window (the window manager's close request) with unsaved
 /// edits asks first: Esc cancels and the viewer goes on; closing again and
-/// choosing Save (Tab, Enter) writes the edit to the preset file and quits.
+/// choosing Save (the default button: Enter) writes the edit to the preset
+/// file and quits.
 #[test]
 fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
     const TEST: &str = "closing_with_unsaved_edits_asks_and_save_writes_the_preset";
@@ -296,7 +297,9 @@ fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
     request_close(&x, &session.window);
     std::thread::sleep(Duration::from_secs(4));
     session.focus();
-    session.run(&["key", "Tab", "Return"]);
+    // Save is the default: Enter chooses it, although the slider dragged
+    // a moment ago had the keyboard focus.
+    session.run(&["key", "Return"]);
     let status = wait_for_exit(&mut child, &dir, STEP_TIMEOUT);
     assert_success(status, &dir);
     assert!(
@@ -311,7 +314,7 @@ fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
 /// as the viewer writes it: a preset and an info file named by the dead
 /// process's pid). The next start offers it; Esc closes the offer and keeps
 /// the files for later; the start after that offers it again, and Recover
-/// (reached with Tab, Enter) brings the edits back and removes the files.
+/// (the default button: Enter) brings the edits back and removes the files.
 #[test]
 fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
     const TEST: &str = "a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered";
@@ -345,8 +348,9 @@ fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
         session.focus();
         session.run(&["key", "Escape"]);
         std::thread::sleep(Duration::from_secs(2));
-        // Had Esc left the offer open, this would press its Recover button.
-        session.run(&["key", "Tab", "Return"]);
+        // Had Esc left the offer open, Enter would choose its default,
+        // Recover.
+        session.run(&["key", "Return"]);
         std::thread::sleep(Duration::from_secs(5));
         session.wait_for("the start scene after Esc", start_look);
         assert!(
@@ -360,7 +364,7 @@ fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
     let (_child, session) = open(&x, &dir, &start);
     session.wait_for("the start scene behind the second offer", start_look);
     session.focus();
-    session.run(&["key", "Tab", "Return"]);
+    session.run(&["key", "Return"]);
     session.wait_for("the recovered edits (lit.ron's white ball)", lit_look);
     assert!(
         !recovered.exists() && !info.exists(),

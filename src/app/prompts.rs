@@ -93,10 +93,21 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
         ui.label(text);
         ui.separator();
         ui.horizontal(|ui| {
-            for (label, choice) in buttons {
-                if ui.button(*label).clicked() {
-                    answer = Some(*choice);
-                }
+            let responses: Vec<egui::Response> = buttons
+                .iter()
+                .map(|(label, choice)| {
+                    let response = ui.button(*label);
+                    if response.clicked() {
+                        answer = Some(*choice);
+                    }
+                    response
+                })
+                .collect();
+            // The first button is the default, as in a native dialog: it
+            // has the keyboard focus, so Enter chooses it (Esc cancels),
+            // whatever had the focus when the prompt opened.
+            if !responses.iter().any(egui::Response::has_focus) {
+                responses[0].request_focus();
             }
         });
     });

@@ -243,8 +243,10 @@ pub fn request_close(x: &Xvfb, window: &str) {
         let protocols = conn.intern_atom(false, b"WM_PROTOCOLS")?.reply()?.atom;
         let delete = conn.intern_atom(false, b"WM_DELETE_WINDOW")?.reply()?.atom;
         let message = ClientMessageEvent::new(32, window, protocols, [delete, 0, 0, 0, 0]);
-        conn.send_event(false, window, EventMask::NO_EVENT, message)?;
-        conn.flush()?;
+        // Checked: a round trip, so the server has the event before this
+        // connection closes.
+        conn.send_event(false, window, EventMask::NO_EVENT, message)?
+            .check()?;
         Ok(())
     };
     send().unwrap_or_else(|e| panic!("sending WM_DELETE_WINDOW to window {window}: {e}"));
