@@ -234,7 +234,6 @@ pub fn xdotool(x: &Xvfb, args: &[&str]) -> std::process::Output {
 /// manager's close button does: a `WM_PROTOCOLS` client message carrying
 /// `WM_DELETE_WINDOW` (winit's `CloseRequested`).
 pub fn request_close(x: &Xvfb, window: &str) {
-    use x11rb::connection::Connection;
     use x11rb::protocol::xproto::{ClientMessageEvent, ConnectionExt, EventMask};
 
     let send = || -> Result<(), Box<dyn std::error::Error>> {
