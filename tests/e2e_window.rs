@@ -13,7 +13,9 @@
 //!
 //! Also: closing the window with an unsaved edit (asked, Esc, then Save);
 //! a crashed run's autosave offered, kept for later by Esc, and
-//! recovered; and a window shrunk to a pixel and back.
+//! recovered; a window shrunk to a pixel and back; and a preset that takes
+//! seconds to load at start-up (its progress shown, a key pressed meanwhile
+//! kept for the scene).
 //!
 //! The panel is found by its layout: a 1280×720 window (the default size,
 //! with a fresh settings folder), the side panel its default 380 points
@@ -27,8 +29,8 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use xvfb::{
-    TempDir, assert_success, display_or_skip, marbre_log, request_close, serial, spawn_marbre,
-    wait_for_exit, xdotool,
+    TempDir, assert_success, display_or_skip, grab_window, marbre_log, request_close, serial,
+    spawn_marbre, wait_for_exit, xdotool,
 };
 
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
@@ -399,5 +401,129 @@ fn shrinking_the_window_to_a_pixel_and_back_keeps_rendering() {
         std::thread::sleep(Duration::from_secs(3));
     }
     session.wait_for("lit.ron after the resizes", lit_look);
+    assert_clean_log(&dir);
+}
+
+/// Quads a side of the start-up test's grid mesh.
+const GRID_QUADS: usize = 60;
+
+/// A preset whose OBJ is the grid: its camera looks down on the grid lit
+/// white by a point light; its second saved view looks away from it, into
+/// the blue sky.
+const SLOW_PRESET: &str = r#"(
+    format_version: 2,
+    description: "e2e: a grid mesh read from a pipe, slow to load",
+    scene: (
+        camera: (target: (0.0, 0.0, 0.0), distance: 2.5, yaw_degrees: 0.0, pitch_degrees: 60.0, fov_degrees: 40.0),
+        views: [
+            (name: "grid", camera: (target: (0.0, 0.0, 0.0), distance: 2.5, yaw_degrees: 0.0, pitch_degrees: 60.0, fov_degrees: 40.0)),
+            (name: "sky", camera: (target: (0.0, 0.0, 40.0), distance: 2.0, yaw_degrees: 0.0, pitch_degrees: -30.0, fov_degrees: 40.0)),
+        ],
+        spheres: [],
+        ground: None,
+        meshes: [(name: "grid", obj: "grid.obj")],
+        point_light: Some((position: (0.0, 3.0, 0.0), color: (1.0, 1.0, 1.0), intensity: 40.0)),
+        environment: (source: Constant(radiance: (0.1, 0.2, 0.9)), intensity: 1.0, background_visible: true),
+        render: (samples_per_frame: 1, exposure: 0.0, tone_map: Clamp, max_bounces: 1),
+    ),
+)"#;
+
+/// Writes a flat `quads`×`quads` grid over [-1, 1]² at y = 0 as an OBJ.
+fn write_grid_obj(path: &Path, quads: usize) {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    for j in 0..=quads {
+        for i in 0..=quads {
+            let (x, z) = (i as f64 / quads as f64, j as f64 / quads as f64);
+            writeln!(out, "v {:.5} 0 {:.5}", 2.0 * x - 1.0, 2.0 * z - 1.0).unwrap();
+        }
+    }
+    for j in 0..quads {
+        for i in 0..quads {
+            let a = j * (quads + 1) + i + 1;
+            let (b, c, d) = (a + 1, a + quads + 1, a + quads + 2);
+            writeln!(out, "f {a} {d} {b}\nf {a} {c} {d}").unwrap();
+        }
+    }
+    out.flush().unwrap();
+}
+
+/// Whether the Preset section shows a load's progress bar: its fill, egui's
+/// selection blue (which egui shades from frame to frame), across a good
+/// part of the row under Undo and Redo.
+fn progress_bar_shown(window: &image::RgbImage) -> bool {
+    let left = PANEL_LEFT as u32 + 25;
+    let filled = (110..145)
+        .flat_map(|y| (left..window.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let [r, g, b] = window.get_pixel(x, y).0.map(i32::from);
+            r < 20 && g > 50 && b > 80 && b - g > 15
+        })
+        .count();
+    filled >= 500
+}
+
+/// A preset that is slow to load at start-up (its OBJ is a named pipe the
+/// test writes only when it chooses, as a slow disk or a network share
+/// would deliver it): the window draws at once, the panel showing the
+/// load's progress, and a key pressed meanwhile (2: the preset's second
+/// saved view) and F12 after it act on the scene once it is drawn, rather
+/// than on the empty placeholder shown until then.
+#[test]
+fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() {
+    const TEST: &str = "a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile";
+    let _serial = serial();
+    let dir = TempDir::new("e2e-slow-start");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool", "mkfifo"]) else {
+        return;
+    };
+    let folder = dir.subdir("slow");
+    let pipe = folder.join("grid.obj");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .unwrap();
+    assert!(made.success(), "mkfifo {}", pipe.display());
+    let preset = folder.join("slow.ron");
+    std::fs::write(&preset, SLOW_PRESET).unwrap();
+    let (_child, session) = open(&x, &dir, &preset);
+    let loading = || progress_bar_shown(&grab_window(&x, &session.window));
+    let wait_while = |what: &str, still: &dyn Fn() -> bool| {
+        let start = Instant::now();
+        while still() {
+            assert!(
+                start.elapsed() < STEP_TIMEOUT,
+                "{what}: not within {STEP_TIMEOUT:?}; marbre's log:\n{}",
+                marbre_log(&dir)
+            );
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    };
+
+    // The loader waits on the pipe: the bar stays until the test writes.
+    wait_while("the progress bar while the preset loads", &|| !loading());
+    session.focus();
+    session.run(&["key", "2"]);
+    session.run(&["key", "F12"]);
+    std::thread::sleep(Duration::from_secs(2));
+    assert!(loading(), "the load cannot end before the pipe is written");
+    assert!(
+        pngs(&session.screenshots).is_empty(),
+        "F12 waits for the scene"
+    );
+    // Opening the pipe waits for its reader, the loader: on a thread, so
+    // that a viewer that died fails the wait below rather than hanging.
+    std::thread::spawn(move || write_grid_obj(&pipe, GRID_QUADS));
+    wait_while("the end of the load (the progress bar gone)", &loading);
+    wait_while("the screenshot F12 asked for during the load", &|| {
+        pngs(&session.screenshots).is_empty()
+    });
+    // The held keys in order: 2 recalled the sky view, then F12 saved it
+    // (not the placeholder, black, nor the preset's own view of the grid).
+    let first = look(&pngs(&session.screenshots)[0]);
+    assert!(
+        first.centre_blue_excess > 0.2 && first.corner_luma > 0.05,
+        "the screenshot taken by the F12 pressed during the load: {first:?}"
+    );
     assert_clean_log(&dir);
 }

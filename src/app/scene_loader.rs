@@ -30,13 +30,16 @@ pub struct SceneLoad {
 }
 
 impl SceneLoad {
-    /// Starts loading `path`; the environment is fitted to `max_side`.
-    pub fn start(path: &Path, max_side: u32) -> Self {
+    /// Starts loading `path`, with `env_override` (the command line's
+    /// `--env`) in place of the preset's environment if given; the
+    /// environment is fitted to `max_side`.
+    pub fn start(path: &Path, env_override: Option<&Path>, max_side: u32) -> Self {
         let (sender, receiver) = mpsc::channel();
         let stage = Arc::new(AtomicUsize::new(0));
         let (worker_path, worker_stage) = (path.to_owned(), stage.clone());
+        let worker_env = env_override.map(Path::to_owned);
         std::thread::spawn(move || {
-            let result = load_scene_reporting(&worker_path, None, &mut |s| {
+            let result = load_scene_reporting(&worker_path, worker_env.as_deref(), &mut |s| {
                 worker_stage.store(s.index(), Ordering::Relaxed);
             })
             .map(|loaded| {
@@ -88,6 +91,7 @@ impl SceneLoad {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::EnvSource;
 
     fn wait(load: SceneLoad) -> anyhow::Result<ReadyScene> {
         load.receiver.recv().expect("the worker sends a result")
@@ -96,14 +100,29 @@ mod tests {
     #[test]
     fn loads_a_preset_with_its_meshes_off_the_thread() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/cornell.ron");
-        let ready = wait(SceneLoad::start(&path, 8192)).expect("cornell loads");
+        let ready = wait(SceneLoad::start(&path, None, 8192)).expect("cornell loads");
         assert!(ready.loaded.scene.triangle_count() > 0);
+    }
+
+    #[test]
+    fn the_command_lines_environment_replaces_the_presets() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let env = root.join("envmaps/sky.exr");
+        let load = SceneLoad::start(&root.join("presets/cornell.ron"), Some(&env), 8192);
+        let ready = wait(load).expect("cornell loads");
+        assert_eq!(
+            ready.loaded.scene.environment.source,
+            EnvSource::LatLong { path: env }
+        );
+        assert!(ready.loaded.env.is_some(), "the map itself is loaded");
     }
 
     #[test]
     fn a_broken_preset_reports_the_file() {
         let path = Path::new("no/such/preset.ron");
-        let error = wait(SceneLoad::start(path, 8192)).err().expect("fails");
+        let error = wait(SceneLoad::start(path, None, 8192))
+            .err()
+            .expect("fails");
         assert!(
             format!("{error:#}").contains("no/such/preset.ron"),
             "{error:#}"

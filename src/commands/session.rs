@@ -23,6 +23,19 @@ pub struct LoadedScene {
     pub notes: Vec<String>,
 }
 
+impl LoadedScene {
+    /// Nothing but the background: what the viewer draws while the scene
+    /// it opens on loads.
+    pub fn placeholder() -> Self {
+        Self {
+            scene: Scene::default(),
+            env: None,
+            images: ImageSet::empty(),
+            notes: Vec::new(),
+        }
+    }
+}
+
 pub fn load_scene(preset_path: &Path, env_override: Option<&Path>) -> Result<LoadedScene> {
     load_scene_reporting(preset_path, env_override, &mut |_| {})
 }

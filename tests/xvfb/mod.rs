@@ -250,3 +250,31 @@ pub fn request_close(x: &Xvfb, window: &str) {
     };
     send().unwrap_or_else(|e| panic!("sending WM_DELETE_WINDOW to window {window}: {e}"));
 }
+
+/// What window `window` (an id as xdotool prints it) shows now, read from
+/// the X server: unlike F12, which the viewer handles between frames, this
+/// sees the window whatever the viewer is busy with.
+pub fn grab_window(x: &Xvfb, window: &str) -> image::RgbImage {
+    use x11rb::protocol::xproto::{ConnectionExt, ImageFormat};
+
+    let grab = || -> Result<image::RgbImage, Box<dyn std::error::Error>> {
+        let window: u32 = window.trim().parse()?;
+        let (conn, _) = x11rb::connect(Some(&x.display))?;
+        let geometry = conn.get_geometry(window)?.reply()?;
+        let (w, h) = (geometry.width, geometry.height);
+        let reply = conn
+            .get_image(ImageFormat::Z_PIXMAP, window, 0, 0, w, h, !0)?
+            .reply()?;
+        // Xvfb's 24-bit screen: 32 bits a pixel, blue first.
+        if reply.depth != 24 || reply.data.len() != usize::from(w) * usize::from(h) * 4 {
+            return Err(format!("unexpected image: depth {}", reply.depth).into());
+        }
+        let rgb = reply
+            .data
+            .chunks_exact(4)
+            .flat_map(|bgrx| [bgrx[2], bgrx[1], bgrx[0]])
+            .collect();
+        Ok(image::RgbImage::from_raw(w.into(), h.into(), rgb).expect("the size matches"))
+    };
+    grab().unwrap_or_else(|e| panic!("reading window {window}'s pixels: {e}"))
+}

@@ -6,10 +6,11 @@
 //! loaded, so a bad file leaves the scene on screen as it was and says why
 //! in the panel.
 
-use super::Viewer;
+use super::{StartupLoad, Viewer};
 use crate::app::document::Document;
 use crate::app::file_dialogs::{DialogPurpose, OpenDialog, dialogs_available};
 use crate::app::file_watch::{FileWatch, is_same_file};
+use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
 use crate::app::scene_loader::{ReadyScene, SceneLoad};
@@ -19,7 +20,7 @@ use crate::gpu::shader_source;
 use crate::preset;
 use crate::scene::{EnvSource, OrbitCamera, Scene};
 use crate::texture::ImageSet;
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use std::path::{Path, PathBuf};
 
 impl Viewer {
@@ -54,41 +55,92 @@ impl Viewer {
     /// Starts a load; `keep_view` is the camera to keep if the file's own
     /// camera is the one the preset had (a reload after an outside edit).
     fn start_loading(&mut self, path: &Path, keep_view: Option<KeepView>) {
-        let load = SceneLoad::start(path, max_texture_side(&self.ctx));
+        let load = SceneLoad::start(path, None, max_texture_side(&self.ctx));
         self.loading = Some((load, keep_view));
     }
 
+    /// Starts loading the preset the window opens on, with the command
+    /// line's `--env`; until it is in, input is held ([`StartupLoad`]).
+    pub(super) fn start_startup_load(&mut self, path: &Path, may_fall_back: bool) {
+        let env = self.options.env.as_deref();
+        let load = SceneLoad::start(path, env, max_texture_side(&self.ctx));
+        self.loading = Some((load, None));
+        self.panel.preset_path = path.display().to_string();
+        let startup = self.startup.get_or_insert_with(StartupLoad::default);
+        startup.may_fall_back = may_fall_back;
+    }
+
     /// Installs a finished load, or says why it failed (the scene on
-    /// screen then stays as it was); shows the progress meanwhile.
-    pub(super) fn poll_loading(&mut self) {
+    /// screen then stays as it was); shows the progress meanwhile. Only a
+    /// start-up load with nothing to fall back to fails the viewer, as a
+    /// preset named on the command line that does not load always has.
+    pub(super) fn poll_loading(&mut self) -> Result<()> {
         let Some((load, _)) = &self.loading else {
             self.panel.progress = None;
-            return;
+            return Ok(());
         };
         let Some(result) = load.poll() else {
             let (stage, fraction) = load.progress();
             self.panel.progress = Some((format!("{}: {stage}", load.path().display()), fraction));
-            return;
+            return Ok(());
         };
         let (load, keep_view) = self.loading.take().expect("a load is under way");
         self.panel.progress = None;
-        match result {
-            Ok(ready) => self.install_loaded(load.path(), ready, keep_view),
-            Err(e) => self.panel.error(format!("{e:#}")),
+        let installed = result.and_then(|ready| self.install_loaded(load.path(), ready, keep_view));
+        match (installed, self.startup.as_ref()) {
+            (Ok(()), None) => Ok(()),
+            // Undo starts at the loaded scene, not at the placeholder.
+            (Ok(()), Some(_)) => {
+                self.history = History::new(&self.scene);
+                Ok(())
+            }
+            (Err(e), None) => {
+                self.panel.error(format!("{e:#}"));
+                Ok(())
+            }
+            // The last session's preset no longer loads: say why, and
+            // start on the default one rather than not at all.
+            (Err(e), Some(startup)) if startup.may_fall_back => {
+                self.panel
+                    .error(format!("{e:#}; opening the default preset instead"));
+                self.start_startup_load(&super::default_preset(), false);
+                Ok(())
+            }
+            (Err(e), Some(_)) => Err(e),
         }
     }
 
-    fn install_loaded(&mut self, path: &Path, ready: ReadyScene, keep_view: Option<KeepView>) {
+    /// Handles the input held while the start-up scene loaded, in order,
+    /// once the scene is in (installing it builds its shader, waiting):
+    /// then it is what the window shows, and an F12 pressed meanwhile saves
+    /// it rather than the placeholder.
+    pub(super) fn release_held_input(&mut self) -> Result<()> {
+        if self.loading.is_some() {
+            return Ok(());
+        }
+        let Some(startup) = self.startup.take() else {
+            return Ok(());
+        };
+        for event in &startup.held_events {
+            self.handle_event(event)?;
+        }
+        Ok(())
+    }
+
+    fn install_loaded(
+        &mut self,
+        path: &Path,
+        ready: ReadyScene,
+        keep_view: Option<KeepView>,
+    ) -> Result<()> {
         let loaded = ready.loaded;
         self.renderer.provide_geometry(ready.geometry);
-        if let Err(e) = self.apply_scene(
+        self.apply_scene(
             loaded.scene.clone(),
             loaded.env.as_ref(),
             Some(loaded.images.clone()),
-        ) {
-            self.panel.error(format!("{}: {e:#}", path.display()));
-            return;
-        }
+        )
+        .with_context(|| path.display().to_string())?;
         if let Some(keep) = keep_view
             && self.scene.camera == keep.preset_camera
         {
@@ -109,6 +161,7 @@ impl Viewer {
         }
         self.opened(path);
         self.start_watching();
+        Ok(())
     }
 
     /// Remembers `path` in the recent files, and a preset as the one to

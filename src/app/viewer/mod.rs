@@ -24,7 +24,9 @@ use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::{ViewerOptions, camera_input};
-use crate::commands::session::{DEFAULT_PRESET, load_scene, max_texture_side, renderer_for};
+use crate::commands::session::{
+    DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_for,
+};
 use crate::gpu::pass_timer::PassTimer;
 use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
 use crate::panel::{self, PanelAction, PanelState};
@@ -94,6 +96,8 @@ pub struct Viewer {
     dialog: Option<OpenDialog>,
     /// A preset loading on its thread, and the view to keep when it lands.
     loading: Option<(SceneLoad, Option<files::KeepView>)>,
+    /// The preset the window opens on is still loading.
+    startup: Option<StartupLoad>,
     /// The preset's folder, and `shaders/` in `--dev` mode, for hot reload.
     watch: Option<FileWatch>,
     shader_watch: Option<FileWatch>,
@@ -110,6 +114,56 @@ pub struct Viewer {
     fps: f32,
     ms_per_frame: f32,
     screenshot_requested: bool,
+}
+
+/// The preset the window opens on, loading on a worker thread while the
+/// window already shows the panel and a progress bar (a big OBJ and its BVH
+/// take seconds) over an empty placeholder scene.
+#[derive(Default)]
+struct StartupLoad {
+    /// A failure opens the default preset instead: the preset was the last
+    /// session's, not one named on the command line.
+    may_fall_back: bool,
+    /// Input that arrived meanwhile, handled in order once the scene is
+    /// drawn ([`Viewer::release_held_input`]): keys pressed and clicks made
+    /// while it loads are meant for it, not for the placeholder.
+    held_events: Vec<WindowEvent>,
+}
+
+/// Whether `event` is input to hold while the start-up scene loads; the
+/// window's own events (drawing, resizing, closing) are handled at once.
+fn held_until_loaded(event: &WindowEvent) -> bool {
+    !matches!(
+        event,
+        WindowEvent::RedrawRequested
+            | WindowEvent::Resized(_)
+            | WindowEvent::CloseRequested
+            | WindowEvent::Destroyed
+            | WindowEvent::ScaleFactorChanged { .. }
+            | WindowEvent::Moved(_)
+            | WindowEvent::Occluded(_)
+            | WindowEvent::ThemeChanged(_)
+    )
+}
+
+/// A scripted run's scene, loaded before the first frame: the preset at
+/// `path`, or if it fails and `may_fall_back`, the default one (`path`
+/// then names it, and `notes` says why).
+fn load_before_first_frame(
+    path: &mut PathBuf,
+    env: Option<&Path>,
+    may_fall_back: bool,
+    notes: &mut Vec<String>,
+) -> Result<LoadedScene> {
+    match load_scene(path, env) {
+        Ok(loaded) => Ok(loaded),
+        Err(e) if may_fall_back => {
+            notes.push(format!("{e:#}; opening the default preset instead"));
+            *path = default_preset();
+            load_scene(path, env)
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// The preset to open: the command line's, else the last one (if it still
@@ -143,21 +197,26 @@ impl Viewer {
         config_dir: Option<PathBuf>,
     ) -> Result<Self> {
         let mut preset_path = startup_preset(&options, &settings);
+        let may_fall_back = options.preset.is_none() && preset_path != default_preset();
+        // A scripted run counts its frames from the first, so its scene must
+        // be there; a person gets the window at once and the scene when it
+        // has loaded.
+        let scripted = options.exit_after_frames.is_some() || options.soak.is_some();
         let mut startup_notes = Vec::new();
-        let loaded = match load_scene(&preset_path, options.env.as_deref()) {
-            Ok(loaded) => loaded,
-            // The last session's preset no longer loads: say why, and
-            // start on the default one rather than not at all.
-            Err(e) if options.preset.is_none() && preset_path != default_preset() => {
-                startup_notes.push(format!("{e:#}; opened the default preset instead"));
-                preset_path = default_preset();
-                load_scene(&preset_path, options.env.as_deref())?
-            }
-            Err(e) => return Err(e),
+        let (loaded, description) = if scripted {
+            let loaded = load_before_first_frame(
+                &mut preset_path,
+                options.env.as_deref(),
+                may_fall_back,
+                &mut startup_notes,
+            )?;
+            let description = preset::load(&preset_path)
+                .map(|l| l.preset.description)
+                .unwrap_or_default();
+            (loaded, description)
+        } else {
+            (LoadedScene::placeholder(), String::new())
         };
-        let description = preset::load(&preset_path)
-            .map(|l| l.preset.description)
-            .unwrap_or_default();
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
         let surface = instance
@@ -190,7 +249,9 @@ impl Viewer {
         for note in startup_notes {
             panel.error(note);
         }
-        panel.info(format!("loaded {}", preset_path.display()));
+        if scripted {
+            panel.info(format!("loaded {}", preset_path.display()));
+        }
         for note in &loaded.notes {
             panel.info(note.clone());
         }
@@ -198,7 +259,6 @@ impl Viewer {
         let preset_camera = loaded.scene.camera;
         let history = History::new(&loaded.scene);
         let document = Document::new(&preset_path, description, &loaded.scene);
-        let scripted = options.exit_after_frames.is_some() || options.soak.is_some();
         // A soak's thousands of edits are not the user's work: nothing of
         // it is autosaved or remembered.
         let config_dir = config_dir.filter(|_| options.soak.is_none());
@@ -236,6 +296,7 @@ impl Viewer {
             prompt,
             dialog: None,
             loading: None,
+            startup: None,
             watch: None,
             shader_watch: None,
             soak,
@@ -249,8 +310,12 @@ impl Viewer {
             ms_per_frame: 0.0,
             screenshot_requested: false,
         };
-        viewer.opened(&preset_path);
-        viewer.start_watching();
+        if scripted {
+            viewer.opened(&preset_path);
+            viewer.start_watching();
+        } else {
+            viewer.start_startup_load(&preset_path, may_fall_back);
+        }
         Ok(viewer)
     }
 
@@ -260,6 +325,12 @@ impl Viewer {
 
     /// Handles one window event; `Ok(false)` asks the loop to exit.
     pub fn handle_event(&mut self, event: &WindowEvent) -> Result<bool> {
+        if let Some(startup) = &mut self.startup
+            && held_until_loaded(event)
+        {
+            startup.held_events.push(event.clone());
+            return Ok(true);
+        }
         let consumed = self
             .egui_state
             .on_window_event(&self.window, event)
@@ -505,7 +576,8 @@ impl Viewer {
         }
         self.poll_dialog();
         self.poll_file_watch();
-        self.poll_loading();
+        self.poll_loading()?;
+        self.release_held_input()?;
         self.soak_step()?;
         let now = Instant::now();
         let dt = now.duration_since(self.last_frame).as_secs_f32();
