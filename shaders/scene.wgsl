@@ -49,6 +49,12 @@ struct Frame {
     opaque_one: f32,
     // The firefly clamp on a sample's largest channel; 0: off.
     sample_clamp: f32,
+    // The rows [band_start, band_end) this pass traces: the compute
+    // kernel's dispatch covers only them (the fragment kernel's scissor
+    // does the same), so a frame can trace part of a sample round
+    // (gpu/trace_rounds.rs).
+    band_start: u32,
+    band_end: u32,
 }
 
 const MAX_SIGNALS: u32 = 4u;

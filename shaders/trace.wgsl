@@ -1,8 +1,12 @@
-// The per-frame trace pass: a full-screen triangle whose fragment shader
-// traces `samples_per_frame` jittered paths per pixel and folds them into the
-// running mean held in the accumulation target, and folds the spread of the
-// frames' means into the second-moment target (what the error meter,
-// shaders/error_meter.wgsl, estimates the image's error from).
+// The per-frame trace pass: `samples_per_frame` jittered paths per pixel,
+// folded into the running mean held in the accumulation target, and the
+// spread of the frames' means folded into the second-moment target (what
+// the error meter, shaders/error_meter.wgsl, estimates the image's error
+// from). One body, `trace_pixel`, and two kernels that call it: `fs_trace`
+// (a full-screen triangle, the targets as colour attachments) and
+// `cs_trace` (a compute dispatch over a band of rows, the targets as
+// storage textures). Which one runs faster depends on the adapter
+// (gpu/kernel.rs); both give the same image.
 
 @group(0) @binding(5) var previous: texture_2d<f32>;
 @group(0) @binding(16) var previous_spread: texture_2d<f32>;
@@ -256,10 +260,10 @@ fn trace_path(pixel: vec2f) -> vec3f {
     return radiance;
 }
 
-@fragment
-fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
-    frame = frame_slots[frame_slot()];
-    let pixel = vec2u(position.xy);
+// The work of one pixel in one frame: its samples, the firefly clamp, the
+// non-finite samples dropped and counted, the compensated mean and the
+// spread. Both kernels call it; `frame` must be set first.
+fn trace_pixel(pixel: vec2u) -> Accumulated {
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);
     var dropped = 0u;
@@ -314,4 +318,37 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
         atomicAdd(&non_finite.pixels, 1u);
     }
     return Accumulated(vec4f(mean, 1.0), vec4f(spread, prev_dropped + f32(dropped)), vec4f(updated.compensation, 0.0));
+}
+
+@fragment
+fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
+    frame = frame_slots[frame_slot()];
+    return trace_pixel(vec2u(position.xy));
+}
+
+// The compute kernel's outputs: the same three targets the fragment kernel
+// writes as colour attachments (locations 0, 1 and 2).
+@group(1) @binding(0) var out_mean: texture_storage_2d<rgba32float, write>;
+@group(1) @binding(1) var out_spread: texture_storage_2d<rgba32float, write>;
+@group(1) @binding(2) var out_compensation: texture_storage_2d<rgba32float, write>;
+
+// The compute kernel's workgroup: 8 x 8 pixels, the shape measured fastest
+// on lavapipe among 8x8, 16x8 and 16x16 (docs/PERFORMANCE.md). Rust:
+// gpu::kernel::WORKGROUP.
+const TRACE_WORKGROUP: vec2u = vec2u(8u, 8u);
+
+// One invocation per pixel of the band of rows starting at
+// `frame.band_start`; the dispatch rounds up to whole workgroups, so the
+// invocations past the traced region do nothing.
+@compute @workgroup_size(8, 8)
+fn cs_trace(@builtin(global_invocation_id) id: vec3u) {
+    frame = frame_slots[frame_slot()];
+    let pixel = vec2u(id.x, id.y + frame.band_start);
+    if pixel.x >= u32(frame.render_size.x) || pixel.y >= frame.band_end {
+        return;
+    }
+    let out = trace_pixel(pixel);
+    textureStore(out_mean, pixel, out.mean);
+    textureStore(out_spread, pixel, out.spread);
+    textureStore(out_compensation, pixel, out.compensation);
 }

@@ -1,9 +1,12 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
-use super::session::{accumulate, load_scene, max_texture_side, renderer_for, trace_frame};
+use super::session::{
+    accumulate, describe_pick, load_scene, max_texture_side, pick_kernel, renderer_with,
+    trace_frame,
+};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
-use crate::gpu::{GpuContext, Renderer};
+use crate::gpu::{GpuContext, KernelChoice, Renderer};
 use crate::image_io;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -38,6 +41,10 @@ pub struct RenderArgs {
     /// "auto exposure". EXR output stays unscaled radiance.
     #[arg(long)]
     pub auto_exposure: bool,
+    /// The trace kernel: fragment, compute, or auto (the faster of the
+    /// two on this scene, timed first).
+    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    pub kernel: KernelChoice,
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -82,7 +89,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     for note in &loaded.notes {
         eprintln!("note: {note}");
     }
-    let mut renderer = renderer_for(&ctx, &loaded, args.size)?;
+    let (kernel, timings) = pick_kernel(&ctx, &loaded, args.size, args.kernel)?;
+    eprintln!("{}", describe_pick(kernel, timings.as_ref()));
+    let mut renderer = renderer_with(&ctx, &loaded, args.size, kernel)?;
     let bar = indicatif::ProgressBar::new(u64::from(spp));
     bar.set_style(
         indicatif::ProgressStyle::with_template(

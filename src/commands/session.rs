@@ -3,7 +3,8 @@
 
 use crate::cubemap;
 use crate::envmap::{EnvImage, EnvLoad};
-use crate::gpu::{GpuContext, Renderer};
+use crate::gpu::kernel;
+use crate::gpu::{GpuContext, Kernel, KernelChoice, Renderer};
 use crate::preset;
 use crate::scene::{EnvSource, Scene};
 use crate::texture::ImageSet;
@@ -175,11 +176,118 @@ pub fn load_images(scene: &Scene, notes: &mut Vec<String>) -> Result<ImageSet> {
     )?)
 }
 
-/// A renderer for a loaded scene, with its environment and images.
+/// A renderer for a loaded scene, with its environment and images,
+/// tracing with the fragment kernel.
 pub fn renderer_for(ctx: &GpuContext, loaded: &LoadedScene, size: (u32, u32)) -> Result<Renderer> {
-    let mut renderer = Renderer::new(ctx, &loaded.scene, loaded.env.as_ref(), size)?;
+    renderer_with(ctx, loaded, size, Kernel::Fragment)
+}
+
+/// [`renderer_for`], tracing with `kernel`.
+pub fn renderer_with(
+    ctx: &GpuContext,
+    loaded: &LoadedScene,
+    size: (u32, u32),
+    kernel: Kernel,
+) -> Result<Renderer> {
+    let mut renderer =
+        Renderer::with_kernel(ctx, &loaded.scene, loaded.env.as_ref(), size, kernel)?;
     renderer.set_images(ctx, loaded.images.clone())?;
     Ok(renderer)
+}
+
+/// The largest size `auto` times the kernels at: the cost per pixel is
+/// what decides, and a slow adapter must not hold the start for long.
+const KERNEL_TIMING_SIZE: (u32, u32) = (320, 180);
+
+/// Frames each kernel is timed for, after two of warm-up.
+const KERNEL_TIMING_FRAMES: usize = 5;
+
+/// The median ms of one whole round of each kernel on one scene, timed
+/// interleaved (a frame of one, then of the other), so that a machine
+/// busy with something else slows both alike.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KernelTimings {
+    pub fragment_ms: f64,
+    pub compute_ms: f64,
+    pub size: (u32, u32),
+}
+
+impl KernelTimings {
+    pub fn faster(&self) -> Kernel {
+        kernel::faster(self.fragment_ms, self.compute_ms)
+    }
+}
+
+impl std::fmt::Display for KernelTimings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "fragment {:.2} ms, compute {:.2} ms per frame at {}x{}",
+            self.fragment_ms, self.compute_ms, self.size.0, self.size.1
+        )
+    }
+}
+
+/// Times both kernels on `loaded` at `size` (at most
+/// [`KERNEL_TIMING_SIZE`]): see [`KernelTimings`].
+pub fn time_kernels(
+    ctx: &GpuContext,
+    loaded: &LoadedScene,
+    size: (u32, u32),
+) -> Result<KernelTimings> {
+    let size = (
+        size.0.clamp(1, KERNEL_TIMING_SIZE.0),
+        size.1.clamp(1, KERNEL_TIMING_SIZE.1),
+    );
+    let mut renderers = [
+        renderer_with(ctx, loaded, size, Kernel::Fragment)?,
+        renderer_with(ctx, loaded, size, Kernel::Compute)?,
+    ];
+    let mut times = [Vec::new(), Vec::new()];
+    for frame in 0..KERNEL_TIMING_FRAMES + 2 {
+        for (renderer, times) in renderers.iter_mut().zip(&mut times) {
+            let start = std::time::Instant::now();
+            trace_frame(ctx, renderer)?;
+            if frame >= 2 {
+                times.push(start.elapsed().as_secs_f64() * 1000.0);
+            }
+        }
+    }
+    let median = |t: &mut Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    };
+    Ok(KernelTimings {
+        fragment_ms: median(&mut times[0]),
+        compute_ms: median(&mut times[1]),
+        size,
+    })
+}
+
+/// The kernel `choice` means for `loaded` on `ctx`: the one named (an
+/// error if the adapter cannot run it), or for `auto` the faster on this
+/// scene, with the timings that decided (the fragment kernel, untimed,
+/// where the compute kernel cannot run).
+pub fn pick_kernel(
+    ctx: &GpuContext,
+    loaded: &LoadedScene,
+    size: (u32, u32),
+    choice: KernelChoice,
+) -> Result<(Kernel, Option<KernelTimings>)> {
+    let kernel = kernel::resolve(ctx, choice)?;
+    if choice != KernelChoice::Auto || kernel == Kernel::Fragment {
+        return Ok((kernel, None));
+    }
+    let timings = time_kernels(ctx, loaded, size)?;
+    Ok((timings.faster(), Some(timings)))
+}
+
+/// One line on how the kernel was chosen, for the commands' output.
+pub fn describe_pick(kernel: Kernel, timings: Option<&KernelTimings>) -> String {
+    match timings {
+        Some(t) => format!("kernel: {kernel} (auto: {t})"),
+        None => format!("kernel: {kernel}"),
+    }
 }
 
 /// `path`, or the default preset.

@@ -10,6 +10,12 @@
 //! error does not grow with the frame count: a plain f32 running mean
 //! drifts by about 1e-3 after 1e6 frames of an HDR pixel, the compensated
 //! one stays within 1e-7 (`tests/accumulation.rs`).
+//!
+//! A frame may trace only part of a round (a band of rows,
+//! [`super::trace_bands`]): the round writes the other set band by band,
+//! and the latest set, which the display shows, flips only when the round
+//! is complete. So the window always shows a whole image: the last
+//! complete round, or the preview of a new accumulation at a reduced size.
 
 use std::time::{Duration, Instant};
 
@@ -24,7 +30,13 @@ struct PingPong {
 }
 
 impl PingPong {
-    fn new(device: &wgpu::Device, label: &str, size: (u32, u32)) -> Self {
+    fn new(device: &wgpu::Device, label: &str, size: (u32, u32), storage: bool) -> Self {
+        // The compute kernel writes them as storage textures.
+        let storage = if storage {
+            wgpu::TextureUsages::STORAGE_BINDING
+        } else {
+            wgpu::TextureUsages::empty()
+        };
         let make = |i: usize| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(&format!("{label} {i}")),
@@ -39,7 +51,8 @@ impl PingPong {
                 format: ACCUMULATION_FORMAT,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
+                    | wgpu::TextureUsages::COPY_SRC
+                    | storage,
                 view_formats: &[],
             })
         };
@@ -60,6 +73,14 @@ pub struct Accumulation {
     latest: usize,
     samples: u32,
     frames: u32,
+    /// The first row the round under way has not traced yet (0: no round
+    /// under way).
+    next_row: u32,
+    /// The size of the traced region the latest set holds: the display's
+    /// source, which may be a preview at a reduced size.
+    shown_size: (u32, u32),
+    /// Whether this accumulation's preview is done (or was not needed).
+    previewed: bool,
     /// When the current accumulation started (its first frame).
     started: Instant,
     /// Counts resets: tells measurements of one accumulation from the next.
@@ -67,14 +88,19 @@ pub struct Accumulation {
 }
 
 impl Accumulation {
-    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+    /// Targets of `size`, usable as storage textures if `storage` (for the
+    /// compute kernel).
+    pub fn new(device: &wgpu::Device, size: (u32, u32), storage: bool) -> Self {
         Self {
-            mean: PingPong::new(device, "accumulated mean", size),
-            spread: PingPong::new(device, "accumulated spread", size),
-            compensation: PingPong::new(device, "mean compensation", size),
+            mean: PingPong::new(device, "accumulated mean", size, storage),
+            spread: PingPong::new(device, "accumulated spread", size, storage),
+            compensation: PingPong::new(device, "mean compensation", size, storage),
             latest: 0,
             samples: 0,
             frames: 0,
+            next_row: 0,
+            shown_size: (size.0.max(1), size.1.max(1)),
+            previewed: false,
             started: Instant::now(),
             generation: 0,
         }
@@ -87,6 +113,46 @@ impl Accumulation {
         }
         self.samples = 0;
         self.frames = 0;
+        self.next_row = 0;
+        self.previewed = false;
+    }
+
+    /// The first row the round under way has yet to trace.
+    pub fn next_row(&self) -> u32 {
+        self.next_row
+    }
+
+    /// Records that the round under way traced up to `row` (exclusive).
+    pub fn traced_to(&mut self, row: u32) {
+        if self.frames == 0 && self.next_row == 0 {
+            self.started = Instant::now();
+        }
+        self.next_row = row;
+    }
+
+    /// The size of the region the latest set holds (what is displayed).
+    pub fn shown_size(&self) -> (u32, u32) {
+        self.shown_size
+    }
+
+    /// Whether the next round should first show a preview: a new
+    /// accumulation that has neither a round nor its preview yet.
+    pub fn wants_preview(&self) -> bool {
+        !self.previewed && self.frames == 0 && self.next_row == 0
+    }
+
+    /// Records that the write set now holds a preview of `size` (a whole
+    /// round at a reduced size, not counted as samples): it becomes the
+    /// latest, what the display shows until the first real round is done.
+    pub fn show_preview(&mut self, size: (u32, u32)) {
+        self.latest = 1 - self.latest;
+        self.shown_size = size;
+        self.previewed = true;
+    }
+
+    /// Skips the preview: the first round fits in one frame.
+    pub fn skip_preview(&mut self) {
+        self.previewed = true;
     }
 
     pub fn generation(&self) -> u32 {
@@ -133,34 +199,42 @@ impl Accumulation {
         &self.spread.textures[self.latest]
     }
 
-    /// The colour attachments a frame writes: mean, spread, compensation
-    /// (the trace shader's locations 0, 1 and 2).
-    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 3] {
+    /// The views a round writes: mean, spread, compensation (the compute
+    /// kernel's storage textures 0, 1 and 2).
+    pub fn write_views(&self) -> [&wgpu::TextureView; 3] {
         let write = 1 - self.latest;
         [
             &self.mean.views[write],
             &self.spread.views[write],
             &self.compensation.views[write],
         ]
-        .map(|view| {
+    }
+
+    /// The colour attachments a round writes: mean, spread, compensation
+    /// (the trace shader's locations 0, 1 and 2). Loaded, not cleared: a
+    /// round is written a band at a time.
+    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 3] {
+        self.write_views().map(|view| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    load: wgpu::LoadOp::Load,
                     store: wgpu::StoreOp::Store,
                 },
             })
         })
     }
 
-    /// Records that a frame of `samples` samples per pixel was written.
-    pub fn advance(&mut self, samples: u32) {
-        if self.frames == 0 {
-            self.started = Instant::now();
-        }
+    /// Records that a round of `samples` samples per pixel over a region
+    /// of `size` was written whole (its bands reported by
+    /// [`Self::traced_to`]).
+    pub fn advance(&mut self, samples: u32, size: (u32, u32)) {
         self.latest = 1 - self.latest;
+        self.shown_size = size;
+        self.next_row = 0;
+        self.previewed = true;
         self.samples = self.samples.saturating_add(samples);
         self.frames = self.frames.saturating_add(1);
     }

@@ -6,6 +6,7 @@
 
 use super::async_readback::AsyncReadback;
 use super::context::GpuContext;
+use super::trace_pass::PassTimestamps;
 use std::cell::Cell;
 
 /// The passes of a viewer frame, in the order they run.
@@ -137,24 +138,24 @@ impl PassTimer {
         Some((first, first + 1))
     }
 
+    /// The timestamp writes of `pass`, whichever kind of pass (or passes:
+    /// the trace's bands) records it.
+    pub fn timestamps(&self, pass: Pass) -> Option<PassTimestamps<'_>> {
+        self.claim(pass).map(|(begin, end)| PassTimestamps {
+            query_set: &self.queries,
+            beginning: Some(begin),
+            end: Some(end),
+        })
+    }
+
     /// The timestamp writes to put on a render pass.
     pub fn render_pass(&self, pass: Pass) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.claim(pass)
-            .map(|(begin, end)| wgpu::RenderPassTimestampWrites {
-                query_set: &self.queries,
-                beginning_of_pass_write_index: Some(begin),
-                end_of_pass_write_index: Some(end),
-            })
+        self.timestamps(pass).map(PassTimestamps::render)
     }
 
     /// The timestamp writes to put on a compute pass.
     pub fn compute_pass(&self, pass: Pass) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.claim(pass)
-            .map(|(begin, end)| wgpu::ComputePassTimestampWrites {
-                query_set: &self.queries,
-                beginning_of_pass_write_index: Some(begin),
-                end_of_pass_write_index: Some(end),
-            })
+        self.timestamps(pass).map(PassTimestamps::compute)
     }
 
     /// Records the resolve and the copy; call after the frame's last timed

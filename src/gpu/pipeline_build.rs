@@ -14,7 +14,9 @@
 
 use super::context::GpuContext;
 use super::features::FeatureSet;
+use super::kernel::Kernel;
 use super::renderer::Renderer;
+use super::trace_pass::TracePipeline;
 use crate::scene::Scene;
 use crate::texture::ImageSet;
 use anyhow::{Result, anyhow};
@@ -23,7 +25,7 @@ use std::time::{Duration, Instant};
 
 /// A built trace pipeline and the size of its WGSL.
 pub struct BuiltPipeline {
-    pub pipeline: wgpu::RenderPipeline,
+    pub pipeline: TracePipeline,
     pub shader_bytes: usize,
     /// From the request to the pipeline being ready.
     pub took: Duration,
@@ -36,12 +38,14 @@ pub struct WarmUp {
     pub scene: Scene,
     pub images: ImageSet,
     pub features: Option<FeatureSet>,
+    /// The kernel being built: each compiles its own entry point.
+    pub kernel: Kernel,
 }
 
 impl WarmUp {
     fn run(self) -> Result<()> {
         let ctx = &*self.ctx;
-        let mut renderer = Renderer::new(ctx, &self.scene, None, (1, 1))?;
+        let mut renderer = Renderer::with_kernel(ctx, &self.scene, None, (1, 1), self.kernel)?;
         renderer.set_feature_override(ctx, self.features)?;
         renderer.set_images(ctx, self.images)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -53,7 +57,7 @@ impl WarmUp {
 }
 
 /// The work of one build: an optional warm-up, then creating the pipeline.
-type BuildFn = Box<dyn FnOnce() -> Result<(wgpu::RenderPipeline, usize)> + Send>;
+type BuildFn = Box<dyn FnOnce() -> Result<(TracePipeline, usize)> + Send>;
 
 /// A build waiting for the worker, and where its result goes.
 struct Job {
@@ -117,7 +121,7 @@ impl PipelineBuilder {
     pub fn start(
         &mut self,
         warm_up: Option<WarmUp>,
-        build: impl FnOnce() -> Result<(wgpu::RenderPipeline, usize)> + Send + 'static,
+        build: impl FnOnce() -> Result<(TracePipeline, usize)> + Send + 'static,
     ) -> PipelineBuild {
         let (sender, receiver) = mpsc::channel();
         let job = Job {

@@ -2,12 +2,13 @@
 //! target, display pass onto any colour target. It owns every GPU resource
 //! derived from the scene and rebuilds only what an edit invalidates.
 
-use super::accumulation::{ACCUMULATION_FORMAT, Accumulation};
+use super::accumulation::Accumulation;
 use super::auto_exposure::{AutoExposure, Metered};
 use super::context::GpuContext;
 use super::error_meter::{self, ErrorEstimate, ErrorMeter};
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
+use super::kernel::{self, Kernel};
 use super::mesh_buffers::{MeshBuffers, MeshStats, PreparedGeometry};
 use super::non_finite::{self, NonFiniteCounter, NonFiniteCounts};
 use super::pass_timer::{Pass, PassTimer};
@@ -20,6 +21,8 @@ use super::readback::read_texture;
 use super::scene_gpu::{self, FrameUniform};
 use super::shader_source::{Program, assemble, sources_generation};
 use super::texture_codegen;
+use super::trace_bands::{self, TraceBudget};
+use super::trace_pass::{BandPass, PassTimestamps, TraceLayouts, TracePipeline};
 use crate::env_sampling::EnvDistribution;
 use crate::envmap::{self, EnvImage};
 use crate::scene::{Scene, ToneMap};
@@ -90,6 +93,7 @@ struct PipelineKey {
     switches: RenderSwitches,
     /// The shader files' generation (`marbre --dev` reloads them).
     sources: u64,
+    kernel: Kernel,
 }
 
 /// The render settings the trace shader reads as override constants
@@ -138,12 +142,24 @@ pub struct Renderer {
     /// When set, the shader is built with these features whatever the scene
     /// uses: `FeatureSet::all()` is the uber shader the benchmarks compare.
     feature_override: Option<FeatureSet>,
-    trace_layout: wgpu::BindGroupLayout,
-    trace_pipeline: wgpu::RenderPipeline,
+    /// The kernel new pipelines are built for (the key holds the one
+    /// drawing now).
+    kernel: Kernel,
+    /// Whether the adapter runs the compute kernel (its targets are then
+    /// storage textures too).
+    compute_supported: bool,
+    trace_layouts: TraceLayouts,
+    trace_pipeline: TracePipeline,
     display_layout: wgpu::BindGroupLayout,
     display_pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
     display_module: wgpu::ShaderModule,
+    /// A ring of [`FRAME_SLOTS`] frame uniforms, one per trace pass: the
+    /// passes of one submit each read their own (a `write_buffer` lands
+    /// before the whole submit, so one slot would give every pass the
+    /// last pass's settings).
     frame_buffer: wgpu::Buffer,
+    /// The next slot of the ring to write.
+    frame_slot: u64,
     display_buffer: wgpu::Buffer,
     /// Meters the accumulation for auto exposure; the display pass reads
     /// its result buffer.
@@ -175,20 +191,63 @@ pub struct Renderer {
     frame_index: u32,
 }
 
+/// Frame uniforms in the ring: more than the passes of one submit
+/// ([`trace_bands::MAX_PASSES`] and a preview).
+const FRAME_SLOTS: u64 = 2 * trace_bands::MAX_PASSES as u64;
+
+/// The bytes of one frame-uniform slot: two copies of the settings (see
+/// `frame_slots` in shaders/scene.wgsl).
+const FRAME_BYTES: u64 = 2 * std::mem::size_of::<FrameUniform>() as u64;
+
+/// What one trace call did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TraceWork {
+    /// Pixels traced, a preview's included.
+    pub pixels: u64,
+    /// Rounds completed (each adds `samples_per_frame` samples per pixel).
+    pub rounds: u32,
+}
+
 impl Renderer {
+    /// A renderer tracing with the fragment kernel, which every adapter
+    /// runs.
     pub fn new(
         ctx: &GpuContext,
         scene: &Scene,
         env: Option<&EnvImage>,
         size: (u32, u32),
     ) -> Result<Self> {
+        Self::with_kernel(ctx, scene, env, size, Kernel::Fragment)
+    }
+
+    /// A renderer tracing with `kernel`; an error if the adapter cannot run
+    /// it ([`kernel::compute_support`]).
+    pub fn with_kernel(
+        ctx: &GpuContext,
+        scene: &Scene,
+        env: Option<&EnvImage>,
+        size: (u32, u32),
+        kernel: Kernel,
+    ) -> Result<Self> {
         let device = &ctx.device;
+        let compute_supported = kernel::compute_support(ctx).is_ok();
+        if kernel == Kernel::Compute {
+            kernel::resolve(ctx, kernel::KernelChoice::Compute)?;
+        }
         let features = FeatureSet::for_scene(scene);
+        let frame_entry = wgpu::BindGroupLayoutEntry {
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(FRAME_BYTES),
+            },
+            ..entry(0, uniform())
+        };
         let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace"),
             entries: &[
-                // Two slots: see `frame_slots` in shaders/scene.wgsl.
-                entry(0, uniform()),
+                // A slot of the frame ring, at a dynamic offset.
+                frame_entry,
                 entry(GeometryBuffers::BINDINGS[0], uniform()),
                 entry(GeometryBuffers::BINDINGS[1], uniform()),
                 entry(GeometryBuffers::BINDINGS[2], uniform()),
@@ -228,9 +287,14 @@ impl Renderer {
             code: textures.wgsl,
             switches: RenderSwitches::of(scene),
             sources: sources_generation(),
+            kernel,
+        };
+        let trace_layouts = TraceLayouts {
+            scene: trace_layout,
+            outputs: TraceLayouts::outputs(device),
         };
         let (trace_pipeline, trace_shader_bytes) =
-            Self::build_trace_pipeline(&ctx.device, &trace_layout, &key)?;
+            Self::build_trace_pipeline(&ctx.device, &trace_layouts, &key)?;
         let display_module = shader_module(device, Program::Display, &FeatureSet::default(), "")?;
         let auto_exposure = AutoExposure::new(device)?;
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -240,11 +304,12 @@ impl Renderer {
                 usage: usage | wgpu::BufferUsages::COPY_DST,
             })
         };
-        let frame_buffer = buffer(
-            "frame",
-            bytemuck::cast_slice(&[scene_gpu::frame_uniform(scene, size, 0, 0); 2]),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame ring"),
+            size: FRAME_SLOTS * frame_stride(device),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let display_buffer = buffer(
             "display",
             bytemuck::bytes_of(&DisplayUniform::zeroed()),
@@ -275,7 +340,7 @@ impl Renderer {
         let env_view = upload_env(ctx, env.as_deref());
         let env_distribution = upload_env_distribution(ctx, env.as_deref());
         let image_atlas_view = upload_atlas(ctx, images.atlas());
-        let accumulation = Accumulation::new(device, size);
+        let accumulation = Accumulation::new(device, size, compute_supported);
         let error_meter = ErrorMeter::new(device)?;
         let non_finite = NonFiniteCounter::new(device);
         Ok(Self {
@@ -286,12 +351,15 @@ impl Renderer {
             last_build: None,
             key,
             feature_override: None,
-            trace_layout,
+            kernel,
+            compute_supported,
+            trace_layouts,
             trace_pipeline,
             display_layout,
             display_pipelines: HashMap::new(),
             display_module,
             frame_buffer,
+            frame_slot: 0,
             display_buffer,
             auto_exposure,
             metered_from: None,
@@ -314,25 +382,57 @@ impl Renderer {
         })
     }
 
-    /// The trace pipeline, and the size of its WGSL.
+    /// The trace pipeline of the key's kernel, and the size of its WGSL.
     fn build_trace_pipeline(
         device: &wgpu::Device,
-        layout: &wgpu::BindGroupLayout,
+        layouts: &TraceLayouts,
         key: &PipelineKey,
-    ) -> Result<(wgpu::RenderPipeline, usize)> {
+    ) -> Result<(TracePipeline, usize)> {
         let source = assemble(Program::Trace, &key.features, &key.code)?;
         let bytes = source.len();
         let module = compile_wgsl(device, Program::Trace, source)?;
-        let pipeline = fullscreen_pipeline(
+        let pipeline = TracePipeline::build(
             device,
-            "trace",
+            layouts,
             &module,
-            layout,
-            "fs_trace",
-            &[ACCUMULATION_FORMAT; 3],
+            key.kernel,
             &key.switches.constants(),
         )?;
         Ok((pipeline, bytes))
+    }
+
+    /// The kernel drawing now.
+    pub fn kernel(&self) -> Kernel {
+        self.trace_pipeline.kernel()
+    }
+
+    /// Traces with `kernel` from now on, waiting for its pipeline (for
+    /// headless renders and tests); an error, leaving the current kernel,
+    /// if the adapter cannot run it.
+    pub fn set_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        self.choose_kernel(ctx, kernel)?;
+        let scene = self.scene.clone();
+        self.set_scene(ctx, &scene)
+    }
+
+    /// Traces with `kernel` once its pipeline is built, without waiting
+    /// (the viewer's Kernel switch): the current one draws until then.
+    pub fn request_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        self.choose_kernel(ctx, kernel)?;
+        let scene = self
+            .pending
+            .as_ref()
+            .map_or(&self.scene, |p| &p.target.scene)
+            .clone();
+        self.start_scene(ctx, &scene, true)
+    }
+
+    fn choose_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        if kernel == Kernel::Compute && !self.compute_supported {
+            kernel::resolve(ctx, kernel::KernelChoice::Compute)?;
+        }
+        self.kernel = kernel;
+        Ok(())
     }
 
     /// Triangles, BVH nodes, lights and the last BVH build time.
@@ -379,8 +479,20 @@ impl Renderer {
 
     /// The size actually traced: the target size times the render scale.
     pub fn render_size(&self) -> (u32, u32) {
-        let s = |v: u32| ((v as f32 * self.render_scale).ceil() as u32).clamp(1, v.max(1));
-        (s(self.size.0), s(self.size.1))
+        scaled(self.size, self.render_scale)
+    }
+
+    /// The size of the image on show: the last complete round's traced
+    /// region, or its preview's (smaller) while the first round of an
+    /// accumulation is under way.
+    pub fn shown_size(&self) -> (u32, u32) {
+        self.accumulation.shown_size()
+    }
+
+    /// The fraction of the round under way already traced (0 between
+    /// rounds): the panel's progress while a slow adapter traces in bands.
+    pub fn round_progress(&self) -> f32 {
+        self.accumulation.next_row() as f32 / self.render_size().1.max(1) as f32
     }
 
     /// Geometry prepared off the render thread for the next scene set
@@ -448,6 +560,7 @@ impl Renderer {
             code,
             switches: RenderSwitches::of(scene),
             sources: sources_generation(),
+            kernel: self.kernel,
         };
         if key == self.key {
             self.pending = None;
@@ -474,11 +587,12 @@ impl Renderer {
             scene: scene.clone(),
             images: self.images.clone(),
             features: self.feature_override.clone(),
+            kernel: self.kernel,
         });
-        let (device, layout) = (ctx.device.clone(), self.trace_layout.clone());
+        let (device, layouts) = (ctx.device.clone(), self.trace_layouts.clone());
         let build_key = key.clone();
         let build = self.builder.start(warm_up, move || {
-            Self::build_trace_pipeline(&device, &layout, &build_key)
+            Self::build_trace_pipeline(&device, &layouts, &build_key)
         });
         self.pending = Some(PendingScene { build, key, target });
         self.follow_camera(scene);
@@ -640,7 +754,7 @@ impl Renderer {
                 ..self.key.clone()
             };
             (self.trace_pipeline, self.trace_shader_bytes) =
-                Self::build_trace_pipeline(&ctx.device, &self.trace_layout, &key)?;
+                Self::build_trace_pipeline(&ctx.device, &self.trace_layouts, &key)?;
             self.key = key;
         }
         ctx.queue.write_buffer(
@@ -668,7 +782,7 @@ impl Renderer {
         let size = (size.0.max(1), size.1.max(1));
         if size != self.size {
             self.size = size;
-            self.accumulation = Accumulation::new(&ctx.device, size);
+            self.accumulation = Accumulation::new(&ctx.device, size, self.compute_supported);
             self.reset_accumulation();
         }
     }
@@ -686,22 +800,100 @@ impl Renderer {
         self.accumulation.reset();
     }
 
-    /// Records one trace pass: `samples_per_frame` more samples per pixel,
-    /// timed by `timestamp_writes` if given (the viewer's
-    /// [`PassTimer::render_pass`], the benchmarks' own query sets).
+    /// Records one whole round: `samples_per_frame` more samples per pixel
+    /// (or the rest of the round under way), timed by `timestamps` if
+    /// given (the viewer's [`PassTimer`], the benchmarks' own query sets).
     pub fn trace(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        if !self.scene.render.accumulate {
+        timestamps: Option<PassTimestamps<'_>>,
+    ) -> TraceWork {
+        self.trace_within(ctx, encoder, TraceBudget::Round, timestamps)
+    }
+
+    /// Records about `budget` of tracing (see [`trace_bands::plan`]): the
+    /// round under way continues where it stopped, and a round completed
+    /// becomes the image. A new accumulation whose first round does not
+    /// fit in the budget first traces a preview whole, at the size that
+    /// fits (at most the interactive scale): the window shows the edit at
+    /// once, at a reduced resolution, then the full one.
+    pub fn trace_within(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        budget: TraceBudget,
+        timestamps: Option<PassTimestamps<'_>>,
+    ) -> TraceWork {
+        if !self.scene.render.accumulate && self.accumulation.next_row() == 0 {
+            // Each round starts anew; the preview was for the first.
+            let previewed = !self.accumulation.wants_preview();
             self.accumulation.reset();
+            if previewed {
+                self.accumulation.skip_preview();
+            }
         }
-        let render_size = self.render_size();
+        let full = self.render_size();
+        let mut passes: Vec<((u32, u32), std::ops::Range<u32>)> = Vec::new();
+        let mut budget = budget;
+        if let TraceBudget::Pixels(pixels) = budget
+            && self.accumulation.wants_preview()
+        {
+            let round = u64::from(full.0) * u64::from(full.1);
+            if round > pixels {
+                let scale = ((pixels as f64 / round as f64).sqrt() as f32)
+                    .min(self.scene.render.interactive_scale);
+                let size = scaled(full, scale);
+                passes.push((size, 0..size.1));
+                budget = TraceBudget::Pixels(pixels.saturating_sub(pixel_count(size)));
+            } else {
+                self.accumulation.skip_preview();
+            }
+        }
+        let bands = trace_bands::plan(full.0, full.1, self.accumulation.next_row(), budget);
+        passes.extend(bands.into_iter().map(|rows| (full, rows)));
+        let mut work = TraceWork::default();
+        let count = passes.len();
+        for (index, (size, rows)) in passes.into_iter().enumerate() {
+            let preview = size != full;
+            if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
+                self.non_finite.clear(encoder);
+            }
+            self.record_band(ctx, encoder, size, rows.clone(), (index, count), timestamps);
+            work.pixels += u64::from(size.0) * u64::from(rows.end - rows.start);
+            if preview {
+                self.accumulation.show_preview(size);
+                self.frame_index = self.frame_index.wrapping_add(1);
+                continue;
+            }
+            self.accumulation.traced_to(rows.end);
+            if rows.end == size.1 {
+                self.accumulation
+                    .advance(self.scene.render.samples_per_frame.max(1), size);
+                self.frame_index = self.frame_index.wrapping_add(1);
+                work.rounds += 1;
+            }
+        }
+        self.non_finite
+            .record_readback(encoder, self.accumulation.generation());
+        work
+    }
+
+    /// Records the pass of one band of rows of a round over a region of
+    /// `size`: the frame uniform in its own slot, the bind groups of the
+    /// accumulation's current sets.
+    fn record_band(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        size: (u32, u32),
+        rows: std::ops::Range<u32>,
+        (index, count): (usize, usize),
+        timestamps: Option<PassTimestamps<'_>>,
+    ) {
         let mut uniform: FrameUniform = scene_gpu::frame_uniform(
             &self.scene,
-            render_size,
+            size,
             self.frame_index,
             self.accumulation.samples(),
         );
@@ -710,11 +902,24 @@ impl Renderer {
         uniform.light_count = table.lights.len() as u32;
         uniform.light_total_power = table.total_power;
         uniform.triangle_count = self.meshes.stats().triangles as u32;
-        ctx.queue
-            .write_buffer(&self.frame_buffer, 0, bytemuck::cast_slice(&[uniform; 2]));
+        uniform.band_start = rows.start;
+        uniform.band_end = rows.end;
+        let stride = frame_stride(&ctx.device);
+        let offset = self.frame_slot * stride;
+        self.frame_slot = (self.frame_slot + 1) % FRAME_SLOTS;
+        ctx.queue.write_buffer(
+            &self.frame_buffer,
+            offset,
+            bytemuck::cast_slice(&[uniform; 2]),
+        );
         let (previous_mean, previous_spread) = self.accumulation.latest_views();
+        let frame = wgpu::BufferBinding {
+            buffer: &self.frame_buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(FRAME_BYTES),
+        };
         let mut entries = vec![
-            bind(0, self.frame_buffer.as_entire_binding()),
+            bind(0, wgpu::BindingResource::Buffer(frame)),
             bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
             bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
             bind(5, wgpu::BindingResource::TextureView(previous_mean)),
@@ -737,40 +942,36 @@ impl Renderer {
         ];
         entries.extend(self.geometry.entries());
         entries.extend(self.meshes.entries());
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let scene_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("trace"),
-            layout: &self.trace_layout,
+            layout: &self.trace_layouts.scene,
             entries: &entries,
         });
-        if self.accumulation.samples() == 0 {
-            self.non_finite.clear(encoder);
+        let outputs = matches!(self.trace_pipeline, TracePipeline::Compute(_)).then(|| {
+            let views = self.accumulation.write_views();
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("trace outputs"),
+                layout: &self.trace_layouts.outputs,
+                entries: &[
+                    bind(0, wgpu::BindingResource::TextureView(views[0])),
+                    bind(1, wgpu::BindingResource::TextureView(views[1])),
+                    bind(2, wgpu::BindingResource::TextureView(views[2])),
+                ],
+            })
+        });
+        BandPass {
+            pipeline: &self.trace_pipeline,
+            scene: &scene_group,
+            frame_offset: offset as u32,
+            outputs: outputs.as_ref(),
+            accumulation: &self.accumulation,
+            width: size.0,
+            rows,
+            height: size.1,
+            index,
+            count,
         }
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("trace"),
-                color_attachments: &self.accumulation.attachments(),
-                depth_stencil_attachment: None,
-                timestamp_writes,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_viewport(
-                0.0,
-                0.0,
-                render_size.0 as f32,
-                render_size.1 as f32,
-                0.0,
-                1.0,
-            );
-            pass.set_pipeline(&self.trace_pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        self.non_finite
-            .record_readback(encoder, self.accumulation.generation());
-        self.accumulation
-            .advance(self.scene.render.samples_per_frame.max(1));
-        self.frame_index = self.frame_index.wrapping_add(1);
+        .record(encoder, timestamps);
     }
 
     /// Records the auto-exposure metering of the latest mean, unless the
@@ -781,7 +982,7 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         timer: Option<&PassTimer>,
     ) {
-        let render_size = self.render_size();
+        let render_size = self.shown_size();
         let from = MeteredFrom {
             frame_index: self.frame_index,
             size: self.size,
@@ -832,7 +1033,7 @@ impl Renderer {
         if auto_exposure {
             self.meter(ctx, encoder, timer);
         }
-        let render_size = self.render_size();
+        let render_size = self.shown_size();
         let uniform = DisplayUniform {
             exposure_scale: self.scene.render.exposure.exp2(),
             tone_map: match self.scene.render.tone_map {
@@ -917,7 +1118,7 @@ impl Renderer {
     ) -> Result<(u32, u32, Vec<[f32; 4]>)> {
         let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
         let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-        let (rw, rh) = self.render_size();
+        let (rw, rh) = self.shown_size();
         let mut out = Vec::with_capacity((rw * rh) as usize);
         for y in 0..rh {
             let start = (y * self.size.0) as usize;
@@ -958,7 +1159,7 @@ impl Renderer {
         error_meter::Accumulated {
             mean,
             spread,
-            region: self.render_size(),
+            region: self.shown_size(),
             frames: self.accumulation.frames(),
             samples: self.accumulation.samples(),
             seconds: self.accumulation.elapsed().as_secs_f32(),
@@ -1005,7 +1206,7 @@ impl Renderer {
 
     /// The displayed (tone-mapped, sRGB) image at the trace resolution.
     pub fn read_display(&mut self, ctx: &GpuContext) -> Result<image::RgbaImage> {
-        let (w, h) = self.render_size();
+        let (w, h) = self.shown_size();
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let target = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("display readback"),
@@ -1040,6 +1241,23 @@ impl Renderer {
         image::RgbaImage::from_raw(w, h, bytes)
             .ok_or_else(|| anyhow::anyhow!("readback returned the wrong number of bytes"))
     }
+}
+
+/// The bytes between frame-uniform slots: a slot rounded up to the
+/// device's uniform offset alignment.
+fn frame_stride(device: &wgpu::Device) -> u64 {
+    let align = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+    FRAME_BYTES.div_ceil(align) * align
+}
+
+/// `size` scaled by `scale`, at least one pixel a side.
+fn scaled(size: (u32, u32), scale: f32) -> (u32, u32) {
+    let s = |v: u32| ((v as f32 * scale).ceil() as u32).clamp(1, v.max(1));
+    (s(size.0), s(size.1))
+}
+
+fn pixel_count(size: (u32, u32)) -> u64 {
+    u64::from(size.0) * u64::from(size.1)
 }
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {

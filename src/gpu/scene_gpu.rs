@@ -58,7 +58,11 @@ pub struct FrameUniform {
     pub opaque_one: f32,
     /// The firefly clamp on a sample's largest channel; 0: off.
     pub sample_clamp: f32,
-    pub _pad: u32,
+    /// The rows `band_start..band_end` a trace pass covers (the compute
+    /// kernel reads them; the fragment kernel's scissor matches).
+    pub band_start: u32,
+    pub band_end: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `NoiseParams` of `shaders/fractal.wgsl`.
@@ -334,7 +338,9 @@ pub fn frame_uniform(
         triangle_count: 0,
         opaque_one: 1.0,
         sample_clamp: scene.render.transport.sample_clamp.unwrap_or(0.0),
-        _pad: 0,
+        band_start: 0,
+        band_end: render_size.1.max(1),
+        _pad: [0; 3],
     }
 }
 
@@ -347,7 +353,7 @@ mod tests {
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 208);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 224);
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);

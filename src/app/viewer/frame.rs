@@ -188,7 +188,7 @@ impl Viewer {
         }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         if !self.paused_at_target() {
-            let trace_writes = self.timer.as_ref().and_then(|t| t.render_pass(Pass::Trace));
+            let trace_writes = self.timer.as_ref().and_then(|t| t.timestamps(Pass::Trace));
             self.renderer.trace(&self.ctx, &mut encoder, trace_writes);
             self.renderer
                 .meter_error(&self.ctx, &mut encoder, self.timer.as_ref());

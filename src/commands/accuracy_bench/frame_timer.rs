@@ -4,7 +4,7 @@
 //! total is the time a user waits for that many samples.
 
 use crate::gpu::readback::read_buffer;
-use crate::gpu::{GpuContext, Renderer};
+use crate::gpu::{GpuContext, PassTimestamps, Renderer};
 use anyhow::{Context, Result};
 use std::time::Instant;
 
@@ -132,11 +132,11 @@ impl Timestamps {
     }
 
     /// Frame `i` of a batch writes timestamps `2i` and `2i + 1`.
-    fn writes(&self, i: u32) -> wgpu::RenderPassTimestampWrites<'_> {
-        wgpu::RenderPassTimestampWrites {
+    fn writes(&self, i: u32) -> PassTimestamps<'_> {
+        PassTimestamps {
             query_set: &self.queries,
-            beginning_of_pass_write_index: Some(2 * i),
-            end_of_pass_write_index: Some(2 * i + 1),
+            beginning: Some(2 * i),
+            end: Some(2 * i + 1),
         }
     }
 

@@ -1,0 +1,186 @@
+//! Which kernel runs the trace: the fragment shader over a full-screen
+//! triangle, or a compute dispatch. Both call the same WGSL body
+//! (`trace_pixel` in shaders/trace.wgsl) and give the same image; which is
+//! faster depends on the adapter. An NVIDIA H100 runs pixel shaders on few
+//! of its units (the prototype traced the default preset at 1080p in 0.7 ms
+//! in compute against 19.5 ms in fragment), while on lavapipe neither wins
+//! everywhere (docs/PERFORMANCE.md). So `auto` times both on the scene at
+//! hand and keeps the faster (`app/kernel_choice.rs` remembers it per
+//! adapter).
+
+use super::context::GpuContext;
+use std::fmt;
+
+/// A kernel the renderer can trace with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Kernel {
+    /// `fs_trace`: a full-screen triangle, the accumulation targets as
+    /// colour attachments.
+    #[default]
+    Fragment,
+    /// `cs_trace`: workgroups of [`WORKGROUP`] pixels, the targets as
+    /// storage textures.
+    Compute,
+}
+
+impl Kernel {
+    pub const ALL: [Kernel; 2] = [Kernel::Fragment, Kernel::Compute];
+
+    /// Its name on the command line, in settings and in the panel.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Fragment => "fragment",
+            Kernel::Compute => "compute",
+        }
+    }
+
+    /// The kernel named `name` (as [`Kernel::name`] writes it).
+    pub fn parse(name: &str) -> Option<Kernel> {
+        Kernel::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+impl fmt::Display for Kernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What the user asked for: a kernel, or the faster of the two.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum KernelChoice {
+    Fragment,
+    Compute,
+    /// Time both on the first scene and keep the faster (remembered per
+    /// adapter by the viewer).
+    #[default]
+    Auto,
+}
+
+impl KernelChoice {
+    /// The kernel this choice names, `None` for `auto`.
+    pub fn fixed(self) -> Option<Kernel> {
+        match self {
+            KernelChoice::Fragment => Some(Kernel::Fragment),
+            KernelChoice::Compute => Some(Kernel::Compute),
+            KernelChoice::Auto => None,
+        }
+    }
+}
+
+/// The compute kernel's workgroup, in pixels (shaders/trace.wgsl's
+/// `@workgroup_size`).
+pub const WORKGROUP: (u32, u32) = (8, 8);
+
+/// The storage textures the compute kernel writes (mean, spread,
+/// compensation).
+const STORAGE_TEXTURES: u32 = 3;
+
+/// Why `ctx`'s adapter cannot run the compute kernel, or `Ok`: it writes
+/// three `Rgba32Float` storage textures from workgroups of [`WORKGROUP`].
+pub fn compute_support(ctx: &GpuContext) -> Result<(), String> {
+    let format = super::accumulation::ACCUMULATION_FORMAT;
+    let usages = ctx
+        .adapter
+        .get_texture_format_features(format)
+        .allowed_usages;
+    let limits = ctx.device.limits();
+    missing_capability(
+        usages.contains(wgpu::TextureUsages::STORAGE_BINDING),
+        &limits,
+    )
+    .map_or(Ok(()), Err)
+}
+
+/// The first capability the compute kernel needs that is missing, named.
+fn missing_capability(storage_format: bool, limits: &wgpu::Limits) -> Option<String> {
+    let invocations = WORKGROUP.0 * WORKGROUP.1;
+    if !storage_format {
+        Some(format!(
+            "{:?} textures cannot be storage textures on this adapter",
+            super::accumulation::ACCUMULATION_FORMAT
+        ))
+    } else if limits.max_storage_textures_per_shader_stage < STORAGE_TEXTURES {
+        Some(format!(
+            "the adapter allows {} storage textures per shader stage, the compute kernel writes {STORAGE_TEXTURES}",
+            limits.max_storage_textures_per_shader_stage
+        ))
+    } else if limits.max_compute_invocations_per_workgroup < invocations
+        || limits.max_compute_workgroup_size_x < WORKGROUP.0
+        || limits.max_compute_workgroup_size_y < WORKGROUP.1
+    {
+        Some(format!(
+            "the adapter's compute workgroups are smaller than {}x{}",
+            WORKGROUP.0, WORKGROUP.1
+        ))
+    } else {
+        None
+    }
+}
+
+/// The kernel `choice` resolves to on `ctx`'s adapter, before any timing:
+/// `auto` starts on the compute kernel where it is supported. `--kernel
+/// compute` where it is not is an error naming what is missing.
+pub fn resolve(ctx: &GpuContext, choice: KernelChoice) -> anyhow::Result<Kernel> {
+    match (choice, compute_support(ctx)) {
+        (KernelChoice::Compute, Err(why)) => Err(anyhow::anyhow!(
+            "the compute kernel cannot run on {}: {why}",
+            ctx.describe()
+        )),
+        (KernelChoice::Fragment, _) | (KernelChoice::Auto, Err(_)) => Ok(Kernel::Fragment),
+        (KernelChoice::Compute, Ok(())) | (KernelChoice::Auto, Ok(())) => Ok(Kernel::Compute),
+    }
+}
+
+/// The faster kernel from the median milliseconds each took on the same
+/// scene and size. A tie keeps the fragment kernel, the one every adapter
+/// runs.
+pub fn faster(fragment_ms: f64, compute_ms: f64) -> Kernel {
+    if compute_ms < fragment_ms {
+        Kernel::Compute
+    } else {
+        Kernel::Fragment
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_unknown_names_are_refused() {
+        for k in Kernel::ALL {
+            assert_eq!(Kernel::parse(k.name()), Some(k));
+        }
+        assert_eq!(Kernel::parse("Compute"), None);
+        assert_eq!(Kernel::parse(""), None);
+    }
+
+    #[test]
+    fn the_faster_kernel_wins_and_a_tie_keeps_fragment() {
+        assert_eq!(faster(10.0, 4.0), Kernel::Compute);
+        assert_eq!(faster(4.0, 10.0), Kernel::Fragment);
+        assert_eq!(faster(5.0, 5.0), Kernel::Fragment);
+    }
+
+    #[test]
+    fn each_missing_capability_is_named() {
+        let full = wgpu::Limits::default();
+        assert_eq!(missing_capability(true, &full), None);
+        let format = missing_capability(false, &full).unwrap();
+        assert!(format.contains("Rgba32Float"), "{format}");
+        let few = wgpu::Limits {
+            max_storage_textures_per_shader_stage: 2,
+            ..full.clone()
+        };
+        let textures = missing_capability(true, &few).unwrap();
+        assert!(textures.contains("allows 2 storage textures"), "{textures}");
+        let small = wgpu::Limits {
+            max_compute_invocations_per_workgroup: 32,
+            ..full.clone()
+        };
+        assert!(missing_capability(true, &small).unwrap().contains("8x8"));
+        // WebGL2's limits have no storage textures at all.
+        assert!(missing_capability(true, &wgpu::Limits::downlevel_webgl2_defaults()).is_some());
+    }
+}

@@ -1,0 +1,191 @@
+//! Recording one band of a trace round with either kernel
+//! ([`super::kernel::Kernel`]): the fragment kernel draws the full-screen
+//! triangle with a scissor around the band, the compute kernel dispatches
+//! workgroups over it. Both read the scene through bind group 0 (its frame
+//! uniform at a dynamic offset, so several passes in one submit each see
+//! their own); the compute kernel writes the accumulation through group 1.
+
+use super::accumulation::{ACCUMULATION_FORMAT, Accumulation};
+use super::kernel::{Kernel, WORKGROUP};
+use super::pipelines::{checked, entry, fullscreen_pipeline};
+use anyhow::Result;
+use std::ops::Range;
+
+/// A built trace pipeline of either kernel.
+pub enum TracePipeline {
+    Fragment(wgpu::RenderPipeline),
+    Compute(wgpu::ComputePipeline),
+}
+
+impl TracePipeline {
+    pub fn kernel(&self) -> Kernel {
+        match self {
+            TracePipeline::Fragment(_) => Kernel::Fragment,
+            TracePipeline::Compute(_) => Kernel::Compute,
+        }
+    }
+
+    /// `kernel`'s pipeline from the assembled trace module, its override
+    /// constants set to `constants`.
+    pub fn build(
+        device: &wgpu::Device,
+        layouts: &TraceLayouts,
+        module: &wgpu::ShaderModule,
+        kernel: Kernel,
+        constants: &[(&str, f64)],
+    ) -> Result<Self> {
+        match kernel {
+            Kernel::Fragment => Ok(TracePipeline::Fragment(fullscreen_pipeline(
+                device,
+                "trace",
+                module,
+                &layouts.scene,
+                "fs_trace",
+                &[ACCUMULATION_FORMAT; 3],
+                constants,
+            )?)),
+            Kernel::Compute => {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("trace (compute)"),
+                    bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.outputs)],
+                    immediate_size: 0,
+                });
+                let pipeline = checked(device, "trace pipeline (compute)", || {
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("trace (compute)"),
+                        layout: Some(&layout),
+                        module,
+                        entry_point: Some("cs_trace"),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants,
+                            ..Default::default()
+                        },
+                        cache: None,
+                    })
+                })?;
+                Ok(TracePipeline::Compute(pipeline))
+            }
+        }
+    }
+}
+
+/// The bind group layouts of the trace pipelines: the scene (both kernels)
+/// and the compute kernel's storage-texture outputs.
+#[derive(Clone)]
+pub struct TraceLayouts {
+    pub scene: wgpu::BindGroupLayout,
+    pub outputs: wgpu::BindGroupLayout,
+}
+
+impl TraceLayouts {
+    pub fn outputs(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let output = |binding| {
+            entry(
+                binding,
+                wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: ACCUMULATION_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+            )
+        };
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("trace outputs"),
+            entries: &[output(0), output(1), output(2)],
+        })
+    }
+}
+
+/// Timestamp writes for a pass that may be recorded as several: the
+/// beginning goes on the first band, the end on the last.
+#[derive(Clone, Copy)]
+pub struct PassTimestamps<'a> {
+    pub query_set: &'a wgpu::QuerySet,
+    pub beginning: Option<u32>,
+    pub end: Option<u32>,
+}
+
+impl<'a> PassTimestamps<'a> {
+    /// The writes of band `index` out of `count`.
+    fn for_band(self, index: usize, count: usize) -> Option<Self> {
+        let beginning = self.beginning.filter(|_| index == 0);
+        let end = self.end.filter(|_| index + 1 == count);
+        (beginning.is_some() || end.is_some()).then_some(Self {
+            beginning,
+            end,
+            ..self
+        })
+    }
+
+    pub fn render(self) -> wgpu::RenderPassTimestampWrites<'a> {
+        wgpu::RenderPassTimestampWrites {
+            query_set: self.query_set,
+            beginning_of_pass_write_index: self.beginning,
+            end_of_pass_write_index: self.end,
+        }
+    }
+
+    pub fn compute(self) -> wgpu::ComputePassTimestampWrites<'a> {
+        wgpu::ComputePassTimestampWrites {
+            query_set: self.query_set,
+            beginning_of_pass_write_index: self.beginning,
+            end_of_pass_write_index: self.end,
+        }
+    }
+}
+
+/// One band's pass: what it binds and where it stands among the call's.
+pub struct BandPass<'a> {
+    pub pipeline: &'a TracePipeline,
+    pub scene: &'a wgpu::BindGroup,
+    /// The frame uniform's offset in its ring buffer.
+    pub frame_offset: u32,
+    /// The compute kernel's outputs (the accumulation's write set).
+    pub outputs: Option<&'a wgpu::BindGroup>,
+    pub accumulation: &'a Accumulation,
+    /// The traced region's width and the rows of this band.
+    pub width: u32,
+    pub rows: Range<u32>,
+    /// The region's height: the fragment kernel's viewport.
+    pub height: u32,
+    pub index: usize,
+    pub count: usize,
+}
+
+impl BandPass<'_> {
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timestamps: Option<PassTimestamps>) {
+        let timestamps = timestamps.and_then(|t| t.for_band(self.index, self.count));
+        let rows = self.rows.end - self.rows.start;
+        match self.pipeline {
+            TracePipeline::Fragment(pipeline) => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("trace"),
+                    color_attachments: &self.accumulation.attachments(),
+                    depth_stencil_attachment: None,
+                    timestamp_writes: timestamps.map(PassTimestamps::render),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_viewport(0.0, 0.0, self.width as f32, self.height as f32, 0.0, 1.0);
+                pass.set_scissor_rect(0, self.rows.start, self.width, rows);
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, self.scene, &[self.frame_offset]);
+                pass.draw(0..3, 0..1);
+            }
+            TracePipeline::Compute(pipeline) => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("trace"),
+                    timestamp_writes: timestamps.map(PassTimestamps::compute),
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, self.scene, &[self.frame_offset]);
+                pass.set_bind_group(1, self.outputs, &[]);
+                pass.dispatch_workgroups(
+                    self.width.div_ceil(WORKGROUP.0),
+                    rows.div_ceil(WORKGROUP.1),
+                    1,
+                );
+            }
+        }
+    }
+}
