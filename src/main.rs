@@ -6,6 +6,7 @@ use clap::{Args, Parser, Subcommand};
 use marbre::commands::{
     accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render, soak,
 };
+use marbre::gpu::KernelChoice;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,6 +42,15 @@ struct ViewerArgs {
     /// to build leaves the old pipeline, and the panel shows the error).
     #[arg(long)]
     dev: bool,
+    /// The trace kernel: fragment, compute, or auto (the faster on this
+    /// adapter, timed on the first scene and remembered).
+    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    kernel: KernelChoice,
+    /// Trace time per frame in ms: the panel stays live while a slow
+    /// adapter refines the image a band at a time; 0 traces a whole round
+    /// of samples every frame.
+    #[arg(long, default_value_t = marbre::app::DEFAULT_FRAME_BUDGET_MS)]
+    frame_budget_ms: f32,
 }
 
 #[derive(Subcommand)]
@@ -87,6 +97,8 @@ fn main() -> ExitCode {
             window_screenshot: cli.viewer.window_screenshot,
             dev: cli.viewer.dev,
             soak: None,
+            kernel: cli.viewer.kernel,
+            frame_budget_ms: cli.viewer.frame_budget_ms,
         }),
     };
     match result {

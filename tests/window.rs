@@ -107,6 +107,9 @@ fn window_shows_panel_and_render() {
         &[
             "--exit-after-frames".into(),
             "10".into(),
+            // Ten whole rounds: this test checks what they show.
+            "--frame-budget-ms".into(),
+            "0".into(),
             "--window-screenshot".into(),
             shot.clone().into(),
         ],
@@ -423,16 +426,15 @@ fn number_keys_recall_saved_views() {
     );
 }
 
-/// The Cornell box from its OBJ/MTL files in the real window: the left wall
-/// red, the right wall green, the ceiling light white, the panel listing the
-/// mesh. A mesh that failed to load, a BVH that misses, or a light that
-/// gives nothing would show black.
-#[test]
-fn the_cornell_box_renders_from_its_obj_file() {
-    const TEST: &str = "the_cornell_box_renders_from_its_obj_file";
+/// The Cornell box from its OBJ/MTL files in the real window, traced by
+/// `kernel` in whole rounds: the left wall red, the right wall green, the
+/// ceiling light white. A mesh that failed to load, a BVH that misses, a
+/// light that gives nothing, or a kernel that writes nothing would show
+/// black.
+fn cornell_box_in_the_window(test: &str, kernel: &str) {
     let _serial = serial();
-    let dir = TempDir::new("cornell");
-    let Some(x) = display_or_skip(TEST, &dir, &[]) else {
+    let dir = TempDir::new(test);
+    let Some(x) = display_or_skip(test, &dir, &[]) else {
         return;
     };
     let shot = dir.path().join("cornell.png");
@@ -443,6 +445,10 @@ fn the_cornell_box_renders_from_its_obj_file() {
         &[
             "--preset".into(),
             "presets/cornell.ron".into(),
+            "--kernel".into(),
+            kernel.into(),
+            "--frame-budget-ms".into(),
+            "0".into(),
             "--exit-after-frames".into(),
             "12".into(),
             "--window-screenshot".into(),
@@ -450,6 +456,11 @@ fn the_cornell_box_renders_from_its_obj_file() {
         ],
     );
     assert_success(wait_for_exit(&mut child, &dir, CHILD_TIMEOUT), &dir);
+    assert!(
+        marbre_log(&dir).contains(&format!("({kernel} kernel)")),
+        "the closing line does not name the {kernel} kernel:\n{}",
+        marbre_log(&dir)
+    );
     let img = image::open(&shot)
         .unwrap_or_else(|e| panic!("{}: {e}", shot.display()))
         .to_rgba8();
@@ -460,7 +471,7 @@ fn the_cornell_box_renders_from_its_obj_file() {
     let right = region(&img, 615..695, 200..400);
     let light = region(&img, 415..485, 74..84);
     let outside = region(&img, 0..60, 0..520);
-    eprintln!("{TEST}: left {left:?}\nright {right:?}\nlight {light:?}\noutside {outside:?}");
+    eprintln!("{test}: left {left:?}\nright {right:?}\nlight {light:?}\noutside {outside:?}");
     let [lr, lg, lb] = left.mean_rgb;
     assert!(
         lr > 0.3 && lr > 2.0 * lg && lr > 2.0 * lb,
@@ -479,5 +490,79 @@ fn the_cornell_box_renders_from_its_obj_file() {
     assert!(
         outside.mean_luma < 0.05,
         "outside the box is not black: {outside:?}"
+    );
+}
+
+#[test]
+fn the_cornell_box_renders_from_its_obj_file_with_the_fragment_kernel() {
+    cornell_box_in_the_window("cornell-fragment", "fragment");
+}
+
+#[test]
+fn the_cornell_box_renders_from_its_obj_file_with_the_compute_kernel() {
+    cornell_box_in_the_window("cornell-compute", "compute");
+}
+
+/// A scene whose round costs far more than a frame's trace budget (the
+/// Cornell box takes about a second a round on lavapipe, the budget is
+/// 12 ms): the window keeps drawing frames, panel included, while the
+/// image refines behind it. Whole rounds would make 60 frames take a
+/// minute and give 60 samples; budgeted, the frames outnumber the
+/// samples, and the image on screen is already the box (its preview,
+/// then its first rounds).
+#[test]
+fn the_panel_keeps_drawing_while_a_slow_scene_accumulates() {
+    const TEST: &str = "the_panel_keeps_drawing_while_a_slow_scene_accumulates";
+    let _serial = serial();
+    let dir = TempDir::new("budget");
+    let Some(x) = display_or_skip(TEST, &dir, &[]) else {
+        return;
+    };
+    let shot = dir.path().join("budget.png");
+    let mut child = spawn_marbre(
+        &x,
+        &dir,
+        Path::new(REPO),
+        &[
+            "--preset".into(),
+            "presets/cornell.ron".into(),
+            "--exit-after-frames".into(),
+            "60".into(),
+            "--window-screenshot".into(),
+            shot.clone().into(),
+        ],
+    );
+    assert_success(wait_for_exit(&mut child, &dir, CHILD_TIMEOUT), &dir);
+    let log = marbre_log(&dir);
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("quality: "))
+        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    eprintln!("{TEST}: {line}");
+    let number_before = |word: &str| -> u32 {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let at = words.iter().position(|w| *w == word).unwrap();
+        words[at - 1].parse().unwrap()
+    };
+    let (spp, frames) = (number_before("spp"), number_before("frames"));
+    assert_eq!(frames, 60, "{line}");
+    assert!(
+        spp < frames / 2,
+        "{spp} spp in {frames} frames: each frame traced whole rounds ({line})"
+    );
+    let img = image::open(&shot)
+        .unwrap_or_else(|e| panic!("{}: {e}", shot.display()))
+        .to_rgba8();
+    let left = region(&img, 200..280, 200..400);
+    let panel = region(&img, img.width() - 300..img.width(), 0..img.height());
+    eprintln!("{TEST}: left wall {left:?}\npanel {panel:?}");
+    let [lr, lg, lb] = left.mean_rgb;
+    assert!(
+        lr > 0.2 && lr > 2.0 * lg && lr > 2.0 * lb,
+        "the box is not on screen yet (left wall not red): {left:?}"
+    );
+    assert!(
+        panel.mean_luma < 0.25 && panel.light_fraction > 0.01,
+        "no panel drawn: {panel:?}"
     );
 }

@@ -12,7 +12,9 @@ mod document;
 mod feature_costs;
 mod file_dialogs;
 mod file_watch;
+mod frame_budget;
 mod history;
+mod kernel_choice;
 mod prompts;
 mod recovery;
 mod scene_loader;
@@ -21,6 +23,8 @@ mod settings;
 mod shortcuts;
 pub mod soak;
 mod viewer;
+
+pub use frame_budget::DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS;
 
 use anyhow::Result;
 use settings::Settings;
@@ -45,6 +49,12 @@ pub struct ViewerOptions {
     /// Run as `marbre soak`: random edits driven frame by frame, memory
     /// judged at the end.
     pub soak: Option<soak::SoakOptions>,
+    /// The trace kernel: fragment, compute, or auto (the faster, timed on
+    /// the first scene and remembered per adapter).
+    pub kernel: crate::gpu::KernelChoice,
+    /// The trace time a frame may take, in ms (`app::frame_budget`); 0
+    /// traces a whole round every frame.
+    pub frame_budget_ms: f32,
 }
 
 struct App {

@@ -1,5 +1,5 @@
-//! Settings that persist between runs: the window size, the last preset and
-//! the recent files, in `settings.ron` in marbre's configuration folder.
+//! Settings that persist between runs: the window size, the last preset,
+//! the recent files and the trace kernel found faster per adapter, in `settings.ron` in marbre's configuration folder.
 //!
 //! A missing or unreadable settings file never stops the app: it starts
 //! with the defaults and says why in the panel, and the next save replaces
@@ -36,6 +36,10 @@ pub struct Settings {
     pub last_preset: Option<PathBuf>,
     /// Presets and environment maps opened or saved, newest first.
     pub recent_files: Vec<PathBuf>,
+    /// The trace kernel `auto` found faster, by adapter ("name (backend)"):
+    /// a name, checked when read (`app::kernel_choice`), so a bad value
+    /// is ignored with a note instead of discarding every setting.
+    pub kernels: std::collections::BTreeMap<String, String>,
 }
 
 impl Settings {

@@ -16,6 +16,7 @@ pub const DEFAULT_PRESET: &str = "presets/default.ron";
 
 /// A preset's scene, with `--env` applied, and its loaded environment image
 /// and image textures.
+#[derive(Clone)]
 pub struct LoadedScene {
     pub scene: Scene,
     pub env: Option<EnvImage>,

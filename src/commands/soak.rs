@@ -29,6 +29,12 @@ pub struct SoakArgs {
     /// Write the memory of every frame to this CSV file.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// The trace kernel, as the viewer's `--kernel`.
+    #[arg(long, value_enum, default_value_t = crate::gpu::KernelChoice::Auto)]
+    pub kernel: crate::gpu::KernelChoice,
+    /// Trace time per frame in ms, as the viewer's `--frame-budget-ms`.
+    #[arg(long, default_value_t = crate::app::DEFAULT_FRAME_BUDGET_MS)]
+    pub frame_budget_ms: f32,
 }
 
 pub fn run(args: &SoakArgs) -> Result<()> {
@@ -49,6 +55,8 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     run_viewer(ViewerOptions {
         preset: args.preset.clone(),
         soak: Some(soak),
+        kernel: args.kernel,
+        frame_budget_ms: args.frame_budget_ms,
         ..ViewerOptions::default()
     })
 }

@@ -81,6 +81,9 @@ pub struct Accumulation {
     shown_size: (u32, u32),
     /// Whether this accumulation's preview is done (or was not needed).
     previewed: bool,
+    /// Images shown so far (rounds and previews): what auto exposure
+    /// metered is compared with it.
+    shown_count: u32,
     /// When the current accumulation started (its first frame).
     started: Instant,
     /// Counts resets: tells measurements of one accumulation from the next.
@@ -101,6 +104,7 @@ impl Accumulation {
             next_row: 0,
             shown_size: (size.0.max(1), size.1.max(1)),
             previewed: false,
+            shown_count: 0,
             started: Instant::now(),
             generation: 0,
         }
@@ -130,6 +134,11 @@ impl Accumulation {
         self.next_row = row;
     }
 
+    /// Images shown so far (rounds and previews), wrapping.
+    pub fn shown_count(&self) -> u32 {
+        self.shown_count
+    }
+
     /// The size of the region the latest set holds (what is displayed).
     pub fn shown_size(&self) -> (u32, u32) {
         self.shown_size
@@ -145,6 +154,7 @@ impl Accumulation {
     /// round at a reduced size, not counted as samples): it becomes the
     /// latest, what the display shows until the first real round is done.
     pub fn show_preview(&mut self, size: (u32, u32)) {
+        self.shown_count = self.shown_count.wrapping_add(1);
         self.latest = 1 - self.latest;
         self.shown_size = size;
         self.previewed = true;
@@ -231,6 +241,7 @@ impl Accumulation {
     /// of `size` was written whole (its bands reported by
     /// [`Self::traced_to`]).
     pub fn advance(&mut self, samples: u32, size: (u32, u32)) {
+        self.shown_count = self.shown_count.wrapping_add(1);
         self.latest = 1 - self.latest;
         self.shown_size = size;
         self.next_row = 0;

@@ -138,6 +138,12 @@ impl PassTimer {
         Some((first, first + 1))
     }
 
+    /// Whether this frame is timed: its passes' times arrive a frame or two
+    /// later, through [`Self::take_fresh`].
+    pub fn is_timing(&self) -> bool {
+        self.timing_this_frame
+    }
+
     /// The timestamp writes of `pass`, whichever kind of pass (or passes:
     /// the trace's bands) records it.
     pub fn timestamps(&self, pass: Pass) -> Option<PassTimestamps<'_>> {

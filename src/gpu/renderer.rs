@@ -52,7 +52,8 @@ struct DisplayUniform {
 /// it, the targets' size and the traced region.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct MeteredFrom {
-    frame_index: u32,
+    /// Counts the images shown (rounds and previews).
+    shown: u32,
     size: (u32, u32),
     render_size: (u32, u32),
 }
@@ -489,6 +490,20 @@ impl Renderer {
         self.accumulation.shown_size()
     }
 
+    /// Traces the rest of the first round and waits for it, if none is
+    /// complete yet (a preview may be on show): for screenshots, which
+    /// must have the full resolution.
+    pub fn complete_first_round(&mut self, ctx: &GpuContext) -> Result<()> {
+        if self.accumulation.frames() > 0 {
+            return Ok(());
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    }
+
     /// The fraction of the round under way already traced (0 between
     /// rounds): the panel's progress while a slow adapter traces in bands.
     pub fn round_progress(&self) -> f32 {
@@ -834,7 +849,8 @@ impl Renderer {
             }
         }
         let full = self.render_size();
-        let mut passes: Vec<((u32, u32), std::ops::Range<u32>)> = Vec::new();
+        // Each pass: the region's size, the band's rows, whether a preview.
+        let mut passes: Vec<((u32, u32), std::ops::Range<u32>, bool)> = Vec::new();
         let mut budget = budget;
         if let TraceBudget::Pixels(pixels) = budget
             && self.accumulation.wants_preview()
@@ -844,26 +860,27 @@ impl Renderer {
                 let scale = ((pixels as f64 / round as f64).sqrt() as f32)
                     .min(self.scene.render.interactive_scale);
                 let size = scaled(full, scale);
-                passes.push((size, 0..size.1));
+                passes.push((size, 0..size.1, true));
                 budget = TraceBudget::Pixels(pixels.saturating_sub(pixel_count(size)));
             } else {
                 self.accumulation.skip_preview();
             }
         }
         let bands = trace_bands::plan(full.0, full.1, self.accumulation.next_row(), budget);
-        passes.extend(bands.into_iter().map(|rows| (full, rows)));
+        passes.extend(bands.into_iter().map(|rows| (full, rows, false)));
         let mut work = TraceWork::default();
         let count = passes.len();
-        for (index, (size, rows)) in passes.into_iter().enumerate() {
-            let preview = size != full;
+        for (index, (size, rows, preview)) in passes.into_iter().enumerate() {
             if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
                 self.non_finite.clear(encoder);
             }
             self.record_band(ctx, encoder, size, rows.clone(), (index, count), timestamps);
             work.pixels += u64::from(size.0) * u64::from(rows.end - rows.start);
             if preview {
+                // The preview draws the first round's samples at its own
+                // size: the frame index (the seed) stays, so the image
+                // that follows is the one a whole pass gives.
                 self.accumulation.show_preview(size);
-                self.frame_index = self.frame_index.wrapping_add(1);
                 continue;
             }
             self.accumulation.traced_to(rows.end);
@@ -984,7 +1001,7 @@ impl Renderer {
     ) {
         let render_size = self.shown_size();
         let from = MeteredFrom {
-            frame_index: self.frame_index,
+            shown: self.accumulation.shown_count(),
             size: self.size,
             render_size,
         };

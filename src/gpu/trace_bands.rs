@@ -6,7 +6,7 @@
 //! A round is one sample (in fact `samples_per_frame`) for every pixel of
 //! the traced region. Every band of a round reads the same accumulated
 //! state and writes its own rows of the next, so a round traced in bands
-//! gives exactly the image a whole pass gives (`tests/gpu/kernels.rs`).
+//! gives exactly the image a whole pass gives (`tests/kernels.rs`).
 
 use std::ops::Range;
 

@@ -159,6 +159,13 @@ pub struct Stats {
     /// Samples the accumulation dropped for being NaN or infinite.
     pub non_finite: NonFiniteCounts,
     pub quality: QualityStats,
+    /// The trace kernel drawing now, what the user chose, and why it runs.
+    pub kernel: crate::gpu::Kernel,
+    pub kernel_choice: crate::gpu::KernelChoice,
+    pub kernel_reason: String,
+    /// The fraction of the sample round under way already traced (a slow
+    /// adapter traces a round over several frames).
+    pub round_progress: f32,
 }
 
 /// A button press the app must act on: these need files, the GPU or the
@@ -175,6 +182,8 @@ pub enum PanelAction {
     /// Compile a shader feature out (or back in), to time the scene
     /// without it.
     ToggleFeature(crate::gpu::Feature),
+    /// Trace with another kernel (or the faster, `auto`).
+    SetKernel(crate::gpu::KernelChoice),
     Undo,
     Redo,
     /// Pick a preset to open, a file to save as, or an environment map,
@@ -215,6 +224,7 @@ pub fn draw(
             });
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
+                kernel_ui(ui, stats, &mut actions);
             });
 
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));
@@ -795,6 +805,37 @@ fn non_finite_ui(ui: &mut Ui, counts: &NonFiniteCounts) {
     );
 }
 
+/// The Kernel switch: which kernel traces (both draw the same image), or
+/// `auto`, the faster on this adapter.
+fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelAction>) {
+    use crate::gpu::KernelChoice;
+    let name = |c: KernelChoice| match c {
+        KernelChoice::Auto => "auto (the faster)",
+        KernelChoice::Fragment => "fragment",
+        KernelChoice::Compute => "compute",
+    };
+    let mut choice = stats.kernel_choice;
+    egui::ComboBox::from_label("kernel")
+        .selected_text(name(choice))
+        .show_ui(ui, |ui| {
+            for c in [
+                KernelChoice::Auto,
+                KernelChoice::Fragment,
+                KernelChoice::Compute,
+            ] {
+                ui.selectable_value(&mut choice, c, name(c));
+            }
+        })
+        .response
+        .on_hover_text(
+            "The trace as a fragment shader or a compute kernel: the same image, at a speed that \
+             depends on the GPU; auto times both on the scene and remembers the faster",
+        );
+    if choice != stats.kernel_choice {
+        actions.push(PanelAction::SetKernel(choice));
+    }
+}
+
 fn stats_ui(ui: &mut Ui, stats: &Stats) {
     ui.label(format!("{:.1} fps", stats.fps));
     ui.label(format!("{} lights", stats.lights)).on_hover_text(
@@ -808,9 +849,30 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
         .on_hover_text("The meshes' triangles and their bounding volume hierarchy (binned SAH)");
     }
     let clock = if stats.ms_is_gpu { "GPU" } else { "CPU" };
-    ui.label(format!("{:.2} ms/frame ({clock})", stats.ms_per_frame))
-        .on_hover_text("GPU: timestamp queries around the passes; CPU: wall time per frame");
+    ui.label(format!(
+        "{:.2} ms per sample round ({clock})",
+        stats.ms_per_frame
+    ))
+    .on_hover_text(
+        "The trace's cost of one round (samples per frame for every pixel), from its measured \
+         time per pixel. GPU: timestamp queries around the passes; CPU: wall time per frame",
+    );
     ui.label(format!("{} samples accumulated", stats.samples));
+    if stats.round_progress > 0.0 {
+        ui.add(
+            egui::ProgressBar::new(stats.round_progress)
+                .text("next round")
+                .desired_height(12.0),
+        )
+        .on_hover_text(
+            "A round costs more than a frame's trace budget: it is traced a band of rows per \
+             frame, and shown once complete",
+        );
+    }
+    ui.label(format!(
+        "trace kernel: {} ({})",
+        stats.kernel, stats.kernel_reason
+    ));
     non_finite_ui(ui, &stats.non_finite);
     let (w, h) = stats.resolution;
     ui.label(format!("{w} × {h}"));

@@ -174,10 +174,19 @@ pub fn display_or_skip(test: &str, dir: &TempDir, extra_tools: &[&str]) -> Optio
 
 /// Starts the viewer on `x`'s display, its output going to `marbre.log` in
 /// `dir`, its settings in a folder of `dir` (never the user's own).
+/// Runs the viewer (or `args[0]`'s subcommand) on the virtual display,
+/// with its own runtime and configuration folders. Unless `args` name a
+/// kernel, it traces with the fragment kernel: `auto`, the default, would
+/// time both kernels on a second device in every test (seconds of CPU on
+/// lavapipe, with a fresh configuration folder each time).
 pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> Guard {
     let log = File::create(dir.path().join("marbre.log")).unwrap();
+    let mut args = args.to_vec();
+    if !args.iter().any(|a| a == "--kernel") {
+        args.extend(["--kernel".into(), "fragment".into()]);
+    }
     let child = Command::new(BIN)
-        .args(args)
+        .args(&args)
         .current_dir(cwd)
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", dir.subdir("runtime"))

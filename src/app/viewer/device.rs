@@ -4,7 +4,7 @@
 //! made is lost; the accumulated samples start over).
 
 use super::{Viewer, surface_config};
-use crate::commands::session::{LoadedScene, load_environment, max_texture_side, renderer_for};
+use crate::commands::session::{LoadedScene, load_environment, max_texture_side, renderer_with};
 use crate::gpu::GpuContext;
 use crate::gpu::pass_timer::PassTimer;
 use anyhow::{Context as _, Result};
@@ -35,7 +35,7 @@ impl Viewer {
             notes: Vec::new(),
         };
         let size = self.renderer.size();
-        self.renderer = renderer_for(&ctx, &loaded, size)?;
+        self.renderer = renderer_with(&ctx, &loaded, size, self.renderer.kernel())?;
         self.timer = PassTimer::new(&ctx);
         self.egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());

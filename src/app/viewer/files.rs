@@ -135,6 +135,8 @@ impl Viewer {
     ) -> Result<()> {
         let loaded = ready.loaded;
         self.renderer.provide_geometry(ready.geometry);
+        self.kernels
+            .time_if_needed(&self.ctx, &loaded, self.renderer.size());
         self.apply_scene(
             loaded.scene.clone(),
             loaded.env.as_ref(),

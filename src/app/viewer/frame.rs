@@ -10,6 +10,7 @@ use crate::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
 use crate::panel::{QualityStats, Stats};
 use anyhow::{Context as _, Result};
 use std::path::Path;
+use std::time::Instant;
 
 impl Viewer {
     fn quality_stats(&self) -> QualityStats {
@@ -51,13 +52,21 @@ impl Viewer {
     }
 
     pub(super) fn stats(&self) -> Stats {
-        let gpu_ms = self.timer.as_ref().and_then(|t| t.ms(Pass::Trace));
+        let (w, h) = self.renderer.render_size();
+        let round_ms = self
+            .budget
+            .round_ms(u64::from(w) * u64::from(h))
+            .or_else(|| self.timer.as_ref().and_then(|t| t.ms(Pass::Trace)));
         let info = self.ctx.adapter.get_info();
         let mesh = self.renderer.mesh_stats();
         Stats {
             fps: self.fps,
-            ms_per_frame: gpu_ms.unwrap_or(self.ms_per_frame),
-            ms_is_gpu: gpu_ms.is_some(),
+            ms_per_frame: round_ms.unwrap_or(self.ms_per_frame),
+            ms_is_gpu: !self.trace_on_wall_clock(),
+            kernel: self.renderer.kernel(),
+            kernel_choice: self.kernels.choice(),
+            kernel_reason: self.kernels.reason().to_owned(),
+            round_progress: self.renderer.round_progress(),
             samples: self.renderer.accumulated_samples(),
             adapter: info.name,
             backend: format!("{:?}", info.backend),
@@ -106,6 +115,7 @@ impl Viewer {
         {
             self.renderer.forget_feature_override();
         }
+        self.poll_kernel_timing();
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
         let edited = self.scene != *self.renderer.scene();
@@ -186,10 +196,28 @@ impl Viewer {
                 t.forget(Pass::AutoExposure);
             }
         }
+        if let Some((ms, pixels)) = self.timer.as_mut().and_then(|t| {
+            let ms = t.take_fresh(Pass::Trace)?;
+            Some((ms, std::mem::take(&mut self.timed_trace_pixels)))
+        }) {
+            self.observe_trace_time(ms, pixels);
+        }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         if !self.paused_at_target() {
-            let trace_writes = self.timer.as_ref().and_then(|t| t.timestamps(Pass::Trace));
-            self.renderer.trace(&self.ctx, &mut encoder, trace_writes);
+            if self.trace_on_wall_clock() {
+                self.trace_and_wait();
+            } else {
+                let trace_writes = self.timer.as_ref().and_then(|t| t.timestamps(Pass::Trace));
+                let work = self.renderer.trace_within(
+                    &self.ctx,
+                    &mut encoder,
+                    self.budget.budget(),
+                    trace_writes,
+                );
+                if self.timer.as_ref().is_some_and(|t| t.is_timing()) {
+                    self.timed_trace_pixels = work.pixels;
+                }
+            }
             self.renderer
                 .meter_error(&self.ctx, &mut encoder, self.timer.as_ref());
         }
@@ -251,7 +279,6 @@ impl Viewer {
             t.after_submit();
         }
         self.renderer.after_submit();
-        self.record_feature_cost();
         self.ctx.queue.present(frame);
         let soak_goes_on = self.soak_record()?;
         self.frames += 1;
@@ -304,26 +331,61 @@ impl Viewer {
                     e.relative, e.rmse, e.samples
                 )
             });
-        let trace = match self.timer.as_ref().and_then(|t| t.ms(Pass::Trace)) {
-            Some(ms) => format!("{ms:.1} ms per frame (GPU timestamps)"),
-            None => "not timed (no timestamp queries)".to_owned(),
+        let (w, h) = self.renderer.render_size();
+        let clock = if self.trace_on_wall_clock() {
+            "CPU clock"
+        } else {
+            "GPU timestamps"
         };
-        eprintln!("quality: {spp} spp accumulated; estimated error {error}; trace pass {trace}");
+        let trace = match self.budget.round_ms(u64::from(w) * u64::from(h)) {
+            Some(ms) => format!("{ms:.1} ms per round ({clock})"),
+            None => "not timed yet".to_owned(),
+        };
+        eprintln!(
+            "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}",
+            self.frames + 1,
+            self.renderer.kernel()
+        );
     }
 
-    /// Feeds the trace pass's time (GPU, or the whole frame's on the CPU
-    /// clock without timestamps) to the feature-cost measurement.
-    fn record_feature_cost(&mut self) {
-        if self.paused_at_target() {
+    /// Whether the trace is timed on the CPU clock, submitted alone and
+    /// waited for: without timestamp queries, and on CPU adapters, whose
+    /// queue runs on this machine's cores anyway and whose compute-pass
+    /// timestamps are not usable (lavapipe's read about 0.02 ms for a pass
+    /// of any size, where the frame took 300 ms: the budget then grew
+    /// without bound).
+    fn trace_on_wall_clock(&self) -> bool {
+        self.timer.is_none() || self.ctx.is_cpu()
+    }
+
+    /// Traces this frame's budget in a submit of its own and waits for it,
+    /// timing it on the CPU clock.
+    fn trace_and_wait(&mut self) {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        let start = Instant::now();
+        let work = self
+            .renderer
+            .trace_within(&self.ctx, &mut encoder, self.budget.budget(), None);
+        self.ctx.queue.submit([encoder.finish()]);
+        if let Err(e) = self.ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
+            log::warn!("waiting for the trace: {e}");
             return;
         }
-        let trace_ms = match &mut self.timer {
-            Some(t) => t.take_fresh(Pass::Trace),
-            None => Some(self.last_frame.elapsed().as_secs_f32() * 1000.0),
-        };
-        if let Some(ms) = trace_ms {
-            self.feature_costs.record(self.renderer.features(), ms);
+        self.observe_trace_time(start.elapsed().as_secs_f32() * 1000.0, work.pixels);
+    }
+
+    /// Takes in a measured trace time and the pixels it traced: it sets
+    /// the next frames' budget, and, scaled to a whole round, feeds the
+    /// feature-cost measurement.
+    fn observe_trace_time(&mut self, ms: f32, pixels: u64) {
+        if pixels == 0 || self.paused_at_target() {
+            return;
         }
+        self.budget.observe(ms, pixels);
+        let (w, h) = self.renderer.render_size();
+        let round_ms = ms * (f64::from(w) * f64::from(h) / pixels as f64) as f32;
+        self.feature_costs
+            .record(self.renderer.features(), round_ms);
     }
 
     /// An offscreen twin of the swapchain image, so the final frame (UI

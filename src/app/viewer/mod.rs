@@ -16,7 +16,9 @@ use super::document::Document;
 use super::feature_costs::FeatureCosts;
 use super::file_dialogs::OpenDialog;
 use super::file_watch::FileWatch;
+use super::frame_budget::FrameBudget;
 use super::history::History;
+use super::kernel_choice::KernelChooser;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
 use super::scene_loader::SceneLoad;
@@ -25,7 +27,7 @@ use super::shortcuts::{self, Shortcut};
 use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::{ViewerOptions, camera_input};
 use crate::commands::session::{
-    DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_for,
+    DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with,
 };
 use crate::gpu::pass_timer::PassTimer;
 use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
@@ -69,6 +71,13 @@ pub struct Viewer {
     convergence: Convergence,
     /// Trace times with shader features compiled out, for the Quality panel.
     feature_costs: FeatureCosts,
+    /// Which trace kernel runs, and `auto`'s timing of both.
+    kernels: KernelChooser,
+    /// How much tracing a frame asks for, learnt from the trace's times.
+    budget: FrameBudget,
+    /// The pixels traced in the last frame the pass timer timed (its time
+    /// arrives a frame or two later), or in the last frame without one.
+    timed_trace_pixels: u64,
     /// Undo and redo of scene edits (Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y).
     history: History,
     /// Samples the current accumulation dropped for being NaN or infinite,
@@ -229,7 +238,12 @@ impl Viewer {
         let config = surface_config(&surface, &ctx, size);
         surface.configure(&ctx.device, &config);
         let loaded = loaded.fit_environment(max_texture_side(&ctx));
-        let renderer = renderer_for(&ctx, &loaded, (config.width, config.height))?;
+        let (mut kernels, kernel, kernel_notes) =
+            KernelChooser::new(options.kernel, &ctx, &settings)?;
+        let renderer = renderer_with(&ctx, &loaded, (config.width, config.height), kernel)?;
+        if scripted {
+            kernels.time_if_needed(&ctx, &loaded, (config.width, config.height));
+        }
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
             egui_ctx.clone(),
@@ -246,7 +260,7 @@ impl Viewer {
             _ => String::new(),
         };
         let mut panel = PanelState::new(preset_path.display().to_string(), env_path);
-        for note in startup_notes {
+        for note in startup_notes.into_iter().chain(kernel_notes) {
             panel.error(note);
         }
         if scripted {
@@ -276,6 +290,9 @@ impl Viewer {
             device_watch,
             convergence: Convergence::default(),
             feature_costs: FeatureCosts::default(),
+            kernels,
+            budget: FrameBudget::new(options.frame_budget_ms),
+            timed_trace_pixels: 0,
             non_finite: (0, NonFiniteCounts::default()),
             window,
             surface,
@@ -392,6 +409,49 @@ impl Viewer {
         self.quitting = true;
     }
 
+    /// The Render panel's Kernel switch: the new kernel is built off the
+    /// render thread while the current one draws; `auto` uses the kernel
+    /// stored for this adapter, or times both again on the current scene.
+    fn set_kernel(&mut self, choice: crate::gpu::KernelChoice) {
+        match self.kernels.choose(choice, &self.ctx, &self.settings) {
+            Ok((kernel, notes)) => {
+                for note in notes {
+                    self.panel.error(note);
+                }
+                if let Err(e) = self.renderer.request_kernel(&self.ctx, kernel) {
+                    self.panel.error(format!("{e:#}"));
+                }
+                let loaded = LoadedScene {
+                    scene: self.renderer.scene().clone(),
+                    env: None,
+                    images: self.renderer.images().clone(),
+                    notes: Vec::new(),
+                };
+                self.kernels
+                    .time_if_needed(&self.ctx, &loaded, self.renderer.size());
+            }
+            Err(e) => self.panel.error(format!("{e:#}")),
+        }
+    }
+
+    /// Installs the kernel `auto` found faster, once its timing is done.
+    fn poll_kernel_timing(&mut self) {
+        match self.kernels.poll(&mut self.settings) {
+            Some(Ok(kernel)) => {
+                self.panel
+                    .info(format!("trace kernel: {}", self.kernels.reason()));
+                self.save_settings();
+                if kernel != self.renderer.kernel()
+                    && let Err(e) = self.renderer.request_kernel(&self.ctx, kernel)
+                {
+                    self.panel.error(format!("{e:#}"));
+                }
+            }
+            Some(Err(e)) => self.panel.error(format!("timing the trace kernels: {e:#}")),
+            None => {}
+        }
+    }
+
     fn save_settings(&mut self) {
         if let Some(dir) = &self.config_dir
             && let Err(e) = self.settings.save(dir)
@@ -441,6 +501,7 @@ impl Viewer {
                 PanelAction::Screenshot => self.screenshot_requested = true,
                 PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
                 PanelAction::ToggleFeature(feature) => self.toggle_feature(feature),
+                PanelAction::SetKernel(choice) => self.set_kernel(choice),
                 PanelAction::Undo => self.step_history(true),
                 PanelAction::Redo => self.step_history(false),
             }
