@@ -21,6 +21,9 @@ Mitsuba is optional for marbre; this script needs it, and marbre built:
     python3 bench/compare_mitsuba.py        # ~10 min on 2 idle cores, 6 of them
                                             # marbre's reference (then cached)
     python3 bench/compare_mitsuba.py --variant llvm_ad_rgb,scalar_rgb
+    python3 bench/compare_mitsuba.py --kernel compute   # marbre's trace kernel
+                                            # (default auto: decided by marbre's
+                                            # first run, then kept for every row)
     python3 bench/compare_mitsuba.py --size 512x512 --reference-spp 4096 \\
         --spp 1,4,16,64,256                 # the full version (hours)
 
@@ -393,6 +396,9 @@ def run_marbre(args, spp):
         "--spp", str(spp),
         "--csv", csv_path,
         "--reference-out", reference_path,
+        # `auto` is decided by marbre's first run and then kept, so that every
+        # row of marbre's is the same kernel.
+        "--kernel", args.kernel_used.split(" ")[0] if args.kernel_used else args.kernel,
     ]
     # From the repository root: the reference cache is target/marbre-references there.
     result = subprocess.run(command, cwd=REPO, stdout=subprocess.PIPE, text=True)
@@ -441,7 +447,14 @@ def measure(args, mi, np, setup, folder):
             if first:
                 print(log, end="", flush=True)
             adapter = next((line[len("adapter: "):] for line in log.splitlines() if line.startswith("adapter: ")), "?")
-            marbre = f"marbre ({adapter.split(' (')[0]})"
+            if args.kernel_used is None:
+                # "kernel: compute", or "kernel: compute (auto: fragment ... ms, compute ... ms per frame at WxH)"
+                args.kernel_used = next(
+                    (line[len("kernel: "):] for line in log.splitlines() if line.startswith("kernel: ")), None
+                )
+                if args.kernel_used is None:
+                    raise SystemExit(f"{args.marbre} printed no `kernel:` line: a build without --kernel?")
+            marbre = f"marbre ({adapter.split(' (')[0]}, {args.kernel_used.split(' ')[0]} kernel)"
             keep(marbre, row)
             print(f"  marbre, {spp} spp: {row['seconds']:.3f} s, RMSE {row['rmse']:.5f}", flush=True)
             for variant, renderer in renderers.items():
@@ -636,8 +649,12 @@ def main():
     p.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variants, comma-separated: llvm_ad_rgb, scalar_rgb (default: %(default)s)")
     default_marbre = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(REPO, "target")), "release", "marbre")
     p.add_argument("--marbre", default=default_marbre, help="the marbre binary (default: $CARGO_TARGET_DIR or target, then release/marbre)")
+    p.add_argument("--kernel", choices=["fragment", "compute", "auto"], default="auto",
+                   help="marbre's trace kernel, passed to `marbre bench-convergence --kernel` (default: %(default)s: "
+                   "the faster of the two on the preset, timed by marbre first)")
     p.add_argument("--out", default=os.path.join(REPO, "target", "compare-mitsuba"), help="output folder (default: target/compare-mitsuba)")
     args = p.parse_args()
+    args.kernel_used = None  # the kernel marbre's first run traced with, as it printed it
     args.preset = os.path.join(REPO, args.preset) if not os.path.isabs(args.preset) else args.preset
     args.marbre = os.path.abspath(args.marbre)
     variants = args.variant.split(",")
@@ -684,7 +701,8 @@ def main():
         f"{os.path.relpath(args.preset, REPO)}: {width}×{height}, marbre max_bounces {setup['max_bounces']} = Mitsuba "
         f"max_depth {setup['max_bounces'] + 1}, Russian roulette from bounce {setup['russian_roulette_from']}; "
         f"references {args.reference_spp} spp, each renderer against its own.",
-        f"CPU: {cpu_name()}; marbre adapter: {adapter}; Mitsuba variants: {', '.join(variants)}{llvm}.",
+        f"CPU: {cpu_name()}; marbre adapter: {adapter}; marbre kernel: {args.kernel_used} (--kernel {args.kernel}); "
+        f"Mitsuba variants: {', '.join(variants)}{llvm}.",
         f"Load average before {load_before[0]:.2f}, after {load_after[0]:.2f}: timings are noisy where other "
         "processes share the CPU.",
     ]

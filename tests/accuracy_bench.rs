@@ -85,6 +85,7 @@ fn the_quick_bench_covers_every_knob_and_finds_the_monte_carlo_rate() {
         out: out.clone(),
         cache: scratch.0.join("references"),
         root: PathBuf::from(env!("CARGO_MANIFEST_DIR")),
+        kernel: marbre::gpu::KernelChoice::Fragment,
     };
     let results = accuracy_bench::run_on(&ctx, &args, false).unwrap();
     // An empty cache: every reference rendered, and kept for the next run;

@@ -599,7 +599,8 @@ fn pick_kernel_honours_the_choice_and_auto_keeps_the_faster() {
     for ms in [t.fragment_ms, t.compute_ms] {
         assert!(ms.is_finite() && ms > 0.0, "{t}");
     }
-    let smaller = if t.compute_ms < t.fragment_ms {
+    // Compute only when clearly faster: a near tie keeps fragment.
+    let smaller = if t.compute_ms < t.fragment_ms * marbre::gpu::kernel::COMPUTE_MARGIN {
         Kernel::Compute
     } else {
         Kernel::Fragment

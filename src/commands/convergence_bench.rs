@@ -7,12 +7,14 @@
 use super::accuracy_bench::ErrorMetrics;
 use super::references::ReferenceCache;
 use super::render::parse_size;
-use super::session::{accumulate, load_scene, renderer_for};
-use crate::gpu::GpuContext;
+use super::session::{
+    LoadedScene, accumulate, describe_pick, load_scene, pick_kernel, renderer_with,
+};
+use crate::gpu::{GpuContext, Kernel, KernelChoice};
 use crate::image_io;
 use anyhow::{Context, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -38,16 +40,22 @@ pub struct ConvergenceBenchArgs {
     /// Also writes the reference (cached or rendered) to this EXR file.
     #[arg(long)]
     pub reference_out: Option<PathBuf>,
+    /// The trace kernel of the measured renders: fragment, compute, or
+    /// auto (the faster of the two on this preset, timed first). The
+    /// reference is rendered with the fragment kernel: both give the same
+    /// image, so one cached reference serves both.
+    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    pub kernel: KernelChoice,
 }
 
 fn render(
     ctx: &GpuContext,
-    preset: &Path,
+    loaded: &LoadedScene,
     size: (u32, u32),
     spp: u32,
+    kernel: Kernel,
 ) -> Result<(Vec<[f32; 4]>, f64)> {
-    let loaded = load_scene(preset, None)?;
-    let mut renderer = renderer_for(ctx, &loaded, size)?;
+    let mut renderer = renderer_with(ctx, loaded, size, kernel)?;
     // One warm-up frame compiles the shader; it is not timed.
     accumulate(ctx, &mut renderer, 1, |_| {})?;
     renderer.reset_accumulation();
@@ -69,6 +77,9 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
         args.reference_spp
     );
     let loaded = load_scene(&args.preset, None)?;
+    let (kernel, timings) = pick_kernel(&ctx, &loaded, args.size, args.kernel)?;
+    // compare_mitsuba.py reads this line.
+    println!("{}", describe_pick(kernel, timings.as_ref()));
     let reference = ReferenceCache::new(&args.cache).get_or_render(
         &ctx,
         &loaded,
@@ -92,7 +103,7 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
     println!("|---|---|---|---|---|");
     let mut points = Vec::new();
     for &spp in &args.spp {
-        let (pixels, seconds) = render(&ctx, &args.preset, args.size, spp)?;
+        let (pixels, seconds) = render(&ctx, &loaded, args.size, spp, kernel)?;
         let error = ErrorMetrics::between(&pixels, &reference).rmse;
         let samples = f64::from(w * h) * f64::from(spp) / seconds;
         println!(

@@ -201,7 +201,7 @@ pub fn renderer_with(
 const KERNEL_TIMING_SIZE: (u32, u32) = (320, 180);
 
 /// Frames each kernel is timed for, after two of warm-up.
-const KERNEL_TIMING_FRAMES: usize = 5;
+const KERNEL_TIMING_FRAMES: usize = 9;
 
 /// The median ms of one whole round of each kernel on one scene, timed
 /// interleaved (a frame of one, then of the other), so that a machine

@@ -7,6 +7,10 @@
 //! the traced region. Every band of a round reads the same accumulated
 //! state and writes its own rows of the next, so a round traced in bands
 //! gives exactly the image a whole pass gives (`tests/kernels.rs`).
+#![allow(
+    clippy::single_range_in_vec_init,
+    reason = "a list of bands of rows, which is often one band"
+)]
 
 use std::ops::Range;
 

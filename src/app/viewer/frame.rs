@@ -343,7 +343,7 @@ impl Viewer {
         };
         eprintln!(
             "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}",
-            self.frames + 1,
+            self.frames,
             self.renderer.kernel()
         );
     }
@@ -361,6 +361,11 @@ impl Viewer {
     /// Traces this frame's budget in a submit of its own and waits for it,
     /// timing it on the CPU clock.
     fn trace_and_wait(&mut self) {
+        // The last frame's display and panel first: the time measured is
+        // the trace's alone.
+        if let Err(e) = self.ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
+            log::warn!("waiting for the last frame: {e}");
+        }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         let start = Instant::now();
         let work = self

@@ -7,8 +7,8 @@ use super::frame_timer::{FrameTimer, TimerKind};
 use super::knob::Knob;
 use super::sweeps::{Sweep, Variant};
 use crate::commands::references::{Reference, ReferenceCache};
-use crate::commands::session::{LoadedScene, accumulate, renderer_for};
-use crate::gpu::{GpuContext, Renderer};
+use crate::commands::session::{LoadedScene, accumulate, pick_kernel, renderer_with};
+use crate::gpu::{GpuContext, Kernel, KernelChoice, Renderer};
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
@@ -34,6 +34,8 @@ pub struct Point {
 /// What a sweep measured.
 pub struct Measured {
     pub points: Vec<Point>,
+    /// The kernel every variant of the sweep was traced with.
+    pub kernel: Kernel,
     pub references_rendered: usize,
     pub references_cached: usize,
 }
@@ -44,6 +46,10 @@ pub struct Bench<'a> {
     pub size: (u32, u32),
     pub cache: &'a ReferenceCache,
     pub timer: &'a FrameTimer,
+    /// The trace kernel: the one named, or for `auto` the faster on each
+    /// sweep's first variant, the same for all its variants so that they
+    /// differ by the knob alone.
+    pub kernel: KernelChoice,
     /// Counts samples per pixel rendered, references included.
     pub progress: &'a ProgressBar,
 }
@@ -55,6 +61,7 @@ impl Bench<'_> {
             .into_iter()
             .map(|scene| Ok((scene, self.reference(sweep, scene)?)))
             .collect::<Result<Vec<_>>>()?;
+        let kernel = self.kernel_of(sweep)?;
         let mut points = Vec::new();
         for variant in &sweep.variants {
             let reference = references
@@ -62,7 +69,7 @@ impl Bench<'_> {
                 .find(|(s, _)| *s == &variant.reference)
                 .map(|(_, reference)| &reference.pixels)
                 .context("every reference was rendered above")?;
-            let mut renderer = self.renderer(sweep, variant)?;
+            let mut renderer = self.renderer(sweep, variant, kernel)?;
             for &spp in &sweep.spp {
                 self.progress.set_message(format!(
                     "{}: {} / {}, {spp} spp",
@@ -90,6 +97,7 @@ impl Bench<'_> {
         }
         Ok(Measured {
             points,
+            kernel,
             references_rendered: references.iter().filter(|(_, r)| !r.cached).count(),
             references_cached: references.iter().filter(|(_, r)| r.cached).count(),
         })
@@ -133,17 +141,41 @@ impl Bench<'_> {
     /// numbers (the shader seeds from the frame count): the variants'
     /// errors then differ by what the knob changes, not by luck, and the
     /// specialised and uber shaders make the same image.
-    fn renderer(&self, sweep: &Sweep, variant: &Variant) -> Result<Renderer> {
-        let mut scene = variant.scene.clone();
-        scene.render.samples_per_frame = 1;
-        scene.render.accumulate = true;
-        let mut renderer = renderer_for(self.ctx, &with_scene(sweep, scene), self.size)?;
+    fn renderer(&self, sweep: &Sweep, variant: &Variant, kernel: Kernel) -> Result<Renderer> {
+        let mut renderer = renderer_with(
+            self.ctx,
+            &with_scene(sweep, measured(variant)),
+            self.size,
+            kernel,
+        )?;
         if variant.features.is_some() {
             renderer.set_feature_override(self.ctx, variant.features.clone())?;
         }
         accumulate(self.ctx, &mut renderer, WARM_UP_FRAMES, |_| {})?;
         Ok(renderer)
     }
+}
+
+impl Bench<'_> {
+    /// The kernel of `sweep`'s renders (see [`Bench::kernel`]).
+    fn kernel_of(&self, sweep: &Sweep) -> Result<Kernel> {
+        let Some(first) = sweep.variants.first() else {
+            return Ok(Kernel::Fragment);
+        };
+        self.progress
+            .set_message(format!("{}: {} kernel", sweep.knob.id(), sweep.scene_name));
+        let loaded = with_scene(sweep, measured(first));
+        Ok(pick_kernel(self.ctx, &loaded, self.size, self.kernel)?.0)
+    }
+}
+
+/// `variant`'s scene as it is measured: one sample per pixel a frame,
+/// accumulated.
+fn measured(variant: &Variant) -> Scene {
+    let mut scene = variant.scene.clone();
+    scene.render.samples_per_frame = 1;
+    scene.render.accumulate = true;
+    scene
 }
 
 /// The scenes whose references the variants of `sweep` are measured

@@ -29,7 +29,7 @@ pub use measure::Point;
 pub use report::CSV_HEADER;
 
 use super::references::ReferenceCache;
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, Kernel, KernelChoice};
 use anyhow::{Context, Result};
 use clap::Args;
 use frame_timer::FrameTimer;
@@ -57,6 +57,12 @@ pub struct AccuracyBenchArgs {
     /// The folder holding presets/ and envmaps/.
     #[arg(long, default_value = ".")]
     pub root: PathBuf,
+    /// The trace kernel: fragment, compute, or auto (the faster of the two
+    /// on each sweep's scene, timed first; all the sweep's variants then
+    /// use it). References are rendered with the fragment kernel: both
+    /// kernels give the same image.
+    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    pub kernel: KernelChoice,
 }
 
 /// What a run measured and concluded.
@@ -67,6 +73,8 @@ pub struct BenchResults {
     pub references_rendered: usize,
     pub references_cached: usize,
     pub timer: TimerKind,
+    /// The kernel of each sweep: its knob, its scene and the kernel.
+    pub kernels: Vec<(Knob, String, Kernel)>,
     pub points: Vec<Point>,
     /// Per knob swept, its findings in words.
     pub findings: Vec<(Knob, Vec<String>)>,
@@ -76,9 +84,10 @@ pub fn run(args: &AccuracyBenchArgs) -> Result<()> {
     let ctx = GpuContext::headless()?;
     let results = run_on(&ctx, args, true)?;
     println!(
-        "adapter: {}; time per frame: {}; {:.0} s ({} references rendered, {} from the cache)",
+        "adapter: {}; time per frame: {}; kernel: {}; {:.0} s ({} references rendered, {} from the cache)",
         results.adapter,
         results.timer.name(),
+        kernel_summary(&results.kernels),
         results.seconds,
         results.references_rendered,
         results.references_cached,
@@ -135,10 +144,13 @@ pub fn run_on(
         cache: &cache,
         timer: &timer,
         progress: &progress,
+        kernel: args.kernel,
     };
     let (mut points, mut rendered, mut cached) = (Vec::new(), 0, 0);
+    let mut kernels = Vec::new();
     for sweep in &sweeps {
         let measured = bench.measure(sweep)?;
+        kernels.push((sweep.knob, sweep.scene_name.clone(), measured.kernel));
         points.extend(measured.points);
         rendered += measured.references_rendered;
         cached += measured.references_cached;
@@ -150,6 +162,7 @@ pub fn run_on(
         references_rendered: rendered,
         references_cached: cached,
         timer: timer.kind(),
+        kernels,
         findings: knobs
             .iter()
             .map(|&k| (k, findings::findings(k, &points)))
@@ -179,6 +192,11 @@ fn write(args: &AccuracyBenchArgs, scale: &Scale, results: &BenchResults) -> Res
     let run = report::RunInfo {
         adapter: &results.adapter,
         timer: results.timer.name(),
+        kernel: &format!(
+            "{} (`--kernel {}`)",
+            kernel_summary(&results.kernels),
+            args.kernel.fixed().map_or("auto", Kernel::name)
+        ),
         scale,
         quick: args.quick,
         seconds: results.seconds,
@@ -186,4 +204,27 @@ fn write(args: &AccuracyBenchArgs, scale: &Scale, results: &BenchResults) -> Res
         references_cached: results.references_cached,
     };
     report::write_markdown(&out.join("results.md"), &run, &knobs)
+}
+
+/// The kernel the sweeps used: one name where they all used one, else
+/// which sweeps used which.
+fn kernel_summary(kernels: &[(Knob, String, Kernel)]) -> String {
+    let Some((_, _, first)) = kernels.first() else {
+        return "none (no sweeps)".to_string();
+    };
+    if kernels.iter().all(|(_, _, k)| k == first) {
+        return first.to_string();
+    }
+    Kernel::ALL
+        .iter()
+        .map(|&kernel| {
+            let sweeps: Vec<String> = kernels
+                .iter()
+                .filter(|(_, _, k)| *k == kernel)
+                .map(|(knob, scene, _)| format!("{}/{scene}", knob.id()))
+                .collect();
+            format!("{kernel} for {}", sweeps.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

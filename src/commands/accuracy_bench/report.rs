@@ -16,6 +16,8 @@ pub const CSV_HEADER: &str =
 pub struct RunInfo<'a> {
     pub adapter: &'a str,
     pub timer: &'a str,
+    /// The trace kernel the sweeps used, in words.
+    pub kernel: &'a str,
     pub scale: &'a Scale,
     pub quick: bool,
     /// Of the whole run, references included.
@@ -70,6 +72,7 @@ pub fn write_markdown(path: &Path, run: &RunInfo, knobs: &[KnobReport]) -> Resul
     let mut md = String::from("# marbre accuracy benchmark\n\n");
     let (w, h) = run.scale.size;
     let _ = writeln!(md, "* adapter: {}", run.adapter);
+    let _ = writeln!(md, "* trace kernel: {}", run.kernel);
     let _ = writeln!(
         md,
         "* time per frame: {} (one sample per pixel a frame, every frame waited for; seconds are wall clock)",
