@@ -341,10 +341,22 @@ impl Viewer {
             Some(ms) => format!("{ms:.1} ms per round ({clock})"),
             None => "not timed yet".to_owned(),
         };
+        // The other passes' GPU times: what a frame costs besides the trace.
+        let passes: Vec<String> = self.timer.as_ref().map_or_else(Vec::new, |t| {
+            Pass::ALL[1..]
+                .iter()
+                .filter_map(|&p| t.ms(p).map(|ms| format!("{} {ms:.1} ms", p.label())))
+                .collect()
+        });
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}",
+            "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}; other passes: {}",
             self.frames,
-            self.renderer.kernel()
+            self.renderer.kernel(),
+            if passes.is_empty() {
+                "not timed".to_owned()
+            } else {
+                passes.join(", ")
+            }
         );
     }
 
