@@ -103,19 +103,20 @@ mod tests {
         assert_eq!(FrameBudget::new(f32::NAN).budget(), TraceBudget::Round);
     }
 
-    /// An adapter whose trace costs a fixed time per pixel: the frames'
-    /// traced time settles at the target, from below, without overshooting
-    /// by more than the smoothing allows.
+    /// An adapter whose trace costs a fixed time per pixel: after the
+    /// first frame (whose cost is unknown: 164 ms at 5 µs a pixel), the
+    /// frames' traced time settles at the target, from below, without
+    /// overshooting by more than the smoothing allows.
     #[test]
     fn the_traced_time_settles_at_the_target() {
         for ns_per_pixel in [2.0, 40.0, 5000.0] {
             let mut budget = FrameBudget::new(12.0);
             let mut ms = 0.0;
-            for _ in 0..40 {
+            for frame in 0..40 {
                 let p = pixels(&budget);
                 ms = (p as f64 * ns_per_pixel / 1e6) as f32;
                 assert!(
-                    ms < 12.0 * 1.01 || p == 1,
+                    frame == 0 || ms < 12.0 * 1.01 || p == 1,
                     "{ms} ms at {ns_per_pixel} ns/pixel"
                 );
                 budget.observe(ms, p);
