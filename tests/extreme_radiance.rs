@@ -20,8 +20,9 @@ const ALBEDO: f32 = 0.5;
 /// Samples per pixel of the emitter test.
 const SPP: u32 = 32;
 
-/// Renders `spp` samples per pixel and checks that no sample was dropped
-/// and every pixel is finite.
+/// Renders `spp` samples per pixel with each kernel, checks that no sample
+/// was dropped, every pixel is finite and the kernels agree, and returns
+/// the image.
 fn render(
     ctx: &GpuContext,
     scene: &Scene,
@@ -29,13 +30,28 @@ fn render(
     size: (u32, u32),
     spp: u32,
 ) -> Vec<[f32; 4]> {
-    let mut r = Renderer::new(ctx, scene, env, size).unwrap();
-    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
-    let dropped = r.count_non_finite(ctx).unwrap();
-    assert!(dropped.is_zero(), "non-finite samples: {dropped:?}");
-    let (_, _, pixels) = r.read_radiance(ctx).unwrap();
-    assert!(pixels.iter().all(|p| p.iter().all(|c| c.is_finite())));
-    pixels
+    let images: Vec<Vec<[f32; 4]>> = common::kernels(ctx)
+        .into_iter()
+        .map(|kernel| {
+            let mut r = Renderer::with_kernel(ctx, scene, env, size, kernel).unwrap();
+            accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+            let dropped = r.count_non_finite(ctx).unwrap();
+            assert!(
+                dropped.is_zero(),
+                "{kernel}: non-finite samples: {dropped:?}"
+            );
+            let (_, _, pixels) = r.read_radiance(ctx).unwrap();
+            assert!(
+                pixels.iter().all(|p| p.iter().all(|c| c.is_finite())),
+                "{kernel}"
+            );
+            pixels
+        })
+        .collect();
+    for other in &images[1..] {
+        common::assert_kernels_agree(&images[0], other, "extreme radiance");
+    }
+    images.into_iter().next().unwrap()
 }
 
 fn esplanade() -> EnvImage {

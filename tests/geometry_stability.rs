@@ -22,7 +22,9 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec2, Vec3};
-use marbre::commands::session::{LoadedScene, accumulate, load_scene, prepare_scene, renderer_for};
+use marbre::commands::session::{
+    LoadedScene, accumulate, load_scene, prepare_scene, renderer_with,
+};
 use marbre::geometry::{NO_HIT, offset_ray, sphere_distance};
 use marbre::gpu::geometry_harness::{
     ShadingQuery, SphereQuery, offset_rays, shading_normals, sphere_distances,
@@ -881,26 +883,42 @@ fn hard_case(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Renders a loaded scene at `size` with `spp` samples per pixel, and
-/// checks that no sample was dropped as non-finite and no pixel is.
+/// Renders a loaded scene at `size` with `spp` samples per pixel with each
+/// kernel, and checks that no sample was dropped as non-finite, no pixel
+/// is, and the kernels agree; the first kernel's renderer and image.
 fn render_loaded(
     ctx: &GpuContext,
     loaded: &LoadedScene,
     size: (u32, u32),
     spp: u32,
 ) -> (Renderer, Vec<[f32; 4]>) {
-    let mut renderer = renderer_for(ctx, loaded, size).unwrap();
-    accumulate(ctx, &mut renderer, spp, |_| {}).unwrap();
-    let (w, h, pixels) = renderer.read_radiance(ctx).unwrap();
-    assert_eq!((w, h), size);
-    // The trace pass drops non-finite samples before they reach a pixel:
-    // its counters must say it dropped none.
-    let dropped = renderer.count_non_finite(ctx).unwrap();
-    assert!(dropped.is_zero(), "non-finite samples dropped: {dropped:?}");
-    for (i, p) in pixels.iter().enumerate() {
-        assert!(p.iter().all(|c| c.is_finite()), "pixel {i}: {p:?}");
+    let mut rendered: Vec<(Renderer, Vec<[f32; 4]>)> = kernels(ctx)
+        .into_iter()
+        .map(|kernel| {
+            let mut renderer = renderer_with(ctx, loaded, size, kernel).unwrap();
+            accumulate(ctx, &mut renderer, spp, |_| {}).unwrap();
+            let (w, h, pixels) = renderer.read_radiance(ctx).unwrap();
+            assert_eq!((w, h), size);
+            // The trace pass drops non-finite samples before they reach a
+            // pixel: its counters must say it dropped none.
+            let dropped = renderer.count_non_finite(ctx).unwrap();
+            assert!(
+                dropped.is_zero(),
+                "{kernel}: non-finite samples dropped: {dropped:?}"
+            );
+            for (i, p) in pixels.iter().enumerate() {
+                assert!(
+                    p.iter().all(|c| c.is_finite()),
+                    "{kernel}: pixel {i}: {p:?}"
+                );
+            }
+            (renderer, pixels)
+        })
+        .collect();
+    for (_, other) in &rendered[1..] {
+        assert_kernels_agree(&rendered[0].1, other, "render_loaded");
     }
-    (renderer, pixels)
+    rendered.swap_remove(0)
 }
 
 fn render_scene(ctx: &GpuContext, scene: Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {

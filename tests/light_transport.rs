@@ -18,17 +18,26 @@ fn render_env(
     size: (u32, u32),
     spp: u32,
 ) -> Vec<[f32; 4]> {
-    let mut r = Renderer::new(ctx, scene, Some(env), size).unwrap();
-    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
-    let (_, _, pixels) = r.read_radiance(ctx).unwrap();
-    for p in &pixels {
-        assert!(
-            p.iter().all(|c| c.is_finite()),
-            "non-finite pixel {:x?}",
-            p.map(f32::to_bits)
-        );
+    let images: Vec<Vec<[f32; 4]>> = common::kernels(ctx)
+        .into_iter()
+        .map(|kernel| {
+            let mut r = Renderer::with_kernel(ctx, scene, Some(env), size, kernel).unwrap();
+            accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+            let (_, _, pixels) = r.read_radiance(ctx).unwrap();
+            for p in &pixels {
+                assert!(
+                    p.iter().all(|c| c.is_finite()),
+                    "{kernel}: non-finite pixel {:x?}",
+                    p.map(f32::to_bits)
+                );
+            }
+            pixels
+        })
+        .collect();
+    for other in &images[1..] {
+        common::assert_kernels_agree(&images[0], other, "render_env");
     }
-    pixels
+    images.into_iter().next().unwrap()
 }
 
 fn lat_long_scene(importance: bool) -> Scene {

@@ -13,8 +13,10 @@
 //! Non-finite values are caught on the read-back bit patterns
 //! (`f32::is_finite`), never in the shader.
 
+mod common;
+
 use glam::{DVec3, Vec2, Vec3};
-use marbre::commands::session::{accumulate, load_scene, renderer_for};
+use marbre::commands::session::{accumulate, load_scene, renderer_with};
 use marbre::gpu::GpuContext;
 use marbre::gpu::noise_harness::{Evaluate, evaluate_scalar};
 use marbre::gpu::testing::gpu_or_skip;
@@ -896,23 +898,32 @@ fn in_range_extremes_load_unchanged() {
 /// finite, and the displayed image exists.
 fn render_finite(ctx: &GpuContext, name: &str) -> Vec<[f32; 4]> {
     let loaded = load_scene(&hard_case(name), None).unwrap();
-    let mut renderer = renderer_for(ctx, &loaded, (48, 32)).unwrap();
-    accumulate(ctx, &mut renderer, 4, |_| {}).unwrap();
-    let dropped = renderer.count_non_finite(ctx).unwrap();
-    assert!(
-        dropped.is_zero(),
-        "{name}: non-finite samples dropped: {dropped:?}"
-    );
-    let (_, _, pixels) = renderer.read_radiance(ctx).unwrap();
-    for (i, p) in pixels.iter().enumerate() {
-        assert!(
-            p.iter().all(|c| c.is_finite()),
-            "{name}: pixel {i} is {p:?}"
-        );
+    let images: Vec<Vec<[f32; 4]>> = common::kernels(ctx)
+        .into_iter()
+        .map(|kernel| {
+            let mut renderer = renderer_with(ctx, &loaded, (48, 32), kernel).unwrap();
+            accumulate(ctx, &mut renderer, 4, |_| {}).unwrap();
+            let dropped = renderer.count_non_finite(ctx).unwrap();
+            assert!(
+                dropped.is_zero(),
+                "{name}, {kernel}: non-finite samples dropped: {dropped:?}"
+            );
+            let (_, _, pixels) = renderer.read_radiance(ctx).unwrap();
+            for (i, p) in pixels.iter().enumerate() {
+                assert!(
+                    p.iter().all(|c| c.is_finite()),
+                    "{name}, {kernel}: pixel {i} is {p:?}"
+                );
+            }
+            let shown = renderer.read_display(ctx).unwrap();
+            assert_eq!(shown.dimensions(), (48, 32), "{name}, {kernel}");
+            pixels
+        })
+        .collect();
+    for other in &images[1..] {
+        common::assert_kernels_agree(&images[0], other, name);
     }
-    let shown = renderer.read_display(ctx).unwrap();
-    assert_eq!(shown.dimensions(), (48, 32), "{name}");
-    pixels
+    images.into_iter().next().unwrap()
 }
 
 /// The parameter extremes and the far-off noise render: no non-finite

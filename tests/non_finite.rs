@@ -9,7 +9,7 @@ use common::lambert;
 use glam::Vec3;
 use marbre::commands::session::accumulate;
 use marbre::gpu::testing::gpu_or_skip;
-use marbre::gpu::{GpuContext, NonFiniteCounts, Renderer};
+use marbre::gpu::{GpuContext, Kernel, NonFiniteCounts, Renderer};
 use marbre::scene::{EnvSource, Material, OrbitCamera, Scene, Sphere, Texture};
 
 const SIZE: (u32, u32) = (16, 12);
@@ -48,8 +48,12 @@ fn emitter_filling_the_view(strength: f32) -> Scene {
     scene
 }
 
-fn render(ctx: &GpuContext, scene: &Scene) -> (Renderer, NonFiniteCounts, Vec<[f32; 4]>) {
-    let mut r = Renderer::new(ctx, scene, None, SIZE).unwrap();
+fn render(
+    ctx: &GpuContext,
+    scene: &Scene,
+    kernel: Kernel,
+) -> (Renderer, NonFiniteCounts, Vec<[f32; 4]>) {
+    let mut r = Renderer::with_kernel(ctx, scene, None, SIZE, kernel).unwrap();
     accumulate(ctx, &mut r, SPP_PER_FRAME * FRAMES, |_| {}).unwrap();
     let counts = r.count_non_finite(ctx).unwrap();
     let (_, _, pixels) = r.read_radiance(ctx).unwrap();
@@ -86,18 +90,21 @@ fn nan_samples_are_dropped_and_counted() {
     let Some(ctx) = gpu_or_skip("nan_samples_are_dropped_and_counted") else {
         return;
     };
-    let (_, counts, pixels) = render(&ctx, &world_of_radiance(f32::NAN));
-    let all_pixels = SIZE.0 * SIZE.1;
-    assert_eq!(
-        counts,
-        NonFiniteCounts {
-            nan: all_pixels * SPP_PER_FRAME * FRAMES,
-            infinite: 0,
-            pixels: all_pixels,
-        }
-    );
-    // Every sample was dropped: the mean stays at the nothing it started from.
-    assert!(pixels.iter().all(|p| p[..3] == [0.0; 3]), "{:?}", pixels[0]);
+    for kernel in common::kernels(&ctx) {
+        eprintln!("{kernel} kernel");
+        let (_, counts, pixels) = render(&ctx, &world_of_radiance(f32::NAN), kernel);
+        let all_pixels = SIZE.0 * SIZE.1;
+        assert_eq!(
+            counts,
+            NonFiniteCounts {
+                nan: all_pixels * SPP_PER_FRAME * FRAMES,
+                infinite: 0,
+                pixels: all_pixels,
+            }
+        );
+        // Every sample was dropped: the mean stays at the nothing it started from.
+        assert!(pixels.iter().all(|p| p[..3] == [0.0; 3]), "{:?}", pixels[0]);
+    }
 }
 
 #[test]
@@ -107,27 +114,30 @@ fn infinite_samples_are_counted_apart_and_shown_magenta_until_the_image_restarts
     ) else {
         return;
     };
-    let mut scene = world_of_radiance(f32::INFINITY);
-    let (mut r, counts, _) = render(&ctx, &scene);
-    let all_pixels = SIZE.0 * SIZE.1;
-    assert_eq!(counts.infinite, all_pixels * SPP_PER_FRAME * FRAMES);
-    assert_eq!((counts.nan, counts.pixels), (0, all_pixels));
-    assert_eq!(magenta_pixels(&ctx, &mut r), 0, "the debug view is off");
-    scene.render.show_non_finite = true;
-    r.set_scene(&ctx, &scene).unwrap();
-    assert_eq!(
-        r.accumulated_samples(),
-        SPP_PER_FRAME * FRAMES,
-        "the debug view is display-only: it keeps the samples"
-    );
-    assert_eq!(magenta_pixels(&ctx, &mut r), all_pixels as usize);
-    // A finite scene restarts the accumulation, and its counters with it.
-    let mut finite = world_of_radiance(1.0);
-    finite.render.show_non_finite = true;
-    r.set_scene(&ctx, &finite).unwrap();
-    accumulate(&ctx, &mut r, SPP_PER_FRAME, |_| {}).unwrap();
-    assert!(r.count_non_finite(&ctx).unwrap().is_zero());
-    assert_eq!(magenta_pixels(&ctx, &mut r), 0, "no stale count is painted");
+    for kernel in common::kernels(&ctx) {
+        eprintln!("{kernel} kernel");
+        let mut scene = world_of_radiance(f32::INFINITY);
+        let (mut r, counts, _) = render(&ctx, &scene, kernel);
+        let all_pixels = SIZE.0 * SIZE.1;
+        assert_eq!(counts.infinite, all_pixels * SPP_PER_FRAME * FRAMES);
+        assert_eq!((counts.nan, counts.pixels), (0, all_pixels));
+        assert_eq!(magenta_pixels(&ctx, &mut r), 0, "the debug view is off");
+        scene.render.show_non_finite = true;
+        r.set_scene(&ctx, &scene).unwrap();
+        assert_eq!(
+            r.accumulated_samples(),
+            SPP_PER_FRAME * FRAMES,
+            "the debug view is display-only: it keeps the samples"
+        );
+        assert_eq!(magenta_pixels(&ctx, &mut r), all_pixels as usize);
+        // A finite scene restarts the accumulation, and its counters with it.
+        let mut finite = world_of_radiance(1.0);
+        finite.render.show_non_finite = true;
+        r.set_scene(&ctx, &finite).unwrap();
+        accumulate(&ctx, &mut r, SPP_PER_FRAME, |_| {}).unwrap();
+        assert!(r.count_non_finite(&ctx).unwrap().is_zero());
+        assert_eq!(magenta_pixels(&ctx, &mut r), 0, "no stale count is painted");
+    }
 }
 
 /// Samples of 0.75 × f32::MAX: two of them in one frame would sum to
@@ -139,24 +149,27 @@ fn samples_near_the_largest_float_accumulate_without_overflow() {
     else {
         return;
     };
-    let strength = 0.75 * f32::MAX;
-    let (r, counts, pixels) = render(&ctx, &emitter_filling_the_view(strength));
-    assert!(counts.is_zero(), "{counts:?}");
-    for p in &pixels {
-        for c in &p[..3] {
-            // The surface also reflects (albedo 0.5) a black world: the
-            // sample is the emission, rounded by the running mean's
-            // (x − mean)·w steps: a few ulps.
-            assert!(
-                ((c - strength) / strength).abs() < 1e-6,
-                "{c} against {strength}"
-            );
+    for kernel in common::kernels(&ctx) {
+        eprintln!("{kernel} kernel");
+        let strength = 0.75 * f32::MAX;
+        let (r, counts, pixels) = render(&ctx, &emitter_filling_the_view(strength), kernel);
+        assert!(counts.is_zero(), "{counts:?}");
+        for p in &pixels {
+            for c in &p[..3] {
+                // The surface also reflects (albedo 0.5) a black world: the
+                // sample is the emission, rounded by the running mean's
+                // (x − mean)·w steps: a few ulps.
+                assert!(
+                    ((c - strength) / strength).abs() < 1e-6,
+                    "{c} against {strength}"
+                );
+            }
         }
+        let (_, _, spread) = r.read_spread(&ctx).unwrap();
+        assert!(
+            spread.iter().all(|s| s.iter().all(|c| c.is_finite())),
+            "the spread overflowed: {:?}",
+            spread[0]
+        );
     }
-    let (_, _, spread) = r.read_spread(&ctx).unwrap();
-    assert!(
-        spread.iter().all(|s| s.iter().all(|c| c.is_finite())),
-        "the spread overflowed: {:?}",
-        spread[0]
-    );
 }

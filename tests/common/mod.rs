@@ -9,6 +9,8 @@ use marbre::scene::{
     EnvSource, Ground, Material, OrbitCamera, RenderSettings, Scene, Sphere, Texture,
 };
 
+/// `scene` rendered at `size` with `spp` samples per pixel by each kernel
+/// the adapter runs, checked to agree; the image.
 pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Vec<[f32; 4]> {
     render_with(ctx, scene, size, spp, None)
 }
@@ -20,19 +22,36 @@ pub fn render_with(
     spp: u32,
     features: Option<marbre::gpu::FeatureSet>,
 ) -> Vec<[f32; 4]> {
-    let mut r = Renderer::new(ctx, scene, None, size).unwrap();
-    r.set_feature_override(ctx, features).unwrap();
-    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
-    let (w, h, pixels) = r.read_radiance(ctx).unwrap();
-    assert_eq!((w, h), size);
-    // The trace pass drops non-finite samples, so finite pixels alone prove
-    // nothing: its counters must say it dropped none.
-    let dropped = r.count_non_finite(ctx).unwrap();
-    assert!(dropped.is_zero(), "non-finite samples dropped: {dropped:?}");
-    for p in &pixels {
-        assert!(p.iter().all(|c| c.is_finite()), "non-finite pixel {p:?}");
+    // Every kernel traces the same accumulation: the caller's checks on the
+    // returned image hold for each.
+    let images: Vec<Vec<[f32; 4]>> = kernels(ctx)
+        .into_iter()
+        .map(|kernel| {
+            let mut r = Renderer::with_kernel(ctx, scene, None, size, kernel).unwrap();
+            r.set_feature_override(ctx, features.clone()).unwrap();
+            accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+            let (w, h, pixels) = r.read_radiance(ctx).unwrap();
+            assert_eq!((w, h), size);
+            // The trace pass drops non-finite samples, so finite pixels
+            // alone prove nothing: its counters must say it dropped none.
+            let dropped = r.count_non_finite(ctx).unwrap();
+            assert!(
+                dropped.is_zero(),
+                "{kernel}: non-finite samples dropped: {dropped:?}"
+            );
+            for p in &pixels {
+                assert!(
+                    p.iter().all(|c| c.is_finite()),
+                    "{kernel}: non-finite pixel {p:?}"
+                );
+            }
+            pixels
+        })
+        .collect();
+    for other in &images[1..] {
+        assert_kernels_agree(&images[0], other, "render");
     }
-    pixels
+    images.into_iter().next().unwrap()
 }
 
 /// Every colour channel of `pixel` within `relative` of `expected`.
@@ -194,4 +213,33 @@ pub fn spheres_in_constant_light(radiance: f32) -> Scene {
         fov_degrees: 45.0,
     };
     scene
+}
+
+/// The trace kernels `ctx`'s adapter runs, for tests that draw frames with
+/// each (`Kernel::ALL` where the compute kernel is supported; a loud note
+/// where it is not).
+pub fn kernels(ctx: &GpuContext) -> Vec<marbre::gpu::Kernel> {
+    match marbre::gpu::kernel::compute_support(ctx) {
+        Ok(()) => marbre::gpu::Kernel::ALL.to_vec(),
+        Err(why) => {
+            eprintln!("NOTE: the compute kernel cannot run here ({why}): fragment only");
+            vec![marbre::gpu::Kernel::Fragment]
+        }
+    }
+}
+
+/// The two kernels' images of the same accumulation agree to rounding
+/// (`tests/kernels.rs` finds them bit-identical on lavapipe; another
+/// driver may contract or reorder float operations differently).
+pub fn assert_kernels_agree(fragment: &[[f32; 4]], compute: &[[f32; 4]], what: &str) {
+    assert_eq!(fragment.len(), compute.len(), "{what}");
+    for (i, (f, c)) in fragment.iter().zip(compute).enumerate() {
+        for k in 0..4 {
+            let tolerance = 1e-5 * (1.0 + f[k].abs().max(c[k].abs()));
+            assert!(
+                f[k].to_bits() == c[k].to_bits() || (f[k] - c[k]).abs() <= tolerance,
+                "{what}: pixel {i}, fragment {f:?}, compute {c:?}"
+            );
+        }
+    }
 }
