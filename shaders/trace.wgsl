@@ -332,15 +332,15 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
 @group(1) @binding(1) var out_spread: texture_storage_2d<rgba32float, write>;
 @group(1) @binding(2) var out_compensation: texture_storage_2d<rgba32float, write>;
 
-// The compute kernel's workgroup: 8 x 8 pixels, the shape measured fastest
-// on lavapipe among 8x8, 16x8 and 16x16 (docs/PERFORMANCE.md). Rust:
-// gpu::kernel::WORKGROUP.
-const TRACE_WORKGROUP: vec2u = vec2u(8u, 8u);
+// The compute kernel's workgroup: 16 x 8 pixels (128 invocations, four
+// 32-wide SIMD groups on a GPU). On lavapipe it was 2-5 % faster than 8x8 on
+// the default, tiles and Cornell presets, and never slower; 16x16 and 32x4
+// lost on some (docs/PERFORMANCE.md). Rust: gpu::kernel::WORKGROUP.
 
 // One invocation per pixel of the band of rows starting at
 // `frame.band_start`; the dispatch rounds up to whole workgroups, so the
 // invocations past the traced region do nothing.
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(16, 8)
 fn cs_trace(@builtin(global_invocation_id) id: vec3u) {
     frame = frame_slots[frame_slot()];
     let pixel = vec2u(id.x, id.y + frame.band_start);

@@ -19,8 +19,8 @@ use marbre::scene::{EnvSource, Material, OrbitCamera, Scene, Sphere, Texture};
 use std::path::{Path, PathBuf};
 
 /// The size every test traces at: small, and neither side a multiple of
-/// the compute kernel's 8×8 workgroup (the invocations past the edge must
-/// do nothing), 60 = 7.5 workgroups, 44 = 5.5.
+/// the compute kernel's 16×8 workgroup (the invocations past the edge must
+/// do nothing): 60 = 3.75 workgroups, 44 = 5.5.
 const SIZE: (u32, u32) = (60, 44);
 
 fn root() -> &'static Path {

@@ -69,8 +69,8 @@ impl KernelChoice {
 }
 
 /// The compute kernel's workgroup, in pixels (shaders/trace.wgsl's
-/// `@workgroup_size`).
-pub const WORKGROUP: (u32, u32) = (8, 8);
+/// `@workgroup_size`, where the measurement that chose it is).
+pub const WORKGROUP: (u32, u32) = (16, 8);
 
 /// The storage textures the compute kernel writes (mean, spread,
 /// compensation).
@@ -189,7 +189,7 @@ mod tests {
             max_compute_invocations_per_workgroup: 32,
             ..full.clone()
         };
-        assert!(missing_capability(true, &small).unwrap().contains("8x8"));
+        assert!(missing_capability(true, &small).unwrap().contains("16x8"));
         // WebGL2's limits have no storage textures at all.
         assert!(missing_capability(true, &wgpu::Limits::downlevel_webgl2_defaults()).is_some());
     }
