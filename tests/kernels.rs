@@ -7,6 +7,10 @@
 //! `marbre::gpu::testing`). Sizes and sample counts are small: the whole
 //! file runs in about 30 s on lavapipe on two cores.
 
+mod common;
+
+use common::{presets_in, root};
+
 use glam::Vec3;
 use marbre::commands::session::{
     LoadedScene, load_scene, pick_kernel, renderer_with, time_kernels, trace_frame,
@@ -22,22 +26,6 @@ use std::path::{Path, PathBuf};
 /// the compute kernel's 16×8 workgroup (the invocations past the edge must
 /// do nothing): 60 = 3.75 workgroups, 44 = 5.5.
 const SIZE: (u32, u32) = (60, 44);
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Every `*.ron` in `presets/<folder>`, sorted.
-fn presets_in(folder: &str) -> Vec<PathBuf> {
-    let dir = root().join(folder);
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("a readable directory entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
-        .collect();
-    out.sort();
-    out
-}
 
 fn load(path: &Path) -> LoadedScene {
     load_scene(path, None).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()))

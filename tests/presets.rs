@@ -4,6 +4,10 @@
 //! which needs a GPU adapter and skips loudly without one (see
 //! `marbre::gpu::testing`).
 
+mod common;
+
+use common::{presets_in, root};
+
 use marbre::commands::session::{accumulate, load_scene, renderer_for};
 use marbre::gpu::pipelines::validate;
 use marbre::gpu::shader_source::{Program, assemble};
@@ -16,22 +20,6 @@ use marbre::scene::{EnvSource, Ground, Pattern, Scene, Sphere, Texture};
 use marbre::texture::ImageSet;
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Every `*.ron` in `presets/<folder>`, sorted.
-fn presets_in(folder: &str) -> Vec<PathBuf> {
-    let dir = root().join(folder);
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("a readable directory entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
-        .collect();
-    out.sort();
-    out
-}
 
 /// Every `presets/*.ron`.
 fn shipped_presets() -> Vec<PathBuf> {

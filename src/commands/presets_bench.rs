@@ -184,7 +184,7 @@ pub fn run(args: &PresetsBenchArgs) -> Result<()> {
             ))
     );
     println!(
-        "auto picks: what `--kernel auto` runs (both kernels timed on the preset at up to 320x180, the faster kept); with it, compute / fragment as auto measured it"
+        "auto picks: what `--kernel auto` runs (both kernels timed on the preset at up to 320x180, compute kept only if 5 % faster); with it, compute / fragment as auto measured it"
     );
     println!(
         "--kernel {}: the kernel of the uber / specialised columns and of the anti-aliasing tables{}",

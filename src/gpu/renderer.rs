@@ -420,12 +420,16 @@ impl Renderer {
     /// (the viewer's Kernel switch): the current one draws until then.
     pub fn request_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
         self.choose_kernel(ctx, kernel)?;
-        let scene = self
-            .pending
+        let scene = self.latest_requested_scene();
+        self.start_scene(ctx, &scene, true)
+    }
+
+    /// The scene of the build under way, else the one drawing.
+    fn latest_requested_scene(&self) -> Scene {
+        self.pending
             .as_ref()
             .map_or(&self.scene, |p| &p.target.scene)
-            .clone();
-        self.start_scene(ctx, &scene, true)
+            .clone()
     }
 
     fn choose_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
@@ -733,11 +737,7 @@ impl Renderer {
             })?;
         }
         self.feature_override = features;
-        let scene = self
-            .pending
-            .as_ref()
-            .map_or(&self.scene, |p| &p.target.scene)
-            .clone();
+        let scene = self.latest_requested_scene();
         self.start_scene(ctx, &scene, true)
     }
 

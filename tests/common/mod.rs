@@ -243,3 +243,20 @@ pub fn assert_kernels_agree(fragment: &[[f32; 4]], compute: &[[f32; 4]], what: &
         }
     }
 }
+
+/// The repository's root, where the presets are.
+pub fn root() -> &'static std::path::Path {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every `*.ron` in `presets/<folder>` (a path from the root), sorted.
+pub fn presets_in(folder: &str) -> Vec<std::path::PathBuf> {
+    let dir = root().join(folder);
+    let mut out: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("a readable directory entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    out.sort();
+    out
+}
