@@ -22,6 +22,7 @@ mod screenshots;
 mod settings;
 mod shortcuts;
 pub mod soak;
+mod ui_layer;
 mod viewer;
 
 pub use frame_budget::DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS;

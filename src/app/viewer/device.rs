@@ -37,6 +37,7 @@ impl Viewer {
         let size = self.renderer.size();
         self.renderer = renderer_with(&ctx, &loaded, size, self.renderer.kernel())?;
         self.timer = PassTimer::new(&ctx);
+        self.ui_layer = None;
         self.egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());
         // The new egui renderer has no textures, and egui only sends what

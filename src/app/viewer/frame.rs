@@ -4,6 +4,7 @@
 
 use super::Viewer;
 use crate::app::screenshots;
+use crate::app::ui_layer::{self, UiLayer};
 use crate::gpu::pass_timer::Pass;
 use crate::gpu::readback::read_texture;
 use crate::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
@@ -12,6 +13,14 @@ use anyhow::{Context as _, Result};
 use std::path::Path;
 use std::time::Instant;
 
+/// The window's colour around the image and under the panels.
+const BACKGROUND: wgpu::Color = wgpu::Color {
+    r: 0.02,
+    g: 0.02,
+    b: 0.02,
+    a: 1.0,
+};
+
 impl Viewer {
     fn quality_stats(&self) -> QualityStats {
         let scene_features: Vec<_> = FeatureSet::for_scene(&self.scene).0.into_iter().collect();
@@ -19,8 +28,15 @@ impl Viewer {
             points: self.convergence.points().to_vec(),
             latest: self.convergence.latest(),
             paused_at_target: self.paused_at_target(),
+            // The trace on the CPU clock where it is timed so (CPU adapters).
             passes: self.timer.as_ref().map_or_else(Vec::new, |t| {
-                Pass::ALL.iter().map(|&p| (p.label(), t.ms(p))).collect()
+                Pass::ALL
+                    .iter()
+                    .map(|&p| match p {
+                        Pass::Trace if self.trace_on_wall_clock() => (p.label(), self.trace_ms),
+                        _ => (p.label(), t.ms(p)),
+                    })
+                    .collect()
             }),
             without_ms: scene_features
                 .iter()
@@ -226,49 +242,21 @@ impl Viewer {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: ppp,
         };
-        let extra = self.egui_renderer.update_buffers(
-            &self.ctx.device,
-            &self.ctx.queue,
-            &mut encoder,
-            &paint_jobs,
-            &screen,
+        let targets: Vec<(&wgpu::Texture, &wgpu::TextureView)> =
+            std::iter::once((&frame.texture, &target))
+                .chain(capture.as_ref().map(|(t, v)| (t, v)))
+                .collect();
+        let image = egui::Rect::from_min_size(
+            egui::pos2(viewport.x, viewport.y),
+            egui::vec2(viewport.width, viewport.height),
         );
-        let background = wgpu::LoadOp::Clear(wgpu::Color {
-            r: 0.02,
-            g: 0.02,
-            b: 0.02,
-            a: 1.0,
-        });
-        let views: Vec<&wgpu::TextureView> = std::iter::once(&target)
-            .chain(capture.as_ref().map(|(_, v)| v))
-            .collect();
-        for view in views {
-            let target = DisplayTarget {
-                view,
-                format: self.config.format,
-                viewport,
-                load: background,
-            };
-            self.renderer
-                .display(&self.ctx, &mut encoder, &target, self.timer.as_ref())?;
-            let mut pass = encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("egui"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    timestamp_writes: self.timer.as_ref().and_then(|t| t.render_pass(Pass::Ui)),
-                    ..Default::default()
-                })
-                .forget_lifetime();
-            self.egui_renderer.render(&mut pass, &paint_jobs, &screen);
-        }
+        let layered = self.config.usage.contains(wgpu::TextureUsages::COPY_DST)
+            && !ui_layer::reaches_into(&paint_jobs, ppp, image);
+        let extra = if layered {
+            self.draw_layered(&mut encoder, &targets, viewport, &paint_jobs, &screen)?
+        } else {
+            self.draw_on_top(&mut encoder, &targets, viewport, &paint_jobs, &screen)?
+        };
         if let Some(t) = &mut self.timer {
             t.resolve(&mut encoder);
         }
@@ -302,6 +290,113 @@ impl Viewer {
             self.report_quality();
         }
         Ok(!is_last && soak_goes_on)
+    }
+
+    /// The image, then egui over it, on each target: for frames whose
+    /// egui output reaches into the image (a popup, a prompt).
+    fn draw_on_top(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &[(&wgpu::Texture, &wgpu::TextureView)],
+        viewport: Viewport,
+        paint_jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) -> Result<Vec<wgpu::CommandBuffer>> {
+        let extra = self.egui_renderer.update_buffers(
+            &self.ctx.device,
+            &self.ctx.queue,
+            encoder,
+            paint_jobs,
+            screen,
+        );
+        for &(_, view) in targets {
+            let target = DisplayTarget {
+                view,
+                format: self.config.format,
+                viewport,
+                load: wgpu::LoadOp::Clear(BACKGROUND),
+            };
+            self.renderer
+                .display(&self.ctx, encoder, &target, self.timer.as_ref())?;
+            self.draw_egui(encoder, view, wgpu::LoadOp::Load, paint_jobs, screen);
+        }
+        Ok(extra)
+    }
+
+    /// The kept panel layer (egui drawn into it again only if its output
+    /// changed, `app/ui_layer.rs`), copied onto each target, then the image
+    /// over it.
+    fn draw_layered(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &[(&wgpu::Texture, &wgpu::TextureView)],
+        viewport: Viewport,
+        paint_jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) -> Result<Vec<wgpu::CommandBuffer>> {
+        if !self.ui_layer.as_ref().is_some_and(|l| l.fits(&self.config)) {
+            self.ui_layer = Some(UiLayer::new(&self.ctx.device, &self.config));
+        }
+        let key = ui_layer::output_key(paint_jobs, screen);
+        let mut layer = self.ui_layer.take().expect("made above");
+        let mut extra = Vec::new();
+        if let Some(view) = layer.view_to_redraw(key) {
+            extra = self.egui_renderer.update_buffers(
+                &self.ctx.device,
+                &self.ctx.queue,
+                encoder,
+                paint_jobs,
+                screen,
+            );
+            self.draw_egui(
+                encoder,
+                view,
+                wgpu::LoadOp::Clear(BACKGROUND),
+                paint_jobs,
+                screen,
+            );
+        }
+        for &(texture, view) in targets {
+            layer.copy_to(encoder, texture);
+            let target = DisplayTarget {
+                view,
+                format: self.config.format,
+                viewport,
+                load: wgpu::LoadOp::Load,
+            };
+            self.renderer
+                .display(&self.ctx, encoder, &target, self.timer.as_ref())?;
+        }
+        self.ui_layer = Some(layer);
+        Ok(extra)
+    }
+
+    /// Records egui's pass onto `view`.
+    fn draw_egui(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        load: wgpu::LoadOp<wgpu::Color>,
+        paint_jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) {
+        let mut pass = encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                timestamp_writes: self.timer.as_ref().and_then(|t| t.render_pass(Pass::Ui)),
+                ..Default::default()
+            })
+            .forget_lifetime();
+        self.egui_renderer.render(&mut pass, paint_jobs, screen);
     }
 
     fn take_screenshot(&mut self) {
@@ -399,6 +494,7 @@ impl Viewer {
             return;
         }
         self.budget.observe(ms, pixels);
+        self.trace_ms = Some(self.trace_ms.map_or(ms, |s| s + 0.2 * (ms - s)));
         let (w, h) = self.renderer.render_size();
         let round_ms = ms * (f64::from(w) * f64::from(h) / pixels as f64) as f32;
         self.feature_costs
@@ -419,7 +515,10 @@ impl Viewer {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: self.config.format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            // COPY_DST: the kept panel layer is copied onto it as onto the window.
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());

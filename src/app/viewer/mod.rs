@@ -25,6 +25,7 @@ use super::scene_loader::SceneLoad;
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::soak::{SoakAction, SoakDriver, sample_memory};
+use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::commands::session::{
     DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with,
@@ -75,6 +76,15 @@ pub struct Viewer {
     kernels: KernelChooser,
     /// How much tracing a frame asks for, learnt from the trace's times.
     budget: FrameBudget,
+    /// The trace's time per frame, smoothed, where it is timed on the CPU
+    /// clock (the Quality strip's trace row).
+    trace_ms: Option<f32>,
+    /// The panel's pixels kept between frames (`app/ui_layer.rs`).
+    ui_layer: Option<UiLayer>,
+    /// The figures the panel shows, and when they were taken: refreshed
+    /// every [`STATS_REFRESH`], so that the panel stays the same (and its
+    /// layer is reused) between refreshes.
+    shown_stats: Option<(Instant, panel::Stats)>,
     /// The pixels traced in the last frame the pass timer timed (its time
     /// arrives a frame or two later), or in the last frame without one.
     timed_trace_pixels: u64,
@@ -292,6 +302,9 @@ impl Viewer {
             feature_costs: FeatureCosts::default(),
             kernels,
             budget: FrameBudget::new(options.frame_budget_ms),
+            trace_ms: None,
+            ui_layer: None,
+            shown_stats: None,
             timed_trace_pixels: 0,
             non_finite: (0, NonFiniteCounts::default()),
             window,
@@ -570,7 +583,14 @@ impl Viewer {
     /// whether the camera is being dragged.
     fn run_ui(&mut self) -> (egui::FullOutput, egui::Rect, bool) {
         let raw_input = self.egui_state.take_egui_input(&self.window);
-        let stats = self.stats();
+        let stats = match &self.shown_stats {
+            Some((taken, stats)) if taken.elapsed() < STATS_REFRESH => stats.clone(),
+            _ => {
+                let stats = self.stats();
+                self.shown_stats = Some((Instant::now(), stats.clone()));
+                stats
+            }
+        };
         let mut actions = Vec::new();
         let mut image_rect = egui::Rect::NOTHING;
         let mut dragging = false;
@@ -651,6 +671,10 @@ impl Viewer {
             .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
         // Texture uploads are applied now, whatever happens to this frame;
         // frees wait until the frame that may still use them is submitted.
+        // A texture the kept panel layer was drawn with may change.
+        if !output.textures_delta.set.is_empty() {
+            self.ui_layer = None;
+        }
         for (id, deltas) in output.textures_delta.set.drain() {
             for delta in &deltas {
                 self.egui_renderer
@@ -756,8 +780,11 @@ fn surface_config(
         // display pass then encodes sRGB itself.
         .find(|f| !f.is_srgb())
         .unwrap_or(caps.formats[0]);
+    // The kept panel layer is copied onto the window's image, where the
+    // surface allows copies (app/ui_layer.rs); else egui draws every frame.
+    let copy = caps.usages & wgpu::TextureUsages::COPY_DST;
     wgpu::SurfaceConfiguration {
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | copy,
         format,
         width: size.width.max(1),
         height: size.height.max(1),
