@@ -427,6 +427,43 @@ fn a_round_traced_in_bands_equals_a_whole_pass() {
     }
 }
 
+/// With accumulation off, every round starts anew, also the second and
+/// third of one call whose budget covers three: the image holds one
+/// round's samples, those of a whole pass at the same frame index.
+#[test]
+fn without_accumulation_each_round_of_a_call_starts_anew() {
+    let Some(ctx) = gpu_with_compute("without_accumulation_each_round_of_a_call_starts_anew")
+    else {
+        return;
+    };
+    let mut loaded = preset("default.ron");
+    loaded.scene.render.accumulate = false;
+    let spp = loaded.scene.render.samples_per_frame;
+    let round = u64::from(SIZE.0) * u64::from(SIZE.1);
+    for kernel in Kernel::ALL {
+        let mut r = renderer_with(&ctx, &loaded, SIZE, kernel).unwrap();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let work = r.trace_within(&ctx, &mut encoder, TraceBudget::Pixels(3 * round), None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .unwrap();
+        assert_eq!(work.rounds, 3, "{kernel}");
+        assert_eq!(
+            r.accumulated_samples(),
+            spp,
+            "{kernel}: one round's samples"
+        );
+        let last = read(&ctx, &r);
+        let whole = whole_pass_from_frame(&ctx, &loaded, kernel, 2, 1);
+        let inexact =
+            assert_same_image(&format!("{kernel}, no accumulation"), &last, &whole, |_| {
+                0.0
+            });
+        assert_eq!(inexact, 0, "{kernel}");
+    }
+}
+
 /// A fresh accumulation whose first round does not fit in the budget
 /// shows a preview first: after the first call the image on show is
 /// smaller than the render size, finite, lit, and counts no samples. The

@@ -871,6 +871,11 @@ impl Renderer {
         let mut work = TraceWork::default();
         let count = passes.len();
         for (index, (size, rows, preview)) in passes.into_iter().enumerate() {
+            if index > 0 && !preview && rows.start == 0 && !self.scene.render.accumulate {
+                // A later round of this call: it too starts anew.
+                self.accumulation.reset();
+                self.accumulation.skip_preview();
+            }
             if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
                 self.non_finite.clear(encoder);
             }
