@@ -20,6 +20,7 @@ pub mod obj_syntax;
 pub mod panel;
 pub mod preset;
 pub mod scene;
+pub mod session;
 #[cfg(test)]
 mod test_dir;
 pub mod texture;

@@ -15,26 +15,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-/// How a light sample picks its light.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum LightSelection {
-    /// Every light equally likely.
-    Uniform,
-    /// In proportion to emitted power.
-    #[default]
-    Power,
-}
-
-impl LightSelection {
-    pub const ALL: [LightSelection; 2] = [LightSelection::Uniform, LightSelection::Power];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            LightSelection::Uniform => "uniform",
-            LightSelection::Power => "by power",
-        }
-    }
-}
+/// How a light sample picks its light: a scene setting, kept with the
+/// other transport settings.
+pub use crate::scene::transport::LightSelection;
 
 /// `Light` of `shaders/scene.wgsl`.
 #[repr(C)]

@@ -3,8 +3,9 @@
 //! tests rely on them.
 
 use clap::{Args, Parser, Subcommand};
+use marbre::app::soak::command as soak;
 use marbre::commands::{
-    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render, soak,
+    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render,
 };
 use marbre::gpu::KernelChoice;
 use std::path::PathBuf;

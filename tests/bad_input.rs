@@ -12,11 +12,11 @@
 mod corpus;
 
 use glam::Vec3;
-use marbre::commands::session::{
-    self, LoadedScene, load_environment, load_images, load_scene, prepare_scene,
-};
 use marbre::envmap::{EnvImage, MAX_TEXELS};
 use marbre::scene::{EnvSource, Material, Mesh, Pattern, Scene, Sphere, Texture};
+use marbre::session::{
+    self, LoadedScene, load_environment, load_images, load_scene, prepare_scene,
+};
 use marbre::texture::{ColorSpace, ImageSource, load_image};
 use std::path::{Path, PathBuf};
 

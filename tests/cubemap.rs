@@ -859,7 +859,7 @@ fn the_cross_as_background_renders_what_the_cube_samples() {
         };
         scene.environment.background_visible = true;
         let mut r = marbre::gpu::Renderer::new(&ctx, &scene, Some(&env), size).unwrap();
-        marbre::commands::session::accumulate(&ctx, &mut r, 64, |_| {}).unwrap();
+        marbre::session::accumulate(&ctx, &mut r, 64, |_| {}).unwrap();
         let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
         for (px, py) in [(12u32, 8u32), (3, 3), (20, 12), (6, 13), (18, 2)] {
             let gpu = pixels[(py * size.0 + px) as usize];

@@ -5,10 +5,10 @@
 mod common;
 
 use common::spheres_in_constant_light;
-use marbre::commands::session::{LoadedScene, accumulate, load_scene, renderer_for};
 use marbre::gpu::error_meter::{self, REL_EPSILON};
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
+use marbre::session::{LoadedScene, accumulate, load_scene, renderer_for};
 use std::path::Path;
 
 const SIZE: (u32, u32) = (48, 32);

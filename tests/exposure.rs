@@ -5,7 +5,6 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use marbre::commands::session::accumulate;
 use marbre::gpu::auto_exposure::{
     AutoExposure, DELTA, KEY, exposure_stops, log_average_luminance, meter,
 };
@@ -13,6 +12,7 @@ use marbre::gpu::metering_grid::grid_pixels;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{PointLight, Scene, ToneMap};
+use marbre::session::accumulate;
 use wgpu::util::DeviceExt;
 
 /// `scene` traced at `spp` from a fresh renderer (so two scenes see the same

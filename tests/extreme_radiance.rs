@@ -8,11 +8,11 @@ mod common;
 
 use common::{camera_ray, lambert};
 use glam::{Vec2, Vec3};
-use marbre::commands::session::accumulate;
 use marbre::envmap::{self, EnvImage};
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{EnvSource, Ground, Material, OrbitCamera, Scene, Sphere, Texture};
+use marbre::session::accumulate;
 use std::f64::consts::PI;
 use std::path::Path;
 

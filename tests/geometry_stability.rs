@@ -22,9 +22,6 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec2, Vec3};
-use marbre::commands::session::{
-    LoadedScene, accumulate, load_scene, prepare_scene, renderer_with,
-};
 use marbre::geometry::{NO_HIT, offset_ray, sphere_distance};
 use marbre::gpu::geometry_harness::{
     ShadingQuery, SphereQuery, offset_rays, shading_normals, sphere_distances,
@@ -34,6 +31,7 @@ use marbre::gpu::{GpuContext, Renderer};
 use marbre::lights::{EmitterTriangle, LightSelection, LightTable, triangle_area};
 use marbre::scene::mesh::{Geometry, TriangleMesh};
 use marbre::scene::{EnvSource, Ground, Material, OrbitCamera, PointLight, Scene, Sphere, Texture};
+use marbre::session::{LoadedScene, accumulate, load_scene, prepare_scene, renderer_with};
 use marbre::texture::bump::{FACING_MIN_COS, facing_shading_normal};
 use marbre::texture::bumped_normal;
 use proptest::prelude::*;

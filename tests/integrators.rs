@@ -7,7 +7,6 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use marbre::commands::session::accumulate;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::lights::LightSelection;
@@ -15,6 +14,7 @@ use marbre::scene::{
     EnvSource, Ground, Integrator, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere,
     Strategy, Texture,
 };
+use marbre::session::accumulate;
 
 const STRATEGIES: [Strategy; 4] = Strategy::ALL;
 
@@ -523,7 +523,7 @@ fn on_two_panels_choosing_by_power_beats_uniform() {
         return;
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene = marbre::commands::session::load_scene(&root.join("presets/two_panels.ron"), None)
+    let scene = marbre::session::load_scene(&root.join("presets/two_panels.ron"), None)
         .unwrap()
         .scene;
     let (uniform, power) = selection_errors(&ctx, scene, (40, 30));

@@ -12,14 +12,14 @@ mod common;
 use common::{presets_in, root};
 
 use glam::Vec3;
-use marbre::commands::session::{
-    LoadedScene, load_scene, pick_kernel, renderer_with, time_kernels, trace_frame,
-};
 use marbre::gpu::kernel::{compute_support, faster, resolve};
 use marbre::gpu::non_finite::NonFiniteCounts;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Kernel, KernelChoice, Renderer, TraceBudget, TraceWork};
 use marbre::scene::{EnvSource, Material, OrbitCamera, Scene, Sphere, Texture};
+use marbre::session::{
+    LoadedScene, load_scene, pick_kernel, renderer_with, time_kernels, trace_frame,
+};
 use std::path::{Path, PathBuf};
 
 /// The size every test traces at: small, and neither side a multiple of

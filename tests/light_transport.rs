@@ -5,11 +5,11 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use marbre::commands::session::accumulate;
 use marbre::envmap::EnvImage;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{EnvSource, Ground, OrbitCamera, Scene, Sphere};
+use marbre::session::accumulate;
 
 fn render_env(
     ctx: &GpuContext,

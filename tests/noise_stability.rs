@@ -16,7 +16,6 @@
 mod common;
 
 use glam::{DVec3, Vec2, Vec3};
-use marbre::commands::session::{accumulate, load_scene, renderer_with};
 use marbre::gpu::GpuContext;
 use marbre::gpu::noise_harness::{Evaluate, evaluate_scalar};
 use marbre::gpu::testing::gpu_or_skip;
@@ -25,6 +24,7 @@ use marbre::noise::perlin::{IMPROVED_NOISE_BOUND, improved_noise};
 use marbre::noise::{self, FractalParams, FractalShape, HashKind, NoiseKind, NoiseSettings};
 use marbre::preset;
 use marbre::scene::{MappingSpace, Pattern, Property, Signal, SurfacePoint, TextureMapping};
+use marbre::session::{accumulate, load_scene, renderer_with};
 use marbre::texture::TextureTransform;
 
 /// The distances from the origin the issue names, the origin first as the

@@ -7,10 +7,10 @@ mod common;
 
 use common::lambert;
 use glam::Vec3;
-use marbre::commands::session::accumulate;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::gpu::{GpuContext, Kernel, NonFiniteCounts, Renderer};
 use marbre::scene::{EnvSource, Material, OrbitCamera, Scene, Sphere, Texture};
+use marbre::session::accumulate;
 
 const SIZE: (u32, u32) = (16, 12);
 const SPP_PER_FRAME: u32 = 2;

@@ -4,10 +4,10 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use marbre::commands::session::accumulate;
 use marbre::gpu::Renderer;
 use marbre::gpu::testing::gpu_or_skip;
 use marbre::scene::{EnvSource, Ground, OrbitCamera, PointLight, Scene, Sphere, Texture};
+use marbre::session::accumulate;
 
 /// A diffuse sphere of albedo ρ under a constant white environment of
 /// radiance 1 reflects exactly ρ: every cosine-sampled bounce escapes to the
@@ -440,10 +440,10 @@ fn uber_and_specialised_shaders_agree() {
         "presets/cutouts.ron",
         "presets/images.ron",
     ] {
-        let loaded = marbre::commands::session::load_scene(&root.join(preset), None).unwrap();
+        let loaded = marbre::session::load_scene(&root.join(preset), None).unwrap();
         let size = (48, 27);
-        let mut specialised = marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
-        let mut uber = marbre::commands::session::renderer_for(&ctx, &loaded, size).unwrap();
+        let mut specialised = marbre::session::renderer_for(&ctx, &loaded, size).unwrap();
+        let mut uber = marbre::session::renderer_for(&ctx, &loaded, size).unwrap();
         uber.set_feature_override(&ctx, Some(marbre::gpu::FeatureSet::all()))
             .unwrap();
         assert!(uber.features().0.len() > specialised.features().0.len());
@@ -469,8 +469,8 @@ fn uber_and_specialised_shaders_agree() {
 /// names the reason and leaves the shader as it was.
 #[test]
 fn a_feature_can_be_compiled_out_unless_the_texture_code_needs_it() {
-    use marbre::commands::session::{load_scene, renderer_for};
     use marbre::gpu::{Feature, FeatureSet};
+    use marbre::session::{load_scene, renderer_for};
     let Some(ctx) = gpu_or_skip("a_feature_can_be_compiled_out_unless_the_texture_code_needs_it")
     else {
         return;

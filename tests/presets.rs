@@ -8,7 +8,6 @@ mod common;
 
 use common::{presets_in, root};
 
-use marbre::commands::session::{accumulate, load_scene, renderer_for};
 use marbre::gpu::pipelines::validate;
 use marbre::gpu::shader_source::{Program, assemble};
 use marbre::gpu::testing::gpu_or_skip;
@@ -17,6 +16,7 @@ use marbre::gpu::{Feature, FeatureSet};
 use marbre::noise::{HashKind, NoiseKind, NoiseSettings};
 use marbre::preset::{self, Preset, PresetError};
 use marbre::scene::{EnvSource, Ground, Pattern, Scene, Sphere, Texture};
+use marbre::session::{accumulate, load_scene, renderer_for};
 use marbre::texture::ImageSet;
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
@@ -242,7 +242,7 @@ fn to_text_writes_the_environment_path_relative_to_the_preset() {
 /// Every program assembles and validates with naga for `features`, the
 /// trace program with the texture code generated from `scene`.
 fn assert_validates(features: &FeatureSet, scene: &Scene, what: &str) {
-    let images = marbre::commands::session::load_images(scene, &mut Vec::new()).unwrap();
+    let images = marbre::session::load_images(scene, &mut Vec::new()).unwrap();
     let textures = generate(scene, &images).unwrap();
     for program in [Program::Trace, Program::Display] {
         let source = assemble(program, features, &textures.wgsl)

@@ -784,20 +784,19 @@ fn sampling_presets_render_without_non_finite_samples() {
             path.display(),
             loaded.notes
         );
-        let scene = marbre::commands::session::load_scene(&path, None).unwrap();
+        let scene = marbre::session::load_scene(&path, None).unwrap();
         let mut cameras = vec![scene.scene.camera];
         cameras.extend(scene.scene.views.iter().map(|v| v.camera));
         for camera in cameras {
-            let mut view = marbre::commands::session::LoadedScene {
+            let mut view = marbre::session::LoadedScene {
                 scene: scene.scene.clone(),
                 env: scene.env.clone(),
                 images: scene.images.clone(),
                 notes: Vec::new(),
             };
             view.scene.camera = camera;
-            let mut renderer =
-                marbre::commands::session::renderer_for(&ctx, &view, (32, 32)).unwrap();
-            marbre::commands::session::accumulate(&ctx, &mut renderer, 8, |_| {}).unwrap();
+            let mut renderer = marbre::session::renderer_for(&ctx, &view, (32, 32)).unwrap();
+            marbre::session::accumulate(&ctx, &mut renderer, 8, |_| {}).unwrap();
             let dropped = renderer.count_non_finite(&ctx).unwrap();
             assert!(
                 dropped.is_zero(),

@@ -540,12 +540,12 @@ fn image_texture_renders_the_cpu_reference() {
         radiance: Vec3::ONE,
     };
     let mut notes = Vec::new();
-    let images = marbre::commands::session::load_images(&scene, &mut notes).unwrap();
+    let images = marbre::session::load_images(&scene, &mut notes).unwrap();
     assert!(notes.is_empty(), "{notes:?}");
     let (w, h) = (64, 64);
     let mut renderer = marbre::gpu::Renderer::new(&ctx, &scene, None, (w, h)).unwrap();
     renderer.set_images(&ctx, images.clone()).unwrap();
-    marbre::commands::session::accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
+    marbre::session::accumulate(&ctx, &mut renderer, 4, |_| {}).unwrap();
     let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
     let frame = polygon.frame().unwrap();
     assert_pixels_match(&pixels, (w, h), 0.3, |at| {
@@ -675,7 +675,7 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
     // Meanwhile: the old pipeline, the old scene.
     assert_eq!(renderer.features(), &before);
     assert_eq!(renderer.scene(), &scene);
-    marbre::commands::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
+    marbre::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
     let (_, _, pixels) = renderer.read_radiance(&ctx).unwrap();
     assert!((pixels[0][0] - red.x).abs() < 1e-3, "{:?}", pixels[0]);
 
@@ -696,7 +696,7 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
     );
     assert_eq!(renderer.scene(), &edited);
     let first_frame = std::time::Instant::now();
-    marbre::commands::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
+    marbre::session::accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
     eprintln!(
         "first frame with the new pipeline: {:?}",
         first_frame.elapsed()

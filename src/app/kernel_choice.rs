@@ -6,9 +6,9 @@
 //! the next start uses it at once.
 
 use super::settings::Settings;
-use crate::commands::session::{KernelTimings, LoadedScene, time_kernels};
 use crate::gpu::kernel::{self, compute_support};
 use crate::gpu::{GpuContext, Kernel, KernelChoice};
+use crate::session::{KernelTimings, LoadedScene, time_kernels};
 use anyhow::Result;
 use std::sync::mpsc;
 

@@ -7,8 +7,8 @@
 //! images, and the BVH ([`PreparedGeometry`]). The viewer then installs the
 //! result on the render thread in one go, or shows why it failed.
 
-use crate::commands::session::{LoadStage, LoadedScene, load_scene_reporting};
 use crate::gpu::mesh_buffers::PreparedGeometry;
+use crate::session::{LoadStage, LoadedScene, load_scene_reporting};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, mpsc};

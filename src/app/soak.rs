@@ -9,6 +9,7 @@
 //! [`sample_memory`] and [`SoakDriver::record`] after presenting, and at
 //! the end prints [`SoakDriver::verdict`].
 
+pub mod command;
 mod edits;
 mod memory;
 mod rng;

@@ -7,11 +7,11 @@
 use super::accuracy_bench::ErrorMetrics;
 use super::references::ReferenceCache;
 use super::render::parse_size;
-use super::session::{
-    LoadedScene, accumulate, describe_pick, load_scene, pick_kernel, renderer_with,
-};
 use crate::gpu::{GpuContext, Kernel, KernelChoice};
 use crate::image_io;
+use crate::session::{
+    LoadedScene, accumulate, describe_pick, load_scene, pick_kernel, renderer_with,
+};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;

@@ -9,5 +9,3 @@ pub mod noise_figure;
 pub mod presets_bench;
 pub mod references;
 pub mod render;
-pub mod session;
-pub mod soak;

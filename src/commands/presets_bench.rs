@@ -3,12 +3,12 @@
 //! kernel `auto` picks, and what specialising the shader gains.
 
 use super::aa_scenes;
-use super::session::{
-    LoadedScene, accumulate, load_scene, pick_kernel, renderer_with, trace_frame,
-};
 use crate::gpu::kernel;
 use crate::gpu::{Feature, FeatureSet, GpuContext, Kernel, KernelChoice, Renderer};
 use crate::scene::Scene;
+use crate::session::{
+    LoadedScene, accumulate, load_scene, pick_kernel, renderer_with, trace_frame,
+};
 use crate::texture::ImageSet;
 use anyhow::{Context, Result};
 use clap::Args;

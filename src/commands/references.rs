@@ -8,10 +8,10 @@
 //! count and the renderer (the shader sources' fingerprint and the crate
 //! version). Change any of them and a new reference is rendered.
 
-use super::session::{LoadedScene, accumulate, renderer_for};
 use crate::gpu::GpuContext;
 use crate::gpu::shader_source::sources_fingerprint;
 use crate::scene::Scene;
+use crate::session::{LoadedScene, accumulate, renderer_for};
 use crate::{envmap, image_io};
 use anyhow::{Context, Result};
 use std::hash::{Hash, Hasher};

@@ -1,13 +1,13 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
-use super::session::{
-    accumulate, describe_pick, load_scene, max_texture_side, pick_kernel, renderer_with,
-    trace_frame,
-};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::{GpuContext, KernelChoice, Renderer};
 use crate::image_io;
+use crate::session::{
+    accumulate, describe_pick, load_scene, max_texture_side, pick_kernel, renderer_with,
+    trace_frame,
+};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;

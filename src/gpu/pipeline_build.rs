@@ -12,13 +12,7 @@
 //! stores the compiled shader in its disk cache, and the real device's
 //! first draw then finds it there.
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::kernel::Kernel;
-use super::renderer::Renderer;
 use super::trace_pass::TracePipeline;
-use crate::scene::Scene;
-use crate::texture::ImageSet;
 use anyhow::{Result, anyhow};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
 use std::time::{Duration, Instant};
@@ -31,30 +25,10 @@ pub struct BuiltPipeline {
     pub took: Duration,
 }
 
-/// What to draw once on a second device, so its compiled shader lands in
-/// the driver's disk cache before the real device first draws it.
-pub struct WarmUp {
-    pub ctx: Arc<GpuContext>,
-    pub scene: Scene,
-    pub images: ImageSet,
-    pub features: Option<FeatureSet>,
-    /// The kernel being built: each compiles its own entry point.
-    pub kernel: Kernel,
-}
-
-impl WarmUp {
-    fn run(self) -> Result<()> {
-        let ctx = &*self.ctx;
-        let mut renderer = Renderer::with_kernel(ctx, &self.scene, None, (1, 1), self.kernel)?;
-        renderer.set_feature_override(ctx, self.features)?;
-        renderer.set_images(ctx, self.images)?;
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.trace(ctx, &mut encoder, None);
-        ctx.queue.submit([encoder.finish()]);
-        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-        Ok(())
-    }
-}
+/// Work to do on the worker before a build: the renderer's warm-up, which
+/// draws one pixel of the new scene on a second device (see the module's
+/// doc). A closure, so that this module needs no renderer.
+pub type WarmUp = Box<dyn FnOnce() -> Result<()> + Send>;
 
 /// The work of one build: an optional warm-up, then creating the pipeline.
 type BuildFn = Box<dyn FnOnce() -> Result<(TracePipeline, usize)> + Send>;
@@ -71,7 +45,7 @@ impl Job {
     fn run(self) {
         let result = (|| {
             if let Some(warm_up) = self.warm_up {
-                warm_up.run()?;
+                warm_up()?;
             }
             let (pipeline, shader_bytes) = (self.build)()?;
             Ok(BuiltPipeline {

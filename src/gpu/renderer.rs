@@ -601,12 +601,15 @@ impl Renderer {
         } else {
             None
         };
-        let warm_up = warm_context.map(|warm| WarmUp {
-            ctx: warm,
-            scene: scene.clone(),
-            images: self.images.clone(),
-            features: self.feature_override.clone(),
-            kernel: self.kernel,
+        let warm_up = warm_context.map(|warm| {
+            let warm_up = ShaderWarmUp {
+                ctx: warm,
+                scene: scene.clone(),
+                images: self.images.clone(),
+                features: self.feature_override.clone(),
+                kernel: self.kernel,
+            };
+            Box::new(move || warm_up.run()) as WarmUp
         });
         let (device, layouts) = (ctx.device.clone(), self.trace_layouts.clone());
         let build_key = key.clone();
@@ -1280,6 +1283,32 @@ fn scaled(size: (u32, u32), scale: f32) -> (u32, u32) {
 
 fn pixel_count(size: (u32, u32)) -> u64 {
     u64::from(size.0) * u64::from(size.1)
+}
+
+/// What to draw once on a second device, so its compiled shader lands in
+/// the driver's disk cache before the real device first draws it
+/// (`pipeline_build` runs it on its worker before the build).
+struct ShaderWarmUp {
+    ctx: Arc<GpuContext>,
+    scene: Scene,
+    images: ImageSet,
+    features: Option<FeatureSet>,
+    /// The kernel being built: each compiles its own entry point.
+    kernel: Kernel,
+}
+
+impl ShaderWarmUp {
+    fn run(self) -> Result<()> {
+        let ctx = &*self.ctx;
+        let mut renderer = Renderer::with_kernel(ctx, &self.scene, None, (1, 1), self.kernel)?;
+        renderer.set_feature_override(ctx, self.features)?;
+        renderer.set_images(ctx, self.images)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    }
 }
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {

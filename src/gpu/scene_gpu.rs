@@ -3,7 +3,7 @@
 use super::texture_codegen;
 use crate::lights::LightSelection;
 use crate::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
-use crate::scene::material::MAX_SIGNALS;
+use crate::scene::pattern::MAX_SIGNALS;
 use crate::scene::primitives::MAX_POLYGON_VERTICES;
 use crate::scene::{
     EnvSource, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,

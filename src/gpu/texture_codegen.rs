@@ -14,7 +14,7 @@
 //! evaluated once per hit by `material_signals` (textures.wgsl); the
 //! generated code reads them from `signals`.
 
-use crate::scene::material::MAX_SIGNALS;
+use crate::scene::pattern::MAX_SIGNALS;
 use crate::scene::texture_tree::IMAGE_UNAVAILABLE;
 use crate::scene::{
     Child, MappingSpace, Material, MathOp, Pattern, Property, Scene, Signal, Texture,

@@ -5,11 +5,6 @@ use super::texture_tree::Texture;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
-/// The most distinct fractal sums (noise signals) one material's textures
-/// may read: the shader evaluates each once per hit (`MAX_SIGNALS` in
-/// shaders/scene.wgsl).
-pub const MAX_SIGNALS: usize = 4;
-
 /// A surface property a texture can drive. Colours use all three channels,
 /// scalars the first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

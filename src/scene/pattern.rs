@@ -11,6 +11,11 @@ use glam::{Affine3A, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
 
+/// The most distinct fractal sums (noise signals) one material's textures
+/// may read: the shader evaluates each once per hit (`MAX_SIGNALS` in
+/// shaders/scene.wgsl).
+pub const MAX_SIGNALS: usize = 4;
+
 /// What drives a property across a surface. Each pattern yields a blend
 /// factor `t` in [0, 1] between the texture's two children: `a` where
 /// `t = 0`, `b` where `t = 1`.

@@ -4,8 +4,7 @@
 //! cell's own unit square, so a texture nested in a cell repeats once per
 //! cell.
 
-use super::material::MAX_SIGNALS;
-use super::pattern::{Pattern, Signal, SurfacePoint, TextureMapping};
+use super::pattern::{MAX_SIGNALS, Pattern, Signal, SurfacePoint, TextureMapping};
 use crate::texture;
 use crate::texture::{ImageSet, ImageSource};
 use glam::{Vec2, Vec3};

@@ -2,8 +2,28 @@
 //! sampled and how the strategies are combined. Every setting is a uniform
 //! the shader reads, so all of them switch live without a shader build.
 
-use crate::lights::LightSelection;
 use serde::{Deserialize, Serialize};
+
+/// How a light sample picks its light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum LightSelection {
+    /// Every light equally likely.
+    Uniform,
+    /// In proportion to emitted power.
+    #[default]
+    Power,
+}
+
+impl LightSelection {
+    pub const ALL: [LightSelection; 2] = [LightSelection::Uniform, LightSelection::Power];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            LightSelection::Uniform => "uniform",
+            LightSelection::Power => "by power",
+        }
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum Integrator {

@@ -3,11 +3,11 @@
 #![allow(dead_code)]
 
 use glam::{Vec2, Vec3};
-use marbre::commands::session::accumulate;
 use marbre::gpu::{GpuContext, Renderer};
 use marbre::scene::{
     EnvSource, Ground, Material, OrbitCamera, RenderSettings, Scene, Sphere, Texture,
 };
+use marbre::session::accumulate;
 
 /// `scene` rendered at `size` with `spp` samples per pixel by each kernel
 /// the adapter runs, checked to agree; the image.

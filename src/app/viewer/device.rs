@@ -4,9 +4,9 @@
 //! made is lost; the accumulated samples start over).
 
 use super::{Viewer, surface_config};
-use crate::commands::session::{LoadedScene, load_environment, max_texture_side, renderer_with};
 use crate::gpu::GpuContext;
 use crate::gpu::pass_timer::PassTimer;
+use crate::session::{LoadedScene, load_environment, max_texture_side, renderer_with};
 use anyhow::{Context as _, Result};
 
 impl Viewer {

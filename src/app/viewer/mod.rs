@@ -27,14 +27,12 @@ use super::shortcuts::{self, Shortcut};
 use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
-use crate::commands::session::{
-    DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with,
-};
 use crate::gpu::pass_timer::PassTimer;
 use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
 use crate::panel::{self, PanelAction, PanelState};
 use crate::preset;
 use crate::scene::{EnvSource, OrbitCamera, Scene};
+use crate::session::{DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with};
 use anyhow::{Context as _, Result};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

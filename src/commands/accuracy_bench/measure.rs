@@ -7,9 +7,9 @@ use super::frame_timer::{FrameTimer, TimerKind};
 use super::knob::Knob;
 use super::sweeps::{Sweep, Variant};
 use crate::commands::references::{Reference, ReferenceCache};
-use crate::commands::session::{LoadedScene, accumulate, pick_kernel, renderer_with};
 use crate::gpu::{GpuContext, Kernel, KernelChoice, Renderer};
 use crate::scene::Scene;
+use crate::session::{LoadedScene, accumulate, pick_kernel, renderer_with};
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 

@@ -2,11 +2,11 @@
 //! that the knob swept is what decides the error.
 
 use crate::commands::aa_scenes;
-use crate::commands::session::{LoadedScene, load_scene};
 use crate::noise::{FractalParams, HashKind, NoiseSettings};
 use crate::scene::{
     EnvSource, Ground, Integrator, Material, OrbitCamera, Pattern, Scene, Sphere, Texture,
 };
+use crate::session::{LoadedScene, load_scene};
 use crate::texture::{ImageFilter, ImageSource, ImageWrap};
 use anyhow::{Context, Result};
 use glam::Vec3;

@@ -5,12 +5,12 @@
 use super::knob::Knob;
 use super::scale::Scale;
 use super::scenes;
-use crate::commands::session::{LoadedScene, prepare_scene};
 use crate::envmap::EnvImage;
 use crate::gpu::FeatureSet;
 use crate::lights::LightSelection;
 use crate::noise::HashKind;
 use crate::scene::{Scene, Strategy};
+use crate::session::{LoadedScene, prepare_scene};
 use crate::texture::{ImageFilter, ImageSet};
 use anyhow::Result;
 use std::path::Path;

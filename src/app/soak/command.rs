@@ -1,7 +1,7 @@
 //! `marbre soak`: the viewer window under seeded random edits for many
 //! frames, its memory judged at the end (see `app::soak`).
 
-use crate::app::soak::{DEFAULT_PRESETS, SoakOptions};
+use super::{DEFAULT_PRESETS, SoakOptions};
 use crate::app::{ViewerOptions, run as run_viewer};
 use anyhow::Result;
 use clap::Args;
