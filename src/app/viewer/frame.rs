@@ -302,25 +302,46 @@ impl Viewer {
         paint_jobs: &[egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
     ) -> Result<Vec<wgpu::CommandBuffer>> {
-        let extra = self.egui_renderer.update_buffers(
+        let extra = self.update_egui_buffers(encoder, paint_jobs, screen);
+        for &(_, view) in targets {
+            self.display_on(encoder, view, viewport, wgpu::LoadOp::Clear(BACKGROUND))?;
+            self.draw_egui(encoder, view, wgpu::LoadOp::Load, paint_jobs, screen);
+        }
+        Ok(extra)
+    }
+
+    /// Uploads egui's meshes for a pass that draws them.
+    fn update_egui_buffers(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        paint_jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) -> Vec<wgpu::CommandBuffer> {
+        self.egui_renderer.update_buffers(
             &self.ctx.device,
             &self.ctx.queue,
             encoder,
             paint_jobs,
             screen,
-        );
-        for &(_, view) in targets {
-            let target = DisplayTarget {
-                view,
-                format: self.config.format,
-                viewport,
-                load: wgpu::LoadOp::Clear(BACKGROUND),
-            };
-            self.renderer
-                .display(&self.ctx, encoder, &target, self.timer.as_ref())?;
-            self.draw_egui(encoder, view, wgpu::LoadOp::Load, paint_jobs, screen);
-        }
-        Ok(extra)
+        )
+    }
+
+    /// Records the display pass of the image into `viewport` of `view`.
+    fn display_on(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        viewport: Viewport,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) -> Result<()> {
+        let target = DisplayTarget {
+            view,
+            format: self.config.format,
+            viewport,
+            load,
+        };
+        self.renderer
+            .display(&self.ctx, encoder, &target, self.timer.as_ref())
     }
 
     /// The kept panel layer (egui drawn into it again only if its output
@@ -341,13 +362,7 @@ impl Viewer {
         let mut layer = self.ui_layer.take().expect("made above");
         let mut extra = Vec::new();
         if let Some(view) = layer.view_to_redraw(key) {
-            extra = self.egui_renderer.update_buffers(
-                &self.ctx.device,
-                &self.ctx.queue,
-                encoder,
-                paint_jobs,
-                screen,
-            );
+            extra = self.update_egui_buffers(encoder, paint_jobs, screen);
             self.draw_egui(
                 encoder,
                 view,
@@ -358,14 +373,7 @@ impl Viewer {
         }
         for &(texture, view) in targets {
             layer.copy_to(encoder, texture);
-            let target = DisplayTarget {
-                view,
-                format: self.config.format,
-                viewport,
-                load: wgpu::LoadOp::Load,
-            };
-            self.renderer
-                .display(&self.ctx, encoder, &target, self.timer.as_ref())?;
+            self.display_on(encoder, view, viewport, wgpu::LoadOp::Load)?;
         }
         self.ui_layer = Some(layer);
         Ok(extra)
