@@ -201,7 +201,7 @@ pub fn renderer_with(
 const KERNEL_TIMING_SIZE: (u32, u32) = (320, 180);
 
 /// Frames each kernel is timed for, after two of warm-up.
-const KERNEL_TIMING_FRAMES: usize = 9;
+const KERNEL_TIMING_FRAMES: u32 = 9;
 
 /// The median ms of one whole round of each kernel on one scene, timed
 /// interleaved (a frame of one, then of the other), so that a machine
@@ -240,29 +240,58 @@ pub fn time_kernels(
         size.0.clamp(1, KERNEL_TIMING_SIZE.0),
         size.1.clamp(1, KERNEL_TIMING_SIZE.1),
     );
-    let mut renderers = [
-        renderer_with(ctx, loaded, size, Kernel::Fragment)?,
-        renderer_with(ctx, loaded, size, Kernel::Compute)?,
-    ];
-    let mut times = [Vec::new(), Vec::new()];
-    for frame in 0..KERNEL_TIMING_FRAMES + 2 {
-        for (renderer, times) in renderers.iter_mut().zip(&mut times) {
-            let start = std::time::Instant::now();
-            trace_frame(ctx, renderer)?;
-            if frame >= 2 {
-                times.push(start.elapsed().as_secs_f64() * 1000.0);
-            }
-        }
-    }
-    let median = |t: &mut Vec<f64>| {
-        t.sort_by(f64::total_cmp);
-        t[t.len() / 2]
-    };
+    let mut fragment = renderer_with(ctx, loaded, size, Kernel::Fragment)?;
+    let mut compute = renderer_with(ctx, loaded, size, Kernel::Compute)?;
+    let ms = time_interleaved(
+        ctx,
+        &mut [&mut fragment, &mut compute],
+        2,
+        KERNEL_TIMING_FRAMES,
+    )?;
     Ok(KernelTimings {
-        fragment_ms: median(&mut times[0]),
-        compute_ms: median(&mut times[1]),
+        fragment_ms: ms[0],
+        compute_ms: ms[1],
         size,
     })
+}
+
+/// The median wall-clock time per frame of each renderer, each frame waited
+/// for (trace plus GPU sync), after `warm_up` untimed frames each, the
+/// renderers' frames interleaved: a round is one frame of each, in turn,
+/// the order reversed every other round. A machine busy with something
+/// else then slows them all alike, so their ratios hold even when the times
+/// drift. The median, not the mean: on a shared CPU (lavapipe) a few frames
+/// stall for reasons unrelated to the shader.
+pub fn time_interleaved(
+    ctx: &GpuContext,
+    renderers: &mut [&mut Renderer],
+    warm_up: u32,
+    frames: u32,
+) -> Result<Vec<f64>> {
+    for _ in 0..warm_up {
+        for renderer in renderers.iter_mut() {
+            trace_frame(ctx, renderer)?;
+        }
+    }
+    let mut times = vec![Vec::with_capacity(frames as usize); renderers.len()];
+    for round in 0..frames.max(1) {
+        let mut order: Vec<usize> = (0..renderers.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for i in order {
+            let start = std::time::Instant::now();
+            trace_frame(ctx, renderers[i])?;
+            times[i].push(start.elapsed().as_secs_f64() * 1000.0);
+        }
+    }
+    Ok(times
+        .into_iter()
+        .map(|mut t| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        })
+        .collect())
 }
 
 /// The kernel `choice` means for `loaded` on `ctx`: the one named (an

@@ -39,41 +39,13 @@ pub struct PresetsBenchArgs {
 /// still run slow.
 const WARM_UP_FRAMES: u32 = 3;
 
-/// The median wall-clock time per frame of each renderer, each frame waited
-/// for (trace plus GPU sync), the renderers' frames interleaved: a round
-/// is one frame of each, in turn, the order reversed every other round.
-/// A machine busy with something else then slows them all alike, so their
-/// ratios hold even when the times drift. The median, not the mean: on a
-/// shared CPU (lavapipe) a few frames stall for reasons unrelated to the
-/// shader.
+/// [`time_interleaved`] after [`WARM_UP_FRAMES`].
 fn time_interleaved(
     ctx: &GpuContext,
     renderers: &mut [&mut Renderer],
     frames: u32,
 ) -> Result<Vec<f64>> {
-    for _ in 0..WARM_UP_FRAMES {
-        for renderer in renderers.iter_mut() {
-            trace_frame(ctx, renderer)?;
-        }
-    }
-    let mut times = vec![Vec::with_capacity(frames as usize); renderers.len()];
-    for round in 0..frames.max(1) {
-        let mut order: Vec<usize> = (0..renderers.len()).collect();
-        if round % 2 == 1 {
-            order.reverse();
-        }
-        for i in order {
-            let start = Instant::now();
-            trace_frame(ctx, renderers[i])?;
-            times[i].push(start.elapsed().as_secs_f64() * 1000.0);
-        }
-    }
-    Ok(times.into_iter().map(median).collect())
-}
-
-fn median(mut times: Vec<f64>) -> f64 {
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
+    crate::session::time_interleaved(ctx, renderers, WARM_UP_FRAMES, frames)
 }
 
 /// [`time_interleaved`] of one renderer.
