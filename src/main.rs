@@ -50,7 +50,7 @@ struct ViewerArgs {
     /// Trace time per frame in ms: the panel stays live while a slow
     /// adapter refines the image a band at a time; 0 traces a whole round
     /// of samples every frame.
-    #[arg(long, default_value_t = marbre::app::DEFAULT_FRAME_BUDGET_MS)]
+    #[arg(long, default_value_t = marbre::app::DEFAULT_FRAME_BUDGET_MS, value_parser = marbre::app::parse_budget_ms)]
     frame_budget_ms: f32,
 }
 

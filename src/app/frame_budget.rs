@@ -27,6 +27,15 @@ const SMOOTHING: f64 = 0.3;
 /// the door to a frame many times too long.
 const MAX_GROWTH: f64 = 4.0;
 
+/// `--frame-budget-ms`: milliseconds, zero or more.
+pub fn parse_budget_ms(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|ms| ms.is_finite() && *ms >= 0.0)
+        .ok_or_else(|| format!("`{s}` is not a number of milliseconds, 0 or more"))
+}
+
 #[derive(Debug, Clone)]
 pub struct FrameBudget {
     /// Target trace time per frame; 0: whole rounds, as before budgets.
@@ -136,6 +145,16 @@ mod tests {
         let first = pixels(&budget);
         budget.observe(0.01, first);
         assert_eq!(pixels(&budget), (first as f64 * MAX_GROWTH) as u64);
+    }
+
+    #[test]
+    fn a_budget_is_a_finite_number_of_milliseconds() {
+        assert_eq!(parse_budget_ms("12"), Ok(12.0));
+        assert_eq!(parse_budget_ms("0"), Ok(0.0));
+        for bad in ["-5", "abc", "inf", "NaN", ""] {
+            let why = parse_budget_ms(bad).unwrap_err();
+            assert!(why.contains("milliseconds"), "{bad}: {why}");
+        }
     }
 
     /// Unusable measurements (nothing traced, a zero or non-finite time)

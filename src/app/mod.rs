@@ -25,7 +25,7 @@ pub mod soak;
 mod ui_layer;
 mod viewer;
 
-pub use frame_budget::DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS;
+pub use frame_budget::{DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS, parse_budget_ms};
 
 use anyhow::Result;
 use settings::Settings;
