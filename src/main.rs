@@ -4,10 +4,8 @@
 
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
-use marbre::commands::{
-    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render,
-};
-use marbre::gpu::KernelChoice;
+use marbre_commands::{accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render};
+use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

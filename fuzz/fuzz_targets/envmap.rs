@@ -7,8 +7,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use marbre::env_sampling::EnvDistribution;
-use marbre::envmap::{IntegerDecode, SUPPORTED_EXTENSIONS, decode_bytes};
+use marbre_core::env_sampling::EnvDistribution;
+use marbre_core::envmap::{IntegerDecode, SUPPORTED_EXTENSIONS, decode_bytes};
 use std::path::PathBuf;
 
 fuzz_target!(|data: &[u8]| {

@@ -13,7 +13,7 @@ fuzz_target!(|data: &[u8]| {
         None => (data, None),
     };
     let _ =
-        marbre::obj_loader::parse_bytes(obj, Path::new("/fuzz/obj/input.obj"), |library| {
+        marbre_core::obj_loader::parse_bytes(obj, Path::new("/fuzz/obj/input.obj"), |library| {
             match (library == Path::new("/fuzz/obj/input.mtl"), mtl) {
                 (true, Some(bytes)) => Ok(bytes.to_vec()),
                 _ => Err(std::io::ErrorKind::NotFound.into()),

@@ -6,5 +6,5 @@ use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = marbre::preset::parse_bytes(data, Path::new("/fuzz/presets/input.ron"));
+    let _ = marbre_core::preset::parse_bytes(data, Path::new("/fuzz/presets/input.ron"));
 });

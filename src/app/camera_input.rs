@@ -1,6 +1,6 @@
 //! Mouse control of the orbit camera over the image area.
 
-use crate::scene::OrbitCamera;
+use marbre_core::scene::OrbitCamera;
 
 /// Degrees of rotation per point of drag.
 const ORBIT_DEGREES_PER_POINT: f32 = 0.3;

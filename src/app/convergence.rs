@@ -2,7 +2,7 @@
 //! the error meter's estimates since the last change, and whether the
 //! user's target error is reached.
 
-use crate::gpu::error_meter::ErrorEstimate;
+use marbre_render::gpu::error_meter::ErrorEstimate;
 
 /// At most this many points are kept; beyond, every other one is dropped,
 /// so a long accumulation keeps its whole history at a coarser step.

@@ -5,8 +5,8 @@
 //! orbiting is looking, not editing, so it never asks "save changes?". A
 //! camera saved on purpose goes in with the next Save.
 
-use crate::preset::{self, Preset, PresetError};
-use crate::scene::Scene;
+use marbre_core::preset::{self, Preset, PresetError};
+use marbre_core::scene::Scene;
 use std::path::{Path, PathBuf};
 
 pub struct Document {
@@ -45,7 +45,7 @@ impl Document {
     pub fn save(&mut self, scene: &Scene, path: &Path) -> Result<(), PresetError> {
         let preset = self.preset(scene);
         let text = preset::to_text(&preset, path)?;
-        crate::atomic_write::write_atomic(path, text.as_bytes()).map_err(|cause| {
+        marbre_core::atomic_write::write_atomic(path, text.as_bytes()).map_err(|cause| {
             PresetError::Write {
                 path: path.to_owned(),
                 cause,
@@ -76,7 +76,6 @@ impl Document {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_dir::TempDir;
 
     #[test]
     fn an_edit_makes_it_dirty_and_a_camera_move_does_not() {
@@ -93,8 +92,11 @@ mod tests {
 
     #[test]
     fn saving_cleans_it_and_its_own_save_is_not_an_outside_change() {
-        let dir = TempDir::new("document-save");
-        let path = dir.path("scene.ron");
+        let dir = tempfile::Builder::new()
+            .prefix("document-save")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("scene.ron");
         let scene = Scene::default();
         let mut document = Document::new(&path, "a test".into(), &scene);
         let mut edited = scene.clone();

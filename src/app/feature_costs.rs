@@ -3,7 +3,7 @@
 //! next to the time with everything in. The image is then wrong (a texture
 //! gone, a light unlit): the point is the difference in time.
 
-use crate::gpu::{Feature, FeatureSet};
+use marbre_render::gpu::{Feature, FeatureSet};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Frames measured for each set of features, after the first few (which

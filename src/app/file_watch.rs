@@ -86,15 +86,17 @@ pub fn is_same_file(changed: &Path, file: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_dir::TempDir;
     use std::time::Instant;
 
     /// A file written after the watch starts is reported, once, after the
     /// debounce; a file in another folder is not.
     #[test]
     fn reports_a_changed_file_in_the_watched_folder() {
-        let dir = TempDir::new("file-watch");
-        let file = dir.path("scene.ron");
+        let dir = tempfile::Builder::new()
+            .prefix("file-watch")
+            .tempdir()
+            .unwrap();
+        let file = dir.path().join("scene.ron");
         std::fs::write(&file, "()").unwrap();
         let mut watch = FileWatch::new().unwrap();
         watch.watch_folder_of(&file).unwrap();

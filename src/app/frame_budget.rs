@@ -8,7 +8,7 @@
 //! timestamps, else the frame's wall time) and the pixels it traced, and
 //! smoothed; the budget in pixels follows from it.
 
-use crate::gpu::TraceBudget;
+use marbre_render::gpu::TraceBudget;
 
 /// The default budget of trace time per frame: about 12 ms leaves room for
 /// the display and the panel within a 60 Hz frame on a GPU, and keeps a

@@ -10,7 +10,7 @@
 //! Blender keeps view navigation out of its undo), so undo keeps the view
 //! the user has now.
 
-use crate::scene::Scene;
+use marbre_core::scene::Scene;
 
 /// Steps kept; the oldest are forgotten first.
 const MAX_STEPS: usize = 200;

@@ -6,10 +6,10 @@
 //! the next start uses it at once.
 
 use super::settings::Settings;
-use crate::gpu::kernel::{self, compute_support};
-use crate::gpu::{GpuContext, Kernel, KernelChoice};
-use crate::session::{KernelTimings, LoadedScene, time_kernels};
 use anyhow::Result;
+use marbre_render::gpu::kernel::{self, compute_support};
+use marbre_render::gpu::{GpuContext, Kernel, KernelChoice};
+use marbre_render::session::{KernelTimings, LoadedScene, time_kernels};
 use std::sync::mpsc;
 
 /// The kernel stored for `adapter`: `Ok(None)` if none is, `Err` with a
@@ -213,11 +213,14 @@ mod tests {
     /// A stored choice is read back after a restart (the settings file).
     #[test]
     fn a_stored_choice_survives_a_restart() {
-        let dir = crate::test_dir::TempDir::new("kernel-choice-restart");
+        let dir = tempfile::Builder::new()
+            .prefix("kernel-choice-restart")
+            .tempdir()
+            .unwrap();
         let mut settings = Settings::default();
         remember(&mut settings, "llvmpipe (Vulkan)", &timings(5.0, 7.0));
-        settings.save(dir.root()).unwrap();
-        let (loaded, note) = Settings::load(dir.root());
+        settings.save(dir.path()).unwrap();
+        let (loaded, note) = Settings::load(dir.path());
         assert_eq!(note, None);
         assert_eq!(
             stored(&loaded, "llvmpipe (Vulkan)"),
@@ -229,13 +232,16 @@ mod tests {
     /// naming it; the rest of the settings stay.
     #[test]
     fn an_invalid_stored_kernel_is_ignored_with_a_note() {
-        let dir = crate::test_dir::TempDir::new("kernel-choice-invalid");
+        let dir = tempfile::Builder::new()
+            .prefix("kernel-choice-invalid")
+            .tempdir()
+            .unwrap();
         std::fs::write(
-            dir.root().join("settings.ron"),
+            dir.path().join("settings.ron"),
             r#"(recent_files: ["/p/a.ron"], kernels: {"gpu A": "warp-drive"})"#,
         )
         .unwrap();
-        let (settings, note) = Settings::load(dir.root());
+        let (settings, note) = Settings::load(dir.path());
         assert_eq!(note, None);
         assert_eq!(settings.recent_files.len(), 1);
         let why = stored(&settings, "gpu A").unwrap_err();

@@ -52,7 +52,7 @@ pub struct ViewerOptions {
     pub soak: Option<soak::SoakOptions>,
     /// The trace kernel: fragment, compute, or auto (the faster, timed on
     /// the first scene and remembered per adapter).
-    pub kernel: crate::gpu::KernelChoice,
+    pub kernel: marbre_render::gpu::KernelChoice,
     /// The trace time a frame may take, in ms (`app::frame_budget`); 0
     /// traces a whole round every frame.
     pub frame_budget_ms: f32,

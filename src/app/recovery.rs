@@ -11,9 +11,9 @@
 //! by its pid, so two marbres open at once never overwrite each other's
 //! edits, and a file whose writer is still running is not offered.
 
-use crate::atomic_write::write_atomic;
-use crate::preset::{self, Preset};
-use crate::scene::Scene;
+use marbre_core::atomic_write::write_atomic;
+use marbre_core::preset::{self, Preset};
+use marbre_core::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -178,7 +178,6 @@ impl Autosave {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_dir::TempDir;
 
     /// A recovery file as process `pid` would leave it.
     fn left_by(dir: &Path, pid: u32, saved_at: &str, exposure: f32) {
@@ -198,32 +197,38 @@ mod tests {
 
     #[test]
     fn a_dead_writers_file_is_offered_and_a_live_ones_is_not() {
-        let dir = TempDir::new("recovery-offer");
-        left_by(dir.root(), std::process::id(), "2026-11-22 19:00:00", 2.0);
-        assert_eq!(pending_offer(dir.root()), None, "this process is alive");
-        left_by(dir.root(), GONE, "2026-11-22 18:00:00", 3.0);
-        let offer = pending_offer(dir.root()).expect("an offer");
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-offer")
+            .tempdir()
+            .unwrap();
+        left_by(dir.path(), std::process::id(), "2026-11-22 19:00:00", 2.0);
+        assert_eq!(pending_offer(dir.path()), None, "this process is alive");
+        left_by(dir.path(), GONE, "2026-11-22 18:00:00", 3.0);
+        let offer = pending_offer(dir.path()).expect("an offer");
         assert_eq!(offer.source, Path::new(&format!("/presets/{GONE}.ron")));
         let recovered = preset::load(&offer.preset).unwrap().preset;
         assert_eq!(recovered.scene.render.exposure, 3.0);
         discard(&offer);
-        assert_eq!(pending_offer(dir.root()), None);
+        assert_eq!(pending_offer(dir.path()), None);
         assert!(
-            preset_file(dir.root(), std::process::id()).exists(),
+            preset_file(dir.path(), std::process::id()).exists(),
             "the live writer's file is left alone"
         );
     }
 
     #[test]
     fn the_newest_of_several_is_offered_first_and_the_rest_later() {
-        let dir = TempDir::new("recovery-several");
-        left_by(dir.root(), GONE, "2026-11-22 18:00:00", 3.0);
-        left_by(dir.root(), GONE + 1, "2026-11-22 18:30:00", 4.0);
-        let newest = pending_offer(dir.root()).unwrap();
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-several")
+            .tempdir()
+            .unwrap();
+        left_by(dir.path(), GONE, "2026-11-22 18:00:00", 3.0);
+        left_by(dir.path(), GONE + 1, "2026-11-22 18:30:00", 4.0);
+        let newest = pending_offer(dir.path()).unwrap();
         assert_eq!(newest.saved_at, "2026-11-22 18:30:00");
         discard(&newest);
         assert_eq!(
-            pending_offer(dir.root()).unwrap().saved_at,
+            pending_offer(dir.path()).unwrap().saved_at,
             "2026-11-22 18:00:00"
         );
     }
@@ -232,13 +237,16 @@ mod tests {
     #[cfg(target_os = "linux")]
     #[test]
     fn a_pid_now_held_by_another_program_counts_as_ended() {
-        let dir = TempDir::new("recovery-reused-pid");
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-reused-pid")
+            .tempdir()
+            .unwrap();
         let mut other = std::process::Command::new("sleep")
             .arg("30")
             .spawn()
             .expect("spawn sleep");
-        left_by(dir.root(), other.id(), "2026-11-22 18:00:00", 3.0);
-        let offer = pending_offer(dir.root());
+        left_by(dir.path(), other.id(), "2026-11-22 18:00:00", 3.0);
+        let offer = pending_offer(dir.path());
         other.kill().unwrap();
         other.wait().unwrap();
         assert!(offer.is_some(), "sleep is not marbre: the file is offered");
@@ -246,9 +254,12 @@ mod tests {
 
     #[test]
     fn autosave_writes_unsaved_edits_after_the_interval_and_removes_them_when_clean() {
-        let dir = TempDir::new("recovery-autosave");
-        let mut autosave = Autosave::new(dir.root().to_owned());
-        let mine = preset_file(dir.root(), std::process::id());
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-autosave")
+            .tempdir()
+            .unwrap();
+        let mut autosave = Autosave::new(dir.path().to_owned());
+        let mine = preset_file(dir.path(), std::process::id());
         let mut edited = Preset::default();
         edited.scene.render.exposure = 3.0;
         autosave
@@ -269,9 +280,12 @@ mod tests {
 
     #[test]
     fn two_processes_autosave_to_their_own_files() {
-        let dir = TempDir::new("recovery-two");
-        let mut first = Autosave::new(dir.root().to_owned());
-        let mut second = Autosave::new(dir.root().to_owned());
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-two")
+            .tempdir()
+            .unwrap();
+        let mut first = Autosave::new(dir.path().to_owned());
+        let mut second = Autosave::new(dir.path().to_owned());
         second.pid = GONE;
         for (autosave, exposure) in [(&mut first, 1.5), (&mut second, 2.5)] {
             let mut edited = Preset::default();
@@ -280,7 +294,7 @@ mod tests {
             autosave.tick(true, Path::new("a.ron"), || edited).unwrap();
         }
         let exposure = |pid| {
-            preset::load(&preset_file(dir.root(), pid))
+            preset::load(&preset_file(dir.path(), pid))
                 .unwrap()
                 .preset
                 .scene
@@ -290,9 +304,9 @@ mod tests {
         assert_eq!(exposure(std::process::id()), 1.5);
         assert_eq!(exposure(GONE), 2.5);
         first.finish();
-        assert!(!preset_file(dir.root(), std::process::id()).exists());
+        assert!(!preset_file(dir.path(), std::process::id()).exists());
         assert!(
-            preset_file(dir.root(), GONE).exists(),
+            preset_file(dir.path(), GONE).exists(),
             "the other's edits stay"
         );
     }

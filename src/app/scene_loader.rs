@@ -7,8 +7,8 @@
 //! images, and the BVH ([`PreparedGeometry`]). The viewer then installs the
 //! result on the render thread in one go, or shows why it failed.
 
-use crate::gpu::mesh_buffers::PreparedGeometry;
-use crate::session::{LoadStage, LoadedScene, load_scene_reporting};
+use marbre_render::gpu::mesh_buffers::PreparedGeometry;
+use marbre_render::session::{LoadStage, LoadedScene, load_scene_reporting};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, mpsc};
@@ -91,7 +91,7 @@ impl SceneLoad {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::EnvSource;
+    use marbre_core::scene::EnvSource;
 
     fn wait(load: SceneLoad) -> anyhow::Result<ReadyScene> {
         load.receiver.recv().expect("the worker sends a result")

@@ -1,9 +1,9 @@
 //! F12 screenshots: the rendered image as PNG (tone-mapped) and EXR (linear
 //! radiance), with timestamped names, without the UI.
 
-use crate::gpu::{GpuContext, Renderer};
-use crate::image_io;
 use anyhow::Result;
+use marbre_core::image_io;
+use marbre_render::gpu::{GpuContext, Renderer};
 use std::path::{Path, PathBuf};
 
 pub const FOLDER: &str = "screenshots";

@@ -5,7 +5,7 @@
 //! with the defaults and says why in the panel, and the next save replaces
 //! the file (atomically, so a crash mid-save keeps the old one).
 
-use crate::atomic_write::write_atomic;
+use marbre_core::atomic_write::write_atomic;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -93,32 +93,40 @@ impl Settings {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_dir::TempDir;
 
     #[test]
     fn round_trips_through_the_file() {
-        let dir = TempDir::new("settings-round-trip");
+        let dir = tempfile::Builder::new()
+            .prefix("settings-round-trip")
+            .tempdir()
+            .unwrap();
         let mut settings = Settings {
             window_size: Some((1400, 900)),
             last_preset: Some(PathBuf::from("/presets/a.ron")),
             ..Settings::default()
         };
         settings.remember(Path::new("/presets/a.ron"));
-        settings.save(dir.root()).unwrap();
-        assert_eq!(Settings::load(dir.root()), (settings, None));
+        settings.save(dir.path()).unwrap();
+        assert_eq!(Settings::load(dir.path()), (settings, None));
     }
 
     #[test]
     fn a_missing_file_gives_defaults_silently() {
-        let dir = TempDir::new("settings-missing");
-        assert_eq!(Settings::load(dir.root()), (Settings::default(), None));
+        let dir = tempfile::Builder::new()
+            .prefix("settings-missing")
+            .tempdir()
+            .unwrap();
+        assert_eq!(Settings::load(dir.path()), (Settings::default(), None));
     }
 
     #[test]
     fn a_broken_file_gives_defaults_and_says_why() {
-        let dir = TempDir::new("settings-broken");
-        std::fs::write(dir.root().join("settings.ron"), "(window_size: Some((1, ").unwrap();
-        let (settings, note) = Settings::load(dir.root());
+        let dir = tempfile::Builder::new()
+            .prefix("settings-broken")
+            .tempdir()
+            .unwrap();
+        std::fs::write(dir.path().join("settings.ron"), "(window_size: Some((1, ").unwrap();
+        let (settings, note) = Settings::load(dir.path());
         assert_eq!(settings, Settings::default());
         let note = note.expect("a note");
         assert!(note.contains("settings.ron"), "{note}");

@@ -17,9 +17,9 @@ mod verdict;
 
 pub use memory::{MemorySample, sample_memory};
 
-use crate::scene::{EnvSource, Scene};
 use anyhow::{Context, Result};
 use edits::Structural;
+use marbre_core::scene::{EnvSource, Scene};
 use rng::Pcg32;
 use std::path::PathBuf;
 use verdict::{Metric, Rule, Unit};
@@ -235,7 +235,7 @@ impl SoakDriver {
             failures.push(format!("{validation_errors} wgpu validation error(s)"));
         }
         if let Some(path) = &self.options.report
-            && let Err(e) = crate::atomic_write::write_atomic(path, self.csv().as_bytes())
+            && let Err(e) = marbre_core::atomic_write::write_atomic(path, self.csv().as_bytes())
         {
             failures.push(format!("{}: cannot write the report: {e}", path.display()));
         }

@@ -2,13 +2,15 @@
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
 use super::{color_button, labelled_color, slider, vec3_ui};
-use crate::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
-use crate::scene::{
-    Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
-};
-use crate::texture::{ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
+use marbre_core::scene::{
+    Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
+};
+use marbre_core::texture::{
+    ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop,
+};
 use std::ops::RangeInclusive;
 use std::path::PathBuf;
 

@@ -13,16 +13,16 @@ mod material_editor;
 mod quality;
 mod transport;
 
-use crate::gpu::NonFiniteCounts;
-use crate::scene::{
-    EnvSource, Environment, OrbitCamera, PointLight, RenderSettings, Scene, ToneMap,
-};
 use egui::emath::Numeric;
 use egui::{
     CollapsingHeader, Color32, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping,
     TextEdit, Ui,
 };
 use glam::Vec3;
+use marbre_core::scene::{
+    EnvSource, Environment, OrbitCamera, PointLight, RenderSettings, Scene, ToneMap,
+};
+use marbre_render::gpu::NonFiniteCounts;
 use material_editor::material_ui;
 pub use quality::{QualityControls, QualityStats};
 use std::ops::RangeInclusive;
@@ -160,8 +160,8 @@ pub struct Stats {
     pub non_finite: NonFiniteCounts,
     pub quality: QualityStats,
     /// The trace kernel drawing now, what the user chose, and why it runs.
-    pub kernel: crate::gpu::Kernel,
-    pub kernel_choice: crate::gpu::KernelChoice,
+    pub kernel: marbre_render::gpu::Kernel,
+    pub kernel_choice: marbre_render::gpu::KernelChoice,
     pub kernel_reason: String,
     /// The fraction of the sample round under way already traced (a slow
     /// adapter traces a round over several frames).
@@ -181,9 +181,9 @@ pub enum PanelAction {
     ResetCamera,
     /// Compile a shader feature out (or back in), to time the scene
     /// without it.
-    ToggleFeature(crate::gpu::Feature),
+    ToggleFeature(marbre_render::gpu::Feature),
     /// Trace with another kernel (or the faster, `auto`).
-    SetKernel(crate::gpu::KernelChoice),
+    SetKernel(marbre_render::gpu::KernelChoice),
     Undo,
     Redo,
     /// Pick a preset to open, a file to save as, or an environment map,
@@ -366,7 +366,7 @@ fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
 
 /// A mesh's placement and each of its MTL materials, editable like any
 /// other (a Cornell box wall can be marble); "reset" goes back to the file.
-fn mesh_ui(ui: &mut Ui, mesh: &mut crate::scene::Mesh) {
+fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) {
     ui.label(format!(
         "{} triangles from {}",
         mesh.geometry.0.len(),
@@ -808,7 +808,7 @@ fn non_finite_ui(ui: &mut Ui, counts: &NonFiniteCounts) {
 /// The Kernel switch: which kernel traces (both draw the same image), or
 /// `auto`, the faster on this adapter.
 fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelAction>) {
-    use crate::gpu::KernelChoice;
+    use marbre_render::gpu::KernelChoice;
     let name = |c: KernelChoice| match c {
         KernelChoice::Auto => "auto (the faster)",
         KernelChoice::Fragment => "fragment",
@@ -902,9 +902,9 @@ fn stats_ui(ui: &mut Ui, stats: &Stats) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::noise::NoiseSettings;
-    use crate::scene::{Ground, Sphere};
-    use crate::scene::{Pattern, Texture};
+    use marbre_core::noise::NoiseSettings;
+    use marbre_core::scene::{Ground, Sphere};
+    use marbre_core::scene::{Pattern, Texture};
 
     fn marble_scene() -> Scene {
         let mut sphere = Sphere::default();
@@ -1025,7 +1025,7 @@ mod tests {
         let stats = Stats {
             quality: QualityStats {
                 points: vec![[0.5, 0.1], [2.0, 0.05]],
-                latest: Some(crate::gpu::error_meter::ErrorEstimate {
+                latest: Some(marbre_render::gpu::error_meter::ErrorEstimate {
                     rmse: 0.01,
                     relative: 0.05,
                     frames: 40,
@@ -1034,7 +1034,7 @@ mod tests {
                     generation: 0,
                 }),
                 passes: vec![("trace", Some(3.5)), ("display", None)],
-                scene_features: vec![crate::gpu::Feature::PatternCutout],
+                scene_features: vec![marbre_render::gpu::Feature::PatternCutout],
                 with_all_ms: Some(3.5),
                 without_ms: vec![Some(3.1)],
                 ..QualityStats::default()

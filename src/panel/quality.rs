@@ -4,10 +4,10 @@
 //! feature, which the user can compile out to see the difference.
 
 use super::PanelAction;
-use crate::gpu::Feature;
-use crate::gpu::error_meter::ErrorEstimate;
 use egui::{Checkbox, DragValue, Grid, Ui};
 use egui_plot::{HLine, Line, Plot, PlotPoints};
+use marbre_render::gpu::Feature;
+use marbre_render::gpu::error_meter::ErrorEstimate;
 use std::collections::BTreeSet;
 
 /// What the user asks of convergence: kept by the panel, not the scene, so

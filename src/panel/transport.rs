@@ -3,9 +3,9 @@
 //! a change restarts accumulation without a shader build.
 
 use super::slider;
-use crate::lights::LightSelection;
-use crate::scene::{Integrator, RenderSettings, Strategy, TransportSettings};
 use egui::{ComboBox, Ui};
+use marbre_core::lights::LightSelection;
+use marbre_core::scene::{Integrator, RenderSettings, Strategy, TransportSettings};
 
 pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
     let t = &mut render.transport;

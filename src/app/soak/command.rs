@@ -30,8 +30,8 @@ pub struct SoakArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// The trace kernel, as the viewer's `--kernel`.
-    #[arg(long, value_enum, default_value_t = crate::gpu::KernelChoice::Auto)]
-    pub kernel: crate::gpu::KernelChoice,
+    #[arg(long, value_enum, default_value_t = marbre_render::gpu::KernelChoice::Auto)]
+    pub kernel: marbre_render::gpu::KernelChoice,
     /// Trace time per frame in ms, as the viewer's `--frame-budget-ms`.
     #[arg(long, default_value_t = crate::app::DEFAULT_FRAME_BUDGET_MS, value_parser = crate::app::parse_budget_ms)]
     pub frame_budget_ms: f32,

@@ -11,12 +11,12 @@
 //! leave behind, not about slow frames.
 
 use super::rng::Pcg32;
-use crate::noise::{FractalParams, HashKind, NoiseKind};
-use crate::scene::{
+use glam::{Vec2, Vec3};
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind};
+use marbre_core::scene::{
     Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Pattern, RenderSettings, Scene, Sphere,
     Texture, ToneMap,
 };
-use glam::{Vec2, Vec3};
 
 /// The structural edits: each changes what the shader is built from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -417,8 +417,8 @@ fn add_or_remove_sphere(rng: &mut Pcg32, scene: &mut Scene) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::noise::NoiseSettings;
-    use crate::scene::Property;
+    use marbre_core::noise::NoiseSettings;
+    use marbre_core::scene::Property;
 
     /// Gives the first `n` properties each its own noise (a distinct
     /// frequency: a distinct signal).

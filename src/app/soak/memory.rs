@@ -1,6 +1,6 @@
 //! What the process and the GPU hold, sampled once per soak frame.
 
-use crate::gpu::GpuContext;
+use marbre_render::gpu::GpuContext;
 
 /// One frame's memory figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -91,7 +91,8 @@ mod tests {
     /// it gives both back.
     #[test]
     fn a_buffer_shows_in_the_gpu_figures() {
-        let Some(ctx) = crate::gpu::testing::gpu_or_skip("a_buffer_shows_in_the_gpu_figures")
+        let Some(ctx) =
+            marbre_render::gpu::testing::gpu_or_skip("a_buffer_shows_in_the_gpu_figures")
         else {
             return;
         };

@@ -1,5 +1,4 @@
 use super::*;
-use crate::test_dir::TempDir;
 use std::path::Path;
 
 const MIB: u64 = 1 << 20;
@@ -48,7 +47,7 @@ fn is_sanitized(scene: &Scene) -> bool {
 }
 
 fn load(path: &Path) -> Scene {
-    crate::preset::load(path)
+    marbre_core::preset::load(path)
         .unwrap_or_else(|e| panic!("{e}"))
         .preset
         .scene
@@ -122,8 +121,11 @@ fn unmeasured_figures_are_reported_as_such() {
 
 #[test]
 fn the_report_csv_has_one_row_per_recorded_frame() {
-    let dir = TempDir::new("soak-report");
-    let path = dir.path("soak.csv");
+    let dir = tempfile::Builder::new()
+        .prefix("soak-report")
+        .tempdir()
+        .unwrap();
+    let path = dir.path().join("soak.csv");
     let options = SoakOptions {
         report: Some(path.clone()),
         ..options(300, 100)
@@ -148,9 +150,12 @@ fn the_report_csv_has_one_row_per_recorded_frame() {
 
 #[test]
 fn an_unwritable_report_fails_the_run_naming_the_file() {
-    let dir = TempDir::new("soak-report-unwritable");
+    let dir = tempfile::Builder::new()
+        .prefix("soak-report-unwritable")
+        .tempdir()
+        .unwrap();
     // A folder where the file should be: the rename cannot replace it.
-    let path = dir.path("soak.csv");
+    let path = dir.path().join("soak.csv");
     std::fs::create_dir_all(path.join("inside")).unwrap();
     let options = SoakOptions {
         report: Some(path.clone()),
@@ -174,14 +179,20 @@ fn default_warm_up_is_a_fifth_within_limits() {
 
 #[test]
 fn preset_arguments_expand_folders_and_refuse_missing_files() {
-    let dir = TempDir::new("soak-presets");
+    let dir = tempfile::Builder::new()
+        .prefix("soak-presets")
+        .tempdir()
+        .unwrap();
     for name in ["b.ron", "a.ron", "notes.txt"] {
-        std::fs::write(dir.path(name), "").unwrap();
+        std::fs::write(dir.path().join(name), "").unwrap();
     }
-    let single = dir.path("b.ron");
-    let files = SoakOptions::preset_files(&[dir.root().to_owned(), single.clone()]).unwrap();
-    assert_eq!(files, [dir.path("a.ron"), dir.path("b.ron"), single]);
-    let missing = dir.path("missing.ron");
+    let single = dir.path().join("b.ron");
+    let files = SoakOptions::preset_files(&[dir.path().to_owned(), single.clone()]).unwrap();
+    assert_eq!(
+        files,
+        [dir.path().join("a.ron"), dir.path().join("b.ron"), single]
+    );
+    let missing = dir.path().join("missing.ron");
     let err = SoakOptions::preset_files(std::slice::from_ref(&missing)).unwrap_err();
     assert_eq!(
         err.to_string(),

@@ -4,10 +4,10 @@
 //! made is lost; the accumulated samples start over).
 
 use super::{Viewer, surface_config};
-use crate::gpu::GpuContext;
-use crate::gpu::pass_timer::PassTimer;
-use crate::session::{LoadedScene, load_environment, max_texture_side, renderer_with};
 use anyhow::{Context as _, Result};
+use marbre_render::gpu::GpuContext;
+use marbre_render::gpu::pass_timer::PassTimer;
+use marbre_render::session::{LoadedScene, load_environment, max_texture_side, renderer_with};
 
 impl Viewer {
     /// Replaces the lost device and everything made on it.

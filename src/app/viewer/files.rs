@@ -14,13 +14,13 @@ use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
 use crate::app::scene_loader::{ReadyScene, SceneLoad};
-use crate::envmap;
-use crate::gpu::shader_source;
-use crate::preset;
-use crate::scene::{EnvSource, OrbitCamera, Scene};
-use crate::session::{load_environment, load_images, load_scene, max_texture_side};
-use crate::texture::ImageSet;
 use anyhow::{Context as _, Result};
+use marbre_core::envmap;
+use marbre_core::preset;
+use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
+use marbre_core::texture::ImageSet;
+use marbre_render::gpu::shader_source;
+use marbre_render::session::{load_environment, load_images, load_scene, max_texture_side};
 use std::path::{Path, PathBuf};
 
 impl Viewer {
@@ -477,7 +477,7 @@ impl Viewer {
 
 /// The `shaders/` folder `--dev` reads: the source tree's.
 fn dev_shader_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")
+    PathBuf::from(marbre_render::gpu::shader_source::SHADER_DIR)
 }
 
 /// The view to keep across a reload, unless the file moved the camera.

@@ -5,11 +5,11 @@
 use super::Viewer;
 use crate::app::screenshots;
 use crate::app::ui_layer::{self, UiLayer};
-use crate::gpu::pass_timer::Pass;
-use crate::gpu::readback::read_texture;
-use crate::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
 use crate::panel::{QualityStats, Stats};
 use anyhow::{Context as _, Result};
+use marbre_render::gpu::pass_timer::Pass;
+use marbre_render::gpu::readback::read_texture;
+use marbre_render::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
 use std::path::Path;
 use std::time::Instant;
 
@@ -545,7 +545,7 @@ impl Viewer {
         }
         let image = image::RgbaImage::from_raw(self.config.width, self.config.height, bytes)
             .context("window capture has the wrong size")?;
-        crate::image_io::save_png(&image, path)
+        marbre_core::image_io::save_png(&image, path)
             .with_context(|| format!("saving the window screenshot {}", path.display()))
     }
 }

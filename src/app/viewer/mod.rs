@@ -27,13 +27,15 @@ use super::shortcuts::{self, Shortcut};
 use super::soak::{SoakAction, SoakDriver, sample_memory};
 use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
-use crate::gpu::pass_timer::PassTimer;
-use crate::gpu::{GpuContext, NonFiniteCounts, Renderer};
 use crate::panel::{self, PanelAction, PanelState};
-use crate::preset;
-use crate::scene::{EnvSource, OrbitCamera, Scene};
-use crate::session::{DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with};
 use anyhow::{Context as _, Result};
+use marbre_core::preset;
+use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
+use marbre_render::gpu::pass_timer::PassTimer;
+use marbre_render::gpu::{GpuContext, NonFiniteCounts, Renderer};
+use marbre_render::session::{
+    DEFAULT_PRESET, LoadedScene, load_scene, max_texture_side, renderer_with,
+};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -423,7 +425,7 @@ impl Viewer {
     /// The Render panel's Kernel switch: the new kernel is built off the
     /// render thread while the current one draws; `auto` uses the kernel
     /// stored for this adapter, or times both again on the current scene.
-    fn set_kernel(&mut self, choice: crate::gpu::KernelChoice) {
+    fn set_kernel(&mut self, choice: marbre_render::gpu::KernelChoice) {
         match self.kernels.choose(choice, &self.ctx, &self.settings) {
             Ok((kernel, notes)) => {
                 for note in notes {
@@ -565,7 +567,7 @@ impl Viewer {
 
     /// Compiles `feature` out of the shader (or back in) to time the scene
     /// without it; a set that cannot be built is refused with the reason.
-    fn toggle_feature(&mut self, feature: crate::gpu::Feature) {
+    fn toggle_feature(&mut self, feature: marbre_render::gpu::Feature) {
         self.feature_costs.toggle(feature);
         let request = self
             .renderer

@@ -1,0 +1,26 @@
+//! marbre's model and CPU reference: the scene, presets, noise, textures,
+//! images and OBJ loading, the acceleration structure, lights, BSDF, MIS and
+//! sampling. No GPU: every function here is what the shaders must match.
+
+pub mod aa_scenes;
+pub mod accel;
+pub mod atomic_write;
+pub mod bsdf;
+pub mod cubemap;
+pub mod env_sampling;
+pub mod envmap;
+pub mod geometry;
+pub mod image_io;
+pub mod lights;
+pub mod mis;
+pub mod noise;
+pub mod obj_loader;
+pub mod obj_syntax;
+pub mod preset;
+pub mod scene;
+pub mod texture;
+
+/// The repository's root, where the shipped presets, images and env maps
+/// that unit tests read live.
+#[cfg(test)]
+const REPO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");

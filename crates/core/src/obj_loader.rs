@@ -1,0 +1,633 @@
+//! OBJ/MTL files into triangle meshes and materials, through `tobj`.
+//!
+//! MTL keys map onto the material model as the lab reads them: `Kd`
+//! diffuse, `Ks` specular, `Ns` roughness (see [`roughness_from_ns`]),
+//! `Ke` emission, `d` or `Tr` opacity, `Tf` transmission (`Kd` when a
+//! see-through material has none, so it tints by its colour), `map_Kd` and
+//! `map_Ks` image textures, `map_bump`/`bump` a bump height image. Texture
+//! paths are relative to the .mtl file; a missing one keeps the magenta
+//! placeholder of image textures and a note naming it.
+
+use crate::obj_syntax;
+use crate::scene::mesh::{Geometry, MeshMaterial, TriangleMesh};
+use crate::scene::{Material, Pattern, Scene, Texture};
+use crate::texture::{ColorSpace, ImageSource};
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    #[error("{path}: cannot read the OBJ file: {cause}")]
+    Read {
+        path: PathBuf,
+        cause: std::io::Error,
+    },
+    #[error("{path}:{line}: not a valid OBJ statement: `{statement}`")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        statement: String,
+    },
+    #[error("{path}: not a valid OBJ file: {cause}")]
+    Parse {
+        path: PathBuf,
+        cause: tobj::LoadError,
+    },
+    #[error("{path}: the OBJ reader failed on this file (a malformed statement it does not check)")]
+    Crashed { path: PathBuf },
+    #[error("{path}: no triangle left to draw ({reason})")]
+    Empty { path: PathBuf, reason: String },
+}
+
+/// An OBJ file's triangles (in the file's coordinates) and materials.
+#[derive(Debug, Clone, Default)]
+pub struct LoadedObj {
+    pub triangles: TriangleMesh,
+    pub materials: Vec<MeshMaterial>,
+    /// What was skipped or replaced, each naming the file.
+    pub notes: Vec<String>,
+}
+
+/// The material of faces the OBJ gives none, or whose MTL is unreadable.
+const DEFAULT_MATERIAL: &str = "(default)";
+
+pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
+    let bytes = std::fs::read(path).map_err(|cause| ObjError::Read {
+        path: path.to_owned(),
+        cause,
+    })?;
+    parse_bytes(&bytes, path, |library| std::fs::read(library))
+}
+
+/// Reads the bytes of an OBJ file. `path` names it in messages, and its
+/// folder resolves the material libraries (whose bytes `read_library`
+/// returns: the file system for [`load`], memory for the fuzz target and
+/// its regression tests) and their textures.
+pub fn parse_bytes(
+    bytes: &[u8],
+    path: &Path,
+    read_library: impl Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<LoadedObj, ObjError> {
+    let text = String::from_utf8_lossy(bytes);
+    // tobj says what is wrong but not where, and panics on some malformed
+    // statements: the syntax check runs first and names the line.
+    if let Some((line, statement)) = obj_syntax::first_bad_obj_line(&text) {
+        return Err(ObjError::Syntax {
+            path: path.to_owned(),
+            line,
+            statement,
+        });
+    }
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let mtl_folder = path.parent().unwrap_or(Path::new("."));
+    // Why the library failed, where tobj's error alone would not say.
+    let library_problem = std::cell::RefCell::new(None);
+    let load_library = |name: &Path| {
+        let mtl = mtl_folder.join(name);
+        let text = match read_library(&mtl) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) => {
+                *library_problem.borrow_mut() = Some(format!(
+                    "its material library {} cannot be read: {e}",
+                    mtl.display()
+                ));
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
+        if let Some((line, statement)) = obj_syntax::first_bad_mtl_line(&text) {
+            *library_problem.borrow_mut() = Some(format!(
+                "its material library {}:{line} cannot be read: `{statement}`",
+                mtl.display()
+            ));
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl_buf(&mut text.as_bytes())
+    };
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &options, load_library)
+    }))
+    .map_err(|_| ObjError::Crashed {
+        path: path.to_owned(),
+    })?;
+    let (models, materials) = parsed.map_err(|cause| ObjError::Parse {
+        path: path.to_owned(),
+        cause,
+    })?;
+    let mut notes = Vec::new();
+    let mtl = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            let why = library_problem
+                .into_inner()
+                .unwrap_or_else(|| format!("its material library cannot be read ({e})"));
+            notes.push(format!("{}: {why}; grey is used instead", path.display()));
+            Vec::new()
+        }
+    };
+    let mut out = LoadedObj::default();
+    for m in &mtl {
+        let (material, material_notes) = convert_material(m, mtl_folder);
+        notes.extend(
+            material_notes
+                .into_iter()
+                .map(|n| format!("{}: material `{}`: {n}", path.display(), m.name)),
+        );
+        out.materials.push(MeshMaterial {
+            name: m.name.clone(),
+            from_file: Some(material.clone()),
+            material,
+        });
+    }
+    let mut default_index = None;
+    let mut non_finite = 0usize;
+    let mut degenerate = 0usize;
+    for model in &models {
+        let mesh = &model.mesh;
+        let material = match mesh.material_id.filter(|&i| i < out.materials.len()) {
+            Some(i) => i as u32,
+            None => *default_index.get_or_insert_with(|| {
+                out.materials.push(MeshMaterial {
+                    name: DEFAULT_MATERIAL.into(),
+                    from_file: Some(Material::default()),
+                    material: Material::default(),
+                });
+                (out.materials.len() - 1) as u32
+            }),
+        };
+        let position = |i: u32| {
+            let i = i as usize * 3;
+            Vec3::new(
+                mesh.positions[i],
+                mesh.positions[i + 1],
+                mesh.positions[i + 2],
+            )
+        };
+        let uv = |i: u32| {
+            let i = i as usize * 2;
+            if mesh.texcoords.len() >= i + 2 {
+                Vec2::new(mesh.texcoords[i], mesh.texcoords[i + 1])
+            } else {
+                Vec2::ZERO
+            }
+        };
+        for face in mesh.indices.chunks_exact(3) {
+            let v = [position(face[0]), position(face[1]), position(face[2])];
+            if !v.iter().all(|p| p.is_finite()) {
+                non_finite += 1;
+                continue;
+            }
+            if (v[1] - v[0]).cross(v[2] - v[0]).length_squared() == 0.0 {
+                degenerate += 1;
+            }
+            out.triangles.positions.push(v);
+            out.triangles
+                .uvs
+                .push([uv(face[0]), uv(face[1]), uv(face[2])]);
+            out.triangles.materials.push(material);
+        }
+    }
+    if non_finite > 0 {
+        notes.push(format!(
+            "{}: {non_finite} triangles with a NaN or infinite vertex were dropped",
+            path.display()
+        ));
+    }
+    if degenerate > 0 {
+        notes.push(format!(
+            "{}: {degenerate} triangles have zero area (kept: rays never hit them, and they give no light)",
+            path.display()
+        ));
+    }
+    if out.triangles.is_empty() {
+        return Err(ObjError::Empty {
+            path: path.to_owned(),
+            reason: if non_finite > 0 {
+                "every triangle has a non-finite vertex".into()
+            } else {
+                "the file has no faces".into()
+            },
+        });
+    }
+    out.notes = notes;
+    Ok(out)
+}
+
+/// GGX roughness from a Phong exponent: the Beckmann match α = √(2/(Ns+2))
+/// (Walter et al. 2007), read as GGX α, with roughness = √α.
+pub fn roughness_from_ns(ns: f32) -> f32 {
+    let alpha = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
+    alpha.sqrt().clamp(0.0, 1.0)
+}
+
+fn rgb(c: Option<[f32; 3]>) -> Option<Vec3> {
+    c.map(Vec3::from_array).filter(|v| v.is_finite())
+}
+
+/// An image texture of `file` (relative to the MTL's folder), scaled by
+/// the grey level of `tint` (a colour tint has no node; its mean stands in).
+fn image_texture(
+    file: &str,
+    folder: &Path,
+    color_space: ColorSpace,
+    tint: Vec3,
+    notes: &mut Vec<String>,
+) -> Texture {
+    let (file, _) = strip_options(file);
+    let path = folder.join(file);
+    if !path.exists() {
+        notes.push(format!(
+            "texture {} not found: shown as the magenta placeholder",
+            path.display()
+        ));
+    }
+    let mut t = Texture::blend(
+        Pattern::Image {
+            filter: Default::default(),
+            wrap: Default::default(),
+        },
+        0.0,
+        1.0,
+    );
+    t.image = Some(ImageSource { path, color_space });
+    let scale = tint.element_sum() / 3.0;
+    if tint.max_element() - tint.min_element() > 1e-3 {
+        notes.push(format!(
+            "colour {tint} times its texture: only its mean {scale:.3} is applied"
+        ));
+    }
+    if scale != 1.0 {
+        t.ops.push(crate::scene::MathOp::Scale(scale));
+    }
+    t
+}
+
+/// MTL texture statements may carry options before the file name
+/// (`-bm 0.5 bumps.png`): the file name, and `-bm`'s value if any.
+fn strip_options(statement: &str) -> (&str, Option<f32>) {
+    let words: Vec<&str> = statement.split_whitespace().collect();
+    let mut bump_multiplier = None;
+    let mut i = 0;
+    while i < words.len() && words[i].starts_with('-') && i + 1 < words.len() {
+        if words[i] == "-bm" {
+            bump_multiplier = words[i + 1].parse().ok();
+        }
+        // Every MTL option takes one value except -o/-s/-t (three) and
+        // -mm (two); only the common ones matter here.
+        i += match words[i] {
+            "-o" | "-s" | "-t" => 4,
+            "-mm" => 3,
+            _ => 2,
+        };
+    }
+    let file = words.get(i..).map_or("", |rest| {
+        let start = rest.first().map_or(statement.len(), |first| {
+            statement.find(first).unwrap_or(statement.len())
+        });
+        statement[start..].trim()
+    });
+    (file, bump_multiplier)
+}
+
+/// One MTL material as a marbre material, and notes on what was replaced.
+pub fn convert_material(m: &tobj::Material, folder: &Path) -> (Material, Vec<String>) {
+    let mut notes = Vec::new();
+    let kd = rgb(m.diffuse).unwrap_or(Vec3::splat(0.8));
+    let ks = rgb(m.specular).unwrap_or(Vec3::ZERO);
+    let ke = rgb(m.emissive).unwrap_or(Vec3::ZERO);
+    let params: HashMap<&str, &str> = m
+        .unknown_param
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.as_str()))
+        .collect();
+    let opacity = m
+        .dissolve
+        .or_else(|| {
+            params
+                .get("Tr")
+                .and_then(|t| t.parse::<f32>().ok())
+                .map(|tr| 1.0 - tr)
+        })
+        .filter(|d| d.is_finite())
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    let transmission = params
+        .get("Tf")
+        .and_then(|t| {
+            let v: Vec<f32> = t
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            match v.as_slice() {
+                [g] => Some(Vec3::splat(*g)),
+                [r, g, b, ..] => Some(Vec3::new(*r, *g, *b)),
+                _ => None,
+            }
+        })
+        .unwrap_or(if opacity < 1.0 { kd } else { Vec3::ONE });
+    let mut material = Material {
+        diffuse: Texture::color(kd.clamp(Vec3::ZERO, Vec3::ONE)),
+        specular: Texture::color(ks.clamp(Vec3::ZERO, Vec3::ONE)),
+        roughness: Texture::scalar(m.shininess.map_or(1.0, roughness_from_ns)),
+        mirror: Texture::scalar(0.0),
+        opacity: Texture::scalar(opacity),
+        transmission: Texture::color(transmission.clamp(Vec3::ZERO, Vec3::ONE)),
+        // Colours stay within [0, 1] (the panel's colour editor): the
+        // emission's brightness goes into its strength.
+        emission: Texture::color(ke.max(Vec3::ZERO) / ke.max_element().max(1.0)),
+        emission_strength: ke.max_element().max(1.0),
+        ..Material::default()
+    };
+    if let Some(file) = &m.diffuse_texture {
+        material.diffuse = image_texture(file, folder, ColorSpace::Srgb, kd, &mut notes);
+    }
+    if let Some(file) = &m.specular_texture {
+        material.specular = image_texture(file, folder, ColorSpace::Srgb, ks, &mut notes);
+    }
+    if let Some(statement) = &m.normal_texture {
+        let (_, multiplier) = strip_options(statement);
+        material.bump = image_texture(statement, folder, ColorSpace::Linear, Vec3::ONE, &mut notes);
+        // Heights in [0, 1] over a hundredth of a unit: a visible relief on
+        // objects a few units across, as most OBJ scenes are.
+        material.bump_height = 0.01 * multiplier.unwrap_or(1.0);
+    }
+    (material, notes)
+}
+
+/// Reads every mesh's OBJ file into the scene: its triangles and its
+/// materials, with the preset's overrides kept (matched by name). A
+/// preset override naming no MTL material is kept too, with a note.
+pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), ObjError> {
+    for mesh in &mut scene.meshes {
+        let loaded = load(&mesh.obj)?;
+        notes.extend(loaded.notes);
+        let overrides = std::mem::take(&mut mesh.materials);
+        let mut materials = loaded.materials;
+        for o in overrides {
+            match materials.iter_mut().find(|m| m.name == o.name) {
+                Some(m) => m.material = o.material,
+                None => {
+                    notes.push(format!(
+                        "mesh `{}`: the preset's material `{}` is not in {}",
+                        mesh.name,
+                        o.name,
+                        mesh.obj.display()
+                    ));
+                    materials.push(o);
+                }
+            }
+        }
+        mesh.materials = materials;
+        mesh.geometry = Geometry(Arc::new(loaded.triangles));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Mesh, Property};
+
+    const CORNELL: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../presets/scenes/cornell-box/CornellBox-Original.obj"
+    );
+
+    /// The Cornell box: every quad in two triangles, its eight materials
+    /// with the MTL's values, the light emitting Ke.
+    #[test]
+    fn the_cornell_box_loads_with_its_materials() {
+        let obj = load(Path::new(CORNELL)).unwrap();
+        assert!(obj.notes.is_empty(), "{:?}", obj.notes);
+        assert_eq!(obj.materials.len(), 8);
+        // 5 walls + 1 light + 2 boxes of 5 visible quads... count from the file.
+        let quads = std::fs::read_to_string(CORNELL)
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count();
+        assert_eq!(obj.triangles.len(), 2 * quads);
+        let light = obj.materials.iter().find(|m| m.name == "light").unwrap();
+        let at = crate::scene::SurfacePoint::new(Vec3::ZERO, Vec2::ZERO);
+        assert_eq!(
+            light.material.value_at(Property::Emission, &at),
+            Vec3::new(17.0, 12.0, 4.0)
+        );
+        let left = obj.materials.iter().find(|m| m.name == "leftWall").unwrap();
+        assert_eq!(
+            left.material.value_at(Property::Diffuse, &at),
+            Vec3::new(0.63, 0.065, 0.05)
+        );
+        assert!(!left.is_override());
+    }
+
+    fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> PathBuf {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    const QUAD: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+
+    /// d, Tr, Tf, Ns and the texture maps, with paths relative to the MTL.
+    #[test]
+    fn mtl_keys_map_onto_the_material() {
+        let dir = tempfile::Builder::new()
+            .prefix("obj-keys")
+            .tempdir()
+            .unwrap();
+        write(
+            &dir,
+            "m.mtl",
+            "newmtl glass\nKd 0.2 0.4 0.8\nd 0.25\nNs 100\nKs 0.5 0.5 0.5\n\
+             newmtl film\nKd 1 1 1\nTr 0.75\nTf 1 0 0\n\
+             newmtl pictured\nKd 1 1 1\nmap_Kd pic.png\nmap_bump -bm 2 bumps.png\n",
+        );
+        let obj = write(
+            &dir,
+            "m.obj",
+            &format!(
+                "mtllib m.mtl\n{QUAD}usemtl glass\nf 1/1 2/2 3/3\nusemtl film\nf 1/1 3/3 4/4\nusemtl pictured\nf 1/1 2/2 4/4\n"
+            ),
+        );
+        let loaded = load(&obj).unwrap();
+        let at = crate::scene::SurfacePoint::new(Vec3::ZERO, Vec2::ZERO);
+        let get = |name: &str, p: Property| {
+            loaded
+                .materials
+                .iter()
+                .find(|m| m.name == name)
+                .unwrap()
+                .material
+                .value_at(p, &at)
+        };
+        assert_eq!(get("glass", Property::Opacity).x, 0.25);
+        // Without Tf, a see-through material tints by its diffuse colour.
+        assert_eq!(
+            get("glass", Property::Transmission),
+            Vec3::new(0.2, 0.4, 0.8)
+        );
+        assert!((get("glass", Property::Roughness).x - roughness_from_ns(100.0)).abs() < 1e-6);
+        assert_eq!(get("film", Property::Opacity).x, 0.25);
+        assert_eq!(get("film", Property::Transmission), Vec3::X);
+        let pictured = &loaded.materials[2].material;
+        assert_eq!(
+            pictured.diffuse.image.as_ref().unwrap().path,
+            dir.path().join("pic.png")
+        );
+        assert_eq!(
+            pictured.bump.image.as_ref().unwrap().path,
+            dir.path().join("bumps.png")
+        );
+        assert!((pictured.bump_height - 0.02).abs() < 1e-6);
+        // Both textures are missing: each named in a note.
+        for file in ["pic.png", "bumps.png"] {
+            assert!(
+                loaded
+                    .notes
+                    .iter()
+                    .any(|n| n.contains(file) && n.contains("not found")),
+                "{:?}",
+                loaded.notes
+            );
+        }
+        assert_eq!(loaded.triangles.uvs[0], [Vec2::ZERO, Vec2::X, Vec2::ONE]);
+    }
+
+    /// Smoother surfaces have higher Phong exponents: roughness falls with
+    /// Ns, from 1 (Ns = 0) towards 0.
+    #[test]
+    fn roughness_falls_as_the_phong_exponent_grows() {
+        assert_eq!(roughness_from_ns(0.0), 1.0);
+        let values: Vec<f32> = [1.0, 10.0, 100.0, 1000.0].map(roughness_from_ns).to_vec();
+        assert!(values.windows(2).all(|w| w[1] < w[0]), "{values:?}");
+        assert!(values[3] < 0.3);
+    }
+
+    /// Broken files: a clear error naming the file and the cause.
+    #[test]
+    fn broken_obj_files_give_errors_naming_them() {
+        let dir = tempfile::Builder::new()
+            .prefix("obj-broken")
+            .tempdir()
+            .unwrap();
+        let missing = dir.path().join("missing.obj");
+        let e = load(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("missing.obj") && e.contains("cannot read"),
+            "{e}"
+        );
+        let out_of_range = write(&dir, "range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n");
+        let e = load(&out_of_range).unwrap_err().to_string();
+        assert!(e.contains("range.obj:3") && e.contains("`f 1 2 9`"), "{e}");
+        let garbage = write(&dir, "garbage.obj", "v 0 0 0\nv 0 zero 0\nf 1 1 1\n");
+        let e = load(&garbage).unwrap_err().to_string();
+        assert!(e.contains("garbage.obj:2"), "{e}");
+        // Truncated mid-statement: the face lost its last corners.
+        let cornell = std::fs::read_to_string(CORNELL).unwrap();
+        let cut = cornell.rfind("\nf ").unwrap() + 6;
+        let truncated = write(&dir, "truncated.obj", &cornell[..cut]);
+        let e = load(&truncated).unwrap_err().to_string();
+        let last_line = cornell[..cut].lines().count();
+        assert!(e.contains(&format!("truncated.obj:{last_line}:")), "{e}");
+        let no_faces = write(&dir, "empty.obj", "v 0 0 0\n");
+        let e = load(&no_faces).unwrap_err().to_string();
+        assert!(e.contains("empty.obj") && e.contains("no faces"), "{e}");
+    }
+
+    /// NaN vertices are rejected with a note, the rest still renders; a
+    /// missing MTL file gives grey and a note naming it.
+    #[test]
+    fn nan_vertices_and_a_missing_library_are_reported() {
+        let dir = tempfile::Builder::new()
+            .prefix("obj-nan")
+            .tempdir()
+            .unwrap();
+        let obj = write(
+            &dir,
+            "nan.obj",
+            &format!("mtllib nowhere.mtl\n{QUAD}v nan 0 0\nf 1 2 3\nf 1 3 5\n"),
+        );
+        let loaded = load(&obj).unwrap();
+        assert_eq!(loaded.triangles.len(), 1);
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("NaN") && n.contains("nan.obj")),
+            "{:?}",
+            loaded.notes
+        );
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("nowhere.mtl") && n.contains("cannot be read")),
+            "{:?}",
+            loaded.notes
+        );
+        // A broken library: its file and line are named, grey is used.
+        write(&dir, "broken.mtl", "newmtl a\nKd 1 1\n");
+        let obj = write(
+            &dir,
+            "b.obj",
+            &format!("mtllib broken.mtl\n{QUAD}usemtl a\nf 1 2 3\n"),
+        );
+        let loaded = load(&obj).unwrap();
+        assert!(
+            loaded
+                .notes
+                .iter()
+                .any(|n| n.contains("broken.mtl:2") && n.contains("`Kd 1 1`")),
+            "{:?}",
+            loaded.notes
+        );
+        assert_eq!(loaded.materials[0].name, DEFAULT_MATERIAL);
+    }
+
+    /// A preset's edited material survives loading the file again, and only
+    /// edited materials are written back.
+    #[test]
+    fn preset_overrides_win_and_only_they_are_saved() {
+        let marble = Material {
+            roughness: Texture::scalar(0.123),
+            ..Material::default()
+        };
+        let mut scene = Scene {
+            meshes: vec![Mesh {
+                name: "box".into(),
+                obj: CORNELL.into(),
+                materials: vec![MeshMaterial {
+                    name: "leftWall".into(),
+                    material: marble.clone(),
+                    from_file: None,
+                }],
+                ..Mesh::default()
+            }],
+            ..Scene::default()
+        };
+        let mut notes = Vec::new();
+        load_meshes(&mut scene, &mut notes).unwrap();
+        let mesh = &scene.meshes[0];
+        assert_eq!(mesh.materials.len(), 8);
+        let left = mesh
+            .materials
+            .iter()
+            .find(|m| m.name == "leftWall")
+            .unwrap();
+        assert_eq!(left.material, marble);
+        let text = ron::to_string(mesh).unwrap();
+        assert_eq!(text.matches("name:").count(), 2, "{text}");
+        assert!(
+            text.contains("leftWall") && !text.contains("rightWall"),
+            "{text}"
+        );
+        assert_eq!(scene.triangle_count(), mesh.geometry.0.len());
+    }
+}

@@ -1,0 +1,232 @@
+//! Every input the fuzz targets kept (tests/data/fuzz/: the minimised
+//! corpora and each crash found, see fuzz/README.md) through the entry point
+//! of its target, read the way the target reads it: none may panic, an error
+//! must name the file, and a result must keep the loader's promises.
+
+use marbre_core::env_sampling::EnvDistribution;
+use marbre_core::envmap::{F16_MAX, IntegerDecode, MAX_TEXELS, SUPPORTED_EXTENSIONS};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+/// The files of `tests/data/fuzz/<target>`, sorted.
+fn inputs(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/fuzz")
+        .join(target);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()))
+        .map(|entry| entry.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "{} is empty", folder.display());
+    files
+        .into_iter()
+        .map(|file| {
+            let bytes = std::fs::read(&file).unwrap();
+            (file, bytes)
+        })
+        .collect()
+}
+
+/// Runs `check` on every input of `target`; fails naming each input that
+/// panicked or broke a promise.
+fn check_all(target: &str, check: impl Fn(&[u8]) -> Result<(), String>) {
+    let failures: Vec<String> = inputs(target)
+        .iter()
+        .filter_map(|(file, bytes)| {
+            let outcome = catch_unwind(AssertUnwindSafe(|| check(bytes)))
+                .unwrap_or_else(|_| Err("panicked".into()));
+            outcome
+                .err()
+                .map(|why| format!("{}: {why}", file.display()))
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// An error's message must name the file it is about.
+fn names_the_file(message: String, file_name: &str) -> Result<(), String> {
+    if message.contains(file_name) {
+        Ok(())
+    } else {
+        Err(format!("the error does not name {file_name}: {message}"))
+    }
+}
+
+#[test]
+fn preset_inputs_parse_or_give_an_error_naming_the_file() {
+    let path = Path::new("/fuzz/presets/input.ron");
+    check_all("preset", |bytes| {
+        match marbre_core::preset::parse_bytes(bytes, path) {
+            Err(e) => names_the_file(e.to_string(), "input.ron"),
+            Ok(loaded) => {
+                let scene = &loaded.preset.scene;
+                // Paths in the file are resolved against the preset's folder.
+                match scene.meshes.iter().find(|m| !m.obj.is_absolute()) {
+                    Some(mesh) => Err(format!("mesh path {} left relative", mesh.obj.display())),
+                    None => Ok(()),
+                }
+            }
+        }
+    });
+}
+
+/// The fuzz target's split: the OBJ, then after a NUL the `input.mtl` it
+/// may name.
+fn obj_and_library(bytes: &[u8]) -> (&[u8], Option<&[u8]>) {
+    match bytes.iter().position(|&b| b == 0) {
+        Some(i) => (&bytes[..i], Some(&bytes[i + 1..])),
+        None => (bytes, None),
+    }
+}
+
+#[test]
+fn obj_inputs_load_or_give_an_error_naming_the_file() {
+    let path = Path::new("/fuzz/obj/input.obj");
+    check_all("obj", |bytes| {
+        let (obj, mtl) = obj_and_library(bytes);
+        let loaded = marbre_core::obj_loader::parse_bytes(obj, path, |library| {
+            match (library == Path::new("/fuzz/obj/input.mtl"), mtl) {
+                (true, Some(bytes)) => Ok(bytes.to_vec()),
+                _ => Err(std::io::ErrorKind::NotFound.into()),
+            }
+        });
+        let loaded = match loaded {
+            Err(e) => return names_the_file(e.to_string(), "input.obj"),
+            Ok(loaded) => loaded,
+        };
+        let mesh = &loaded.triangles;
+        if mesh.is_empty() || mesh.uvs.len() != mesh.len() || mesh.materials.len() != mesh.len() {
+            return Err(format!(
+                "{} triangles, {} uv triples, {} material indices",
+                mesh.len(),
+                mesh.uvs.len(),
+                mesh.materials.len()
+            ));
+        }
+        if !mesh.positions.iter().flatten().all(|p| p.is_finite()) {
+            return Err("a non-finite vertex was kept".into());
+        }
+        match mesh
+            .materials
+            .iter()
+            .find(|&&m| m as usize >= loaded.materials.len())
+        {
+            Some(m) => Err(format!("material index {m} of {}", loaded.materials.len())),
+            None => Ok(()),
+        }
+    });
+}
+
+/// The fuzz target's split: the first byte picks the extension (by its low
+/// seven bits) and how integer codes decode (by its top bit), the rest is the
+/// file.
+fn envmap_path_and_file(bytes: &[u8]) -> Option<(PathBuf, IntegerDecode, &[u8])> {
+    let (&selector, file) = bytes.split_first()?;
+    let extension = SUPPORTED_EXTENSIONS[usize::from(selector & 0x7f) % SUPPORTED_EXTENSIONS.len()];
+    let decode = if selector & 0x80 == 0 {
+        IntegerDecode::Srgb
+    } else {
+        IntegerDecode::Linear
+    };
+    Some((
+        PathBuf::from(format!("/fuzz/envmaps/input.{extension}")),
+        decode,
+        file,
+    ))
+}
+
+#[test]
+fn envmap_inputs_decode_to_clean_images_or_give_an_error_naming_the_file() {
+    check_all("envmap", |bytes| {
+        let Some((path, decode, file)) = envmap_path_and_file(bytes) else {
+            return Err("empty input".into());
+        };
+        let file_name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let image = match marbre_core::envmap::decode_bytes(file, &path, decode) {
+            Err(e) => return names_the_file(e.to_string(), &file_name),
+            Ok(loaded) => loaded.image,
+        };
+        let texels = u64::from(image.width) * u64::from(image.height);
+        if texels == 0 || texels > MAX_TEXELS || image.pixels.len() as u64 != texels {
+            return Err(format!(
+                "{}x{} with {} texels",
+                image.width,
+                image.height,
+                image.pixels.len()
+            ));
+        }
+        let clean =
+            |px: &[f32; 4]| px[..3].iter().all(|c| (0.0..=F16_MAX).contains(c)) && px[3] == 1.0;
+        if let Some(px) = image.pixels.iter().find(|px| !clean(px)) {
+            return Err(format!("texel {px:?} was not sanitised"));
+        }
+        let distribution = EnvDistribution::new(&image);
+        let (t, pdf) = distribution.sample(0.5, 0.5);
+        if pdf.is_finite() && t.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("the sampling table drew {t} with density {pdf}"))
+        }
+    });
+}
+
+/// Headers declaring more than [`MAX_TEXELS`] texels (the files
+/// `too_large_<width>x<height>.*`) are refused with their size, before the
+/// decoder allocates the image.
+#[test]
+fn oversized_envmap_headers_are_refused_with_their_size() {
+    let oversized: Vec<(PathBuf, Vec<u8>)> = inputs("envmap")
+        .into_iter()
+        .filter(|(file, _)| {
+            file.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("too_large_")
+        })
+        .collect();
+    assert_eq!(oversized.len(), 3, "one file per format with a size check");
+    for (file, bytes) in oversized {
+        let stem = file.file_stem().unwrap().to_string_lossy().into_owned();
+        let size = stem.trim_start_matches("too_large_");
+        let (path, decode, data) = envmap_path_and_file(&bytes).unwrap();
+        let e = marbre_core::envmap::decode_bytes(data, &path, decode)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("declares {size} texels, more than")),
+            "{}: {e}",
+            file.display()
+        );
+    }
+}
+
+/// The hand-made seeds (`<what>_<width>x<height>.*`: EXR float, half and
+/// ZIP-compressed, luminance-only EXR, flat and run-length Radiance HDR,
+/// 8- and 16-bit, grey, alpha and palette PNG, JPEG) decode to their size:
+/// the corpus starts from files each decoder accepts.
+#[test]
+fn envmap_seeds_decode_to_their_size() {
+    let mut decoded = 0;
+    for (file, bytes) in inputs("envmap") {
+        let stem = file.file_stem().unwrap().to_string_lossy().into_owned();
+        let Some(size) = stem.rsplit('_').next().filter(|s| s.contains('x')) else {
+            continue;
+        };
+        if stem.starts_with("too_large_") {
+            continue;
+        }
+        let (path, decode, data) = envmap_path_and_file(&bytes).unwrap();
+        let image = marbre_core::envmap::decode_bytes(data, &path, decode)
+            .unwrap_or_else(|e| panic!("{}: {e}", file.display()))
+            .image;
+        assert_eq!(
+            format!("{}x{}", image.width, image.height),
+            size,
+            "{}",
+            file.display()
+        );
+        decoded += 1;
+    }
+    assert_eq!(decoded, 12);
+}

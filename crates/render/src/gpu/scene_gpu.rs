@@ -1,0 +1,480 @@
+//! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
+
+use super::texture_codegen;
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use marbre_core::lights::LightSelection;
+use marbre_core::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
+use marbre_core::scene::pattern::MAX_SIGNALS;
+use marbre_core::scene::primitives::MAX_POLYGON_VERTICES;
+use marbre_core::scene::{
+    EnvSource, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,
+};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    pub cam_pos: [f32; 3],
+    pub tan_half_fov: f32,
+    pub cam_right: [f32; 3],
+    pub aspect: f32,
+    pub cam_up: [f32; 3],
+    pub frame_index: u32,
+    pub cam_forward: [f32; 3],
+    pub accumulated: u32,
+    pub light_pos: [f32; 3],
+    pub env_intensity: f32,
+    pub light_power: [f32; 3],
+    pub env_rotation: f32,
+    pub env_constant: [f32; 3],
+    pub background_visible: u32,
+    pub ground_height: f32,
+    pub sphere_count: u32,
+    pub samples_per_frame: u32,
+    pub max_bounces: u32,
+    pub render_size: [f32; 2],
+    pub env_kind: u32,
+    pub has_ground: u32,
+    pub cylinder_count: u32,
+    pub polygon_count: u32,
+    /// The angle a pixel subtends at the camera: the spread of ray cones.
+    pub pixel_spread: f32,
+    /// Non-zero: sample the environment map by its luminance (MIS).
+    pub env_sampling: u32,
+    /// Cells of the environment's sampling distribution (width, height).
+    pub env_distribution_size: [u32; 2],
+    /// The light table's length, how it is sampled (0 uniform, 1 by power)
+    /// and its total power.
+    pub light_count: u32,
+    pub light_selection: u32,
+    pub light_total_power: f32,
+    pub light_samples: u32,
+    /// `scene::Strategy::id`.
+    pub strategy: u32,
+    pub russian_roulette_from: u32,
+    pub triangle_count: u32,
+    /// Always 1.0, but a uniform: see `compensated_mean_update` in
+    /// `shaders/accumulate.wgsl`.
+    pub opaque_one: f32,
+    /// The firefly clamp on a sample's largest channel; 0: off.
+    pub sample_clamp: f32,
+    /// The rows `band_start..band_end` a trace pass covers (the compute
+    /// kernel reads them; the fragment kernel's scissor matches).
+    pub band_start: u32,
+    pub band_end: u32,
+    pub _pad: [u32; 3],
+}
+
+/// `NoiseParams` of `shaders/fractal.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
+pub struct NoiseParamsGpu {
+    pub kind: u32,
+    pub hash: u32,
+    pub octaves: f32,
+    pub frequency: f32,
+    pub amplitude: f32,
+    pub persistence: f32,
+    pub lacunarity: f32,
+    /// [`FractalShape::id`]: fBm, turbulence or ridged.
+    pub shape: u32,
+    pub distortion: f32,
+    /// 1: the signal's mapping reads world coordinates, 0: object ones.
+    pub world: u32,
+    /// How much the signal's mapping enlarges a footprint.
+    pub footprint_scale: f32,
+    pub _pad: f32,
+}
+
+impl NoiseParamsGpu {
+    pub fn new(n: &NoiseSettings, shape: FractalShape) -> Self {
+        let f = &n.fractal;
+        Self {
+            kind: noise_kind_id(n.kind),
+            hash: hash_id(n.hash),
+            octaves: f.octaves,
+            frequency: f.frequency,
+            amplitude: f.amplitude,
+            persistence: f.persistence,
+            lacunarity: f.lacunarity,
+            shape: shape.id(),
+            distortion: f.distortion,
+            world: 0,
+            footprint_scale: 1.0,
+            _pad: 0.0,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct MaterialGpu {
+    pub signals: [NoiseParamsGpu; MAX_SIGNALS],
+    /// Each signal's mapping as three affine rows (identity without one).
+    pub signal_rows: [[f32; 4]; 3 * MAX_SIGNALS],
+    pub signal_count: u32,
+    /// Signals before this index are gradient noise, from it on Perlin.
+    pub first_perlin: u32,
+    pub bump_height: f32,
+    /// The mean emitted luminance ([`marbre_core::lights::emitted_luminance`]):
+    /// above 0, the spheres and triangles of this material are lights, and
+    /// an emitter hit by a BSDF ray finds its light-sampling density from it.
+    pub emitted_luminance: f32,
+}
+
+/// `Cylinder` of `shaders/scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct CylinderGpu {
+    pub base: [f32; 3],
+    pub radius: f32,
+    pub height: f32,
+    pub _pad: [f32; 3],
+}
+
+/// `Polygon` of `shaders/scene.wgsl`: vertices, plane and (u, v) frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct PolygonGpu {
+    pub vertices: [[f32; 4]; MAX_POLYGON_VERTICES],
+    pub normal: [f32; 3],
+    pub vertex_count: u32,
+    pub uv_origin: [f32; 4],
+    pub uv_u: [f32; 4],
+    pub uv_v: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct SphereGpu {
+    pub center: [f32; 3],
+    pub radius: f32,
+}
+
+pub fn noise_kind_id(k: NoiseKind) -> u32 {
+    match k {
+        NoiseKind::Gradient => 0,
+        NoiseKind::Perlin => 1,
+    }
+}
+
+pub fn hash_id(h: HashKind) -> u32 {
+    match h {
+        HashKind::Pcg => 0,
+        HashKind::Sin => 1,
+        HashKind::PcgTiled => 2,
+    }
+}
+
+/// A material's noise signals (its textures' distinct fractal sums,
+/// deduplicated so that rust's diffuse and specular colours share one
+/// evaluation per hit, gradient noise first) and its bump height. The
+/// textures themselves are generated code (`texture_codegen`).
+pub fn material(m: &Material) -> MaterialGpu {
+    let signals = texture_codegen::material_signals(m);
+    let mut out = MaterialGpu {
+        signal_count: signals.len() as u32,
+        first_perlin: signals
+            .iter()
+            .position(|s| s.noise.kind == NoiseKind::Perlin)
+            .unwrap_or(signals.len()) as u32,
+        bump_height: m.bump_height,
+        emitted_luminance: marbre_core::lights::emitted_luminance(m),
+        ..Default::default()
+    };
+    for (k, signal) in signals.iter().enumerate() {
+        out.signals[k] = NoiseParamsGpu::new(&signal.noise, signal.shape);
+        let mapping = signal.mapping.unwrap_or_default();
+        out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
+        out.signals[k].footprint_scale = mapping.footprint_scale()[2];
+        out.signal_rows[3 * k..3 * k + 3].copy_from_slice(&signal.rows());
+    }
+    out
+}
+
+/// Materials in the order the shader indexes them, padded to the uniform
+/// array's length.
+pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
+    let mut out: Vec<_> = scene.materials().map(material).collect();
+    out.resize(MAX_MATERIALS, MaterialGpu::default());
+    out
+}
+
+/// Entries of the `materials` uniform array: every primitive's, the
+/// ground's and the meshes'.
+pub use marbre_core::scene::MAX_MATERIALS;
+
+/// Cylinders, padded to the uniform array's length.
+pub fn cylinders(scene: &Scene) -> Vec<CylinderGpu> {
+    let mut out: Vec<_> = scene
+        .cylinders
+        .iter()
+        .take(MAX_CYLINDERS)
+        .map(|c| CylinderGpu {
+            base: c.base.to_array(),
+            radius: c.radius,
+            height: c.height,
+            _pad: [0.0; 3],
+        })
+        .collect();
+    out.resize(MAX_CYLINDERS, CylinderGpu::default());
+    out
+}
+
+/// Polygons (those `Scene::sanitize` kept: convex, flat), padded to the
+/// uniform array's length.
+pub fn polygons(scene: &Scene) -> Vec<PolygonGpu> {
+    let mut out: Vec<_> = scene
+        .polygons
+        .iter()
+        .take(MAX_POLYGONS)
+        .map(|p| {
+            let mut gpu = PolygonGpu {
+                normal: p.normal().unwrap_or(Vec3::Y).to_array(),
+                vertex_count: p.vertices.len().min(MAX_POLYGON_VERTICES) as u32,
+                ..Default::default()
+            };
+            for (slot, v) in gpu.vertices.iter_mut().zip(&p.vertices) {
+                *slot = v.extend(0.0).to_array();
+            }
+            if let Some(frame) = p.frame() {
+                gpu.uv_origin = frame.origin.extend(0.0).to_array();
+                gpu.uv_u = frame.u_axis.extend(0.0).to_array();
+                gpu.uv_v = frame.v_axis.extend(0.0).to_array();
+            }
+            gpu
+        })
+        .collect();
+    out.resize(MAX_POLYGONS, PolygonGpu::default());
+    out
+}
+
+/// Spheres, padded to the uniform array's length.
+pub fn spheres(scene: &Scene) -> Vec<SphereGpu> {
+    let mut out: Vec<_> = scene
+        .spheres
+        .iter()
+        .map(|s| SphereGpu {
+            center: s.center.to_array(),
+            radius: s.radius,
+        })
+        .take(MAX_SPHERES)
+        .collect();
+    out.resize(MAX_SPHERES, SphereGpu::default());
+    out
+}
+
+/// Per-frame values: camera, lights, counters.
+pub fn frame_uniform(
+    scene: &Scene,
+    render_size: (u32, u32),
+    frame_index: u32,
+    accumulated: u32,
+) -> FrameUniform {
+    let cam = scene.camera.frame();
+    let (w, h) = (render_size.0.max(1) as f32, render_size.1.max(1) as f32);
+    // No light: zero power, so an uber shader that compiles the light in adds nothing.
+    let (light_pos, light_power) = scene
+        .point_light
+        .as_ref()
+        .map_or(([0.0; 3], [0.0; 3]), |l| {
+            (l.position.to_array(), (l.color * l.intensity).to_array())
+        });
+    let env = &scene.environment;
+    let env_constant = match env.source {
+        EnvSource::Constant { radiance } => radiance.to_array(),
+        _ => [0.0; 3],
+    };
+    FrameUniform {
+        cam_pos: cam.position.to_array(),
+        tan_half_fov: cam.tan_half_fov,
+        cam_right: cam.right.to_array(),
+        aspect: w / h,
+        cam_up: cam.up.to_array(),
+        frame_index,
+        cam_forward: cam.forward.to_array(),
+        accumulated,
+        light_pos,
+        env_intensity: env.intensity,
+        light_power,
+        env_rotation: env.rotation_degrees.to_radians(),
+        env_constant,
+        background_visible: u32::from(env.background_visible),
+        ground_height: scene.ground.as_ref().map_or(0.0, |g| g.height),
+        sphere_count: scene.spheres.len().min(MAX_SPHERES) as u32,
+        samples_per_frame: scene.render.samples_per_frame.max(1),
+        // The direct integrator is a path of one bounce: what it reaches
+        // adds only its emission or the environment.
+        max_bounces: match scene.render.transport.integrator {
+            Integrator::Direct => 1,
+            Integrator::Path => scene.render.max_bounces.max(1),
+        },
+        render_size: [w, h],
+        env_kind: match env.source {
+            EnvSource::None => 0,
+            EnvSource::Constant { .. } => 1,
+            // A cube map reaches the GPU resampled to lat-long.
+            EnvSource::LatLong { .. }
+            | EnvSource::CubeFaces { .. }
+            | EnvSource::CubeCross { .. } => 2,
+        },
+        has_ground: u32::from(scene.ground.is_some()),
+        cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
+        polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
+        pixel_spread: 2.0 * cam.tan_half_fov / h,
+        env_sampling: u32::from(env.source.is_map() && scene.render.env_importance),
+        // Filled in by the renderer, which holds the distribution and the
+        // light table.
+        env_distribution_size: [0; 2],
+        light_count: 0,
+        light_selection: match scene.render.transport.light_selection {
+            LightSelection::Uniform => 0,
+            LightSelection::Power => 1,
+        },
+        light_total_power: 0.0,
+        light_samples: scene.render.transport.light_samples.max(1),
+        strategy: scene.render.transport.strategy.id(),
+        russian_roulette_from: scene.render.transport.russian_roulette_from,
+        triangle_count: 0,
+        opaque_one: 1.0,
+        sample_clamp: scene.render.transport.sample_clamp.unwrap_or(0.0),
+        band_start: 0,
+        band_end: render_size.1.max(1),
+        _pad: [0; 3],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use marbre_core::scene::{Pattern, Texture};
+
+    #[test]
+    fn struct_sizes_match_the_wgsl_layout() {
+        // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 224);
+        assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
+        assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
+        assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 400);
+        assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
+    }
+
+    /// The element count of a uniform array global in the trace shader.
+    fn wgsl_array_len(name: &str) -> u32 {
+        let generated =
+            texture_codegen::generate(&Scene::default(), &marbre_core::texture::ImageSet::empty())
+                .unwrap();
+        let source = crate::gpu::shader_source::assemble(
+            crate::gpu::shader_source::Program::Trace,
+            &crate::gpu::features::FeatureSet::all(),
+            &generated.wgsl,
+        )
+        .unwrap();
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let (_, global) = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.name.as_deref() == Some(name))
+            .unwrap();
+        match module.types[global.ty].inner {
+            naga::TypeInner::Array {
+                size: naga::ArraySize::Constant(n),
+                ..
+            } => n.get(),
+            ref other => panic!("{name} is {other:?}"),
+        }
+    }
+
+    #[test]
+    fn uniform_arrays_hold_what_the_cpu_uploads() {
+        let scene = Scene::default();
+        assert_eq!(wgsl_array_len("spheres") as usize, spheres(&scene).len());
+        assert_eq!(
+            wgsl_array_len("materials") as usize,
+            materials(&scene).len()
+        );
+        assert_eq!(spheres(&scene).len(), MAX_SPHERES);
+        assert_eq!(
+            wgsl_array_len("cylinders") as usize,
+            cylinders(&scene).len()
+        );
+        assert_eq!(wgsl_array_len("polygons") as usize, polygons(&scene).len());
+        assert_eq!(
+            wgsl_array_len("texture_params") as usize,
+            texture_codegen::generate(&scene, &marbre_core::texture::ImageSet::empty())
+                .unwrap()
+                .params
+                .len()
+        );
+    }
+
+    fn fbm_texture(noise: NoiseSettings) -> Texture {
+        Texture::blend(Pattern::Fbm { noise }, Vec3::ZERO, Vec3::ONE)
+    }
+
+    #[test]
+    fn textures_reading_the_same_sum_share_one_signal() {
+        let noise = NoiseSettings::default();
+        let mut m = Material {
+            diffuse: fbm_texture(noise),
+            specular: fbm_texture(noise),
+            ..Default::default()
+        };
+        m.roughness.pattern = Pattern::Turbulence { noise };
+        let gpu = material(&m);
+        // fBm once for both colours; turbulence, |noise|, is another sum.
+        assert_eq!(gpu.signal_count, 2);
+        assert_eq!(gpu.signals[0].shape, FractalShape::Signed.id());
+        assert_eq!(gpu.signals[1].shape, FractalShape::Absolute.id());
+    }
+
+    #[test]
+    fn perlin_signals_come_after_gradient_ones() {
+        let perlin = NoiseSettings {
+            kind: NoiseKind::Perlin,
+            ..Default::default()
+        };
+        let m = Material {
+            diffuse: fbm_texture(perlin),
+            specular: fbm_texture(NoiseSettings::default()),
+            ..Default::default()
+        };
+        let gpu = material(&m);
+        assert_eq!((gpu.signal_count, gpu.first_perlin), (2, 1));
+        assert_eq!(gpu.signals[0].kind, 0);
+        assert_eq!(gpu.signals[1].kind, 1);
+    }
+
+    /// Nested textures add their sums; past the limit, `Scene::sanitize`
+    /// turns the extra patterns constant.
+    #[test]
+    fn nested_sums_count_up_to_the_limit() {
+        let at = |frequency| NoiseSettings {
+            fractal: marbre_core::noise::FractalParams {
+                frequency,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let nested = Texture::blend(
+            Pattern::Fbm { noise: at(1.0) },
+            fbm_texture(at(2.0)),
+            fbm_texture(at(3.0)),
+        );
+        let mut m = Material {
+            diffuse: nested,
+            specular: fbm_texture(at(4.0)),
+            roughness: fbm_texture(at(5.0)),
+            ..Default::default()
+        };
+        let mut notes = Vec::new();
+        m.sanitize("test", &mut notes);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert_eq!(m.roughness.pattern, Pattern::Constant);
+        let gpu = material(&m);
+        assert_eq!(gpu.signal_count, MAX_SIGNALS as u32);
+        assert_eq!(gpu.signals[3].frequency, 4.0);
+    }
+}

@@ -1,0 +1,739 @@
+//! Generates the WGSL that evaluates a scene's texture trees.
+//!
+//! Each material's three property textures become straight-line WGSL
+//! functions whose structure (pattern kinds, nesting) is fixed in the code
+//! and whose numbers (colours, cell sizes, frequencies) are read at constant
+//! indices from the `texture_params` uniform. So a parameter edit rewrites a
+//! buffer and the next frame shows it; only a structural edit (a new
+//! pattern, a nested texture) changes the code and rebuilds the pipeline.
+//! Constant indices matter on lavapipe: a uniform read at an index that
+//! differs between lanes costs eight scalar loads, one at a constant index a
+//! single broadcast.
+//!
+//! The fractal sums the patterns read are the material's noise signals,
+//! evaluated once per hit by `material_signals` (textures.wgsl); the
+//! generated code reads them from `signals`.
+
+use anyhow::{Result, ensure};
+use marbre_core::scene::pattern::MAX_SIGNALS;
+use marbre_core::scene::texture_tree::IMAGE_UNAVAILABLE;
+use marbre_core::scene::{
+    Child, MappingSpace, Material, MathOp, Pattern, Property, Scene, Signal, Texture,
+    TextureMapping,
+};
+use marbre_core::texture::{ImageFilter, ImageSet, ImageWrap};
+use std::fmt::Write;
+
+/// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
+/// shaders/scene.wgsl): 16 KiB.
+pub const MAX_TEXTURE_PARAMS: usize = 1024;
+
+/// The generated code and the parameters it reads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneratedTextures {
+    /// WGSL defining `surface_textures`; identical for two scenes whose
+    /// textures differ only in their numbers.
+    pub wgsl: String,
+    /// The `texture_params` values, padded to [`MAX_TEXTURE_PARAMS`].
+    pub params: Vec<[f32; 4]>,
+}
+
+/// The code and parameters for every material of `scene`, in GPU order:
+/// `surface_textures`, and `surface_height` for the bump textures.
+pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
+    let mut generator = Generator {
+        images,
+        code: String::new(),
+        params: Vec::new(),
+        next: 0,
+    };
+    let mut dispatch = String::new();
+    let mut transmittances = String::new();
+    let mut emissions = String::new();
+    let mut heights = String::new();
+    for (index, material) in scene.materials().enumerate() {
+        let cases = generator.material(index, material);
+        writeln!(
+            dispatch,
+            "        case {index}u: {{\n{}        }}",
+            cases.textures
+        )?;
+        writeln!(
+            transmittances,
+            "        case {index}u: {{\n{}        }}",
+            cases.transmittance
+        )?;
+        writeln!(
+            emissions,
+            "        case {index}u: {{\n{}        }}",
+            cases.emission
+        )?;
+        if material.has_bump() {
+            let name = format!("texture_{index}_bump");
+            generator.function(&name, &material.bump, &material_signals(material));
+            writeln!(
+                heights,
+                "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals).x;\n        }}"
+            )?;
+        }
+    }
+    ensure!(
+        generator.params.len() <= MAX_TEXTURE_PARAMS,
+        "the scene's textures need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
+        generator.params.len()
+    );
+    let mut wgsl =
+        String::from("// Generated from the scene's texture trees (gpu::texture_codegen).\n\n");
+    wgsl.push_str(&generator.code);
+    write!(
+        wgsl,
+        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(1.0), vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+    )?;
+    // Shadow rays read opacity and transmission alone, light samples
+    // emission alone; each evaluates the noise signals only if one of its
+    // textures reads one.
+    let signals_for = |properties: &[Property]| {
+        let reads_noise = scene.materials().any(|m| {
+            properties.iter().any(|&property| {
+                std::iter::once(m.texture(property))
+                    .chain(
+                        m.layers
+                            .iter()
+                            .flat_map(|l| [Some(&l.mask), l.texture(property)])
+                            .flatten(),
+                    )
+                    .flat_map(Texture::patterns)
+                    .any(|p| p.signal().is_some())
+            })
+        });
+        if reads_noise {
+            "material_signals(material, p, pw)"
+        } else {
+            "vec4f(0.0)"
+        }
+    };
+    let signals = signals_for(&[Property::Opacity, Property::Transmission]);
+    write!(
+        wgsl,
+        "\n// The fraction of light a material lets straight through, per channel:\n// (1 - opacity) tinted by the transmission colour, for shadow rays.\nfn surface_transmittance(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> vec3f {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{transmittances}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
+    )?;
+    let signals = signals_for(&[Property::Emission]);
+    write!(
+        wgsl,
+        "\n// A material's emitted radiance alone, for points sampled on lights.\nfn surface_emission(material: u32, p: vec3f, pw: vec3f, uv: vec2f) -> vec3f {{\n    let signals = {signals};\n    let fp = Footprint(vec2f(0.0), 0.0, vec3f(0.0));\n    switch material {{\n{emissions}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
+    )?;
+    let bump_reads_noise = scene
+        .materials()
+        .filter(|m| m.has_bump())
+        .flat_map(|m| m.bump.patterns())
+        .any(|p| p.signal().is_some());
+    write!(
+        wgsl,
+        "\n// Whether a bump height reads noise (bump.wgsl then evaluates the\n// signals at its offset points).\nconst BUMP_READS_NOISE: bool = {bump_reads_noise};\n"
+    )?;
+    // Always defined, so that a shader with the bump feature forced on (the
+    // uber shader) builds for any scene.
+    write!(
+        wgsl,
+        "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
+    )?;
+    let mut params = generator.params;
+    params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
+    Ok(GeneratedTextures { wgsl, params })
+}
+
+/// A material's distinct fractal sums, gradient noise first (the order
+/// `material_signals` in textures.wgsl expects), at most [`MAX_SIGNALS`]
+/// (`Scene::sanitize` keeps materials within it).
+pub fn material_signals(material: &Material) -> Vec<Signal> {
+    let mut signals = Vec::new();
+    for signal in material.all_textures().iter().flat_map(|t| t.signals(None)) {
+        if !signals.contains(&signal) {
+            signals.push(signal);
+        }
+    }
+    signals.truncate(MAX_SIGNALS);
+    signals.sort_by_key(|s| s.noise.kind as u8);
+    signals
+}
+
+/// Where a texture node is evaluated: the WGSL expressions of its 3D point
+/// and (u, v), and the mapping they came through (which its noise signals
+/// are taken through too).
+#[derive(Clone)]
+struct Site {
+    p: String,
+    uv: String,
+    /// A `Footprint`: the sample's extent around `p` and `uv`.
+    footprint: String,
+    mapping: Option<TextureMapping>,
+}
+
+/// What [`Generator::material`] returns: a material's statements in the
+/// two dispatch functions.
+struct MaterialCases {
+    textures: String,
+    /// The statements of `surface_transmittance`.
+    transmittance: String,
+    /// The statements of `surface_emission`.
+    emission: String,
+}
+
+struct Generator<'a> {
+    /// Where each image lies in the atlas (image nodes read it).
+    images: &'a ImageSet,
+    code: String,
+    params: Vec<[f32; 4]>,
+    /// Numbers the local variables of the function being generated.
+    next: usize,
+}
+
+impl Generator<'_> {
+    /// Generates the functions of material `index`'s textures and returns
+    /// the statements of its case in `surface_textures` (each property's
+    /// base texture, then each layer over it where its mask lies) and in
+    /// `surface_opacity` (the same for opacity alone).
+    fn material(&mut self, index: usize, material: &Material) -> MaterialCases {
+        let signals = material_signals(material);
+        let mut masks = Vec::new();
+        for (l, layer) in material.layers.iter().enumerate() {
+            let name = format!("texture_{index}_layer{l}_mask");
+            self.function(&name, &layer.mask, &signals);
+            masks.push(format!(
+                "            let mask{l} = clamp({name}(p, pw, uv, fp, signals).x, 0.0, 1.0);\n"
+            ));
+        }
+        let mut cases = MaterialCases {
+            textures: masks.concat(),
+            transmittance: String::new(),
+            emission: String::new(),
+        };
+        let strength = self.param([material.emission_strength, 0.0, 0.0, 0.0]);
+        // The layer masks the transmittance reads (each declared once).
+        let mut transmittance_masks = std::collections::BTreeSet::new();
+        let mut transmittance = String::new();
+        for property in Property::ALL {
+            let value = property.name();
+            let name = format!("texture_{index}_{value}");
+            self.function(&name, material.texture(property), &signals);
+            let mut statements =
+                format!("            var {value} = {name}(p, pw, uv, fp, signals);\n");
+            let mut masks_read = Vec::new();
+            for (l, layer) in material.layers.iter().enumerate() {
+                if let Some(texture) = layer.texture(property) {
+                    let name = format!("texture_{index}_layer{l}_{value}");
+                    self.function(&name, texture, &signals);
+                    let _ = writeln!(
+                        statements,
+                        "            {value} = mix({value}, {name}(p, pw, uv, fp, signals), mask{l});"
+                    );
+                    masks_read.push(l);
+                }
+            }
+            cases.textures.push_str(&statements);
+            match property {
+                Property::Opacity | Property::Transmission => {
+                    transmittance_masks.extend(masks_read);
+                    transmittance.push_str(&statements);
+                }
+                Property::Emission => {
+                    let masks_read: String =
+                        masks_read.iter().map(|&l| masks[l].as_str()).collect();
+                    cases.emission = format!(
+                        "{masks_read}{statements}            return emission * {strength}.x;\n"
+                    );
+                }
+                _ => {}
+            }
+        }
+        cases.transmittance = transmittance_masks
+            .iter()
+            .map(|&l| masks[l].as_str())
+            .collect::<String>()
+            + &transmittance
+            + "            return (1.0 - clamp(opacity.x, 0.0, 1.0)) * clamp(transmission, vec3f(0.0), vec3f(1.0));\n";
+        let _ = writeln!(
+            cases.textures,
+            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, transmission, emission * {strength}.x);"
+        );
+        cases
+    }
+
+    fn function(&mut self, name: &str, texture: &Texture, signals: &[Signal]) {
+        self.next = 0;
+        let mut body = String::new();
+        let site = Site {
+            p: "p".into(),
+            uv: "uv".into(),
+            footprint: "fp".into(),
+            mapping: None,
+        };
+        let value = self.texture(texture, &site, signals, &mut body);
+        let _ = write!(
+            self.code,
+            "fn {name}(p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> vec3f {{\n{body}    return {value};\n}}\n\n"
+        );
+    }
+
+    /// Reserves a parameter slot and returns the WGSL that reads it.
+    fn param(&mut self, value: [f32; 4]) -> String {
+        self.params.push(value);
+        format!("texture_params[{}]", self.params.len() - 1)
+    }
+
+    fn child(
+        &mut self,
+        child: &Child,
+        site: &Site,
+        signals: &[Signal],
+        body: &mut String,
+    ) -> String {
+        match child {
+            Child::Scalar(v) => format!("{}.xyz", self.param([*v, *v, *v, 0.0])),
+            Child::Color(c) => format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0])),
+            Child::Texture(t) => self.texture(t, site, signals, body),
+        }
+    }
+
+    /// The ramp of texture `k` at its blend factor `t{k}`, unrolled stop by
+    /// stop (twin of `texture::ramp`): before the first stop its colour, then
+    /// each pair of neighbours takes over past its first position.
+    fn ramp(
+        &mut self,
+        stops: &[marbre_core::texture::RampStop],
+        k: usize,
+        body: &mut String,
+    ) -> String {
+        let slots: Vec<String> = stops
+            .iter()
+            .map(|s| self.param([s.color.x, s.color.y, s.color.z, s.position]))
+            .collect();
+        let _ = writeln!(body, "    var ramp{k} = {}.xyz;", slots[0]);
+        for pair in slots.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let _ = writeln!(
+                body,
+                "    ramp{k} = select(ramp{k}, mix({a}.xyz, {b}.xyz, clamp(select(1.0, (t{k} - {a}.w) / ({b}.w - {a}.w), {b}.w > {a}.w), 0.0, 1.0)), t{k} > {a}.w);"
+            );
+        }
+        format!("ramp{k}")
+    }
+
+    /// An image node: its colour from the atlas (or, with a ramp, its
+    /// luminance mapped). An image not loaded shows the CPU reference's
+    /// stand-in colour.
+    fn image(
+        &mut self,
+        texture: &Texture,
+        k: usize,
+        filter: ImageFilter,
+        wrap: ImageWrap,
+        site: &Site,
+        body: &mut String,
+    ) -> String {
+        let rect = texture.image.as_ref().and_then(|s| self.images.rect(s));
+        let color = match rect {
+            Some(rect) => {
+                let rect = self.param(rect);
+                let (uv, wrap) = (&site.uv, wrap.id());
+                match filter {
+                    ImageFilter::Nearest => format!("image_nearest({rect}, {uv}, {wrap}u).xyz"),
+                    ImageFilter::Bilinear => {
+                        format!("image_bilinear({rect}, 0, {uv}, {wrap}u).xyz")
+                    }
+                    ImageFilter::Trilinear => {
+                        // The level whose texels are as wide as the footprint.
+                        let fp = &site.footprint;
+                        format!(
+                            "image_trilinear({rect}, {uv}, {wrap}u, log2(max(max({fp}.uv.x * {rect}.z, {fp}.uv.y * {rect}.w), 1e-8))).xyz"
+                        )
+                    }
+                }
+            }
+            None => {
+                let c = IMAGE_UNAVAILABLE;
+                format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0]))
+            }
+        };
+        let _ = writeln!(body, "    let c{k} = {color};");
+        if texture.ramp.is_empty() {
+            return format!("c{k}");
+        }
+        let _ = writeln!(body, "    let t{k} = luminance(c{k});");
+        self.ramp(&texture.ramp, k, body)
+    }
+
+    /// Appends the statements evaluating `texture` at `site` to `body` and
+    /// returns the expression holding its colour. A mapped texture reads the
+    /// surface's coordinates (the function's `p` or `pw`, and `uv`) afresh
+    /// through its map, whose rows are parameters.
+    fn texture(
+        &mut self,
+        texture: &Texture,
+        site: &Site,
+        signals: &[Signal],
+        body: &mut String,
+    ) -> String {
+        let k = self.next;
+        self.next += 1;
+        let mapped;
+        let site = match &texture.mapping {
+            Some(mapping) => {
+                let [r0, r1, r2] = mapping.rows().map(|row| self.param(row));
+                let point = match mapping.space {
+                    MappingSpace::Object => "p",
+                    MappingSpace::World => "pw",
+                };
+                let [su, sv, s3] = mapping.footprint_scale();
+                let scale = self.param([su, sv, s3, 0.0]);
+                let _ = writeln!(
+                    body,
+                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z, fp.axes * {scale}.z);"
+                );
+                mapped = Site {
+                    p: format!("p{k}"),
+                    uv: format!("uv{k}"),
+                    footprint: format!("fp{k}"),
+                    mapping: Some(*mapping),
+                };
+                &mapped
+            }
+            None => site,
+        };
+        let value = self.blended(texture, k, site, signals, body);
+        if texture.ops.is_empty() {
+            return value;
+        }
+        let _ = writeln!(body, "    var r{k} = {value};");
+        for op in &texture.ops {
+            let r = format!("r{k}");
+            let expression = match op {
+                MathOp::Abs => format!("abs({r})"),
+                MathOp::Invert => format!("1.0 - {r}"),
+                MathOp::Scale(_) => format!("{r} * {}.x", self.param(op.params())),
+                MathOp::Bias(_) => format!("{r} + {}.x", self.param(op.params())),
+                MathOp::Clamp { .. } => {
+                    let q = self.param(op.params());
+                    format!("min(max({r}, vec3f({q}.x)), vec3f({q}.y))")
+                }
+                MathOp::Power(_) => {
+                    let q = self.param(op.params());
+                    format!("pow(max({r}, vec3f(0.0)), vec3f({q}.x))")
+                }
+            };
+            let _ = writeln!(body, "    {r} = {expression};");
+        }
+        format!("r{k}")
+    }
+
+    /// [`Generator::texture`] before the math steps: texture number `k`'s
+    /// blend of its children (or ramp).
+    fn blended(
+        &mut self,
+        texture: &Texture,
+        k: usize,
+        site: &Site,
+        signals: &[Signal],
+        body: &mut String,
+    ) -> String {
+        if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
+            return self.child(&texture.a, site, signals, body);
+        }
+        if let Pattern::Image { filter, wrap } = texture.pattern {
+            return self.image(texture, k, filter, wrap, site, body);
+        }
+        let (p, uv, fp) = (site.p.as_str(), site.uv.as_str(), site.footprint.as_str());
+        let signal = texture
+            .pattern
+            .signal()
+            .map(|s| Signal {
+                mapping: site.mapping,
+                ..s
+            })
+            .and_then(|s| signals.iter().position(|x| *x == s))
+            .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
+        let mut child_uv = uv.to_string();
+        let mut child_footprint = fp.to_string();
+        let t = match texture.pattern {
+            Pattern::Constant => "0.0".to_string(),
+            Pattern::Checker { size } => {
+                let q = self.param([size, size, size, 0.0]);
+                format!(
+                    "select(checker_3d({p}, {q}.xyz), filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.axes), filter_checkers)"
+                )
+            }
+            Pattern::Fbm { .. } => format!("clamp(0.5 + 0.5 * {signal}, 0.0, 1.0)"),
+            Pattern::Turbulence { .. } | Pattern::Ridged { .. } => {
+                format!("clamp({signal}, 0.0, 1.0)")
+            }
+            Pattern::Image { .. } => unreachable!("image nodes are generated by `image`"),
+            Pattern::Mix => match &texture.factor {
+                Some(factor) => {
+                    let f = self.texture(factor, site, signals, body);
+                    format!("clamp({f}.x, 0.0, 1.0)")
+                }
+                None => "0.0".to_string(),
+            },
+            Pattern::Marble {
+                stripe_frequency, ..
+            } => {
+                let q = self.param([stripe_frequency, 0.0, 0.0, 0.0]);
+                format!("0.5 + 0.5 * marble_stripes({p}.x, {signal}, {q}.x)")
+            }
+            Pattern::Checker2d { size, phase } => {
+                let q = self.param([size.x, size.y, phase, 0.0]);
+                let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
+                child_uv = format!("cell{k}.local");
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
+                format!(
+                    "select(cell{k}.select, filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv), filter_checkers)"
+                )
+            }
+            Pattern::Brick {
+                size,
+                mortar,
+                row_offset,
+            } => {
+                let q = self.param([size.x, size.y, mortar, row_offset]);
+                let _ = writeln!(body, "    let cell{k} = brick({uv}, {q}.xy, {q}.z, {q}.w);");
+                child_uv = format!("cell{k}.local");
+                child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
+                format!("cell{k}.select")
+            }
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => {
+                let q = self.param([mortar_half_width, bevel, 0.0, 0.0]);
+                format!("tile_height({uv}, {q}.x, {q}.y)")
+            }
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => {
+                let q = self.param([frequency, direction.x, direction.y, 0.0]);
+                format!("waves({uv}, {q}.x, {q}.yz)")
+            }
+            Pattern::Cutout { sides, radius } => {
+                let q = self.param([radius, sides as f32, 0.0, 0.0]);
+                format!("cutout({uv}, u32({q}.y), {q}.x)")
+            }
+            Pattern::Wood {
+                ring_width,
+                turbulence_amount,
+                ..
+            } => {
+                let q = self.param([ring_width, turbulence_amount, 0.0, 0.0]);
+                format!("wood_rings({p}, WOOD_AXIS, {q}.x, {q}.y * {signal})")
+            }
+            Pattern::Veins {
+                frequency,
+                turbulence_amount,
+                ..
+            } => {
+                let q = self.param([frequency, turbulence_amount, 0.0, 0.0]);
+                format!("max(sin({q}.x * {p}.x + {q}.y * {signal}), 0.0)")
+            }
+        };
+        let _ = writeln!(body, "    let t{k} = {t};");
+        if !texture.ramp.is_empty() {
+            return self.ramp(&texture.ramp, k, body);
+        }
+        let child_site = Site {
+            uv: child_uv,
+            footprint: child_footprint,
+            ..site.clone()
+        };
+        let a = self.child(&texture.a, &child_site, signals, body);
+        let b = self.child(&texture.b, &child_site, signals, body);
+        let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
+        format!("v{k}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec2, Vec3};
+    use marbre_core::scene::{Ground, Sphere};
+
+    fn generate_plain(scene: &Scene) -> Result<GeneratedTextures> {
+        generate(scene, &ImageSet::empty())
+    }
+
+    fn nested() -> Texture {
+        let inner = Texture::blend(
+            Pattern::Checker2d {
+                size: Vec2::splat(1.0 / 3.0),
+                phase: 0.0,
+            },
+            Vec3::new(0.8, 0.0, 0.0),
+            Vec3::new(0.4, 0.8, 0.0),
+        );
+        Texture::blend(
+            Pattern::Checker2d {
+                size: Vec2::splat(0.25),
+                phase: 0.0,
+            },
+            inner,
+            Vec3::new(0.0, 0.0, 0.8),
+        )
+    }
+
+    fn scene_with(texture: Texture) -> Scene {
+        let mut ground = Ground::default();
+        ground.material.diffuse = texture;
+        Scene {
+            spheres: vec![Sphere::default()],
+            ground: Some(ground),
+            ..Scene::default()
+        }
+    }
+
+    /// Numbers live in the parameter buffer: editing them keeps the code,
+    /// so the pipeline is not rebuilt; a structural edit changes it.
+    #[test]
+    fn parameter_edits_keep_the_code_and_structural_edits_change_it() {
+        let base = generate_plain(&scene_with(nested())).unwrap();
+        let mut edited = nested();
+        edited.pattern = Pattern::Checker2d {
+            size: Vec2::splat(0.1),
+            phase: 0.5,
+        };
+        edited.b = Child::Color(Vec3::ONE);
+        let numbers = generate_plain(&scene_with(edited.clone())).unwrap();
+        assert_eq!(numbers.wgsl, base.wgsl);
+        assert_ne!(numbers.params, base.params);
+        assert!(numbers.params.contains(&[0.1, 0.1, 0.5, 0.0]));
+
+        edited.pattern = Pattern::Cutout {
+            sides: 5,
+            radius: 0.3,
+        };
+        let structure = generate_plain(&scene_with(edited)).unwrap();
+        assert_ne!(structure.wgsl, base.wgsl);
+        assert!(structure.wgsl.contains("cutout("));
+    }
+
+    /// Nested cell patterns hand their children the cell's local (u, v).
+    #[test]
+    fn nested_cells_read_the_parent_cell_coordinates() {
+        let code = generate_plain(&scene_with(nested())).unwrap().wgsl;
+        assert!(code.contains("checker_2d(uv,"), "{code}");
+        assert!(
+            code.contains("checker_2d(cell1.local,") || code.contains("checker_2d(cell0.local,"),
+            "{code}"
+        );
+    }
+
+    /// The CPU reference of the same tree: a 4×4 board whose even cells
+    /// hold 3×3 boards.
+    #[test]
+    fn cpu_reference_of_a_nested_checker() {
+        let t = nested();
+        let red = Vec3::new(0.8, 0.0, 0.0);
+        let green = Vec3::new(0.4, 0.8, 0.0);
+        let blue = Vec3::new(0.0, 0.0, 0.8);
+        // Outer cell (0, 0) is even: the inner board, whose cell (0, 0) is red
+        // and (1, 0) green.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.01, 0.01)), red);
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.12, 0.01)), green);
+        // Outer cell (1, 0) is odd: blue.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), blue);
+    }
+
+    /// With a ramp, the pattern's t picks a stop colour: the children are
+    /// neither generated nor evaluated, and each stop is one parameter.
+    #[test]
+    fn a_ramp_replaces_the_blend_of_the_children() {
+        use marbre_core::texture::RampStop;
+        let mut t = nested();
+        t.ramp = vec![
+            RampStop {
+                position: 0.0,
+                color: Vec3::X,
+            },
+            RampStop {
+                position: 1.0,
+                color: Vec3::Y,
+            },
+        ];
+        let generated = generate_plain(&scene_with(t.clone())).unwrap();
+        assert!(generated.wgsl.contains("var ramp0"), "{}", generated.wgsl);
+        assert!(!generated.wgsl.contains("cell1"), "children were generated");
+        assert!(generated.params.contains(&[0.0, 1.0, 0.0, 1.0]));
+        // Outer cell (1, 0) is odd: t = 1, the last stop.
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.3, 0.1)), Vec3::Y);
+        assert_eq!(t.eval(Vec3::ZERO, Vec2::new(0.1, 0.1)), Vec3::X);
+    }
+
+    /// Shadow rays evaluate the noise signals only when an opacity texture
+    /// reads one; layers' opacity bindings count. A layer that sets both
+    /// opacity and transmission declares its mask once.
+    #[test]
+    fn surface_transmittance_reads_noise_only_when_opacity_does() {
+        let mut scene = scene_with(nested());
+        scene.spheres[0].material.diffuse = Texture::blend(
+            Pattern::Fbm {
+                noise: Default::default(),
+            },
+            0.0,
+            1.0,
+        );
+        let code = generate_plain(&scene).unwrap().wgsl;
+        assert!(code.contains("fn surface_transmittance"), "{code}");
+        assert!(!code.contains("let signals = material_signals"), "{code}");
+        scene.spheres[0]
+            .material
+            .layers
+            .push(marbre_core::scene::Layer {
+                opacity: Some(Texture::blend(
+                    Pattern::Turbulence {
+                        noise: Default::default(),
+                    },
+                    0.0,
+                    1.0,
+                )),
+                transmission: Some(Texture::color(Vec3::X)),
+                ..Default::default()
+            });
+        let code = generate_plain(&scene).unwrap().wgsl;
+        assert!(code.contains("let signals = material_signals"), "{code}");
+        let transmittance = &code[code.find("fn surface_transmittance").unwrap()..];
+        let transmittance = &transmittance[..transmittance.find("\n}\n").unwrap()];
+        assert_eq!(transmittance.matches("let mask0").count(), 1, "{code}");
+        assert!(
+            code.contains("opacity = mix(opacity, texture_0_layer0_opacity"),
+            "{code}"
+        );
+    }
+
+    /// The anti-aliasing switches are override constants: toggling them
+    /// changes neither the generated code nor the feature set, so the
+    /// module is the same and only the pipeline's constants differ.
+    #[test]
+    fn anti_aliasing_switches_leave_the_module_alone() {
+        let on = scene_with(nested());
+        let mut off = on.clone();
+        off.render.filter_checkers = false;
+        off.render.clamp_octaves = false;
+        assert_eq!(generate_plain(&on).unwrap(), generate_plain(&off).unwrap());
+        let features = crate::gpu::FeatureSet::for_scene;
+        assert_eq!(features(&on), features(&off));
+        assert!(
+            generate_plain(&on)
+                .unwrap()
+                .wgsl
+                .contains("filter_checkers)")
+        );
+    }
+
+    #[test]
+    fn every_material_has_a_case() {
+        let scene = scene_with(nested());
+        let code = generate_plain(&scene).unwrap().wgsl;
+        for i in 0..scene.materials().count() {
+            assert!(code.contains(&format!("case {i}u:")), "{code}");
+        }
+    }
+}

@@ -1,0 +1,6 @@
+//! marbre's renderer as a library: the WGSL shaders specialised per scene,
+//! the GPU passes (trace, accumulation, metering, display, readback) and the
+//! sessions that turn a preset into a ready renderer. No window, no UI.
+
+pub mod gpu;
+pub mod session;

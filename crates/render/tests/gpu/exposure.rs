@@ -1,0 +1,282 @@
+//! Auto exposure: the GPU's metering against its CPU twin, and what the
+//! display pass (screen, PNG) makes of it.
+
+use crate::common::*;
+use glam::Vec3;
+use marbre_core::scene::{PointLight, Scene, ToneMap};
+use marbre_render::gpu::auto_exposure::{
+    AutoExposure, DELTA, KEY, exposure_stops, log_average_luminance, meter,
+};
+use marbre_render::gpu::metering_grid::grid_pixels;
+use marbre_render::gpu::testing::gpu_or_skip;
+use marbre_render::gpu::{GpuContext, Renderer};
+use marbre_render::session::accumulate;
+use wgpu::util::DeviceExt;
+
+/// `scene` traced at `spp` from a fresh renderer (so two scenes see the same
+/// random numbers).
+fn traced(ctx: &GpuContext, scene: &Scene, size: (u32, u32), spp: u32) -> Renderer {
+    let mut r = Renderer::new(ctx, scene, None, size).unwrap();
+    accumulate(ctx, &mut r, spp, |_| {}).unwrap();
+    r
+}
+
+/// The largest difference between two displayed images, in 8-bit levels.
+fn max_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
+    a.as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap()
+}
+
+/// An environment 1000× brighter makes every radiance 1000× larger; auto
+/// exposure divides it out again, so the two display alike. Without it they
+/// do not (the premise).
+#[test]
+fn auto_exposure_displays_dim_and_bright_light_alike() {
+    let Some(ctx) = gpu_or_skip("auto_exposure_displays_dim_and_bright_light_alike") else {
+        return;
+    };
+    let size = (48, 32);
+    let mut shown = Vec::new();
+    for auto_exposure in [false, true] {
+        let images: Vec<image::RgbaImage> = [0.05, 50.0]
+            .map(|radiance| {
+                let mut scene = spheres_in_constant_light(radiance);
+                scene.render.auto_exposure = auto_exposure;
+                traced(&ctx, &scene, size, 4).read_display(&ctx).unwrap()
+            })
+            .into();
+        shown.push(max_difference(&images[0], &images[1]));
+        if auto_exposure {
+            // Not a black or white image: the metering found the mid-tones.
+            let rgb: Vec<f32> = images[1]
+                .pixels()
+                .flat_map(|p| p.0[..3].iter().map(|&v| f32::from(v)))
+                .collect();
+            let mean = rgb.iter().sum::<f32>() / rgb.len() as f32;
+            assert!((60.0..220.0).contains(&mean), "mean level {mean}");
+        }
+    }
+    let [manual, auto] = shown[..] else {
+        unreachable!()
+    };
+    assert!(
+        manual > 100,
+        "manual exposure: the premise fails ({manual})"
+    );
+    // δ = 1e-4 against radiances of 5e-3 and more: under 2% of a stop.
+    assert!(auto <= 2, "auto exposure: images differ by {auto} levels");
+}
+
+/// The metering pass reads every texel of an image up to 256 on a side (a
+/// centred strided grid beyond) and agrees with the CPU twin on the
+/// rendered radiance.
+#[test]
+fn gpu_log_average_matches_the_cpu_twin() {
+    let Some(ctx) = gpu_or_skip("gpu_log_average_matches_the_cpu_twin") else {
+        return;
+    };
+    let mut scene = spheres_in_constant_light(0.2);
+    // A light makes a wide range of luminances (and noise) to average.
+    scene.point_light = Some(PointLight {
+        position: Vec3::new(0.0, 3.0, 2.0),
+        color: Vec3::new(1.0, 0.9, 0.7),
+        intensity: 40.0,
+    });
+    scene.render.auto_exposure = true;
+    for (size, strided) in [((64, 40), false), ((300, 270), true)] {
+        let mut r = traced(&ctx, &scene, size, 2);
+        let gpu = r.metering(&ctx).unwrap();
+        let (w, h, pixels) = r.read_radiance(&ctx).unwrap();
+        assert_eq!((w, h), size);
+        let metered = grid_pixels(&pixels, size);
+        let cpu = log_average_luminance(&metered);
+        if !strided {
+            assert_eq!(metered, pixels);
+            assert_eq!(cpu, log_average_luminance(&pixels));
+        }
+        assert_eq!(gpu.count as usize, metered.len(), "{size:?}");
+        let relative = (gpu.log_average - cpu).abs() / cpu;
+        assert!(
+            relative < 1e-3,
+            "{size:?}: GPU {} vs CPU {cpu}",
+            gpu.log_average
+        );
+        assert!((gpu.stops - exposure_stops(cpu)).abs() < 2e-3, "{gpu:?}");
+        assert!((gpu.scale - gpu.stops.exp2()).abs() < 1e-4 * gpu.scale);
+        // The grid stands for the whole image.
+        let whole = log_average_luminance(&pixels);
+        assert!((cpu - whole).abs() < 0.05 * whole, "{cpu} vs {whole}");
+    }
+}
+
+/// The metering pass on a texture of chosen values: NaN, ±Inf and negative
+/// texels are skipped, the region is honoured, and black gives a bounded
+/// exposure.
+#[test]
+fn metering_skips_non_finite_and_negative_texels() {
+    let Some(ctx) = gpu_or_skip("metering_skips_non_finite_and_negative_texels") else {
+        return;
+    };
+    let (w, h) = (20_u32, 10_u32);
+    let clean: Vec<[f32; 4]> = (0..w * h)
+        .map(|i| {
+            let t = i as f32 / (w * h) as f32;
+            [0.02 + 3.0 * t, 0.5 * t * t, 1.0 - t, 1.0]
+        })
+        .collect();
+    let mut dirty = clean.clone();
+    let bad = [
+        [f32::NAN, 0.5, 0.5, 1.0],
+        [0.5, f32::INFINITY, 0.5, 1.0],
+        [0.5, 0.5, f32::NEG_INFINITY, 1.0],
+        [-1.0, 0.5, 0.5, 1.0],
+        [0.2, -1e-3, 0.5, 1.0],
+        [f32::NAN; 4],
+    ];
+    let bad_at = [3, 17, 44, 90, 101, 150];
+    for (i, p) in bad_at.iter().zip(bad) {
+        dirty[*i] = p;
+    }
+    let expected: Vec<[f32; 4]> = dirty
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !bad_at.contains(i))
+        .map(|(_, p)| *p)
+        .collect();
+    let metering = AutoExposure::new(&ctx.device).unwrap();
+    let run = |pixels: &[[f32; 4]], region: (u32, u32)| {
+        let texture = ctx.device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("test radiance"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(pixels),
+        );
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        metering.record(
+            &ctx,
+            &mut encoder,
+            &texture.create_view(&Default::default()),
+            region,
+            None,
+        );
+        ctx.queue.submit([encoder.finish()]);
+        metering.read(&ctx).unwrap()
+    };
+    let near = |a: f32, b: f32| (a - b).abs() <= 1e-4 * b.abs();
+
+    let got = run(&dirty, (w, h));
+    assert_eq!(got.count as usize, expected.len());
+    assert!(got.log_average.is_finite() && got.scale.is_finite());
+    let cpu = meter(&dirty);
+    assert_eq!(cpu, meter(&expected));
+    assert!(near(got.log_average, cpu.log_average), "{got:?} vs {cpu:?}");
+    assert!((got.stops - cpu.stops).abs() < 1e-3, "{got:?} vs {cpu:?}");
+
+    // A region: the top-left 13×7 texels only.
+    let region = (13, 7);
+    let sub: Vec<[f32; 4]> = (0..region.1)
+        .flat_map(|y| (0..region.0).map(move |x| (x, y)))
+        .map(|(x, y)| dirty[(y * w + x) as usize])
+        .collect();
+    let got = run(&dirty, region);
+    let cpu = meter(&sub);
+    assert_eq!(got.count, cpu.count);
+    assert!(near(got.log_average, cpu.log_average), "{got:?} vs {cpu:?}");
+
+    // Black, and nothing usable at all: L_avg = δ, a finite exposure.
+    let black_stops = (KEY / DELTA).log2();
+    for pixels in [
+        vec![[0.0; 4]; (w * h) as usize],
+        vec![[f32::NAN; 4]; (w * h) as usize],
+    ] {
+        let got = run(&pixels, (w, h));
+        assert!(near(got.log_average, DELTA), "{got:?}");
+        assert!((got.stops - black_stops).abs() < 1e-3, "{got:?}");
+        assert!(got.scale.is_finite());
+    }
+}
+
+/// What the display pass shows (the PNG of `marbre render` and of F12, and
+/// the screen) is the radiance scaled by 2^(metered stops + compensation),
+/// tone mapped: checked against the CPU with Reinhard's x / (1 + x).
+#[test]
+fn displayed_pixels_are_the_radiance_at_the_metered_exposure() {
+    let Some(ctx) = gpu_or_skip("displayed_pixels_are_the_radiance_at_the_metered_exposure") else {
+        return;
+    };
+    let size = (40, 30);
+    for compensation in [0.0, 1.5] {
+        let mut scene = spheres_in_constant_light(3.0);
+        scene.render.auto_exposure = true;
+        scene.render.exposure = compensation;
+        scene.render.tone_map = ToneMap::Reinhard;
+        let mut r = traced(&ctx, &scene, size, 2);
+        let shown = r.read_display(&ctx).unwrap();
+        let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
+        let stops = exposure_stops(log_average_luminance(&pixels));
+        // Bright light: the automatic exposure darkens.
+        assert!(stops < -2.0, "{stops}");
+        let scale = (stops + compensation).exp2();
+        let encode = |c: f32| {
+            let c = c.max(0.0) * scale;
+            let c = c / (1.0 + c);
+            let s = if c <= 0.003_130_8 {
+                c * 12.92
+            } else {
+                1.055 * c.powf(1.0 / 2.4) - 0.055
+            };
+            s * 255.0
+        };
+        for (p, q) in pixels.iter().zip(shown.pixels()) {
+            for c in 0..3 {
+                let expected = encode(p[c]);
+                assert!(
+                    (f32::from(q[c]) - expected).abs() <= 1.0,
+                    "compensation {compensation}: radiance {p:?} shows {q:?}, expected {expected}"
+                );
+            }
+        }
+    }
+}
+
+/// Toggling auto exposure and moving the exposure are display-only: the
+/// accumulated samples stay (and a traced edit does restart them).
+#[test]
+fn exposure_edits_keep_the_samples() {
+    let Some(ctx) = gpu_or_skip("exposure_edits_keep_the_samples") else {
+        return;
+    };
+    let scene = spheres_in_constant_light(1.0);
+    let mut r = traced(&ctx, &scene, (16, 16), 3);
+    let before = r.read_display(&ctx).unwrap();
+    let mut edited = scene.clone();
+    edited.render.auto_exposure = true;
+    edited.render.exposure = -1.0;
+    r.set_scene(&ctx, &edited).unwrap();
+    assert_eq!(r.accumulated_samples(), 3);
+    let after = r.read_display(&ctx).unwrap();
+    assert!(max_difference(&before, &after) > 10, "the edit shows");
+    edited.render.auto_exposure = false;
+    r.set_scene(&ctx, &edited).unwrap();
+    assert_eq!(r.accumulated_samples(), 3);
+    edited.render.max_bounces += 1;
+    r.set_scene(&ctx, &edited).unwrap();
+    assert_eq!(r.accumulated_samples(), 0);
+}

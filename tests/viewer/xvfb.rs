@@ -1,0 +1,287 @@
+//! Running the real `marbre` binary in a window under a private Xvfb
+//! server: temporary folders, the X server, the child process and its log.
+//! Shared by the window and soak tests.
+//!
+//! Each test starts its own Xvfb (`-displayfd` lets the server pick a free
+//! display number itself, so a desktop session or another test run on the
+//! same machine is never disturbed) and kills it on the way out. Without
+//! `Xvfb` (or another tool a test names) or a GPU adapter the tests skip
+//! loudly through `marbre_render::gpu::testing::skip`, which fails instead when
+//! `MARBRE_REQUIRE_GPU=1` (as in CI).
+
+use marbre_render::gpu::testing::{gpu_or_skip, skip};
+use std::ffi::OsString;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::os::unix::fs::DirBuilderExt;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Mutex, MutexGuard, mpsc};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+const BIN: &str = env!("CARGO_BIN_EXE_marbre");
+
+static SERIAL: Mutex<()> = Mutex::new(());
+
+/// One window at a time within a test binary: on a software rasteriser
+/// each frame takes about a second of every core, and two windows at once
+/// would only make both slower and the timeouts less meaningful.
+pub fn serial() -> MutexGuard<'static, ()> {
+    // A failed test poisons the lock; the next one may still run.
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A private temporary folder, removed on drop unless the test failed (then
+/// its path is printed so the logs and images can be inspected).
+pub struct TempDir(PathBuf);
+
+impl TempDir {
+    pub fn new(tag: &str) -> Self {
+        let nanos = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .unwrap()
+            .as_nanos();
+        let path =
+            std::env::temp_dir().join(format!("marbre-xvfb-{tag}-{}-{nanos}", std::process::id()));
+        make_private_dir(&path);
+        Self(path)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    /// A 0700 subfolder (`XDG_RUNTIME_DIR` must be private to its user).
+    pub fn subdir(&self, name: &str) -> PathBuf {
+        let path = self.0.join(name);
+        make_private_dir(&path);
+        path
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("kept {} for inspection", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+fn make_private_dir(path: &Path) {
+    std::fs::DirBuilder::new()
+        .recursive(true)
+        .mode(0o700)
+        .create(path)
+        .unwrap_or_else(|e| panic!("creating {}: {e}", path.display()));
+}
+
+fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
+}
+
+/// A child process killed on drop, so a failing assertion never leaves a
+/// window or an X server behind.
+pub struct Guard(pub Child);
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        if let Ok(None) = self.0.try_wait() {
+            let _ = self.0.kill();
+        }
+        let _ = self.0.wait();
+    }
+}
+
+/// A private X server.
+pub struct Xvfb {
+    _server: Guard,
+    pub display: String,
+}
+
+impl Xvfb {
+    pub fn start(log_dir: &Path) -> Result<Self, String> {
+        let log_path = log_dir.join("xvfb.log");
+        let log = File::create(&log_path).map_err(|e| e.to_string())?;
+        // `-displayfd 1`: the server picks the first free display number and
+        // writes it to its stdout once it accepts connections, so there is
+        // neither a race for a number nor a socket to poll for.
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x800x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(log)
+            .spawn()
+            .map_err(|e| format!("cannot run Xvfb: {e}"))?;
+        let stdout = child.stdout.take().unwrap();
+        let server = Guard(child);
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let _ = BufReader::new(stdout).read_line(&mut line);
+            let _ = tx.send(line);
+        });
+        let line = rx.recv_timeout(Duration::from_secs(30)).unwrap_or_default();
+        let number = line.trim();
+        if number.is_empty() || !number.bytes().all(|b| b.is_ascii_digit()) {
+            let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+            return Err(format!(
+                "Xvfb did not report a display number; its log:\n{log}"
+            ));
+        }
+        Ok(Self {
+            _server: server,
+            display: format!(":{number}"),
+        })
+    }
+}
+
+/// Xvfb and a GPU adapter, or `None` after a loud skip. `extra_tools` must be
+/// on `PATH` too.
+pub fn display_or_skip(test: &str, dir: &TempDir, extra_tools: &[&str]) -> Option<Xvfb> {
+    for tool in std::iter::once(&"Xvfb").chain(extra_tools) {
+        if !on_path(tool) {
+            skip(
+                test,
+                &format!("`{tool}` is not on PATH (Debian: apt-get install xvfb xdotool)"),
+            );
+            return None;
+        }
+    }
+    // The child finds its own adapter for the window's surface; this only
+    // tells "no GPU at all" (skip) from "the viewer is broken" (fail).
+    gpu_or_skip(test)?;
+    match Xvfb::start(dir.path()) {
+        Ok(x) => Some(x),
+        Err(why) => {
+            skip(test, &why);
+            None
+        }
+    }
+}
+
+/// Starts the viewer on `x`'s display, its output going to `marbre.log` in
+/// `dir`, its settings in a folder of `dir` (never the user's own).
+/// Runs the viewer (or `args[0]`'s subcommand) on the virtual display,
+/// with its own runtime and configuration folders. Unless `args` name a
+/// kernel, it traces with the fragment kernel: `auto`, the default, would
+/// time both kernels on a second device in every test (seconds of CPU on
+/// lavapipe, with a fresh configuration folder each time).
+pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> Guard {
+    let log = File::create(dir.path().join("marbre.log")).unwrap();
+    let mut args = args.to_vec();
+    if !args.iter().any(|a| a == "--kernel") {
+        args.extend(["--kernel".into(), "fragment".into()]);
+    }
+    let child = Command::new(BIN)
+        .args(&args)
+        .current_dir(cwd)
+        .env("DISPLAY", &x.display)
+        .env("XDG_RUNTIME_DIR", dir.subdir("runtime"))
+        .env("MARBRE_CONFIG_DIR", dir.subdir("config"))
+        // winit would prefer Wayland if the test itself runs in a Wayland session.
+        .env_remove("WAYLAND_DISPLAY")
+        .stdin(Stdio::null())
+        .stdout(log.try_clone().unwrap())
+        .stderr(log)
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"));
+    Guard(child)
+}
+
+pub fn marbre_log(dir: &TempDir) -> String {
+    std::fs::read_to_string(dir.path().join("marbre.log")).unwrap_or_default()
+}
+
+/// Waits for the viewer to exit; fails (and kills it) after `timeout`.
+pub fn wait_for_exit(child: &mut Guard, dir: &TempDir, timeout: Duration) -> ExitStatus {
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.0.try_wait().unwrap() {
+            return status;
+        }
+        if start.elapsed() > timeout {
+            let _ = child.0.kill();
+            panic!(
+                "marbre did not exit within {timeout:?}; its log:\n{}",
+                marbre_log(dir)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+pub fn assert_success(status: ExitStatus, dir: &TempDir) {
+    assert!(
+        status.success(),
+        "marbre exited with {status}; its log:\n{}",
+        marbre_log(dir)
+    );
+}
+
+pub fn xdotool(x: &Xvfb, args: &[&str]) -> std::process::Output {
+    Command::new("xdotool")
+        .args(args)
+        .env("DISPLAY", &x.display)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run xdotool: {e}"))
+}
+
+/// Asks window `window` (an id as xdotool prints it) to close, as a window
+/// manager's close button does: a `WM_PROTOCOLS` client message carrying
+/// `WM_DELETE_WINDOW` (winit's `CloseRequested`).
+pub fn request_close(x: &Xvfb, window: &str) {
+    use x11rb::protocol::xproto::{ClientMessageEvent, ConnectionExt, EventMask};
+
+    let send = || -> Result<(), Box<dyn std::error::Error>> {
+        let window: u32 = window.trim().parse()?;
+        let (conn, _) = x11rb::connect(Some(&x.display))?;
+        let protocols = conn.intern_atom(false, b"WM_PROTOCOLS")?.reply()?.atom;
+        let delete = conn.intern_atom(false, b"WM_DELETE_WINDOW")?.reply()?.atom;
+        let message = ClientMessageEvent::new(32, window, protocols, [delete, 0, 0, 0, 0]);
+        // Checked: a round trip, so the server has the event before this
+        // connection closes.
+        conn.send_event(false, window, EventMask::NO_EVENT, message)?
+            .check()?;
+        Ok(())
+    };
+    send().unwrap_or_else(|e| panic!("sending WM_DELETE_WINDOW to window {window}: {e}"));
+}
+
+/// What window `window` (an id as xdotool prints it) shows now, read from
+/// the X server: unlike F12, which the viewer handles between frames, this
+/// sees the window whatever the viewer is busy with.
+pub fn grab_window(x: &Xvfb, window: &str) -> image::RgbImage {
+    use x11rb::protocol::xproto::{ConnectionExt, ImageFormat};
+
+    let grab = || -> Result<image::RgbImage, Box<dyn std::error::Error>> {
+        let window: u32 = window.trim().parse()?;
+        let (conn, _) = x11rb::connect(Some(&x.display))?;
+        let geometry = conn.get_geometry(window)?.reply()?;
+        let (w, h) = (geometry.width, geometry.height);
+        let reply = conn
+            .get_image(ImageFormat::Z_PIXMAP, window, 0, 0, w, h, !0)?
+            .reply()?;
+        // Xvfb's 24-bit screen: 32 bits a pixel, blue first.
+        if reply.depth != 24 || reply.data.len() != usize::from(w) * usize::from(h) * 4 {
+            return Err(format!("unexpected image: depth {}", reply.depth).into());
+        }
+        let rgb = reply
+            .data
+            .chunks_exact(4)
+            .flat_map(|bgrx| [bgrx[2], bgrx[1], bgrx[0]])
+            .collect();
+        Ok(image::RgbImage::from_raw(w.into(), h.into(), rgb).expect("the size matches"))
+    };
+    grab().unwrap_or_else(|e| panic!("reading window {window}'s pixels: {e}"))
+}
