@@ -36,8 +36,8 @@ struct ViewerArgs {
     /// Save the whole window, UI included, as PNG just before exiting.
     #[arg(long)]
     window_screenshot: Option<PathBuf>,
-    /// Development mode: read the shaders from the source tree's `shaders/`
-    /// and rebuild the trace pipeline when one changes (a shader that fails
+    /// Development mode: read the WGSL files from the source tree (each
+    /// beside its CPU twin under `crates/`) and rebuild the trace pipeline when one changes (a shader that fails
     /// to build leaves the old pipeline, and the panel shows the error).
     #[arg(long)]
     dev: bool,

@@ -85,7 +85,7 @@ mod tests {
         moved.camera.distance *= 2.0;
         assert!(!document.is_dirty(&moved));
         let mut edited = moved.clone();
-        edited.render.exposure += 1.0;
+        edited.render.display.exposure += 1.0;
         assert!(document.is_dirty(&edited));
         assert!(!document.is_dirty(&moved), "undoing the edit cleans it");
     }
@@ -100,14 +100,14 @@ mod tests {
         let scene = Scene::default();
         let mut document = Document::new(&path, "a test".into(), &scene);
         let mut edited = scene.clone();
-        edited.render.exposure = 2.0;
+        edited.render.display.exposure = 2.0;
         assert!(document.is_dirty(&edited));
         document.save(&edited, &path).unwrap();
         assert!(!document.is_dirty(&edited));
         assert!(!document.changed_on_disk());
         let loaded = preset::load(&path).unwrap().preset;
         assert_eq!(loaded.description, "a test");
-        assert_eq!(loaded.scene.render.exposure, 2.0);
+        assert_eq!(loaded.scene.render.display.exposure, 2.0);
         std::fs::write(&path, "(description: \"edited outside\")").unwrap();
         assert!(document.changed_on_disk());
     }

@@ -1,5 +1,6 @@
 //! Hot reload: watches the open preset's folder (and, in `--dev` mode, the
-//! `shaders/` folder) and reports changed files, debounced so that an
+//! source tree's `crates/`, where the WGSL files live) and reports changed
+//! files, debounced so that an
 //! editor's save (often a write, a rename and a metadata change) is one
 //! event.
 //!
@@ -46,6 +47,17 @@ impl FileWatch {
         self.debouncer
             .watcher()
             .watch(&dir, RecursiveMode::NonRecursive)
+            .map_err(|e| anyhow::anyhow!("cannot watch {} for changes: {e}", dir.display()))?;
+        self.watched_dir = Some(dir);
+        Ok(())
+    }
+
+    /// Watches the folder `dir` and every folder below it, once.
+    pub fn watch_tree(&mut self, dir: &Path) -> anyhow::Result<()> {
+        let dir = std::path::absolute(dir).unwrap_or_else(|_| dir.to_owned());
+        self.debouncer
+            .watcher()
+            .watch(&dir, RecursiveMode::Recursive)
             .map_err(|e| anyhow::anyhow!("cannot watch {} for changes: {e}", dir.display()))?;
         self.watched_dir = Some(dir);
         Ok(())

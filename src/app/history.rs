@@ -99,7 +99,7 @@ mod tests {
 
     fn with_exposure(exposure: f32) -> Scene {
         let mut scene = Scene::default();
-        scene.render.exposure = exposure;
+        scene.render.display.exposure = exposure;
         scene
     }
 
@@ -109,13 +109,13 @@ mod tests {
         h.observe(&with_exposure(1.0), false);
         h.observe(&with_exposure(2.0), false);
         let one = h.undo(&with_exposure(2.0)).unwrap();
-        assert_eq!(one.render.exposure, 1.0);
+        assert_eq!(one.render.display.exposure, 1.0);
         h.observe(&one, false);
         let zero = h.undo(&one).unwrap();
-        assert_eq!(zero.render.exposure, 0.0);
+        assert_eq!(zero.render.display.exposure, 0.0);
         assert!(h.undo(&zero).is_none(), "nothing before the first scene");
-        assert_eq!(h.redo(&zero).unwrap().render.exposure, 1.0);
-        assert_eq!(h.redo(&one).unwrap().render.exposure, 2.0);
+        assert_eq!(h.redo(&zero).unwrap().render.display.exposure, 1.0);
+        assert_eq!(h.redo(&one).unwrap().render.display.exposure, 2.0);
         assert!(!h.can_redo());
     }
 
@@ -129,7 +129,7 @@ mod tests {
         // The pointer is released: the gesture ends without a change.
         h.observe(&with_exposure(3.0), false);
         let before = h.undo(&with_exposure(3.0)).unwrap();
-        assert_eq!(before.render.exposure, 0.0);
+        assert_eq!(before.render.display.exposure, 0.0);
         assert!(!h.can_undo());
     }
 
@@ -167,10 +167,10 @@ mod tests {
         h.observe(&moved, false);
         assert!(!h.can_undo());
         let mut edited = moved.clone();
-        edited.render.exposure = 1.0;
+        edited.render.display.exposure = 1.0;
         h.observe(&edited, false);
         let undone = h.undo(&edited).unwrap();
-        assert_eq!(undone.render.exposure, 0.0);
+        assert_eq!(undone.render.display.exposure, 0.0);
         assert_eq!(undone.camera.yaw_degrees, 40.0);
     }
 
@@ -187,6 +187,6 @@ mod tests {
             undone += 1;
         }
         assert_eq!(undone, MAX_STEPS);
-        assert_eq!(current.render.exposure, 10.0);
+        assert_eq!(current.render.display.exposure, 10.0);
     }
 }

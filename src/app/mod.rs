@@ -13,6 +13,7 @@ mod feature_costs;
 mod file_dialogs;
 mod file_watch;
 mod frame_budget;
+pub mod frame_script;
 mod history;
 mod kernel_choice;
 mod prompts;
@@ -44,8 +45,8 @@ pub struct ViewerOptions {
     pub env: Option<PathBuf>,
     pub exit_after_frames: Option<u64>,
     pub window_screenshot: Option<PathBuf>,
-    /// Read `shaders/` from the source tree and rebuild the trace pipeline
-    /// when a file there changes.
+    /// Read the WGSL files from the source tree and rebuild the trace
+    /// pipeline when one changes.
     pub dev: bool,
     /// Run as `marbre soak`: random edits driven frame by frame, memory
     /// judged at the end.

@@ -182,7 +182,7 @@ mod tests {
     /// A recovery file as process `pid` would leave it.
     fn left_by(dir: &Path, pid: u32, saved_at: &str, exposure: f32) {
         let mut preset = Preset::default();
-        preset.scene.render.exposure = exposure;
+        preset.scene.render.display.exposure = exposure;
         preset::save(&preset, &preset_file(dir, pid)).unwrap();
         let info = RecoveryInfo {
             source: PathBuf::from(format!("/presets/{pid}.ron")),
@@ -207,7 +207,7 @@ mod tests {
         let offer = pending_offer(dir.path()).expect("an offer");
         assert_eq!(offer.source, Path::new(&format!("/presets/{GONE}.ron")));
         let recovered = preset::load(&offer.preset).unwrap().preset;
-        assert_eq!(recovered.scene.render.exposure, 3.0);
+        assert_eq!(recovered.scene.render.display.exposure, 3.0);
         discard(&offer);
         assert_eq!(pending_offer(dir.path()), None);
         assert!(
@@ -261,7 +261,7 @@ mod tests {
         let mut autosave = Autosave::new(dir.path().to_owned());
         let mine = preset_file(dir.path(), std::process::id());
         let mut edited = Preset::default();
-        edited.scene.render.exposure = 3.0;
+        edited.scene.render.display.exposure = 3.0;
         autosave
             .tick(true, Path::new("a.ron"), || edited.clone())
             .unwrap();
@@ -271,7 +271,7 @@ mod tests {
             .tick(true, Path::new("a.ron"), || edited.clone())
             .unwrap();
         let saved = preset::load(&mine).unwrap().preset;
-        assert_eq!(saved.scene.render.exposure, 3.0);
+        assert_eq!(saved.scene.render.display.exposure, 3.0);
         autosave
             .tick(false, Path::new("a.ron"), || unreachable!())
             .unwrap();
@@ -289,7 +289,7 @@ mod tests {
         second.pid = GONE;
         for (autosave, exposure) in [(&mut first, 1.5), (&mut second, 2.5)] {
             let mut edited = Preset::default();
-            edited.scene.render.exposure = exposure;
+            edited.scene.render.display.exposure = exposure;
             autosave.last_write -= AUTOSAVE_INTERVAL;
             autosave.tick(true, Path::new("a.ron"), || edited).unwrap();
         }
@@ -299,6 +299,7 @@ mod tests {
                 .preset
                 .scene
                 .render
+                .display
                 .exposure
         };
         assert_eq!(exposure(std::process::id()), 1.5);

@@ -4,10 +4,11 @@
 //! judged at the end: RSS, the GPU allocator's bytes and wgpu's live
 //! objects must stay within a bound of what they were after the warm-up.
 //!
-//! The viewer owns the loop; per frame it calls [`SoakDriver::step`]
-//! before the UI runs and applies the action it returns, then
-//! [`sample_memory`] and [`SoakDriver::record`] after presenting, and at
-//! the end prints [`SoakDriver::verdict`].
+//! The viewer owns the loop and calls the driver through its one hook,
+//! [`FrameScript`]: [`SoakDriver::step`] before the UI runs (the viewer
+//! applies the action it returns), then [`sample_memory`] and
+//! [`SoakDriver::record`] after presenting, and at the end the driver
+//! prints [`SoakDriver::verdict`].
 
 pub mod command;
 mod edits;
@@ -17,6 +18,7 @@ mod verdict;
 
 pub use memory::{MemorySample, sample_memory};
 
+use super::frame_script::{FrameScript, Presented, ScriptAction};
 use anyhow::{Context, Result};
 use edits::Structural;
 use marbre_core::scene::{EnvSource, Scene};
@@ -86,16 +88,6 @@ impl SoakOptions {
     }
 }
 
-/// What the viewer is to do this frame besides the edit already made.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum SoakAction {
-    Nothing,
-    /// Load this preset through the viewer's own load path.
-    LoadPreset(PathBuf),
-    /// Destroy the device (`device.destroy()`) and recover from the loss.
-    LoseDevice,
-}
-
 /// The chance that a frame makes a structural edit (a shader rebuild,
 /// about a second of CPU on lavapipe, off the render thread).
 const STRUCTURAL_CHANCE: f32 = 1.0 / 40.0;
@@ -148,22 +140,22 @@ impl SoakDriver {
     /// preset load (cycling through the presets) or, once mid-run, a
     /// simulated device loss. An edit the renderer refuses is put back by
     /// the viewer, as any refused panel edit is.
-    pub fn step(&mut self, frame: u64, scene: &mut Scene) -> SoakAction {
+    pub fn step(&mut self, frame: u64, scene: &mut Scene) -> ScriptAction {
         // A frame the viewer could not present (an outdated surface) comes
         // round again with the same number: it gets no second action.
         if self.last_step.replace(frame) == Some(frame) {
-            return SoakAction::Nothing;
+            return ScriptAction::Nothing;
         }
         if frame == self.loss_frame {
             self.losses += 1;
-            return SoakAction::LoseDevice;
+            return ScriptAction::LoseDevice;
         }
         if !self.options.presets.is_empty() && frame > 0 && frame.is_multiple_of(self.load_interval)
         {
             let index = (self.loads % self.options.presets.len() as u64) as usize;
             self.loads += 1;
             self.env_map = None;
-            return SoakAction::LoadPreset(self.options.presets[index].clone());
+            return ScriptAction::LoadPreset(self.options.presets[index].clone());
         }
         if scene.environment.source.is_map() {
             self.env_map = Some(scene.environment.source.clone());
@@ -176,7 +168,7 @@ impl SoakDriver {
         } else if self.rng.chance(PARAMETER_CHANCE) && edits::parameter_edit(&mut self.rng, scene) {
             self.parameter_edits += 1;
         }
-        SoakAction::Nothing
+        ScriptAction::Nothing
     }
 
     /// Once per frame, after present. Every tenth of the run (a 10,000-frame
@@ -327,6 +319,31 @@ impl SoakDriver {
             ));
         }
         out
+    }
+}
+
+impl FrameScript for SoakDriver {
+    fn before_frame(&mut self, frame: u64, scene: &mut Scene) -> ScriptAction {
+        self.step(frame, scene)
+    }
+
+    /// Records the frame's memory; after the last frame prints the verdict
+    /// and fails the run if it says so.
+    fn after_present(&mut self, presented: Presented<'_>) -> Result<bool> {
+        self.record(presented.frame, sample_memory(presented.ctx));
+        if !self.finished(presented.frame) {
+            return Ok(true);
+        }
+        match self.verdict(presented.validation_errors) {
+            Ok(report) => {
+                eprintln!("{report}");
+                Ok(false)
+            }
+            Err(report) => {
+                eprintln!("{report}");
+                anyhow::bail!("the soak failed (see above)")
+            }
+        }
     }
 }
 

@@ -1,5 +1,5 @@
 //! `marbre bench-bvh`: builds the BVH of a heavy procedural mesh and times
-//! the GPU's traversal of it (`shaders/bvh.wgsl` through the compute
+//! the GPU's traversal of it (`crates/core/src/accel/traverse.wgsl` through the compute
 //! harness), with the CPU's traversal on one thread for scale.
 
 use anyhow::{Result, ensure};
@@ -8,7 +8,7 @@ use glam::Vec3;
 use marbre_core::accel::shapes::bumpy_sphere;
 use marbre_core::accel::{Bvh, TriangleVerts};
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::bvh_harness::{BvhHarness, Query, Ray};
+use marbre_render::gpu::harness::bvh::{BvhHarness, Query, Ray};
 use std::time::{Duration, Instant};
 
 #[derive(Args, Debug)]

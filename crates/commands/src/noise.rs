@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 use marbre_core::noise::{self, FractalParams, HashKind, NoiseKind, NoiseSettings};
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::noise_harness::{Evaluate, evaluate_scalar};
+use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 

@@ -10,7 +10,7 @@ use anyhow::{Context, Result, anyhow};
 use glam::{DVec3, Vec3};
 use marbre_core::noise::{self, HashKind, NoiseKind, NoiseSettings};
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::noise_harness::{Evaluate, evaluate_scalar};
+use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use plotters::prelude::*;
 use std::path::Path;
 

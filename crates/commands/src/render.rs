@@ -82,7 +82,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
     if args.auto_exposure {
-        loaded.scene.render.auto_exposure = true;
+        loaded.scene.render.display.auto_exposure = true;
     }
     let ctx = GpuContext::headless()?;
     let loaded = loaded.fit_environment(max_texture_side(&ctx));
@@ -110,7 +110,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     bar.finish();
     // EXR output is the radiance, unscaled: only a PNG is exposed.
-    if loaded.scene.render.auto_exposure && matches!(format, image_io::ImageFormat::Png) {
+    if loaded.scene.render.display.auto_exposure && matches!(format, image_io::ImageFormat::Png) {
         report_auto_exposure(&ctx, &mut renderer)?;
     }
     match format {
@@ -188,7 +188,7 @@ fn report_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstimate
 fn report_auto_exposure(ctx: &GpuContext, renderer: &mut Renderer) -> Result<()> {
     let metered = renderer.metering(ctx)?;
     let (_, _, pixels) = renderer.read_radiance(ctx)?;
-    let compensation = renderer.scene().render.exposure;
+    let compensation = renderer.scene().render.display.exposure;
     eprintln!(
         "auto exposure: {:+.2} stops{} (log-average luminance {:.4} over {} metered texels; \
          {:.4} over the whole image)",

@@ -1,4 +1,4 @@
-//! CPU twin of `shaders/bsdf.wgsl`: Lambert plus GGX (Smith, separable)
+//! CPU twin of `crates/core/src/bsdf.wgsl`: Lambert plus GGX (Smith, separable)
 //! with an optional perfect mirror, its value and sampling density
 //! together, and its sampling from four uniform numbers. Written line for
 //! line after the shader so the chi² and property tests can check the
@@ -7,6 +7,9 @@
 use crate::texture::luminance;
 use glam::{Mat3, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/bsdf.wgsl");
 
 /// The material at a shading point, as `SurfacePoint` holds it.
 #[derive(Debug, Clone, Copy, PartialEq)]

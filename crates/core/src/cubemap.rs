@@ -28,7 +28,7 @@
 //! grows from +z (0.5) towards +x (0.75). So a cube map and the lat-long
 //! made from the same panorama look the same here, and [`CubeMap::from_latlong`]
 //! followed by [`CubeMap::to_latlong`] gives back the original
-//! (tests/cubemap.rs checks both).
+//! (crates/render/tests/gpu/cubemap.rs checks both).
 //!
 //! A horizontal cross ([`CubeMap::from_cross`]) is 4 × 3 faces, each face
 //! in its file orientation, so that it unfolds the cube without cuts along

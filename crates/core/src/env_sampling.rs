@@ -2,7 +2,7 @@
 //! proportion to luminance × sin θ (the solid angle a row of texels spans),
 //! by a marginal CDF over rows and a conditional CDF over each row's
 //! columns (pbrt's `Distribution2D`). The GPU holds the same CDFs and
-//! samples them the same way (shaders/env_sampling.wgsl).
+//! samples them the same way (crates/core/src/env_sampling.wgsl).
 //!
 //! Coordinates are the image's texel uv `t` (row 0 at the top, as in
 //! [`crate::envmap::uv_to_texel_uv`]): the lab's (u, v) = (t.x, 1 − t.y).
@@ -23,6 +23,9 @@ use crate::envmap::{EnvImage, direction_to_uv, rotate_y, uv_to_texel_uv};
 use crate::texture::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/env_sampling.wgsl");
 
 /// Piecewise-constant 2D distribution over the map's texel uv.
 #[derive(Debug, Clone, PartialEq)]

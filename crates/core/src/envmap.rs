@@ -35,6 +35,9 @@ use glam::{Vec2, Vec3};
 use half::f16;
 use thiserror::Error;
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/envmap.wgsl");
+
 /// The largest finite half float. The GPU texture is `Rgba16Float`, so
 /// anything brighter would become +Inf there.
 pub const F16_MAX: f32 = 65504.0;

@@ -19,6 +19,7 @@ pub mod obj_syntax;
 pub mod preset;
 pub mod scene;
 pub mod texture;
+pub mod wgsl;
 
 /// The repository's root, where the shipped presets, images and env maps
 /// that unit tests read live.

@@ -7,7 +7,7 @@
 //! one small and bright, one large and dim made of many triangles; picking
 //! triangles uniformly starves the bright one). The table holds the
 //! cumulative distribution of power, searched by bisection on the GPU
-//! (`shaders/lights.wgsl`).
+//! (`crates/core/src/lights.wgsl`).
 
 use crate::scene::{Material, Property, Scene, SurfacePoint};
 use crate::texture::luminance;
@@ -19,7 +19,10 @@ use std::f32::consts::PI;
 /// other transport settings.
 pub use crate::scene::transport::LightSelection;
 
-/// `Light` of `shaders/scene.wgsl`.
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/lights.wgsl");
+
+/// `Light` of `crates/render/shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
 pub struct LightGpu {

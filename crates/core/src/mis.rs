@@ -1,4 +1,4 @@
-//! CPU twin of `shaders/mis.wgsl`: the weights that combine light sampling
+//! CPU twin of `crates/core/src/mis.wgsl`: the weights that combine light sampling
 //! and BSDF sampling of the same light (Veach 1997), guarded so that every
 //! weight is finite and in [0, 1], and a pair sums to 1 wherever either
 //! density is positive, whatever the densities: 0, subnormal, huge or
@@ -6,6 +6,9 @@
 //! 1 / (2π (1 − cos θmax)) for a radius under ~3e-20 of its distance).
 
 use crate::scene::Strategy;
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/mis.wgsl");
 
 /// The weight of a sample drawn with density `a` against the other
 /// strategy's density `b` for the same direction. An infinite density

@@ -21,7 +21,7 @@ fn height_at(hit: Hit, fp: Footprint, signals: vec4f, du: f32, dv: f32) -> f32 {
     return surface_height(hit.material, p, pw, hit.uv + vec2f(du, dv), fp, offset_signals);
 }
 
-// The bumped normal, kept facing the viewer `wo` (shading_normal.wgsl).
+// The bumped normal, kept facing the viewer `wo` (texture/bump.wgsl).
 fn bumped_shading_normal(hit: Hit, fp: Footprint, signals: vec4f, wo: vec3f) -> vec3f {
     let height = materials[hit.material].bump_height;
     let dh_du = height_at(hit, fp, signals, BUMP_STEP, 0.0) - height_at(hit, fp, signals, -BUMP_STEP, 0.0);

@@ -1,5 +1,6 @@
 // Ray-scene intersection. Rays start on robustly offset origins (see
-// offset_ray in ray_geometry.wgsl), so t > 0 is the only lower bound needed.
+// offset_ray in geometry/ray_offset.wgsl), so t > 0 is the only lower
+// bound needed.
 
 struct Hit {
     t: f32,
@@ -30,7 +31,7 @@ const SHAPE_POLYGON: u32 = 2u;
 const SHAPE_GROUND: u32 = 3u;
 const SHAPE_TRIANGLE: u32 = 4u;
 
-// The sphere's distance (ray_geometry.wgsl) read from the uniform array.
+// The sphere's distance (geometry/sphere.wgsl) read from the uniform array.
 fn intersect_sphere(o: vec3f, d: vec3f, s: Sphere) -> f32 {
     return sphere_distance(o, d, s.center, s.radius);
 }

@@ -45,7 +45,7 @@ struct Frame {
     // Russian roulette from this bounce on (0: never).
     russian_roulette_from: u32,
     triangle_count: u32,
-    // Always 1.0, but the compiler cannot know it (accumulate.wgsl).
+    // Always 1.0, but the compiler cannot know it (accumulation.wgsl).
     opaque_one: f32,
     // The firefly clamp on a sample's largest channel; 0: off.
     sample_clamp: f32,
@@ -135,7 +135,7 @@ const MAX_SPHERES: u32 = 63u;
 
 #if IMAGE
 // Every image of the scene with its mip levels (Rust: texture::ImageAtlas),
-// read with textureLoad and filtered by hand (texture_image.wgsl).
+// read with textureLoad and filtered by hand (texture/image.wgsl).
 @group(0) @binding(8) var image_atlas: texture_2d<f32>;
 #endif
 
@@ -163,7 +163,7 @@ struct TriangleAttributes {
     _pad: u32,
 }
 
-// The meshes' triangles in BVH order (bvh.wgsl reads the nodes and the
+// The meshes' triangles in BVH order (accel/traverse.wgsl reads the nodes and the
 // vertices; the attributes are read once per hit).
 @group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(13) var<storage, read> mesh_triangles: array<TriangleVerts>;

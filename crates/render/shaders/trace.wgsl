@@ -1,7 +1,7 @@
 // The per-frame trace pass: `samples_per_frame` jittered paths per pixel,
 // folded into the running mean held in the accumulation target, and the
 // spread of the frames' means folded into the second-moment target (what
-// the error meter, shaders/error_meter.wgsl, estimates the image's error
+// the error meter, crates/render/src/gpu/error_meter.wgsl, estimates the image's error
 // from). One body, `trace_pixel`, and two kernels that call it: `fs_trace`
 // (a full-screen triangle, the targets as colour attachments) and
 // `cs_trace` (a compute dispatch over a band of rows, the targets as
@@ -24,7 +24,7 @@ struct NonFiniteCounters {
 
 // What one frame leaves per pixel: the running mean of every sample so far,
 // the running weighted second moment about it (Welford's update), and the
-// mean's Kahan compensation (accumulate.wgsl).
+// mean's Kahan compensation (accumulation.wgsl).
 struct Accumulated {
     @location(0) mean: vec4f,
     @location(1) spread: vec4f,

@@ -316,11 +316,11 @@ fn edit_fractal(rng: &mut Pcg32, f: &mut FractalParams) {
 fn edit_render_settings(rng: &mut Pcg32, render: &mut RenderSettings) {
     let stops = RenderSettings::MAX_EXPOSURE_STOPS;
     match rng.below(6) {
-        0 => render.exposure = rng.range(-stops, stops),
-        1 => render.tone_map = ToneMap::ALL[rng.below(ToneMap::ALL.len())],
+        0 => render.display.exposure = rng.range(-stops, stops),
+        1 => render.display.tone_map = ToneMap::ALL[rng.below(ToneMap::ALL.len())],
         2 => render.samples_per_frame = 1 + rng.below(4) as u32,
         3 => render.max_bounces = 1 + rng.below(6) as u32,
-        4 => render.auto_exposure = !render.auto_exposure,
+        4 => render.display.auto_exposure = !render.display.auto_exposure,
         _ => render.interactive_scale = rng.range(0.1, 1.0),
     }
 }

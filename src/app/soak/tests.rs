@@ -217,7 +217,7 @@ fn step_is_deterministic_for_a_seed() {
             .collect::<Vec<_>>()
     };
     let (a, b, other) = (run(5), run(5), run(6));
-    assert!(a.iter().any(|(action, _)| *action != SoakAction::Nothing));
+    assert!(a.iter().any(|(action, _)| *action != ScriptAction::Nothing));
     assert!(a == b, "two runs with seed 5 differ");
     assert!(a != other, "seeds 5 and 6 made the same edits");
     assert!(a.iter().any(|(_, scene)| *scene != start));
@@ -240,12 +240,12 @@ fn ten_thousand_steps_make_every_edit_and_keep_the_scene_valid() {
     let (mut loads, mut losses, mut nothing) = (Vec::new(), 0, 0);
     for frame in 0..options.frames {
         match driver.step(frame, &mut scene) {
-            SoakAction::Nothing => nothing += 1,
-            SoakAction::LoadPreset(path) => {
+            ScriptAction::Nothing => nothing += 1,
+            ScriptAction::LoadPreset(path) => {
                 scene = load(&path);
                 loads.push(path);
             }
-            SoakAction::LoseDevice => losses += 1,
+            ScriptAction::LoseDevice => losses += 1,
         }
         assert!(
             is_sanitized(&scene),
@@ -289,7 +289,7 @@ fn a_repeated_frame_gets_no_second_action() {
     for frame in 0..300 {
         for _ in 0..2 {
             let action = driver.step(frame, &mut scene);
-            if action != SoakAction::Nothing {
+            if action != ScriptAction::Nothing {
                 actions.push((frame, action));
             }
         }
@@ -298,10 +298,10 @@ fn a_repeated_frame_gets_no_second_action() {
     assert_eq!(
         actions,
         [
-            (75, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[0]))),
-            (150, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[1]))),
-            (187, SoakAction::LoseDevice),
-            (225, SoakAction::LoadPreset(root.join(DEFAULT_PRESETS[2]))),
+            (75, ScriptAction::LoadPreset(root.join(DEFAULT_PRESETS[0]))),
+            (150, ScriptAction::LoadPreset(root.join(DEFAULT_PRESETS[1]))),
+            (187, ScriptAction::LoseDevice),
+            (225, ScriptAction::LoadPreset(root.join(DEFAULT_PRESETS[2]))),
         ]
     );
 }

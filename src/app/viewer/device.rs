@@ -36,7 +36,7 @@ impl Viewer {
         };
         let size = self.renderer.size();
         self.renderer = renderer_with(&ctx, &loaded, size, self.renderer.kernel())?;
-        self.timer = PassTimer::new(&ctx);
+        self.meters.timer = PassTimer::new(&ctx);
         self.ui_layer = None;
         self.egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());

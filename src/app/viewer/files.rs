@@ -39,8 +39,8 @@ impl Viewer {
 
     /// Loads `path`, first asking what to do with unsaved edits.
     pub(super) fn request_load_preset(&mut self, path: &Path) {
-        if self.document.is_dirty(&self.scene) {
-            self.prompt = Some(Prompt::LoadPreset(path.to_owned()));
+        if self.edits.document.is_dirty(&self.scene) {
+            self.edits.prompt = Some(Prompt::LoadPreset(path.to_owned()));
         } else {
             self.load_preset(path);
         }
@@ -56,7 +56,7 @@ impl Viewer {
     /// camera is the one the preset had (a reload after an outside edit).
     fn start_loading(&mut self, path: &Path, keep_view: Option<KeepView>) {
         let load = SceneLoad::start(path, None, max_texture_side(&self.ctx));
-        self.loading = Some((load, keep_view));
+        self.incoming.loading = Some((load, keep_view));
     }
 
     /// Starts loading the preset the window opens on, with the command
@@ -64,9 +64,12 @@ impl Viewer {
     pub(super) fn start_startup_load(&mut self, path: &Path, may_fall_back: bool) {
         let env = self.options.env.as_deref();
         let load = SceneLoad::start(path, env, max_texture_side(&self.ctx));
-        self.loading = Some((load, None));
+        self.incoming.loading = Some((load, None));
         self.panel.preset_path = path.display().to_string();
-        let startup = self.startup.get_or_insert_with(StartupLoad::default);
+        let startup = self
+            .incoming
+            .startup
+            .get_or_insert_with(StartupLoad::default);
         startup.may_fall_back = may_fall_back;
     }
 
@@ -75,7 +78,7 @@ impl Viewer {
     /// start-up load with nothing to fall back to fails the viewer, as a
     /// preset named on the command line that does not load always has.
     pub(super) fn poll_loading(&mut self) -> Result<()> {
-        let Some((load, _)) = &self.loading else {
+        let Some((load, _)) = &self.incoming.loading else {
             self.panel.progress = None;
             return Ok(());
         };
@@ -84,14 +87,14 @@ impl Viewer {
             self.panel.progress = Some((format!("{}: {stage}", load.path().display()), fraction));
             return Ok(());
         };
-        let (load, keep_view) = self.loading.take().expect("a load is under way");
+        let (load, keep_view) = self.incoming.loading.take().expect("a load is under way");
         self.panel.progress = None;
         let installed = result.and_then(|ready| self.install_loaded(load.path(), ready, keep_view));
-        match (installed, self.startup.as_ref()) {
+        match (installed, self.incoming.startup.as_ref()) {
             (Ok(()), None) => Ok(()),
             // Undo starts at the loaded scene, not at the placeholder.
             (Ok(()), Some(_)) => {
-                self.history = History::new(&self.scene);
+                self.edits.history = History::new(&self.scene);
                 Ok(())
             }
             (Err(e), None) => {
@@ -115,10 +118,10 @@ impl Viewer {
     /// then it is what the window shows, and an F12 pressed meanwhile saves
     /// it rather than the placeholder.
     pub(super) fn release_held_input(&mut self) -> Result<()> {
-        if self.loading.is_some() {
+        if self.incoming.loading.is_some() {
             return Ok(());
         }
-        let Some(startup) = self.startup.take() else {
+        let Some(startup) = self.incoming.startup.take() else {
             return Ok(());
         };
         for event in &startup.held_events {
@@ -148,11 +151,11 @@ impl Viewer {
         {
             self.scene.camera = keep.camera;
         }
-        self.preset_camera = loaded.scene.camera;
+        self.edits.preset_camera = loaded.scene.camera;
         let description = preset::load(path)
             .map(|l| l.preset.description)
             .unwrap_or_default();
-        self.document = Document::new(path, description, &self.scene);
+        self.edits.document = Document::new(path, description, &self.scene);
         self.panel.preset_path = path.display().to_string();
         if let EnvSource::LatLong { path } = &self.scene.environment.source {
             self.panel.env_path = path.display().to_string();
@@ -254,7 +257,7 @@ impl Viewer {
 
     /// Saves the scene to `path` (atomically); returns whether it saved.
     pub(super) fn save_preset(&mut self, path: &Path) -> bool {
-        match self.document.save(&self.scene, path) {
+        match self.edits.document.save(&self.scene, path) {
             Ok(()) => {
                 self.panel.preset_path = path.display().to_string();
                 self.panel.info(format!("saved {}", path.display()));
@@ -272,7 +275,7 @@ impl Viewer {
     /// Opens a native file dialog; where none can open, points the user
     /// to the typed path and to drag and drop instead.
     pub(super) fn open_dialog(&mut self, purpose: DialogPurpose) {
-        if self.dialog.is_some() {
+        if self.incoming.dialog.is_some() {
             return;
         }
         if !dialogs_available() {
@@ -288,17 +291,18 @@ impl Viewer {
         }
         let start = match purpose {
             DialogPurpose::OpenEnvironment => self.settings.recent_files.first().cloned(),
-            _ => Some(self.document.path.clone()),
+            _ => Some(self.edits.document.path.clone()),
         };
-        self.dialog = Some(OpenDialog::open(purpose, start));
+        self.incoming.dialog = Some(OpenDialog::open(purpose, start));
     }
 
     /// Acts on a dialog that has closed.
     pub(super) fn poll_dialog(&mut self) {
-        let Some((purpose, chosen)) = self.dialog.as_ref().and_then(OpenDialog::poll) else {
+        let Some((purpose, chosen)) = self.incoming.dialog.as_ref().and_then(OpenDialog::poll)
+        else {
             return;
         };
-        self.dialog = None;
+        self.incoming.dialog = None;
         let Some(path) = chosen else {
             return;
         };
@@ -313,10 +317,10 @@ impl Viewer {
 
     /// Carries out what the user answered to the open prompt.
     pub(super) fn answer_prompt(&mut self, answer: Answer) {
-        let Some(prompt) = self.prompt.take() else {
+        let Some(prompt) = self.edits.prompt.take() else {
             return;
         };
-        let path = self.document.path.clone();
+        let path = self.edits.document.path.clone();
         match (prompt, answer) {
             (_, Answer::Cancel) | (Prompt::ReloadFromDisk, Answer::SaveFirst) => {}
             (Prompt::LoadPreset(next), Answer::SaveFirst) => {
@@ -373,7 +377,7 @@ impl Viewer {
             .map(|l| l.preset.description.clone())
             .unwrap_or_default();
         let saved = original.map_or_else(Scene::default, |l| l.preset.scene);
-        self.document = Document::new(&offer.source, description, &saved);
+        self.edits.document = Document::new(&offer.source, description, &saved);
         self.panel.preset_path = offer.source.display().to_string();
         self.panel.info(format!(
             "recovered the unsaved changes to {} from {}",
@@ -384,28 +388,28 @@ impl Viewer {
         true
     }
 
-    /// Watches the preset's folder, and `shaders/` in `--dev` mode.
+    /// Watches the preset's folder, and the WGSL sources in `--dev` mode.
     pub(super) fn start_watching(&mut self) {
-        if self.watch.is_none() {
+        if self.incoming.watch.is_none() {
             match FileWatch::new() {
-                Ok(watch) => self.watch = Some(watch),
+                Ok(watch) => self.incoming.watch = Some(watch),
                 Err(e) => self.panel.error(format!("hot reload is off: {e:#}")),
             }
         }
-        if let Some(watch) = &mut self.watch
-            && let Err(e) = watch.watch_folder_of(&self.document.path)
+        if let Some(watch) = &mut self.incoming.watch
+            && let Err(e) = watch.watch_folder_of(&self.edits.document.path)
         {
             self.panel.error(format!("hot reload is off: {e:#}"));
         }
-        if self.options.dev && self.shader_watch.is_none() {
+        if self.options.dev && self.incoming.shader_watch.is_none() {
             let shaders = dev_shader_dir();
             let watch = FileWatch::new().and_then(|mut w| {
-                w.watch_folder_of(&shaders.join("trace.wgsl"))?;
+                w.watch_tree(&shaders)?;
                 Ok(w)
             });
             match watch {
                 Ok(watch) => {
-                    self.shader_watch = Some(watch);
+                    self.incoming.shader_watch = Some(watch);
                     self.panel.info(format!(
                         "--dev: editing a shader in {} rebuilds the trace pipeline",
                         shaders.display()
@@ -422,21 +426,21 @@ impl Viewer {
     /// with unsaved edits); a shader in `--dev` mode rebuilds the pipeline,
     /// a failed build keeping the old one and showing why.
     pub(super) fn poll_file_watch(&mut self) {
-        let preset_changed = self.watch.as_ref().is_some_and(|w| {
+        let preset_changed = self.incoming.watch.as_ref().is_some_and(|w| {
             w.changed()
                 .iter()
-                .any(|p| is_same_file(p, &self.document.path))
+                .any(|p| is_same_file(p, &self.edits.document.path))
         });
-        if preset_changed && self.document.changed_on_disk() {
-            if self.document.is_dirty(&self.scene) {
-                if self.prompt.is_none() {
-                    self.prompt = Some(Prompt::ReloadFromDisk);
+        if preset_changed && self.edits.document.changed_on_disk() {
+            if self.edits.document.is_dirty(&self.scene) {
+                if self.edits.prompt.is_none() {
+                    self.edits.prompt = Some(Prompt::ReloadFromDisk);
                 }
             } else {
                 self.reload_from_disk();
             }
         }
-        let shaders_changed = self.shader_watch.as_ref().is_some_and(|w| {
+        let shaders_changed = self.incoming.shader_watch.as_ref().is_some_and(|w| {
             w.changed()
                 .iter()
                 .any(|p| p.extension().is_some_and(|e| e == "wgsl"))
@@ -451,15 +455,15 @@ impl Viewer {
     fn reload_from_disk(&mut self) {
         let keep = KeepView {
             camera: self.scene.camera,
-            preset_camera: self.preset_camera,
+            preset_camera: self.edits.preset_camera,
         };
-        let path = self.document.path.clone();
+        let path = self.edits.document.path.clone();
         self.start_loading(&path, Some(keep));
     }
 
     fn reload_shaders(&mut self) {
         let dir = dev_shader_dir();
-        match shader_source::load_dev_sources(&dir) {
+        match shader_source::load_dev_sources() {
             Ok(None) => {}
             Ok(Some(generation)) => {
                 self.panel.info(format!(
@@ -475,9 +479,10 @@ impl Viewer {
     }
 }
 
-/// The `shaders/` folder `--dev` reads: the source tree's.
+/// The folder holding every WGSL file `--dev` reads: the source tree's
+/// `crates/`.
 fn dev_shader_dir() -> PathBuf {
-    PathBuf::from(marbre_render::gpu::shader_source::SHADER_DIR)
+    PathBuf::from(shader_source::DEV_SOURCE_ROOT)
 }
 
 /// The view to keep across a reload, unless the file moved the camera.

@@ -25,26 +25,28 @@ impl Viewer {
     fn quality_stats(&self) -> QualityStats {
         let scene_features: Vec<_> = FeatureSet::for_scene(&self.scene).0.into_iter().collect();
         QualityStats {
-            points: self.convergence.points().to_vec(),
-            latest: self.convergence.latest(),
+            points: self.meters.convergence.points().to_vec(),
+            latest: self.meters.convergence.latest(),
             paused_at_target: self.paused_at_target(),
             // The trace on the CPU clock where it is timed so (CPU adapters).
-            passes: self.timer.as_ref().map_or_else(Vec::new, |t| {
+            passes: self.meters.timer.as_ref().map_or_else(Vec::new, |t| {
                 Pass::ALL
                     .iter()
                     .map(|&p| match p {
-                        Pass::Trace if self.trace_on_wall_clock() => (p.label(), self.trace_ms),
+                        Pass::Trace if self.trace_on_wall_clock() => {
+                            (p.label(), self.meters.trace_ms)
+                        }
                         _ => (p.label(), t.ms(p)),
                     })
                     .collect()
             }),
             without_ms: scene_features
                 .iter()
-                .map(|&f| self.feature_costs.without(f))
+                .map(|&f| self.meters.feature_costs.without(f))
                 .collect(),
             scene_features,
-            disabled: self.feature_costs.disabled().clone(),
-            with_all_ms: self.feature_costs.with_all(),
+            disabled: self.meters.feature_costs.disabled().clone(),
+            with_all_ms: self.meters.feature_costs.with_all(),
         }
     }
 
@@ -52,18 +54,18 @@ impl Viewer {
     /// and the estimate of the current image is there.
     fn paused_at_target(&self) -> bool {
         let controls = &self.panel.quality;
-        controls.stop_at_target && self.convergence.reached(controls.target_error)
+        controls.stop_at_target && self.meters.convergence.reached(controls.target_error)
     }
 
     /// Follows the non-finite counters: they restart with the
     /// accumulation, and a readback arrives a frame or two late.
     fn observe_non_finite(&mut self) {
         let generation = self.renderer.accumulation_generation();
-        if self.non_finite.0 != generation {
-            self.non_finite = (generation, NonFiniteCounts::default());
+        if self.meters.non_finite.0 != generation {
+            self.meters.non_finite = (generation, NonFiniteCounts::default());
         }
         if let Some(counts) = self.renderer.poll_non_finite() {
-            self.non_finite.1 = counts;
+            self.meters.non_finite.1 = counts;
         }
     }
 
@@ -72,12 +74,12 @@ impl Viewer {
         let round_ms = self
             .budget
             .round_ms(u64::from(w) * u64::from(h))
-            .or_else(|| self.timer.as_ref().and_then(|t| t.ms(Pass::Trace)));
+            .or_else(|| self.meters.timer.as_ref().and_then(|t| t.ms(Pass::Trace)));
         let info = self.ctx.adapter.get_info();
         let mesh = self.renderer.mesh_stats();
         Stats {
-            fps: self.fps,
-            ms_per_frame: round_ms.unwrap_or(self.ms_per_frame),
+            fps: self.clock.fps,
+            ms_per_frame: round_ms.unwrap_or(self.clock.ms_per_frame),
             ms_is_gpu: !self.trace_on_wall_clock(),
             kernel: self.renderer.kernel(),
             kernel_choice: self.kernels.choice(),
@@ -101,7 +103,7 @@ impl Viewer {
             triangles: mesh.triangles,
             bvh_nodes: mesh.bvh_nodes,
             bvh_build_ms: mesh.bvh_build.as_secs_f32() * 1000.0,
-            non_finite: self.non_finite.1,
+            non_finite: self.meters.non_finite.1,
             quality: self.quality_stats(),
         }
     }
@@ -126,6 +128,7 @@ impl Viewer {
         // A structural edit that changes the scene's features ends any
         // feature-cost experiment: the new shader is specialised again.
         if self
+            .meters
             .feature_costs
             .follow_scene(&FeatureSet::for_scene(&self.scene))
         {
@@ -150,7 +153,7 @@ impl Viewer {
         // step of the undo history unless a drag or typing goes on.
         let gesture = self.egui_ctx.input(|i| i.pointer.any_down())
             || self.egui_ctx.egui_wants_keyboard_input();
-        self.history.observe(&self.scene, gesture);
+        self.edits.history.observe(&self.scene, gesture);
         // Only an edit can add an image or change a path.
         if edited {
             self.reload_images_if_needed();
@@ -189,7 +192,7 @@ impl Viewer {
         let is_last = self
             .options
             .exit_after_frames
-            .is_some_and(|n| self.frames + 1 >= n);
+            .is_some_and(|n| self.clock.frames + 1 >= n);
         let capture = if is_last && self.options.window_screenshot.is_some() {
             Some(self.capture_texture())
         } else {
@@ -201,20 +204,20 @@ impl Viewer {
         if let Err(e) = self.ctx.device.poll(wgpu::PollType::Poll) {
             log::warn!("polling the device: {e}");
         }
-        self.convergence.observe(
+        self.meters.convergence.observe(
             self.renderer.accumulation_generation(),
             self.renderer.poll_error(),
         );
         self.observe_non_finite();
-        if let Some(t) = &mut self.timer {
+        if let Some(t) = &mut self.meters.timer {
             t.begin_frame();
-            if !self.scene.render.auto_exposure {
+            if !self.scene.render.display.auto_exposure {
                 t.forget(Pass::AutoExposure);
             }
         }
-        if let Some((ms, pixels)) = self.timer.as_mut().and_then(|t| {
+        if let Some((ms, pixels)) = self.meters.timer.as_mut().and_then(|t| {
             let ms = t.take_fresh(Pass::Trace)?;
-            Some((ms, std::mem::take(&mut self.timed_trace_pixels)))
+            Some((ms, std::mem::take(&mut self.meters.timed_trace_pixels)))
         }) {
             self.observe_trace_time(ms, pixels);
         }
@@ -223,19 +226,23 @@ impl Viewer {
             if self.trace_on_wall_clock() {
                 self.trace_and_wait();
             } else {
-                let trace_writes = self.timer.as_ref().and_then(|t| t.timestamps(Pass::Trace));
+                let trace_writes = self
+                    .meters
+                    .timer
+                    .as_ref()
+                    .and_then(|t| t.timestamps(Pass::Trace));
                 let work = self.renderer.trace_within(
                     &self.ctx,
                     &mut encoder,
                     self.budget.budget(),
                     trace_writes,
                 );
-                if self.timer.as_ref().is_some_and(|t| t.is_timing()) {
-                    self.timed_trace_pixels = work.pixels;
+                if self.meters.timer.as_ref().is_some_and(|t| t.is_timing()) {
+                    self.meters.timed_trace_pixels = work.pixels;
                 }
             }
             self.renderer
-                .meter_error(&self.ctx, &mut encoder, self.timer.as_ref());
+                .meter_error(&self.ctx, &mut encoder, self.meters.timer.as_ref());
         }
         let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
         let screen = egui_wgpu::ScreenDescriptor {
@@ -257,22 +264,23 @@ impl Viewer {
         } else {
             self.draw_on_top(&mut encoder, &targets, viewport, &paint_jobs, &screen)?
         };
-        if let Some(t) = &mut self.timer {
+        if let Some(t) = &mut self.meters.timer {
             t.resolve(&mut encoder);
         }
         self.ctx
             .queue
             .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
-        if let Some(t) = &mut self.timer {
+        if let Some(t) = &mut self.meters.timer {
             t.after_submit();
         }
         self.renderer.after_submit();
         self.ctx.queue.present(frame);
-        let soak_goes_on = self.soak_record()?;
-        self.frames += 1;
+        let script_goes_on = self.script_after_present()?;
+        self.clock.frames += 1;
         let controls = &self.panel.quality;
         if controls.screenshot_at_target
             && self
+                .meters
                 .convergence
                 .take_screenshot_moment(controls.target_error)
         {
@@ -289,7 +297,7 @@ impl Viewer {
         if is_last {
             self.report_quality();
         }
-        Ok(!is_last && soak_goes_on)
+        Ok(!is_last && script_goes_on)
     }
 
     /// The image, then egui over it, on each target: for frames whose
@@ -341,7 +349,7 @@ impl Viewer {
             load,
         };
         self.renderer
-            .display(&self.ctx, encoder, &target, self.timer.as_ref())
+            .display(&self.ctx, encoder, &target, self.meters.timer.as_ref())
     }
 
     /// The kept panel layer (egui drawn into it again only if its output
@@ -400,7 +408,11 @@ impl Viewer {
                         store: wgpu::StoreOp::Store,
                     },
                 })],
-                timestamp_writes: self.timer.as_ref().and_then(|t| t.render_pass(Pass::Ui)),
+                timestamp_writes: self
+                    .meters
+                    .timer
+                    .as_ref()
+                    .and_then(|t| t.render_pass(Pass::Ui)),
                 ..Default::default()
             })
             .forget_lifetime();
@@ -426,6 +438,7 @@ impl Viewer {
     fn report_quality(&self) {
         let spp = self.renderer.accumulated_samples();
         let error = self
+            .meters
             .convergence
             .latest()
             .map_or("none yet".to_owned(), |e| {
@@ -445,7 +458,7 @@ impl Viewer {
             None => "not timed yet".to_owned(),
         };
         // The other passes' GPU times: what a frame costs besides the trace.
-        let passes: Vec<String> = self.timer.as_ref().map_or_else(Vec::new, |t| {
+        let passes: Vec<String> = self.meters.timer.as_ref().map_or_else(Vec::new, |t| {
             Pass::ALL[1..]
                 .iter()
                 .filter_map(|&p| t.ms(p).map(|ms| format!("{} {ms:.1} ms", p.label())))
@@ -453,7 +466,7 @@ impl Viewer {
         });
         eprintln!(
             "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}; other passes: {}",
-            self.frames,
+            self.clock.frames,
             self.renderer.kernel(),
             if passes.is_empty() {
                 "not timed".to_owned()
@@ -470,7 +483,7 @@ impl Viewer {
     /// of any size, where the frame took 300 ms: the budget then grew
     /// without bound).
     fn trace_on_wall_clock(&self) -> bool {
-        self.timer.is_none() || self.ctx.is_cpu()
+        self.meters.timer.is_none() || self.ctx.is_cpu()
     }
 
     /// Traces this frame's budget in a submit of its own and waits for it,
@@ -502,10 +515,11 @@ impl Viewer {
             return;
         }
         self.budget.observe(ms, pixels);
-        self.trace_ms = Some(self.trace_ms.map_or(ms, |s| s + 0.2 * (ms - s)));
+        self.meters.trace_ms = Some(self.meters.trace_ms.map_or(ms, |s| s + 0.2 * (ms - s)));
         let (w, h) = self.renderer.render_size();
         let round_ms = ms * (f64::from(w) * f64::from(h) / pixels as f64) as f32;
-        self.feature_costs
+        self.meters
+            .feature_costs
             .record(self.renderer.features(), round_ms);
     }
 

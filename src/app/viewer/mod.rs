@@ -17,6 +17,7 @@ use super::feature_costs::FeatureCosts;
 use super::file_dialogs::OpenDialog;
 use super::file_watch::FileWatch;
 use super::frame_budget::FrameBudget;
+use super::frame_script::{FrameScript, Presented, ScriptAction};
 use super::history::History;
 use super::kernel_choice::KernelChooser;
 use super::prompts::{self, Prompt};
@@ -24,7 +25,7 @@ use super::recovery::{self, Autosave};
 use super::scene_loader::SceneLoad;
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
-use super::soak::{SoakAction, SoakDriver, sample_memory};
+use super::soak::SoakDriver;
 use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::panel::{self, PanelAction, PanelState};
@@ -64,23 +65,52 @@ pub struct Viewer {
     config: wgpu::SurfaceConfiguration,
     ctx: GpuContext,
     renderer: Renderer,
-    /// GPU time of each pass, where the adapter has timestamp queries.
-    timer: Option<PassTimer>,
     /// Lost devices and uncaptured GPU errors.
     device_watch: DeviceWatch,
-    /// The error estimates since the last change, for the Quality panel.
-    convergence: Convergence,
-    /// Trace times with shader features compiled out, for the Quality panel.
-    feature_costs: FeatureCosts,
     /// Which trace kernel runs, and `auto`'s timing of both.
     kernels: KernelChooser,
     /// How much tracing a frame asks for, learnt from the trace's times.
     budget: FrameBudget,
+    /// What the Quality strip and the Stats panel report.
+    meters: Meters,
+    /// The panel's pixels kept between frames (`app/ui_layer.rs`).
+    ui_layer: Option<UiLayer>,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    scene: Scene,
+    /// The preset being edited, its undo history and what guards it.
+    edits: Editing,
+    panel: PanelState,
+    options: ViewerOptions,
+    /// Window size, last preset, recent files; saved on exit.
+    settings: Settings,
+    /// Where settings and the recovery file live (none: not persisted).
+    config_dir: Option<PathBuf>,
+    /// Files on their way in: dialogs, loads, hot reload.
+    incoming: Incoming,
+    /// A script driving the frames (`marbre soak`), through its one hook.
+    script: Option<Box<dyn FrameScript>>,
+    show_help: bool,
+    ui_hidden: bool,
+    /// The user chose to quit: the loop exits after this frame.
+    quitting: bool,
+    clock: FrameClock,
+    screenshot_requested: bool,
+}
+
+/// What the Quality strip and the Stats panel report, gathered frame by
+/// frame.
+struct Meters {
+    /// GPU time of each pass, where the adapter has timestamp queries.
+    timer: Option<PassTimer>,
+    /// The error estimates since the last change, for the Quality panel.
+    convergence: Convergence,
+    /// Trace times with shader features compiled out, for the Quality panel.
+    feature_costs: FeatureCosts,
     /// The trace's time per frame, smoothed, where it is timed on the CPU
     /// clock (the Quality strip's trace row).
     trace_ms: Option<f32>,
-    /// The panel's pixels kept between frames (`app/ui_layer.rs`).
-    ui_layer: Option<UiLayer>,
     /// The figures the panel shows, and when they were taken: refreshed
     /// every [`STATS_REFRESH`], so that the panel stays the same (and its
     /// layer is reused) between refreshes.
@@ -88,51 +118,49 @@ pub struct Viewer {
     /// The pixels traced in the last frame the pass timer timed (its time
     /// arrives a frame or two later), or in the last frame without one.
     timed_trace_pixels: u64,
-    /// Undo and redo of scene edits (Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y).
-    history: History,
     /// Samples the current accumulation dropped for being NaN or infinite,
     /// and the accumulation they count.
     non_finite: (u32, NonFiniteCounts),
-    egui_ctx: egui::Context,
-    egui_state: egui_winit::State,
-    egui_renderer: egui_wgpu::Renderer,
-    scene: Scene,
+}
+
+/// The preset being edited and what keeps its edits safe.
+struct Editing {
     /// The preset file being edited and what it holds.
     document: Document,
     /// The camera the preset was loaded with, for the panel's Reset.
     preset_camera: OrbitCamera,
-    panel: PanelState,
-    options: ViewerOptions,
-    /// Window size, last preset, recent files; saved on exit.
-    settings: Settings,
-    /// Where settings and the recovery file live (none: not persisted).
-    config_dir: Option<PathBuf>,
+    /// Undo and redo of scene edits (Ctrl+Z, Ctrl+Shift+Z or Ctrl+Y).
+    history: History,
     /// Copies unsaved edits to the recovery file now and then.
     autosave: Option<Autosave>,
     /// A question waiting for the user's answer (unsaved changes, recovery).
     prompt: Option<Prompt>,
+}
+
+/// Files on their way in: each arrives on a worker thread or from a
+/// watcher, and lands in the scene between frames.
+#[derive(Default)]
+struct Incoming {
     /// A native file dialog open on its thread.
     dialog: Option<OpenDialog>,
     /// A preset loading on its thread, and the view to keep when it lands.
     loading: Option<(SceneLoad, Option<files::KeepView>)>,
     /// The preset the window opens on is still loading.
     startup: Option<StartupLoad>,
-    /// The preset's folder, and `shaders/` in `--dev` mode, for hot reload.
+    /// The preset's folder, for hot reload.
     watch: Option<FileWatch>,
+    /// The WGSL sources, in `--dev` mode.
     shader_watch: Option<FileWatch>,
-    /// `marbre soak`: random edits each frame, memory judged at the end.
-    soak: Option<SoakDriver>,
-    show_help: bool,
-    ui_hidden: bool,
-    /// The user chose to quit: the loop exits after this frame.
-    quitting: bool,
+}
+
+/// Frames counted and timed.
+struct FrameClock {
     frames: u64,
     last_frame: Instant,
     /// When free heap memory was last handed back ([`HEAP_TRIM_INTERVAL`]).
     last_heap_trim: Instant,
     fps: f32,
     ms_per_frame: f32,
-    screenshot_requested: bool,
 }
 
 /// The preset the window opens on, loading on a worker thread while the
@@ -293,20 +321,24 @@ impl Viewer {
             .and_then(recovery::pending_offer)
             .map(Prompt::Recover);
         let autosave = config_dir.clone().map(Autosave::new);
-        let soak = options.soak.as_ref().map(SoakDriver::new);
+        let script = options
+            .soak
+            .as_ref()
+            .map(|soak| Box::new(SoakDriver::new(soak)) as Box<dyn FrameScript>);
         let mut viewer = Self {
-            history,
-            timer,
             device_watch,
-            convergence: Convergence::default(),
-            feature_costs: FeatureCosts::default(),
             kernels,
             budget: FrameBudget::new(options.frame_budget_ms),
-            trace_ms: None,
+            meters: Meters {
+                timer,
+                convergence: Convergence::default(),
+                feature_costs: FeatureCosts::default(),
+                trace_ms: None,
+                shown_stats: None,
+                timed_trace_pixels: 0,
+                non_finite: (0, NonFiniteCounts::default()),
+            },
             ui_layer: None,
-            shown_stats: None,
-            timed_trace_pixels: 0,
-            non_finite: (0, NonFiniteCounts::default()),
             window,
             surface,
             config,
@@ -316,28 +348,29 @@ impl Viewer {
             egui_state,
             egui_renderer,
             scene: loaded.scene,
-            document,
-            preset_camera,
+            edits: Editing {
+                document,
+                preset_camera,
+                history,
+                autosave,
+                prompt,
+            },
             panel,
             options,
             settings,
             config_dir,
-            autosave,
-            prompt,
-            dialog: None,
-            loading: None,
-            startup: None,
-            watch: None,
-            shader_watch: None,
-            soak,
+            incoming: Incoming::default(),
+            script,
             show_help: false,
             ui_hidden: false,
             quitting: false,
-            frames: 0,
-            last_frame: Instant::now(),
-            last_heap_trim: Instant::now(),
-            fps: 0.0,
-            ms_per_frame: 0.0,
+            clock: FrameClock {
+                frames: 0,
+                last_frame: Instant::now(),
+                last_heap_trim: Instant::now(),
+                fps: 0.0,
+                ms_per_frame: 0.0,
+            },
             screenshot_requested: false,
         };
         if scripted {
@@ -355,7 +388,7 @@ impl Viewer {
 
     /// Handles one window event; `Ok(false)` asks the loop to exit.
     pub fn handle_event(&mut self, event: &WindowEvent) -> Result<bool> {
-        if let Some(startup) = &mut self.startup
+        if let Some(startup) = &mut self.incoming.startup
             && held_until_loaded(event)
         {
             startup.held_events.push(event.clone());
@@ -398,8 +431,8 @@ impl Viewer {
     /// The window's close button or the system asks to quit: with unsaved
     /// edits the user chooses first (a scripted run just ends).
     fn request_quit(&mut self) {
-        if self.options.exit_after_frames.is_none() && self.document.is_dirty(&self.scene) {
-            self.prompt = Some(Prompt::Quit);
+        if self.options.exit_after_frames.is_none() && self.edits.document.is_dirty(&self.scene) {
+            self.edits.prompt = Some(Prompt::Quit);
         } else {
             self.quit();
         }
@@ -408,7 +441,7 @@ impl Viewer {
     /// Ends the session cleanly: no recovery file is left, and the
     /// settings remember the window and the preset.
     fn quit(&mut self) {
-        if let Some(autosave) = &mut self.autosave {
+        if let Some(autosave) = &mut self.edits.autosave {
             autosave.finish();
         }
         if self.window.fullscreen().is_none() {
@@ -416,7 +449,8 @@ impl Viewer {
             self.settings.window_size = Some((size.width, size.height));
         }
         self.settings.last_preset = Some(
-            std::path::absolute(&self.document.path).unwrap_or_else(|_| self.document.path.clone()),
+            std::path::absolute(&self.edits.document.path)
+                .unwrap_or_else(|_| self.edits.document.path.clone()),
         );
         self.save_settings();
         self.quitting = true;
@@ -476,9 +510,9 @@ impl Viewer {
     /// Undoes or redoes one step of scene edits, keeping the view.
     fn step_history(&mut self, undo: bool) {
         let restored = if undo {
-            self.history.undo(&self.scene)
+            self.edits.history.undo(&self.scene)
         } else {
-            self.history.redo(&self.scene)
+            self.edits.history.redo(&self.scene)
         };
         match restored {
             Some(scene) => self.scene = scene,
@@ -495,7 +529,7 @@ impl Viewer {
             match action {
                 PanelAction::LoadPreset(p) => self.request_load_preset(&p),
                 PanelAction::SavePreset => {
-                    self.save_preset(&self.document.path.clone());
+                    self.save_preset(&self.edits.document.path.clone());
                 }
                 PanelAction::SavePresetAs(p) => {
                     self.save_preset(&p);
@@ -512,7 +546,7 @@ impl Viewer {
                 PanelAction::OpenRecent(p) => self.load_dropped(&p),
                 PanelAction::LoadEnvironment(p) => self.load_environment(&p),
                 PanelAction::Screenshot => self.screenshot_requested = true,
-                PanelAction::ResetCamera => self.scene.camera = self.preset_camera,
+                PanelAction::ResetCamera => self.scene.camera = self.edits.preset_camera,
                 PanelAction::ToggleFeature(feature) => self.toggle_feature(feature),
                 PanelAction::SetKernel(choice) => self.set_kernel(choice),
                 PanelAction::Undo => self.step_history(true),
@@ -527,7 +561,7 @@ impl Viewer {
             // A prompt waits for its answer: Esc is Cancel (which keeps an
             // offered recovery for later), and shortcuts that would change
             // the scene or open files behind it wait too.
-            if self.prompt.is_some() {
+            if self.edits.prompt.is_some() {
                 match shortcut {
                     Shortcut::Close if !self.show_help => {
                         self.answer_prompt(prompts::Answer::Cancel);
@@ -546,7 +580,7 @@ impl Viewer {
                 Shortcut::Undo => self.step_history(true),
                 Shortcut::Redo => self.step_history(false),
                 Shortcut::Save => {
-                    self.save_preset(&self.document.path.clone());
+                    self.save_preset(&self.edits.document.path.clone());
                 }
                 Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
                 Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
@@ -568,12 +602,12 @@ impl Viewer {
     /// Compiles `feature` out of the shader (or back in) to time the scene
     /// without it; a set that cannot be built is refused with the reason.
     fn toggle_feature(&mut self, feature: marbre_render::gpu::Feature) {
-        self.feature_costs.toggle(feature);
+        self.meters.feature_costs.toggle(feature);
         let request = self
             .renderer
-            .request_feature_override(&self.ctx, self.feature_costs.override_set());
+            .request_feature_override(&self.ctx, self.meters.feature_costs.override_set());
         if let Err(e) = request {
-            self.feature_costs.toggle(feature);
+            self.meters.feature_costs.toggle(feature);
             self.panel
                 .error(format!("cannot compile {feature:?} out: {e:#}"));
         }
@@ -583,26 +617,26 @@ impl Viewer {
     /// whether the camera is being dragged.
     fn run_ui(&mut self) -> (egui::FullOutput, egui::Rect, bool) {
         let raw_input = self.egui_state.take_egui_input(&self.window);
-        let stats = match &self.shown_stats {
+        let stats = match &self.meters.shown_stats {
             Some((taken, stats)) if taken.elapsed() < STATS_REFRESH => stats.clone(),
             _ => {
                 let stats = self.stats();
-                self.shown_stats = Some((Instant::now(), stats.clone()));
+                self.meters.shown_stats = Some((Instant::now(), stats.clone()));
                 stats
             }
         };
         let mut actions = Vec::new();
         let mut image_rect = egui::Rect::NOTHING;
         let mut dragging = false;
-        self.panel.can_undo = self.history.can_undo();
-        self.panel.can_redo = self.history.can_redo();
-        self.panel.unsaved = self.document.is_dirty(&self.scene);
+        self.panel.can_undo = self.edits.history.can_undo();
+        self.panel.can_redo = self.edits.history.can_redo();
+        self.panel.unsaved = self.edits.document.is_dirty(&self.scene);
         self.panel
             .recent_files
             .clone_from(&self.settings.recent_files);
         let preset_name = self.document_name();
         let (scene, panel_state) = (&mut self.scene, &mut self.panel);
-        let (prompt, ui_hidden) = (&self.prompt, self.ui_hidden);
+        let (prompt, ui_hidden) = (&self.edits.prompt, self.ui_hidden);
         let mut show_help = self.show_help;
         let mut pressed = Vec::new();
         let mut answer = None;
@@ -659,12 +693,12 @@ impl Viewer {
         self.poll_file_watch();
         self.poll_loading()?;
         self.release_held_input()?;
-        self.soak_step()?;
+        self.script_before_frame()?;
         let now = Instant::now();
-        let dt = now.duration_since(self.last_frame).as_secs_f32();
-        self.last_frame = now;
-        self.ms_per_frame = 0.9 * self.ms_per_frame + 0.1 * dt * 1000.0;
-        self.fps = 1000.0 / self.ms_per_frame.max(1e-3);
+        let dt = now.duration_since(self.clock.last_frame).as_secs_f32();
+        self.clock.last_frame = now;
+        self.clock.ms_per_frame = 0.9 * self.clock.ms_per_frame + 0.1 * dt * 1000.0;
+        self.clock.fps = 1000.0 / self.clock.ms_per_frame.max(1e-3);
 
         let (mut output, image_rect, dragging) = self.run_ui();
         self.egui_state
@@ -687,8 +721,8 @@ impl Viewer {
             self.egui_renderer.free_texture(id);
         }
         self.autosave();
-        if self.last_heap_trim.elapsed() >= HEAP_TRIM_INTERVAL {
-            self.last_heap_trim = Instant::now();
+        if self.clock.last_heap_trim.elapsed() >= HEAP_TRIM_INTERVAL {
+            self.clock.last_heap_trim = Instant::now();
             crate::heap::release_free_memory();
         }
         let go_on = result? && !self.quitting;
@@ -699,15 +733,15 @@ impl Viewer {
         Ok(go_on)
     }
 
-    /// Applies this frame's soak edit or action, if soaking.
-    fn soak_step(&mut self) -> Result<()> {
-        let Some(driver) = &mut self.soak else {
+    /// Applies this frame's scripted edit or action, if a script runs.
+    fn script_before_frame(&mut self) -> Result<()> {
+        let Some(script) = &mut self.script else {
             return Ok(());
         };
-        match driver.step(self.frames, &mut self.scene) {
-            SoakAction::Nothing => {}
-            SoakAction::LoadPreset(path) => self.load_preset(&path),
-            SoakAction::LoseDevice => {
+        match script.before_frame(self.clock.frames, &mut self.scene) {
+            ScriptAction::Nothing => {}
+            ScriptAction::LoadPreset(path) => self.load_preset(&path),
+            ScriptAction::LoseDevice => {
                 // As a driver reset would: the device goes, its loss is
                 // reported on the next poll, and the viewer recovers.
                 self.ctx.device.destroy();
@@ -722,35 +756,26 @@ impl Viewer {
         Ok(())
     }
 
-    /// After a presented frame of a soak: its memory sample, and at the
-    /// end the verdict (an error fails the run). Whether to go on.
-    fn soak_record(&mut self) -> Result<bool> {
-        let Some(driver) = &mut self.soak else {
+    /// After a presented frame, the script's turn (none: go on). Whether
+    /// to go on; an error fails the run.
+    fn script_after_present(&mut self) -> Result<bool> {
+        let Some(script) = &mut self.script else {
             return Ok(true);
         };
-        driver.record(self.frames, sample_memory(&self.ctx));
-        if !driver.finished(self.frames) {
-            return Ok(true);
-        }
-        match driver.verdict(self.device_watch.validation_errors()) {
-            Ok(report) => {
-                eprintln!("{report}");
-                Ok(false)
-            }
-            Err(report) => {
-                eprintln!("{report}");
-                anyhow::bail!("the soak failed (see above)")
-            }
-        }
+        script.after_present(Presented {
+            frame: self.clock.frames,
+            ctx: &self.ctx,
+            validation_errors: self.device_watch.validation_errors(),
+        })
     }
 
     /// Copies unsaved edits to the recovery file when it is time.
     fn autosave(&mut self) {
-        let dirty = self.document.is_dirty(&self.scene);
-        let Some(autosave) = &mut self.autosave else {
+        let dirty = self.edits.document.is_dirty(&self.scene);
+        let Some(autosave) = &mut self.edits.autosave else {
             return;
         };
-        let (document, scene) = (&self.document, &self.scene);
+        let (document, scene) = (&self.edits.document, &self.scene);
         if let Err(e) = autosave.tick(dirty, &document.path, || document.preset(scene)) {
             self.panel.error(format!("autosave failed: {e:#}"));
         }
@@ -758,7 +783,7 @@ impl Viewer {
 
     /// The preset's file name, for prompts.
     fn document_name(&self) -> String {
-        self.document.path.file_name().map_or_else(
+        self.edits.document.path.file_name().map_or_else(
             || "The scene".to_owned(),
             |n| n.to_string_lossy().into_owned(),
         )

@@ -1,6 +1,6 @@
 //! A bounding volume hierarchy over triangles, built on the CPU with the
 //! binned surface area heuristic and flattened into the 32-byte nodes that
-//! `shaders/bvh.wgsl` walks.
+//! `crates/core/src/accel/traverse.wgsl` walks.
 //!
 //! # Layout
 //!
@@ -48,7 +48,7 @@ pub const MAX_LEAF_TRIANGLES: usize = 4;
 pub const SAH_BINS: usize = 16;
 /// The deepest a node may be (the root is at depth 0): a leaf at depth d
 /// leaves at most d entries on the traversal stack, so `BVH_STACK_SIZE` in
-/// `shaders/bvh.wgsl` must be at least this.
+/// `crates/core/src/accel/traverse.wgsl` must be at least this.
 pub const MAX_DEPTH: usize = 64;
 /// SAH cost of visiting an interior node (testing its two children's boxes)
 /// relative to one triangle test. On the GPU the two box tests cost a bit
@@ -59,7 +59,7 @@ pub const TRAVERSAL_COST: f32 = 1.0;
 /// SAH cost of one ray–triangle test.
 pub const TRIANGLE_COST: f32 = 1.0;
 
-/// One flattened node, as `struct BvhNode` in `shaders/bvh.wgsl` (32 bytes:
+/// One flattened node, as `struct BvhNode` in `crates/core/src/accel/traverse.wgsl` (32 bytes:
 /// `vec3f` min, `u32`, `vec3f` max, `u32`). See the module documentation for
 /// what `a` and `count` mean.
 #[repr(C)]

@@ -1,5 +1,5 @@
 //! Acceleration structures for triangle meshes, built on the CPU and walked
-//! by the GPU (`shaders/bvh.wgsl`): the watertight ray–triangle test, the
+//! by the GPU (`crates/core/src/accel/traverse.wgsl`): the watertight ray–triangle test, the
 //! binned-SAH BVH and its flattened nodes, a CPU traversal that mirrors the
 //! shader's, and procedural meshes for tests and benchmarks.
 
@@ -16,7 +16,7 @@ pub use triangle::{TriangleHit, intersect};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-/// One triangle as `struct TriangleVerts` in `shaders/bvh.wgsl`: three
+/// One triangle as `struct TriangleVerts` in `crates/core/src/accel/traverse.wgsl`: three
 /// `vec4f` whose w is unused (48 bytes, no padding rules to get wrong).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

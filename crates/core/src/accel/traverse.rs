@@ -1,10 +1,13 @@
 //! Closest-hit and any-hit traversal of a [`Bvh`] on the CPU: the same
-//! algorithm as `shaders/bvh.wgsl` (stack of [`MAX_DEPTH`] entries, near
+//! algorithm as `crates/core/src/accel/traverse.wgsl` (stack of [`MAX_DEPTH`] entries, near
 //! child first, the same slab test), so the GPU's results can be held to it.
 
 use super::bvh::{Bvh, BvhNode, MAX_DEPTH};
 use super::triangle::WatertightRay;
 use glam::Vec3;
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/accel/traverse.wgsl");
 
 /// The closest hit of a ray with a mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,7 +23,7 @@ pub struct MeshHit {
 
 /// A direction component at most this times the largest one counts as
 /// zero for the slab test, which then does not cull along that axis at all
-/// (`SLAB_PARALLEL` in bvh.wgsl). Keeps 1/d finite and bounded (|1/d| ≤
+/// (`SLAB_PARALLEL` in accel/traverse.wgsl). Keeps 1/d finite and bounded (|1/d| ≤
 /// 2^40 / max|d|), so no 0·∞ = NaN or ∞ ever appears, which WGSL does not
 /// promise to handle; not culling is conservative, so no hit is lost.
 pub const SLAB_PARALLEL: f32 = 1.0 / (1u64 << 40) as f32;
@@ -34,7 +37,7 @@ const SLAB_PAD: f32 = 1.0e30;
 /// 1 + 2γ₃ covers the rounding of (bound − origin) · (1/d) on both sides,
 /// so a ray through a box's face or edge, or a flat box, is never culled;
 /// this is 1 + 16 ε (≈ 1 + 1.9e−6), more than enough for a GPU's 2.5-ulp
-/// division (`SLAB_INFLATE` in bvh.wgsl).
+/// division (`SLAB_INFLATE` in accel/traverse.wgsl).
 pub const SLAB_INFLATE: f32 = 1.0 + 16.0 * f32::EPSILON;
 
 /// A ray prepared for slab tests: its origin, a finite inverse direction

@@ -1,7 +1,8 @@
-//! CPU twins of the scene-free ray geometry in `shaders/ray_geometry.wgsl`:
+//! CPU twins of the scene-free ray geometry in `sphere.wgsl` and
+//! `ray_offset.wgsl`, each beside its Rust module:
 //! the sphere's distance and the robust ray offset, line for line, so that
 //! tests can hold the f32 shader and its twin to double precision
-//! (`tests/geometry_stability.rs`, through `gpu::geometry_harness`).
+//! (`crates/render/tests/gpu/geometry_stability.rs`, through `gpu::harness::geometry`).
 
 pub mod ray_offset;
 pub mod sphere;

@@ -1,7 +1,11 @@
-//! The robust ray offset, the twin of `offset_ray` in
-//! `shaders/ray_geometry.wgsl`.
+//! The robust ray offset, the twin of `offset_ray` in `ray_offset.wgsl`
+//! beside this file.
 
 use glam::Vec3;
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile =
+    crate::wgsl_file!("crates/core/src/geometry/ray_offset.wgsl");
 
 /// Below this magnitude a coordinate moves by a fixed [`FLOAT_SCALE`]
 /// (integer steps of its bits would be too small near zero).

@@ -1,7 +1,10 @@
-//! Ray–sphere distance, the twin of `sphere_distance` in
-//! `shaders/ray_geometry.wgsl`.
+//! Ray–sphere distance, the twin of `sphere_distance` in `sphere.wgsl`
+//! beside this file.
 
 use glam::Vec3;
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/geometry/sphere.wgsl");
 
 /// `NO_HIT` in the shaders: the distance of a miss.
 pub const NO_HIT: f32 = 3.0e38;

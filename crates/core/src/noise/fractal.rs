@@ -5,6 +5,9 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/fractal.wgsl");
+
 /// The knobs of a fractal sum. Octave `i` is `amplitude · persistenceⁱ ·
 /// noise(p · frequency · lacunarityⁱ)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

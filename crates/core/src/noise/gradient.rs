@@ -5,6 +5,9 @@
 use super::hash::{HashKind, gradient_pcg, gradient_pcg_tiled, gradient_sin};
 use glam::{IVec3, Vec3};
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/gradient.wgsl");
+
 /// A provable bound on |gradient_noise|: each corner value is
 /// |g|·|f − c| ≤ √3·√3 = 3, and the interpolation is a convex combination.
 /// The values actually observed stay far inside it (see the tests).

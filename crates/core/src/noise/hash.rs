@@ -3,6 +3,9 @@
 use glam::{IVec3, UVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/hash.wgsl");
+
 /// How the lab's gradient noise picks a gradient for a lattice corner.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum HashKind {

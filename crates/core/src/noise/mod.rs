@@ -1,6 +1,6 @@
 //! CPU reference of every noise function the shaders evaluate.
 //!
-//! The WGSL in `shaders/noise_*.wgsl` and `shaders/fractal.wgsl` mirrors these
+//! The WGSL in `shaders/noise_*.wgsl` and `crates/core/src/noise/fractal.wgsl` mirrors these
 //! functions operation for operation, so that the parity tests (GPU against CPU)
 //! and the `marbre noise --cpu` command can check the shader against a trusted
 //! implementation. The CPU side is the reference: when the two disagree, the

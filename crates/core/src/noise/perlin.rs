@@ -4,6 +4,9 @@
 //! The gradient function is the reference's, not the tutorial's variant in the
 //! course material, which differs at h = 13 and 14.
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/perlin.wgsl");
+
 /// Perlin's permutation of 0..=255.
 pub const PERMUTATION: [u8; 256] = [
     151, 160, 137, 91, 90, 15, 131, 13, 201, 95, 96, 53, 194, 233, 7, 225, 140, 36, 103, 30, 69,

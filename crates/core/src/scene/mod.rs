@@ -21,7 +21,7 @@ pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
-pub use render_settings::{RenderSettings, ToneMap};
+pub use render_settings::{DisplaySettings, RenderSettings, ToneMap};
 pub use texture_tree::{Child, MathOp, Texture};
 pub use transport::{Integrator, Strategy, TransportSettings};
 
@@ -86,12 +86,12 @@ impl Default for PointLight {
 
 /// The most spheres a scene holds: the renderer keeps spheres and their
 /// materials (one more, the ground's) in fixed-size uniform arrays
-/// (`shaders/scene.wgsl`), whose divergent reads cost far less than
+/// (`crates/render/shaders/scene.wgsl`), whose divergent reads cost far less than
 /// storage-buffer reads on lavapipe.
 pub const MAX_SPHERES: usize = 63;
 
 /// The most materials a scene holds: every primitive's, the ground's and the
-/// meshes' (a uniform array in `shaders/scene.wgsl`, within the 64 KiB a
+/// meshes' (a uniform array in `crates/render/shaders/scene.wgsl`, within the 64 KiB a
 /// uniform binding may hold).
 pub const MAX_MATERIALS: usize = 160;
 
@@ -117,6 +117,35 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Whether the two scenes trace the same samples: equal but for their
+    /// display settings (exposure, tone map, the debug view), whose edits
+    /// keep the accumulation. Destructured in full, so that a new field has
+    /// to be sorted into traced or displayed.
+    pub fn traces_like(&self, other: &Scene) -> bool {
+        let Scene {
+            camera,
+            views,
+            spheres,
+            cylinders,
+            polygons,
+            ground,
+            meshes,
+            point_light,
+            environment,
+            render,
+        } = self;
+        *camera == other.camera
+            && *views == other.views
+            && *spheres == other.spheres
+            && *cylinders == other.cylinders
+            && *polygons == other.polygons
+            && *ground == other.ground
+            && *meshes == other.meshes
+            && *point_light == other.point_light
+            && *environment == other.environment
+            && render.traces_like(&other.render)
+    }
+
     /// Every material in GPU order: the spheres', the cylinders', the
     /// polygons', the ground's, then each mesh's.
     pub fn materials(&self) -> impl Iterator<Item = &Material> {

@@ -13,7 +13,7 @@ use std::ops::RangeInclusive;
 
 /// The most distinct fractal sums (noise signals) one material's textures
 /// may read: the shader evaluates each once per hit (`MAX_SIGNALS` in
-/// shaders/scene.wgsl).
+/// crates/render/shaders/scene.wgsl).
 pub const MAX_SIGNALS: usize = 4;
 
 /// What drives a property across a surface. Each pattern yields a blend

@@ -7,7 +7,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// The most cylinders and polygons a scene holds (the renderer's uniform
-/// arrays, `shaders/scene.wgsl`).
+/// arrays, `crates/render/shaders/scene.wgsl`).
 pub const MAX_CYLINDERS: usize = 8;
 pub const MAX_POLYGONS: usize = 16;
 /// The most vertices of one polygon.

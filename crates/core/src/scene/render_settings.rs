@@ -25,22 +25,16 @@ impl ToneMap {
     }
 }
 
+/// What is traced and how the result is shown. The display part is its
+/// own type: an edit there keeps the accumulated samples, and
+/// [`RenderSettings::traces_like`] compares the rest.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(from = "RenderSettingsFile", into = "RenderSettingsFile")]
 pub struct RenderSettings {
     /// Jittered samples traced per pixel each frame.
     pub samples_per_frame: u32,
     /// Average frames while nothing changes; off shows each frame alone.
     pub accumulate: bool,
-    /// Exposure in stops: the radiance is scaled by 2^exposure. With
-    /// `auto_exposure` it is a compensation added to the automatic value.
-    pub exposure: f32,
-    /// Expose by Reinhard's key: the image's log-average luminance is
-    /// brought to middle grey (0.18), `exposure` stops on top; metered on
-    /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
-    /// sets it: the manual override.
-    pub auto_exposure: bool,
-    pub tone_map: ToneMap,
     /// Resolution scale used while the camera is being dragged, so the view
     /// stays responsive; full resolution comes back when the mouse is still.
     pub interactive_scale: f32,
@@ -59,9 +53,124 @@ pub struct RenderSettings {
     /// finds it.
     pub env_importance: bool,
     pub transport: super::transport::TransportSettings,
+    /// How the accumulated radiance is shown.
+    pub display: DisplaySettings,
+}
+
+/// How the accumulated radiance becomes pixels: exposure, tone map and the
+/// non-finite debug view. Nothing here changes what is traced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisplaySettings {
+    /// Exposure in stops: the radiance is scaled by 2^exposure. With
+    /// `auto_exposure` it is a compensation added to the automatic value.
+    pub exposure: f32,
+    /// Expose by Reinhard's key: the image's log-average luminance is
+    /// brought to middle grey (0.18), `exposure` stops on top; metered on
+    /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
+    /// sets it: the manual override.
+    pub auto_exposure: bool,
+    pub tone_map: ToneMap,
     /// Debug view: pixels where a path gave a NaN or infinite sample (which
     /// the accumulation drops and counts) are painted magenta.
     pub show_non_finite: bool,
+}
+
+impl Default for DisplaySettings {
+    fn default() -> Self {
+        Self {
+            exposure: 0.0,
+            auto_exposure: false,
+            tone_map: ToneMap::Aces,
+            show_non_finite: false,
+        }
+    }
+}
+
+/// The render settings as presets write them: one flat record, as they
+/// always were, whatever the types in memory.
+#[derive(Serialize, Deserialize)]
+#[serde(default)]
+struct RenderSettingsFile {
+    /// Jittered samples traced per pixel each frame.
+    samples_per_frame: u32,
+    /// Average frames while nothing changes; off shows each frame alone.
+    accumulate: bool,
+    /// Exposure in stops: the radiance is scaled by 2^exposure. With
+    /// `auto_exposure` it is a compensation added to the automatic value.
+    exposure: f32,
+    /// Expose by Reinhard's key: the image's log-average luminance is
+    /// brought to middle grey (0.18), `exposure` stops on top; metered on
+    /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
+    /// sets it: the manual override.
+    auto_exposure: bool,
+    tone_map: ToneMap,
+    /// Resolution scale used while the camera is being dragged, so the view
+    /// stays responsive; full resolution comes back when the mouse is still.
+    interactive_scale: f32,
+    /// Path length: 1 is direct light only (point light and environment),
+    /// each more bounce adds one more reflection.
+    max_bounces: u32,
+    /// Checkerboards averaged over each ray's footprint in closed form,
+    /// rather than point sampled (which aliases far away).
+    filter_checkers: bool,
+    /// Fractal sums stop at the octaves the footprint resolves (pbrt's
+    /// rule), rather than summing detail finer than a pixel.
+    clamp_octaves: bool,
+    /// A lat-long environment is also sampled in proportion to its
+    /// luminance at every bounce, combined with BSDF sampling by multiple
+    /// importance sampling (power heuristic); off, only BSDF sampling
+    /// finds it.
+    env_importance: bool,
+    transport: super::transport::TransportSettings,
+    /// Debug view: pixels where a path gave a NaN or infinite sample (which
+    /// the accumulation drops and counts) are painted magenta.
+    show_non_finite: bool,
+}
+
+impl From<RenderSettingsFile> for RenderSettings {
+    fn from(f: RenderSettingsFile) -> Self {
+        Self {
+            samples_per_frame: f.samples_per_frame,
+            accumulate: f.accumulate,
+            interactive_scale: f.interactive_scale,
+            max_bounces: f.max_bounces,
+            filter_checkers: f.filter_checkers,
+            clamp_octaves: f.clamp_octaves,
+            env_importance: f.env_importance,
+            transport: f.transport,
+            display: DisplaySettings {
+                exposure: f.exposure,
+                auto_exposure: f.auto_exposure,
+                tone_map: f.tone_map,
+                show_non_finite: f.show_non_finite,
+            },
+        }
+    }
+}
+
+impl From<RenderSettings> for RenderSettingsFile {
+    fn from(r: RenderSettings) -> Self {
+        Self {
+            samples_per_frame: r.samples_per_frame,
+            accumulate: r.accumulate,
+            exposure: r.display.exposure,
+            auto_exposure: r.display.auto_exposure,
+            tone_map: r.display.tone_map,
+            interactive_scale: r.interactive_scale,
+            max_bounces: r.max_bounces,
+            filter_checkers: r.filter_checkers,
+            clamp_octaves: r.clamp_octaves,
+            env_importance: r.env_importance,
+            transport: r.transport,
+            show_non_finite: r.display.show_non_finite,
+        }
+    }
+}
+
+impl Default for RenderSettingsFile {
+    fn default() -> Self {
+        RenderSettings::default().into()
+    }
 }
 
 impl RenderSettings {
@@ -69,6 +178,42 @@ impl RenderSettings {
     pub const MAX_BOUNCES: u32 = 16;
     /// The exposure (or compensation) range of the panel and of presets.
     pub const MAX_EXPOSURE_STOPS: f32 = 20.0;
+
+    /// Whether `self` and `other` trace the same samples: every setting
+    /// but the display's equal. Destructured in full, so that a new field
+    /// has to be sorted into traced or displayed.
+    pub fn traces_like(&self, other: &Self) -> bool {
+        let Self {
+            samples_per_frame,
+            accumulate,
+            interactive_scale,
+            max_bounces,
+            filter_checkers,
+            clamp_octaves,
+            env_importance,
+            transport,
+            display: _,
+        } = *self;
+        (
+            samples_per_frame,
+            accumulate,
+            interactive_scale,
+            max_bounces,
+            filter_checkers,
+            clamp_octaves,
+            env_importance,
+            transport,
+        ) == (
+            other.samples_per_frame,
+            other.accumulate,
+            other.interactive_scale,
+            other.max_bounces,
+            other.filter_checkers,
+            other.clamp_octaves,
+            other.env_importance,
+            other.transport,
+        )
+    }
 
     pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
         let d = Self::default();
@@ -88,18 +233,20 @@ impl RenderSettings {
             ));
             self.max_bounces = b;
         }
-        if !self.exposure.is_finite() || self.exposure.abs() > Self::MAX_EXPOSURE_STOPS {
-            let what = if self.auto_exposure {
+        let display = &mut self.display;
+        if !display.exposure.is_finite() || display.exposure.abs() > Self::MAX_EXPOSURE_STOPS {
+            let what = if display.auto_exposure {
                 "exposure compensation"
             } else {
                 "exposure"
             };
-            notes.push(format!("render: {what} {} clamped", self.exposure));
-            self.exposure = if self.exposure.is_finite() {
-                self.exposure
+            notes.push(format!("render: {what} {} clamped", display.exposure));
+            display.exposure = if display.exposure.is_finite() {
+                display
+                    .exposure
                     .clamp(-Self::MAX_EXPOSURE_STOPS, Self::MAX_EXPOSURE_STOPS)
             } else {
-                d.exposure
+                d.display.exposure
             };
         }
         if !(self.interactive_scale.is_finite() && (0.1..=1.0).contains(&self.interactive_scale)) {
@@ -118,16 +265,13 @@ impl Default for RenderSettings {
         Self {
             samples_per_frame: 1,
             accumulate: true,
-            exposure: 0.0,
-            auto_exposure: false,
-            tone_map: ToneMap::Aces,
             interactive_scale: 0.5,
             max_bounces: 3,
             filter_checkers: true,
             clamp_octaves: true,
             env_importance: true,
             transport: Default::default(),
-            show_non_finite: false,
+            display: DisplaySettings::default(),
         }
     }
 }
@@ -139,24 +283,69 @@ mod tests {
     #[test]
     fn auto_exposure_reads_off_from_old_presets_and_on_when_set() {
         let old: RenderSettings = ron::from_str("(exposure: 1.5, tone_map: Reinhard)").unwrap();
-        assert!(!old.auto_exposure);
-        assert_eq!(old.exposure, 1.5);
+        assert!(!old.display.auto_exposure);
+        assert_eq!(old.display.exposure, 1.5);
+        assert_eq!(old.display.tone_map, ToneMap::Reinhard);
         let auto: RenderSettings = ron::from_str("(auto_exposure: true, exposure: -1.0)").unwrap();
-        assert!(auto.auto_exposure);
-        assert_eq!(auto.exposure, -1.0);
+        assert!(auto.display.auto_exposure);
+        assert_eq!(auto.display.exposure, -1.0);
+    }
+
+    /// The display settings live in their own type in memory, but a preset
+    /// still writes one flat record, which reads back the same.
+    #[test]
+    fn presets_keep_the_flat_record() {
+        let render = RenderSettings {
+            max_bounces: 5,
+            display: DisplaySettings {
+                exposure: 2.5,
+                show_non_finite: true,
+                ..DisplaySettings::default()
+            },
+            ..RenderSettings::default()
+        };
+        let text = ron::to_string(&render).unwrap();
+        assert!(
+            text.starts_with("(samples_per_frame:1,accumulate:true,exposure:2.5,"),
+            "{text}"
+        );
+        assert!(!text.contains("display"), "{text}");
+        assert_eq!(ron::from_str::<RenderSettings>(&text).unwrap(), render);
+    }
+
+    #[test]
+    fn only_traced_settings_change_what_is_traced() {
+        let base = RenderSettings::default();
+        let mut shown = base;
+        shown.display = DisplaySettings {
+            exposure: 3.0,
+            auto_exposure: true,
+            tone_map: ToneMap::Clamp,
+            show_non_finite: true,
+        };
+        assert!(base.traces_like(&shown));
+        let mut traced = base;
+        traced.max_bounces += 1;
+        assert!(!base.traces_like(&traced));
+        let mut traced = base;
+        traced.transport.light_samples += 1;
+        assert!(!base.traces_like(&traced));
     }
 
     #[test]
     fn exposure_compensation_is_clamped_with_a_note() {
         let mut render = RenderSettings {
-            auto_exposure: true,
-            exposure: 35.0,
+            display: DisplaySettings {
+                auto_exposure: true,
+                exposure: 35.0,
+                ..DisplaySettings::default()
+            },
             ..RenderSettings::default()
         };
         let mut notes = Vec::new();
         render.sanitize(&mut notes);
-        assert_eq!(render.exposure, 20.0);
-        assert!(render.auto_exposure);
+        assert_eq!(render.display.exposure, 20.0);
+        assert!(render.display.auto_exposure);
         assert_eq!(notes, ["render: exposure compensation 35 clamped"]);
     }
 }

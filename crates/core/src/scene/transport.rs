@@ -66,7 +66,7 @@ impl Strategy {
         }
     }
 
-    /// The number `shaders/mis.wgsl` reads.
+    /// The number `crates/core/src/mis.wgsl` reads.
     pub fn id(self) -> u32 {
         self as u32
     }

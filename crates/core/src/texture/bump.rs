@@ -3,6 +3,9 @@
 
 use glam::Vec3;
 
+/// The shader code of [`facing_shading_normal`].
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/texture/bump.wgsl");
+
 /// The normal of the surface displaced by a small height `h(u, v)` along
 /// `n` (Blinn 1978), given ∂h/∂u, ∂h/∂v and the tangents ∂p/∂u, ∂p/∂v of an
 /// orthogonal frame: `normalize(n − (∂h/∂u)·∂p/∂u/|∂p/∂u|² −
@@ -39,14 +42,14 @@ pub const MIN_TILTED_LENGTH: f32 = 1e-3;
 
 /// The least cosine between the shading normal and the viewer that
 /// [`facing_shading_normal`] asks for (`FACING_MIN_COS` in
-/// `shaders/shading_normal.wgsl`): 0.57° above the view's horizon, or less
+/// `crates/core/src/texture/bump.wgsl`): 0.57° above the view's horizon, or less
 /// where the geometric normal itself faces the viewer less.
 pub const FACING_MIN_COS: f32 = 0.01;
 
 /// The shading normal the BSDF may use, given the bumped normal `n_s`, the
 /// geometric normal `n_g` (facing the viewer) and the direction `wo` to the
 /// viewer, all unit length; the twin of `facing_shading_normal` in
-/// `shaders/shading_normal.wgsl`.
+/// `crates/core/src/texture/bump.wgsl`.
 ///
 /// A bump can tilt `n_s` away from the viewer: every BSDF value is then 0
 /// (a black pixel on a lit surface), and one that barely faces it divides

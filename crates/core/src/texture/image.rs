@@ -13,7 +13,7 @@
 //! # Why filtering is done by hand
 //!
 //! The GPU holds every image of a scene in one `Rgba16Float` texture, the
-//! [`ImageAtlas`], read with `textureLoad`; `shaders/texture_image.wgsl`
+//! [`ImageAtlas`], read with `textureLoad`; `crates/core/src/texture/image.wgsl`
 //! wraps and filters by hand. A hardware sampler could do neither here:
 //! wrapping in an atlas must stay inside one image's rectangle, and the
 //! filter and wrap mode are per texture, while a sampler is per binding.
@@ -41,6 +41,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::envmap::{self, EnvMapError, IntegerDecode};
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/texture/image.wgsl");
 
 /// The largest side of an image's level 0: larger images are resampled down
 /// to it.
@@ -403,7 +406,7 @@ fn footprint(size: IVec2) -> UVec2 {
 
 /// A mip chain as sampling sees it: level 0's size and a way to read texel
 /// `(x, y)` of level `k`. The same code samples a [`MipImage`] and an
-/// image in the [`ImageAtlas`]; it is `shaders/texture_image.wgsl`
+/// image in the [`ImageAtlas`]; it is `crates/core/src/texture/image.wgsl`
 /// operation for operation.
 struct Chain<F: Fn(i32, IVec2) -> Vec4> {
     size: IVec2,
@@ -1213,7 +1216,7 @@ mod tests {
     fn wgsl_parses_and_validates() {
         let source = [
             "@group(0) @binding(8) var image_atlas: texture_2d<f32>;\n",
-            include_str!("../../../render/shaders/texture_image.wgsl"),
+            WGSL.text,
             "@group(0) @binding(0) var<storage, read_write> samples: array<vec4f>;\n\
              @compute @workgroup_size(1)\n\
              fn main() {\n\

@@ -11,6 +11,9 @@ use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/texture/mapping.wgsl");
+
 /// (u, v) of the point at `offset` from a sphere's centre: longitude around
 /// +y and latitude from the south pole, each in [0, 1]. Finite everywhere,
 /// the poles and the centre included (there u = 0.5).

@@ -2,9 +2,11 @@
 //! functions of a point (uv in 2D, p in 3D) and their parameters, and the
 //! mappings that give a surface point those coordinates.
 //!
-//! This is the CPU reference. `shaders/texture_patterns.wgsl` mirrors every
-//! function here operation for operation; the GPU parity tests run it in a
-//! compute harness (`gpu::texture_harness`) and compare. Composition (which
+//! This is the CPU reference. `patterns.wgsl` (beside this file) mirrors
+//! every pattern here operation for operation, and `shading.wgsl` the
+//! shading helpers of `bump`, `waves` and `ramp`; the GPU parity tests run
+//! them in a compute harness (`marbre_render::gpu::harness::texture`) and
+//! compare. Composition (which
 //! child texture a cell shows, what a blend weight mixes) is the texture
 //! tree's business: a pattern only says where a point falls.
 
@@ -34,6 +36,14 @@ pub use marble::marble_veins;
 pub use ramp::{MAX_RAMP_STOPS, RampStop, luminance, ramp};
 pub use waves::{waves, waves_gradient};
 pub use wood::{default_axis, wood};
+
+/// The patterns' shader code, the twin of this module's patterns.
+pub const PATTERNS_WGSL: crate::wgsl::WgslFile =
+    crate::wgsl_file!("crates/core/src/texture/patterns.wgsl");
+
+/// The shading helpers' shader code (bump tilt, waves' gradient, ramps).
+pub const SHADING_WGSL: crate::wgsl::WgslFile =
+    crate::wgsl_file!("crates/core/src/texture/shading.wgsl");
 
 /// The fraction of an n×n grid of cell centres over the unit square moved
 /// to `origin` where `inside` holds: the area a pattern covers, for tests.

@@ -9,7 +9,7 @@
 //! Averages rather than sums, and the mean compensated, so that rounding
 //! error does not grow with the frame count: a plain f32 running mean
 //! drifts by about 1e-3 after 1e6 frames of an HDR pixel, the compensated
-//! one stays within 1e-7 (`tests/accumulation.rs`).
+//! one stays within 1e-7 (`crates/render/tests/gpu/accumulation.rs`).
 //!
 //! A frame may trace only part of a round (a band of rows,
 //! [`super::trace_bands`]): the round writes the other set band by band,
@@ -18,6 +18,10 @@
 //! complete round, or the preview of a new accumulation at a reduced size.
 
 use std::time::{Duration, Instant};
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: marbre_core::wgsl::WgslFile =
+    marbre_core::wgsl_file!("crates/render/src/gpu/accumulation.wgsl");
 
 /// The format of both targets: linear radiance needs floats, and the
 /// running mean needs more than half precision to keep averaging.

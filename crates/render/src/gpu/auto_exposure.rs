@@ -4,7 +4,7 @@
 //! log2(key / L_avg) that brings it to middle grey.
 //!
 //! [`AutoExposure`] meters the accumulation target on the GPU
-//! (`shaders/auto_exposure.wgsl`): one workgroup reads a grid of texels
+//! (`crates/render/src/gpu/auto_exposure.wgsl`): one workgroup reads a grid of texels
 //! spread over the traced region ([`super::metering_grid`]) and reduces it,
 //! and the result stays in a buffer that the display pass binds, so the
 //! frame never waits for a readback. The free functions are its CPU twin.
@@ -19,6 +19,10 @@ use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: marbre_core::wgsl::WgslFile =
+    marbre_core::wgsl_file!("crates/render/src/gpu/auto_exposure.wgsl");
+
 /// Reinhard's key: the scene's log-average maps to this middle grey.
 pub const KEY: f32 = 0.18;
 /// Added to every luminance before the log, so black does not give -∞.
@@ -26,8 +30,8 @@ pub const DELTA: f32 = 1e-4;
 /// The automatic exposure is clamped to ±this many stops.
 pub const MAX_STOPS: f32 = 20.0;
 
-/// What the metering pass writes (`Metered` in shaders/auto_exposure.wgsl
-/// and shaders/tonemap.wgsl).
+/// What the metering pass writes (`Metered` in crates/render/src/gpu/auto_exposure.wgsl
+/// and crates/render/shaders/tonemap.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Metered {
@@ -311,7 +315,7 @@ mod tests {
                 .filter(|l| !l.is_empty())
                 .collect::<Vec<_>>()
         };
-        let metering = declaration(include_str!("../../shaders/auto_exposure.wgsl"));
+        let metering = declaration(WGSL.text);
         let display = declaration(include_str!("../../shaders/tonemap.wgsl"));
         assert_eq!(metering, display);
         assert_eq!(metering.len() - 1, std::mem::size_of::<Metered>() / 4);
@@ -319,7 +323,7 @@ mod tests {
 
     #[test]
     fn the_shader_constants_are_the_cpu_twins() {
-        let source = include_str!("../../shaders/auto_exposure.wgsl");
+        let source = WGSL.text;
         for line in [
             format!("const DELTA: f32 = {DELTA:e};"),
             format!("const KEY: f32 = {KEY};"),

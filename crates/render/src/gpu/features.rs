@@ -78,7 +78,7 @@ impl Feature {
         Feature::HashSin,
     ];
 
-    /// Whether the feature's pattern is one of texture_patterns.wgsl's.
+    /// Whether the feature's pattern is one of texture/patterns.wgsl's.
     fn reads_library(self) -> bool {
         matches!(
             self,

@@ -1,6 +1,6 @@
 //! Which kernel runs the trace: the fragment shader over a full-screen
 //! triangle, or a compute dispatch. Both call the same WGSL body
-//! (`trace_pixel` in shaders/trace.wgsl) and give the same image; which is
+//! (`trace_pixel` in crates/render/shaders/trace.wgsl) and give the same image; which is
 //! faster depends on the adapter. An NVIDIA H100 runs pixel shaders on few
 //! of its units (the prototype traced the default preset at 1080p in 0.7 ms
 //! in compute against 19.5 ms in fragment), while on lavapipe neither wins
@@ -68,7 +68,7 @@ impl KernelChoice {
     }
 }
 
-/// The compute kernel's workgroup, in pixels (shaders/trace.wgsl's
+/// The compute kernel's workgroup, in pixels (crates/render/shaders/trace.wgsl's
 /// `@workgroup_size`, where the measurement that chose it is).
 pub const WORKGROUP: (u32, u32) = (16, 8);
 

@@ -1,22 +1,19 @@
 //! Everything that talks to wgpu: device creation, shader assembly and
-//! specialisation, the progressive renderer, auto exposure, and the noise
-//! compute harness.
+//! specialisation, the progressive renderer, auto exposure, and (in
+//! `harness/`) the compute passes that run shader functions for tests and
+//! tools.
 
 pub mod accumulation;
-pub mod accumulation_harness;
 pub mod async_readback;
 pub mod auto_exposure;
-pub mod bvh_harness;
-pub mod compute_harness;
 pub mod context;
 pub mod error_meter;
 pub mod features;
 pub mod geometry_buffers;
-pub mod geometry_harness;
+pub mod harness;
 pub mod kernel;
 pub mod mesh_buffers;
 pub mod metering_grid;
-pub mod noise_harness;
 pub mod non_finite;
 pub mod pass_timer;
 pub mod pipeline_build;
@@ -24,12 +21,10 @@ pub mod pipelines;
 pub mod preprocess;
 pub mod readback;
 pub mod renderer;
-pub mod sampling_harness;
 pub mod scene_gpu;
 pub mod shader_source;
 pub mod testing;
 pub mod texture_codegen;
-pub mod texture_harness;
 pub mod trace_bands;
 pub mod trace_pass;
 

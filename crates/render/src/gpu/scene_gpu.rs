@@ -1,4 +1,4 @@
-//! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
+//! The scene flattened into the std140/std430 structs of `crates/render/shaders/scene.wgsl`.
 
 use super::texture_codegen;
 use bytemuck::{Pod, Zeroable};
@@ -54,7 +54,7 @@ pub struct FrameUniform {
     pub russian_roulette_from: u32,
     pub triangle_count: u32,
     /// Always 1.0, but a uniform: see `compensated_mean_update` in
-    /// `shaders/accumulate.wgsl`.
+    /// `crates/render/src/gpu/accumulation.wgsl`.
     pub opaque_one: f32,
     /// The firefly clamp on a sample's largest channel; 0: off.
     pub sample_clamp: f32,
@@ -65,7 +65,7 @@ pub struct FrameUniform {
     pub _pad: [u32; 3],
 }
 
-/// `NoiseParams` of `shaders/fractal.wgsl`.
+/// `NoiseParams` of `crates/core/src/noise/fractal.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
 pub struct NoiseParamsGpu {
@@ -122,7 +122,7 @@ pub struct MaterialGpu {
     pub emitted_luminance: f32,
 }
 
-/// `Cylinder` of `shaders/scene.wgsl`.
+/// `Cylinder` of `crates/render/shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct CylinderGpu {
@@ -132,7 +132,7 @@ pub struct CylinderGpu {
     pub _pad: [f32; 3],
 }
 
-/// `Polygon` of `shaders/scene.wgsl`: vertices, plane and (u, v) frame.
+/// `Polygon` of `crates/render/shaders/scene.wgsl`: vertices, plane and (u, v) frame.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct PolygonGpu {
@@ -352,7 +352,7 @@ mod tests {
 
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
-        // Sizes computed by hand from shaders/scene.wgsl's alignment rules.
+        // Sizes computed by hand from crates/render/shaders/scene.wgsl's alignment rules.
         assert_eq!(std::mem::size_of::<FrameUniform>(), 224);
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);

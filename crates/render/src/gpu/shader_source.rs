@@ -1,122 +1,82 @@
-//! Assembles a WGSL module from the files in `shaders/` for one program and
-//! one [`FeatureSet`].
+//! Assembles a WGSL module for one program and one [`FeatureSet`] from the
+//! WGSL files, each kept beside its CPU twin (`marbre_core::noise::perlin`
+//! and `perlin.wgsl`, …) or, for the renderer's own passes, in
+//! `crates/render/shaders/`.
 
 use super::features::{Feature, FeatureSet};
 use super::preprocess::{PreprocessError, preprocess};
 
-/// The source tree's `shaders/` folder, which `marbre --dev` reads and
-/// watches instead of the embedded copies.
-pub const SHADER_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/shaders");
+/// The renderer's own WGSL: the trace and display passes and what only
+/// they use (no CPU twin), in `crates/render/shaders/`.
+mod renderer_files {
+    use marbre_core::wgsl::WgslFile;
+    use marbre_core::wgsl_file;
 
-/// The WGSL sources, embedded at build time so the binary is self-contained.
-const SOURCES: &[(&str, &str)] = &[
-    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
-    (
-        "fullscreen.wgsl",
-        include_str!("../../shaders/fullscreen.wgsl"),
-    ),
-    ("hash.wgsl", include_str!("../../shaders/hash.wgsl")),
-    (
-        "noise_gradient.wgsl",
-        include_str!("../../shaders/noise_gradient.wgsl"),
-    ),
-    (
-        "noise_perlin.wgsl",
-        include_str!("../../shaders/noise_perlin.wgsl"),
-    ),
-    ("fractal.wgsl", include_str!("../../shaders/fractal.wgsl")),
-    (
-        "env_mapping.wgsl",
-        include_str!("../../shaders/env_mapping.wgsl"),
-    ),
-    ("scene.wgsl", include_str!("../../shaders/scene.wgsl")),
-    ("textures.wgsl", include_str!("../../shaders/textures.wgsl")),
-    (
-        "intersect.wgsl",
-        include_str!("../../shaders/intersect.wgsl"),
-    ),
-    ("random.wgsl", include_str!("../../shaders/random.wgsl")),
-    ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
-    ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
-    (
-        "env_lookup.wgsl",
-        include_str!("../../shaders/env_lookup.wgsl"),
-    ),
-    ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
-    (
-        "accumulate.wgsl",
-        include_str!("../../shaders/accumulate.wgsl"),
-    ),
-    (
-        "accumulation_harness.wgsl",
-        include_str!("../../shaders/accumulation_harness.wgsl"),
-    ),
-    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
-    (
-        "metering_grid.wgsl",
-        include_str!("../../shaders/metering_grid.wgsl"),
-    ),
-    (
-        "auto_exposure.wgsl",
-        include_str!("../../shaders/auto_exposure.wgsl"),
-    ),
-    (
-        "error_meter.wgsl",
-        include_str!("../../shaders/error_meter.wgsl"),
-    ),
-    (
-        "noise_harness.wgsl",
-        include_str!("../../shaders/noise_harness.wgsl"),
-    ),
-    (
-        "texture_patterns.wgsl",
-        include_str!("../../shaders/texture_patterns.wgsl"),
-    ),
-    ("bump.wgsl", include_str!("../../shaders/bump.wgsl")),
-    (
-        "texture_shading.wgsl",
-        include_str!("../../shaders/texture_shading.wgsl"),
-    ),
-    (
-        "texture_mapping.wgsl",
-        include_str!("../../shaders/texture_mapping.wgsl"),
-    ),
-    (
-        "texture_harness.wgsl",
-        include_str!("../../shaders/texture_harness.wgsl"),
-    ),
-    (
-        "texture_image.wgsl",
-        include_str!("../../shaders/texture_image.wgsl"),
-    ),
-    (
-        "env_sampling.wgsl",
-        include_str!("../../shaders/env_sampling.wgsl"),
-    ),
-    ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
-    ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
-    ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
-    (
-        "bvh_harness.wgsl",
-        include_str!("../../shaders/bvh_harness.wgsl"),
-    ),
-    (
-        "ray_geometry.wgsl",
-        include_str!("../../shaders/ray_geometry.wgsl"),
-    ),
-    (
-        "shading_normal.wgsl",
-        include_str!("../../shaders/shading_normal.wgsl"),
-    ),
-    (
-        "geometry_harness.wgsl",
-        include_str!("../../shaders/geometry_harness.wgsl"),
-    ),
-    (
-        "sampling_harness.wgsl",
-        include_str!("../../shaders/sampling_harness.wgsl"),
-    ),
+    pub const COMMON: WgslFile = wgsl_file!("crates/render/shaders/common.wgsl");
+    pub const FULLSCREEN: WgslFile = wgsl_file!("crates/render/shaders/fullscreen.wgsl");
+    pub const SCENE: WgslFile = wgsl_file!("crates/render/shaders/scene.wgsl");
+    pub const TEXTURES: WgslFile = wgsl_file!("crates/render/shaders/textures.wgsl");
+    pub const INTERSECT: WgslFile = wgsl_file!("crates/render/shaders/intersect.wgsl");
+    pub const RANDOM: WgslFile = wgsl_file!("crates/render/shaders/random.wgsl");
+    pub const SURFACE: WgslFile = wgsl_file!("crates/render/shaders/surface.wgsl");
+    pub const ENV_LOOKUP: WgslFile = wgsl_file!("crates/render/shaders/env_lookup.wgsl");
+    pub const BUMP: WgslFile = wgsl_file!("crates/render/shaders/bump.wgsl");
+    pub const TRACE: WgslFile = wgsl_file!("crates/render/shaders/trace.wgsl");
+    pub const TONEMAP: WgslFile = wgsl_file!("crates/render/shaders/tonemap.wgsl");
+}
+
+use super::harness;
+use marbre_core::wgsl::WgslFile;
+use marbre_core::{accel, bsdf, env_sampling, envmap, geometry, lights, mis, noise, texture};
+use renderer_files as r;
+
+/// Every WGSL file, each named by the module it belongs to: the CPU twin
+/// beside which it lives, or the renderer's own files. `--dev` reloads
+/// them all and the benchmark references are keyed by their text.
+const SOURCES: &[WgslFile] = &[
+    r::COMMON,
+    r::FULLSCREEN,
+    noise::hash::WGSL,
+    noise::gradient::WGSL,
+    noise::perlin::WGSL,
+    noise::fractal::WGSL,
+    envmap::WGSL,
+    r::SCENE,
+    r::TEXTURES,
+    r::INTERSECT,
+    r::RANDOM,
+    bsdf::WGSL,
+    r::SURFACE,
+    r::ENV_LOOKUP,
+    r::TRACE,
+    super::accumulation::WGSL,
+    harness::accumulation::WGSL,
+    r::TONEMAP,
+    super::metering_grid::WGSL,
+    super::auto_exposure::WGSL,
+    super::error_meter::WGSL,
+    harness::noise::WGSL,
+    texture::PATTERNS_WGSL,
+    r::BUMP,
+    texture::SHADING_WGSL,
+    texture::mapping::WGSL,
+    harness::texture::WGSL,
+    texture::image::WGSL,
+    env_sampling::WGSL,
+    mis::WGSL,
+    lights::WGSL,
+    accel::traverse::WGSL,
+    harness::bvh::WGSL,
+    geometry::sphere::WGSL,
+    geometry::ray_offset::WGSL,
+    texture::bump::WGSL,
+    harness::geometry::WGSL,
+    harness::sampling::WGSL,
 ];
+
+/// The folder `marbre --dev` watches for edited WGSL: the repository's
+/// `crates/`, where every file of [`SOURCES`] lives.
+pub const DEV_SOURCE_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Program {
@@ -160,90 +120,94 @@ impl Program {
     ];
 
     /// The files this program is made of, in order, for a feature set.
-    fn files(self, features: &FeatureSet) -> Vec<&'static str> {
-        let noise = |out: &mut Vec<&'static str>| {
-            out.push("hash.wgsl");
+    fn files(self, features: &FeatureSet) -> Vec<WgslFile> {
+        let noise = |out: &mut Vec<WgslFile>| {
+            out.push(noise::hash::WGSL);
             if features.contains(Feature::NoiseGradient) {
-                out.push("noise_gradient.wgsl");
+                out.push(noise::gradient::WGSL);
             }
             if features.contains(Feature::NoisePerlin) {
-                out.push("noise_perlin.wgsl");
+                out.push(noise::perlin::WGSL);
             }
-            out.push("fractal.wgsl");
-            out.push("env_mapping.wgsl");
+            out.push(noise::fractal::WGSL);
+            out.push(envmap::WGSL);
         };
-        let mut out = vec!["common.wgsl"];
+        let mut out = vec![r::COMMON];
         match self {
             Program::Trace => {
                 noise(&mut out);
-                out.extend([
-                    "scene.wgsl",
-                    "texture_patterns.wgsl",
-                    "texture_mapping.wgsl",
-                ]);
+                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
                 if features.contains(Feature::Image) {
-                    out.push("texture_image.wgsl");
+                    out.push(texture::image::WGSL);
                 }
-                out.push("textures.wgsl");
+                out.push(r::TEXTURES);
                 if features.contains(Feature::Mesh) {
-                    out.push("bvh.wgsl");
+                    out.push(accel::traverse::WGSL);
                 }
                 out.extend([
-                    "ray_geometry.wgsl",
-                    "intersect.wgsl",
-                    "random.wgsl",
-                    "bsdf.wgsl",
-                    "surface.wgsl",
-                    "env_lookup.wgsl",
-                    "mis.wgsl",
+                    geometry::sphere::WGSL,
+                    geometry::ray_offset::WGSL,
+                    r::INTERSECT,
+                    r::RANDOM,
+                    bsdf::WGSL,
+                    r::SURFACE,
+                    r::ENV_LOOKUP,
+                    mis::WGSL,
                 ]);
                 if features.contains(Feature::PointLight) || features.contains(Feature::AreaLight) {
-                    out.push("lights.wgsl");
+                    out.push(lights::WGSL);
                 }
                 if features.contains(Feature::EnvSampling) {
-                    out.push("env_sampling.wgsl");
+                    out.push(env_sampling::WGSL);
                 }
-                out.extend(["fullscreen.wgsl", "accumulate.wgsl", "trace.wgsl"]);
+                out.extend([r::FULLSCREEN, super::accumulation::WGSL, r::TRACE]);
                 if features.contains(Feature::Bump) {
-                    out.extend(["texture_shading.wgsl", "shading_normal.wgsl", "bump.wgsl"]);
+                    out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP]);
                 }
             }
-            Program::Display => out = vec!["fullscreen.wgsl", "tonemap.wgsl"],
-            Program::AutoExposure => out.extend(["metering_grid.wgsl", "auto_exposure.wgsl"]),
-            Program::ErrorMeter => out.extend(["metering_grid.wgsl", "error_meter.wgsl"]),
+            Program::Display => out = vec![r::FULLSCREEN, r::TONEMAP],
+            Program::AutoExposure => {
+                out.extend([super::metering_grid::WGSL, super::auto_exposure::WGSL])
+            }
+            Program::ErrorMeter => {
+                out.extend([super::metering_grid::WGSL, super::error_meter::WGSL])
+            }
             Program::NoiseHarness => {
                 noise(&mut out);
-                out.push("noise_harness.wgsl");
+                out.push(harness::noise::WGSL);
             }
             Program::TextureHarness => {
                 noise(&mut out);
                 out.extend([
-                    "texture_patterns.wgsl",
-                    "texture_shading.wgsl",
-                    "texture_mapping.wgsl",
-                    "texture_image.wgsl",
-                    "texture_harness.wgsl",
+                    texture::PATTERNS_WGSL,
+                    texture::SHADING_WGSL,
+                    texture::mapping::WGSL,
+                    texture::image::WGSL,
+                    harness::texture::WGSL,
                 ]);
             }
-            Program::BvhHarness => out.extend(["bvh.wgsl", "bvh_harness.wgsl"]),
-            Program::AccumulationHarness => {
-                out.extend(["hash.wgsl", "accumulate.wgsl", "accumulation_harness.wgsl"])
-            }
+            Program::BvhHarness => out.extend([accel::traverse::WGSL, harness::bvh::WGSL]),
+            Program::AccumulationHarness => out.extend([
+                noise::hash::WGSL,
+                super::accumulation::WGSL,
+                harness::accumulation::WGSL,
+            ]),
             Program::GeometryHarness => out.extend([
-                "texture_shading.wgsl",
-                "ray_geometry.wgsl",
-                "shading_normal.wgsl",
-                "geometry_harness.wgsl",
+                texture::SHADING_WGSL,
+                geometry::sphere::WGSL,
+                geometry::ray_offset::WGSL,
+                texture::bump::WGSL,
+                harness::geometry::WGSL,
             ]),
             Program::SamplingHarness => out.extend([
-                "hash.wgsl",
-                "random.wgsl",
-                "env_mapping.wgsl",
-                "bsdf.wgsl",
-                "env_lookup.wgsl",
-                "mis.wgsl",
-                "env_sampling.wgsl",
-                "sampling_harness.wgsl",
+                noise::hash::WGSL,
+                r::RANDOM,
+                envmap::WGSL,
+                bsdf::WGSL,
+                r::ENV_LOOKUP,
+                mis::WGSL,
+                env_sampling::WGSL,
+                harness::sampling::WGSL,
             ]),
         }
         out
@@ -261,18 +225,17 @@ struct DevSources {
 
 static DEV_SOURCES: std::sync::RwLock<Option<DevSources>> = std::sync::RwLock::new(None);
 
-/// Reads every shader file from `dir` (the repository's `shaders/`), to be
-/// used instead of the embedded copies from now on; returns the new
-/// generation, or `None` when the text is what was loaded last (reading
-/// the files is itself a file event to a watcher). On error nothing
-/// changes.
-pub fn load_dev_sources(dir: &std::path::Path) -> anyhow::Result<Option<u64>> {
+/// Reads every shader file from the source tree (each from its
+/// `source_path`), to be used instead of the embedded copies from now on;
+/// returns the new generation, or `None` when the text is what was loaded
+/// last (reading the files is itself a file event to a watcher). On error
+/// nothing changes.
+pub fn load_dev_sources() -> anyhow::Result<Option<u64>> {
     let mut files = Vec::with_capacity(SOURCES.len());
-    for (name, _) in SOURCES {
-        let path = dir.join(name);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        files.push((*name, text));
+    for file in SOURCES {
+        let text = std::fs::read_to_string(file.source_path)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", file.name))?;
+        files.push((file.name, text));
     }
     let mut dev = DEV_SOURCES.write().unwrap_or_else(|e| e.into_inner());
     if dev.as_ref().is_some_and(|d| d.files == files) {
@@ -290,20 +253,14 @@ pub fn sources_generation() -> u64 {
     dev.as_ref().map_or(0, |d| d.generation)
 }
 
-/// The text of shader file `name`: the dev copy if loaded, else embedded.
-fn source_text(name: &str) -> String {
+/// The text of `file`: the dev copy if loaded, else embedded.
+fn source_text(file: &WgslFile) -> String {
     let dev = DEV_SOURCES.read().unwrap_or_else(|e| e.into_inner());
     let dev_text = dev
         .as_ref()
-        .and_then(|d| d.files.iter().find(|(n, _)| *n == name))
+        .and_then(|d| d.files.iter().find(|(n, _)| *n == file.name))
         .map(|(_, text)| text.clone());
-    dev_text.unwrap_or_else(|| {
-        let (_, text) = SOURCES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .expect("every listed file is embedded");
-        (*text).to_owned()
-    })
+    dev_text.unwrap_or_else(|| file.text.to_owned())
 }
 
 /// A hash of every WGSL source in use: results cached on disk (benchmark
@@ -311,9 +268,9 @@ fn source_text(name: &str) -> String {
 pub fn sources_fingerprint() -> u64 {
     use std::hash::{Hash, Hasher};
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    for (name, _) in SOURCES {
-        name.hash(&mut hasher);
-        source_text(name).hash(&mut hasher);
+    for file in SOURCES {
+        file.name.hash(&mut hasher);
+        source_text(file).hash(&mut hasher);
     }
     hasher.finish()
 }
@@ -328,9 +285,9 @@ pub fn assemble(
 ) -> Result<String, PreprocessError> {
     let defines = features.defines();
     let mut module = String::new();
-    for name in program.files(features) {
-        module.push_str(&format!("{SECTION_HEADER}{name}\n"));
-        module.push_str(&preprocess(&source_text(name), name, &defines)?);
+    for file in program.files(features) {
+        module.push_str(&format!("{SECTION_HEADER}{}\n", file.name));
+        module.push_str(&preprocess(&source_text(&file), file.name, &defines)?);
     }
     if program == Program::Trace {
         module.push_str(&format!("{SECTION_HEADER}generated textures\n"));
@@ -363,6 +320,42 @@ pub fn source_position(module: &str, line: u32) -> Option<(String, u32)> {
 mod tests {
     use super::*;
 
+    /// `--dev` reads each file from its `source_path`: in the source tree
+    /// it holds the embedded text, and every file a program uses is in the
+    /// table that `--dev` reloads, once.
+    #[test]
+    fn every_source_is_found_in_the_tree_and_listed_once() {
+        let root = std::path::Path::new(DEV_SOURCE_ROOT);
+        for file in SOURCES {
+            let on_disk = std::fs::read_to_string(file.source_path)
+                .unwrap_or_else(|e| panic!("{}: {e}", file.source_path));
+            assert!(
+                on_disk == file.text,
+                "{} differs from the copy built in",
+                file.name
+            );
+            let from_root = root.join("..").join(file.name);
+            assert!(
+                from_root.is_file(),
+                "{} is not under the repository",
+                file.name
+            );
+        }
+        let mut names: Vec<&str> = SOURCES.iter().map(|f| f.name).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), SOURCES.len(), "a file is listed twice");
+        for program in Program::ALL {
+            for file in program.files(&FeatureSet::all()) {
+                assert!(
+                    SOURCES.contains(&file),
+                    "{program:?} uses {} unlisted",
+                    file.name
+                );
+            }
+        }
+    }
+
     #[test]
     fn a_module_line_maps_back_to_its_file_and_line() {
         let module = assemble(Program::Trace, &FeatureSet::all(), "fn generated() {}\n").unwrap();
@@ -371,14 +364,14 @@ mod tests {
             .position(|l| l.starts_with("fn fs_trace("))
             .unwrap() as u32
             + 1;
-        let file_line = source_text("trace.wgsl")
+        let file_line = source_text(&r::TRACE)
             .lines()
             .position(|l| l.starts_with("fn fs_trace("))
             .unwrap() as u32
             + 1;
         assert_eq!(
             source_position(&module, module_line),
-            Some(("trace.wgsl".to_owned(), file_line))
+            Some(("crates/render/shaders/trace.wgsl".to_owned(), file_line))
         );
         let last = module.lines().count() as u32;
         assert_eq!(

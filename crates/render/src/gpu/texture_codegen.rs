@@ -25,7 +25,7 @@ use marbre_core::texture::{ImageFilter, ImageSet, ImageWrap};
 use std::fmt::Write;
 
 /// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
-/// shaders/scene.wgsl): 16 KiB.
+/// crates/render/shaders/scene.wgsl): 16 KiB.
 pub const MAX_TEXTURE_PARAMS: usize = 1024;
 
 /// The generated code and the parameters it reads.

@@ -6,7 +6,7 @@
 //! A round is one sample (in fact `samples_per_frame`) for every pixel of
 //! the traced region. Every band of a round reads the same accumulated
 //! state and writes its own rows of the next, so a round traced in bands
-//! gives exactly the image a whole pass gives (`tests/kernels.rs`).
+//! gives exactly the image a whole pass gives (`crates/render/tests/gpu/kernels.rs`).
 #![allow(
     clippy::single_range_in_vec_init,
     reason = "a list of bands of rows, which is often one band"

@@ -1,12 +1,12 @@
 //! Long accumulation: the trace pass's running mean (Kahan-compensated,
-//! `shaders/accumulate.wgsl`) keeps its rounding error at a few ulps over
+//! `crates/render/src/gpu/accumulation.wgsl`) keeps its rounding error at a few ulps over
 //! 1e5 and 1e6 frames, where an uncompensated running mean and a plain f32
 //! sum drift. The streams are an HDR pixel's frames (mostly 0.01, one in
 //! ~1000 a firefly of 1000), the hard case for rounding. Runs on the CPU
 //! twin and, through a compute harness, on the GPU (skips loudly without
 //! an adapter, see `marbre_render::gpu::testing`).
 
-use marbre_render::gpu::accumulation_harness::{
+use marbre_render::gpu::harness::accumulation::{
     LongAccumulation, accumulate_on_cpu, exact_mean, frame_value, run,
 };
 use marbre_render::gpu::testing::gpu_or_skip;

@@ -1,4 +1,4 @@
-//! The triangle-mesh BVH (`marbre_core::accel`, `shaders/bvh.wgsl`):
+//! The triangle-mesh BVH (`marbre_core::accel`, `crates/core/src/accel/traverse.wgsl`):
 //!
 //! * on the CPU, closest hits through the BVH equal brute force over every
 //!   triangle, and every node bounds what is under it;
@@ -13,7 +13,7 @@ use marbre_core::accel::bvh::{MAX_DEPTH, MAX_LEAF_TRIANGLES};
 use marbre_core::accel::shapes::{IndexedMesh, bumpy_sphere, grid_plane, uv_sphere};
 use marbre_core::accel::{Bvh, BvhNode, MeshHit, TriangleHit, TriangleVerts, intersect};
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::bvh_harness::{BvhHarness, Ray};
+use marbre_render::gpu::harness::bvh::{BvhHarness, Ray};
 use marbre_render::gpu::testing::gpu_or_skip;
 use proptest::prelude::*;
 use std::collections::HashMap;
@@ -765,7 +765,7 @@ fn edge_on_sphere_rays(n: usize, rng: &mut Rng) -> (IndexedMesh, Vec<AimedRay>) 
 
 /// Issue 6, case 11: 1,000 rays along shared edges of a closed tessellated
 /// sphere, at its vertices and edges, all hit it where aimed, by brute
-/// force and through the BVH on the CPU, and through bvh.wgsl on the GPU
+/// force and through the BVH on the CPU, and through accel/traverse.wgsl on the GPU
 /// (closest and any hit). The naive Möller–Trumbore test's misses are
 /// printed for contrast.
 #[test]

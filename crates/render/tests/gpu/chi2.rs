@@ -22,7 +22,7 @@ use marbre_core::bsdf::{Surface, eval_bsdf, sample_bsdf};
 use marbre_core::env_sampling::EnvDistribution;
 use marbre_core::envmap::{EnvImage, load};
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::sampling_harness::{BsdfSetup, SamplingHarness};
+use marbre_render::gpu::harness::sampling::{BsdfSetup, SamplingHarness};
 use marbre_render::gpu::testing::gpu_or_skip;
 use std::path::Path;
 

@@ -227,7 +227,7 @@ pub fn kernels(ctx: &GpuContext) -> Vec<marbre_render::gpu::Kernel> {
 }
 
 /// The two kernels' images of the same accumulation agree to rounding
-/// (`tests/kernels.rs` finds them bit-identical on lavapipe; another
+/// (`crates/render/tests/gpu/kernels.rs` finds them bit-identical on lavapipe; another
 /// driver may contract or reorder float operations differently).
 pub fn assert_kernels_agree(fragment: &[[f32; 4]], compute: &[[f32; 4]], what: &str) {
     assert_eq!(fragment.len(), compute.len(), "{what}");

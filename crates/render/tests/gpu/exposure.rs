@@ -45,7 +45,7 @@ fn auto_exposure_displays_dim_and_bright_light_alike() {
         let images: Vec<image::RgbaImage> = [0.05, 50.0]
             .map(|radiance| {
                 let mut scene = spheres_in_constant_light(radiance);
-                scene.render.auto_exposure = auto_exposure;
+                scene.render.display.auto_exposure = auto_exposure;
                 traced(&ctx, &scene, size, 4).read_display(&ctx).unwrap()
             })
             .into();
@@ -86,7 +86,7 @@ fn gpu_log_average_matches_the_cpu_twin() {
         color: Vec3::new(1.0, 0.9, 0.7),
         intensity: 40.0,
     });
-    scene.render.auto_exposure = true;
+    scene.render.display.auto_exposure = true;
     for (size, strided) in [((64, 40), false), ((300, 270), true)] {
         let mut r = traced(&ctx, &scene, size, 2);
         let gpu = r.metering(&ctx).unwrap();
@@ -224,9 +224,9 @@ fn displayed_pixels_are_the_radiance_at_the_metered_exposure() {
     let size = (40, 30);
     for compensation in [0.0, 1.5] {
         let mut scene = spheres_in_constant_light(3.0);
-        scene.render.auto_exposure = true;
-        scene.render.exposure = compensation;
-        scene.render.tone_map = ToneMap::Reinhard;
+        scene.render.display.auto_exposure = true;
+        scene.render.display.exposure = compensation;
+        scene.render.display.tone_map = ToneMap::Reinhard;
         let mut r = traced(&ctx, &scene, size, 2);
         let shown = r.read_display(&ctx).unwrap();
         let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
@@ -267,13 +267,13 @@ fn exposure_edits_keep_the_samples() {
     let mut r = traced(&ctx, &scene, (16, 16), 3);
     let before = r.read_display(&ctx).unwrap();
     let mut edited = scene.clone();
-    edited.render.auto_exposure = true;
-    edited.render.exposure = -1.0;
+    edited.render.display.auto_exposure = true;
+    edited.render.display.exposure = -1.0;
     r.set_scene(&ctx, &edited).unwrap();
     assert_eq!(r.accumulated_samples(), 3);
     let after = r.read_display(&ctx).unwrap();
     assert!(max_difference(&before, &after) > 10, "the edit shows");
-    edited.render.auto_exposure = false;
+    edited.render.display.auto_exposure = false;
     r.set_scene(&ctx, &edited).unwrap();
     assert_eq!(r.accumulated_samples(), 3);
     edited.render.max_bounces += 1;

@@ -13,7 +13,7 @@
 //!   above, a camera inside, where the naive quadratic fails;
 //! * case 6, degenerate OBJ geometry rendered, with a finite light table;
 //! * case 11, a tessellated sphere in a white furnace shows no crack (the
-//!   rays aimed at its edges are in tests/bvh.rs);
+//!   rays aimed at its edges are in crates/render/tests/gpu/bvh.rs);
 //! * case 7, a bump whose normal vanishes or faces away from the viewer.
 //!
 //! Every read-back value is checked with `f32::is_finite` on the CPU.
@@ -28,7 +28,7 @@ use marbre_core::scene::{
 };
 use marbre_core::texture::bump::{FACING_MIN_COS, facing_shading_normal};
 use marbre_core::texture::bumped_normal;
-use marbre_render::gpu::geometry_harness::{
+use marbre_render::gpu::harness::geometry::{
     ShadingQuery, SphereQuery, offset_rays, shading_normals, sphere_distances,
 };
 use marbre_render::gpu::testing::gpu_or_skip;

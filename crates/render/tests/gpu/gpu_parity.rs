@@ -5,7 +5,7 @@
 use glam::Vec3;
 use marbre_core::envmap;
 use marbre_core::noise::{self, FractalParams, HashKind, NoiseKind, NoiseSettings};
-use marbre_render::gpu::noise_harness::{Evaluate, env_uv, evaluate, evaluate_scalar};
+use marbre_render::gpu::harness::noise::{Evaluate, env_uv, evaluate, evaluate_scalar};
 use marbre_render::gpu::testing::gpu_or_skip;
 
 const N: usize = 10_000;

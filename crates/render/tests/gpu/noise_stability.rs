@@ -23,7 +23,7 @@ use marbre_core::preset;
 use marbre_core::scene::{MappingSpace, Pattern, Property, Signal, SurfacePoint, TextureMapping};
 use marbre_core::texture::TextureTransform;
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::noise_harness::{Evaluate, evaluate_scalar};
+use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use marbre_render::gpu::testing::gpu_or_skip;
 use marbre_render::session::{accumulate, load_scene, renderer_with};
 
@@ -859,7 +859,7 @@ fn out_of_range_parameters_are_clamped_at_load_with_a_note_each() {
     }
     assert_eq!(loaded.notes.len(), 7, "{notes}");
     let scene = &loaded.preset.scene;
-    assert_eq!(scene.render.exposure, -20.0);
+    assert_eq!(scene.render.display.exposure, -20.0);
     let Pattern::Fbm { noise } = scene.spheres[0].material.diffuse.pattern else {
         panic!("the preset's sphere lost its fBm");
     };

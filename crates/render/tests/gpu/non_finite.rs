@@ -122,7 +122,7 @@ fn infinite_samples_are_counted_apart_and_shown_magenta_until_the_image_restarts
         assert_eq!(counts.infinite, all_pixels * SPP_PER_FRAME * FRAMES);
         assert_eq!((counts.nan, counts.pixels), (0, all_pixels));
         assert_eq!(magenta_pixels(&ctx, &mut r), 0, "the debug view is off");
-        scene.render.show_non_finite = true;
+        scene.render.display.show_non_finite = true;
         r.set_scene(&ctx, &scene).unwrap();
         assert_eq!(
             r.accumulated_samples(),
@@ -132,7 +132,7 @@ fn infinite_samples_are_counted_apart_and_shown_magenta_until_the_image_restarts
         assert_eq!(magenta_pixels(&ctx, &mut r), all_pixels as usize);
         // A finite scene restarts the accumulation, and its counters with it.
         let mut finite = world_of_radiance(1.0);
-        finite.render.show_non_finite = true;
+        finite.render.display.show_non_finite = true;
         r.set_scene(&ctx, &finite).unwrap();
         accumulate(&ctx, &mut r, SPP_PER_FRAME, |_| {}).unwrap();
         assert!(r.count_non_finite(&ctx).unwrap().is_zero());

@@ -13,7 +13,7 @@ use marbre_core::envmap::{EnvImage, direction_to_uv, texel_for_direction};
 use marbre_core::mis::{bsdf_sample_weight, light_sample_weight, mis_heuristic};
 use marbre_core::scene::Strategy as MisStrategy;
 use marbre_core::texture::{TextureTransform, cylinder_uv, plane_uv, sphere_uv, triangle_uv};
-use marbre_render::gpu::sampling_harness::{BsdfSetup, SamplingHarness};
+use marbre_render::gpu::harness::sampling::{BsdfSetup, SamplingHarness};
 use marbre_render::gpu::testing::gpu_or_skip;
 use proptest::prelude::*;
 

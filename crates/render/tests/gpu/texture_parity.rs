@@ -1,4 +1,4 @@
-//! The texture library's WGSL (`shaders/texture_patterns.wgsl`), run on the
+//! The texture library's WGSL (`crates/core/src/texture/patterns.wgsl`), run on the
 //! GPU through the compute harness, against the CPU reference in
 //! `marbre_core::texture`, at 10,000 points per pattern and per mapping.
 //!
@@ -10,8 +10,8 @@
 use glam::{Vec2, Vec3};
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, turbulence};
 use marbre_core::texture::{self, RampStop};
+use marbre_render::gpu::harness::texture::{PatternQuery, evaluate};
 use marbre_render::gpu::testing::gpu_or_skip;
-use marbre_render::gpu::texture_harness::{PatternQuery, evaluate};
 
 const N: usize = 10_000;
 

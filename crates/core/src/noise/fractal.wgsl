@@ -1,0 +1,162 @@
+// Fractal sums; twin of fractal.rs.
+
+struct NoiseParams {
+    kind: u32,        // 0 gradient, 1 Perlin
+    hash: u32,        // 0 pcg3d, 1 sin, 2 pcg3d tiled every 256 cells
+    octaves: f32,
+    frequency: f32,
+    amplitude: f32,
+    persistence: f32,
+    lacunarity: f32,
+    // What each octave adds: 0 noise (fBm), 1 |noise| (turbulence),
+    // 2 (1 - |noise|)² (ridged).
+    shape: u32,
+    // Domain warp amount (0: none); compiled in with NOISE_WARP only.
+    distortion: f32,
+    // 1: the renderer takes the signal at world coordinates, 0: object ones.
+    world: u32,
+    // How much the signal's mapping enlarges a footprint.
+    footprint_scale: f32,
+    _pad0: f32,
+}
+
+const MAX_OCTAVES: f32 = 16.0;
+
+fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
+#if NOISE_PERLIN
+    if kind == 1u {
+        return perlin_noise(p);
+    }
+#endif
+#if NOISE_GRADIENT
+    return gradient_noise(p, hash);
+#else
+    return 0.0;
+#endif
+}
+
+#if FOOTPRINT
+// The octaves a footprint `width` wide resolves; twin of
+// noise::footprint_octaves (pbrt's rule, any lacunarity).
+fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    if !(width > 0.0 && n.lacunarity > 1.0 && n.frequency > 0.0) {
+        return octaves;
+    }
+    let resolved = max((-1.0 - log2(n.frequency * width)) / log2(n.lacunarity), 0.0);
+    let whole = floor(resolved);
+    let x = clamp((resolved - whole - 0.3) / 0.4, 0.0, 1.0);
+    return min(whole + x * x * (3.0 - 2.0 * x), octaves);
+}
+#endif
+
+// Octave i's share of the sum, in one place for both kinds' loops: the last,
+// fractional octave fades in, and the shape applies.
+fn octave_term(v: f32, n: NoiseParams, octaves: f32, i: u32, amplitude: f32) -> f32 {
+    let ridge = (1.0 - abs(v)) * (1.0 - abs(v));
+    let shaped = select(select(v, abs(v), n.shape == 1u), ridge, n.shape == 2u);
+    return min(octaves - f32(i), 1.0) * amplitude * shaped;
+}
+
+#if NOISE_WARP
+// Offsets that decorrelate the warp's three components (fractal.rs).
+const WARP_OFFSET_0 = vec3f(5.2, 1.3, 7.1);
+const WARP_OFFSET_1 = vec3f(1.7, 9.2, 3.4);
+const WARP_OFFSET_2 = vec3f(8.3, 2.8, 4.9);
+#endif
+
+// p moved by the signal's domain warp: three noises at the base frequency.
+// Without NOISE_WARP no signal of the scene warps, and p stays.
+fn warped(p: vec3f, n: NoiseParams) -> vec3f {
+#if NOISE_WARP
+    let q = p * n.frequency;
+    let w = vec3f(
+        lattice_noise(q + WARP_OFFSET_0, n.kind, n.hash),
+        lattice_noise(q + WARP_OFFSET_1, n.kind, n.hash),
+        lattice_noise(q + WARP_OFFSET_2, n.kind, n.hash),
+    );
+    return select(p + n.distortion * w, p, n.distortion == 0.0);
+#else
+    return p;
+#endif
+}
+
+// One octave loop per noise kind, each calling only its own noise. A loop
+// shared by both kinds would hold both noises, and SIMD lanes run both
+// whenever either is needed (lavapipe runs every branch): the renderer calls
+// each kind's loop only for the signals of that kind.
+
+#if NOISE_GRADIENT
+fn fractal_sum_gradient(point: vec3f, n: NoiseParams) -> f32 {
+    let p = warped(point, n);
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    var frequency = n.frequency;
+    var amplitude = n.amplitude;
+    var sum = 0.0;
+    for (var i = 0u; i < u32(ceil(octaves)); i++) {
+        let v = gradient_noise(p * frequency, n.hash);
+        sum += octave_term(v, n, octaves, i, amplitude);
+        frequency *= n.lacunarity;
+        amplitude *= n.persistence;
+    }
+    return sum;
+}
+#endif
+
+#if NOISE_PERLIN
+fn fractal_sum_perlin(point: vec3f, n: NoiseParams) -> f32 {
+    let p = warped(point, n);
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    var frequency = n.frequency;
+    var amplitude = n.amplitude;
+    var sum = 0.0;
+    for (var i = 0u; i < u32(ceil(octaves)); i++) {
+        let v = perlin_noise(p * frequency);
+        sum += octave_term(v, n, octaves, i, amplitude);
+        frequency *= n.lacunarity;
+        amplitude *= n.persistence;
+    }
+    return sum;
+}
+#endif
+
+// The fractal sum of either kind, for callers that hold one signal.
+fn fractal_sum(p: vec3f, n: NoiseParams) -> f32 {
+#if NOISE_PERLIN
+    if n.kind == 1u {
+        return fractal_sum_perlin(p, n);
+    }
+#endif
+#if NOISE_GRADIENT
+    return fractal_sum_gradient(p, n);
+#else
+    return 0.0;
+#endif
+}
+
+fn fbm(p: vec3f, n: NoiseParams) -> f32 {
+    var signed = n;
+    signed.shape = 0u;
+    return fractal_sum(p, signed);
+}
+
+fn turbulence(p: vec3f, n: NoiseParams) -> f32 {
+    var absolute = n;
+    absolute.shape = 1u;
+    return fractal_sum(p, absolute);
+}
+
+fn ridged(p: vec3f, n: NoiseParams) -> f32 {
+    var ridges = n;
+    ridges.shape = 2u;
+    return fractal_sum(p, ridges);
+}
+
+// The stripes of marble, given the fBm value at the point.
+fn marble_stripes(x: f32, fbm_value: f32, stripe_frequency: f32) -> f32 {
+    return sin(x * stripe_frequency + fbm_value);
+}
+
+fn marble(p: vec3f, n: NoiseParams, stripe_frequency: f32) -> f32 {
+    return marble_stripes(p.x, fbm(p, n), stripe_frequency);
+}

@@ -1,0 +1,60 @@
+// Auto exposure (Reinhard et al. 2002, "Photographic tone reproduction"):
+// the log-average luminance L_avg = exp(mean(log(DELTA + L))) of the
+// accumulated radiance, and the exposure that maps it to the middle grey
+// KEY. One workgroup meters a grid of texels (metering_grid.wgsl) and
+// reduces it in workgroup memory; the result stays in a buffer the display
+// pass reads (`Metered` in tonemap.wgsl mirrors it).
+// CPU twin: auto_exposure.rs.
+
+const DELTA: f32 = 1e-4;
+const KEY: f32 = 0.18;
+const MAX_STOPS: f32 = 20.0;
+
+struct Metered {
+    log_average: f32,
+    stops: f32,
+    scale: f32,
+    count: u32,
+}
+
+@group(0) @binding(0) var<uniform> metering: MeteringGrid;
+@group(0) @binding(1) var radiance: texture_2d<f32>;
+@group(0) @binding(2) var<storage, read_write> metered: Metered;
+
+var<workgroup> sums: array<f32, WORKGROUP>;
+var<workgroup> counts: array<u32, WORKGROUP>;
+
+@compute @workgroup_size(256)
+fn cs_meter(@builtin(local_invocation_index) t: u32) {
+    let grid = metering.grid;
+    let n = grid.x * grid.y;
+    var sum = 0.0;
+    var count = 0u;
+    for (var k = t; k < n; k += WORKGROUP) {
+        let c = textureLoad(radiance, grid_cell_texel(k, metering), 0).rgb;
+        // NaN, ±Inf and negative texels (and a luminance that overflows) are
+        // left out rather than poisoning the mean.
+        let l = luminance(c);
+        if !any_non_finite(c) && all(c >= vec3f(0.0)) && !is_non_finite(l) {
+            sum += log(DELTA + l);
+            count += 1u;
+        }
+    }
+    sums[t] = sum;
+    counts[t] = count;
+    workgroupBarrier();
+    for (var stride = WORKGROUP / 2u; stride > 0u; stride /= 2u) {
+        if t < stride {
+            sums[t] += sums[t + stride];
+            counts[t] += counts[t + stride];
+        }
+        workgroupBarrier();
+    }
+    if t == 0u {
+        // Nothing metered reads as black: L_avg = DELTA.
+        let mean = select(log(DELTA), sums[0] / f32(max(counts[0], 1u)), counts[0] > 0u);
+        let log_average = exp(mean);
+        let stops = clamp(log2(KEY / log_average), -MAX_STOPS, MAX_STOPS);
+        metered = Metered(log_average, stops, exp2(stops), counts[0]);
+    }
+}

@@ -1,0 +1,113 @@
+//! Runs the shader's noise and mapping functions in a compute pass, so the
+//! real WGSL can be checked against the CPU reference and queried from the
+//! command line (`marbre noise`).
+
+use super::points;
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::scene_gpu::NoiseParamsGpu;
+use crate::gpu::shader_source::Program;
+use anyhow::Result;
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+use marbre_core::noise::{FractalShape, NoiseSettings};
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: marbre_core::wgsl::WgslFile =
+    marbre_core::wgsl_file!("crates/render/src/gpu/harness/noise.wgsl");
+
+/// What the harness evaluates at each point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Evaluate {
+    Noise,
+    Fbm,
+    Turbulence,
+    Ridged,
+    /// The octaves a footprint `width` wide keeps (x only).
+    FootprintOctaves {
+        width: f32,
+    },
+    Marble {
+        stripe_frequency: f32,
+    },
+    /// The lat-long mapping of a direction.
+    EnvUv,
+    /// The environment rotation applied to a direction, in radians.
+    RotateY {
+        angle: f32,
+    },
+}
+
+impl Evaluate {
+    fn mode_and_param(self) -> (u32, f32) {
+        match self {
+            Evaluate::Noise => (0, 0.0),
+            Evaluate::Fbm => (1, 0.0),
+            Evaluate::Turbulence => (2, 0.0),
+            Evaluate::Marble { stripe_frequency } => (3, stripe_frequency),
+            Evaluate::EnvUv => (4, 0.0),
+            Evaluate::RotateY { angle } => (5, angle),
+            Evaluate::Ridged => (6, 0.0),
+            Evaluate::FootprintOctaves { width } => (7, width),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct HarnessUniform {
+    noise: NoiseParamsGpu,
+    mode: u32,
+    count: u32,
+    param: f32,
+    _pad1: f32,
+}
+
+/// Evaluates `what` at every point on the GPU; one vec4 of results each
+/// (x for scalars, xy for uv, xyz for directions).
+pub fn evaluate(
+    ctx: &GpuContext,
+    noise: &NoiseSettings,
+    what: Evaluate,
+    points: &[Vec3],
+) -> Result<Vec<[f32; 4]>> {
+    let (mode, param) = what.mode_and_param();
+    let params = HarnessUniform {
+        noise: NoiseParamsGpu::new(noise, FractalShape::Signed),
+        mode,
+        count: points.len() as u32,
+        param,
+        _pad1: 0.0,
+    };
+    points::run(
+        ctx,
+        Program::NoiseHarness,
+        &FeatureSet::for_noise_harness(noise),
+        bytemuck::bytes_of(&params),
+        None,
+        points,
+    )
+}
+
+/// Scalar results (the x component).
+pub fn evaluate_scalar(
+    ctx: &GpuContext,
+    noise: &NoiseSettings,
+    what: Evaluate,
+    points: &[Vec3],
+) -> Result<Vec<f32>> {
+    Ok(evaluate(ctx, noise, what, points)?
+        .iter()
+        .map(|r| r[0])
+        .collect())
+}
+
+/// The GPU's lat-long uv for each direction.
+pub fn env_uv(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<Vec2>> {
+    Ok(
+        evaluate(ctx, &NoiseSettings::default(), Evaluate::EnvUv, directions)?
+            .iter()
+            .map(|r| Vec2::new(r[0], r[1]))
+            .collect(),
+    )
+}

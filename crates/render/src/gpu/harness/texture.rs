@@ -1,0 +1,307 @@
+//! Runs the texture library's WGSL patterns (`crates/core/src/texture/patterns.wgsl`)
+//! in a compute pass, so the parity tests can hold them to the CPU reference
+//! in [`marbre_core::texture`].
+
+use super::points;
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::scene_gpu::NoiseParamsGpu;
+use crate::gpu::shader_source::Program;
+use anyhow::{Result, ensure};
+use bytemuck::{Pod, Zeroable};
+use glam::{Affine3A, Vec2, Vec3};
+use marbre_core::noise::{FractalShape, NoiseSettings};
+use marbre_core::texture::{ImageAtlas, ImageFilter, ImageWrap, MAX_RAMP_STOPS, RampStop};
+
+/// The shader code this module is the CPU twin of (or, for a harness, runs).
+pub const WGSL: marbre_core::wgsl::WgslFile =
+    marbre_core::wgsl_file!("crates/render/src/gpu/harness/texture.wgsl");
+
+/// One pattern with its parameters. 2D patterns read uv from the points'
+/// x and y; `Bump` reads the unbumped normal from the point.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PatternQuery {
+    /// Result: (select, local u, local v).
+    Checker2d {
+        size: Vec2,
+        phase: f32,
+    },
+    Checker3d {
+        size: Vec3,
+    },
+    FilteredChecker2d {
+        size: Vec2,
+        phase: f32,
+        half_width: Vec2,
+    },
+    FilteredChecker3d {
+        size: Vec3,
+        half_width: Vec3,
+    },
+    /// Result: (select, local u, local v).
+    Brick {
+        size: Vec2,
+        mortar: f32,
+        row_offset: f32,
+    },
+    /// Result: (select, ∂h/∂u, ∂h/∂v, the height profile for a bevel one
+    /// unit high).
+    Tile {
+        mortar_half_width: f32,
+        bevel_width: f32,
+        bevel_height: f32,
+    },
+    Cutout {
+        sides: u32,
+        radius: f32,
+    },
+    Wood {
+        axis: Vec3,
+        ring_width: f32,
+        turbulence_amount: f32,
+        noise: NoiseSettings,
+    },
+    MarbleVeins {
+        axis: Vec3,
+        frequency: f32,
+        turbulence_amount: f32,
+        noise: NoiseSettings,
+    },
+    /// Result: (∂h/∂u, ∂h/∂v, the unit waves' height).
+    WavesGradient {
+        frequency: f32,
+        amplitude: f32,
+        direction: Vec2,
+    },
+    /// Result: the bumped normal.
+    Bump {
+        dp_du: Vec3,
+        dp_dv: Vec3,
+        dh_du: f32,
+        dh_dv: f32,
+    },
+    /// Result: the colour at t = the point's x.
+    Ramp {
+        stops: Vec<RampStop>,
+    },
+    /// Result: (u, v) of the point as an offset from a sphere's centre.
+    SphereUv,
+    /// Result: (u, v) of the point as an offset from a cylinder's base.
+    CylinderUv {
+        height: f32,
+    },
+    /// Result: (u, v) in the frame origin + u·u_axis + v·v_axis.
+    PlaneUv {
+        origin: Vec3,
+        u_axis: Vec3,
+        v_axis: Vec3,
+    },
+    /// Result: the triangle's interpolated (u, v).
+    TriangleUv {
+        vertices: [Vec3; 3],
+        uvs: [Vec2; 3],
+    },
+    /// Result: the 3D texture point.
+    Transform {
+        to_texture: Affine3A,
+    },
+    /// Result: image `entry` of the atlas sampled at the point's (x, y) as
+    /// (u, v), with its z as the level of detail.
+    Image {
+        atlas: ImageAtlas,
+        entry: usize,
+        filter: ImageFilter,
+        wrap: ImageWrap,
+    },
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct HarnessUniform {
+    noise: NoiseParamsGpu,
+    mode: u32,
+    count: u32,
+    sides: u32,
+    _pad: u32,
+    a: [f32; 4],
+    b: [f32; 4],
+    c: [f32; 4],
+    stops: [[f32; 4]; MAX_RAMP_STOPS],
+}
+
+impl PatternQuery {
+    fn uniform(&self, count: u32) -> Result<HarnessUniform> {
+        let mut u = HarnessUniform::zeroed();
+        u.count = count;
+        let v2 = |v: Vec2, z: f32, w: f32| [v.x, v.y, z, w];
+        let v3 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+        match self {
+            PatternQuery::Checker2d { size, phase } => {
+                u.mode = 0;
+                u.a = v2(*size, *phase, 0.0);
+            }
+            PatternQuery::Checker3d { size } => {
+                u.mode = 1;
+                u.a = v3(*size, 0.0);
+            }
+            PatternQuery::FilteredChecker2d {
+                size,
+                phase,
+                half_width,
+            } => {
+                u.mode = 2;
+                u.a = v2(*size, *phase, 0.0);
+                u.b = v2(*half_width, 0.0, 0.0);
+            }
+            PatternQuery::FilteredChecker3d { size, half_width } => {
+                u.mode = 17;
+                u.a = v3(*size, 0.0);
+                u.b = v3(*half_width, 0.0);
+            }
+            PatternQuery::Brick {
+                size,
+                mortar,
+                row_offset,
+            } => {
+                u.mode = 3;
+                u.a = v2(*size, *mortar, *row_offset);
+            }
+            PatternQuery::Tile {
+                mortar_half_width,
+                bevel_width,
+                bevel_height,
+            } => {
+                u.mode = 4;
+                u.a = [*mortar_half_width, *bevel_width, *bevel_height, 0.0];
+            }
+            PatternQuery::Cutout { sides, radius } => {
+                u.mode = 5;
+                u.sides = *sides;
+                u.a[0] = *radius;
+            }
+            PatternQuery::Wood {
+                axis,
+                ring_width,
+                turbulence_amount,
+                noise,
+            } => {
+                u.mode = 6;
+                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.a = v3(*axis, *ring_width);
+                u.b[0] = *turbulence_amount;
+            }
+            PatternQuery::MarbleVeins {
+                axis,
+                frequency,
+                turbulence_amount,
+                noise,
+            } => {
+                u.mode = 7;
+                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.a = v3(*axis, *frequency);
+                u.b[0] = *turbulence_amount;
+            }
+            PatternQuery::WavesGradient {
+                frequency,
+                amplitude,
+                direction,
+            } => {
+                u.mode = 8;
+                u.a = [*frequency, *amplitude, 0.0, 0.0];
+                u.b = v2(*direction, 0.0, 0.0);
+            }
+            PatternQuery::Bump {
+                dp_du,
+                dp_dv,
+                dh_du,
+                dh_dv,
+            } => {
+                u.mode = 9;
+                u.a = v3(*dp_du, 0.0);
+                u.b = v3(*dp_dv, 0.0);
+                u.c = [*dh_du, *dh_dv, 0.0, 0.0];
+            }
+            PatternQuery::Ramp { stops } => {
+                ensure!(
+                    stops.len() <= MAX_RAMP_STOPS,
+                    "a ramp holds at most {MAX_RAMP_STOPS} stops on the GPU, not {}",
+                    stops.len()
+                );
+                u.mode = 10;
+                u.sides = stops.len() as u32;
+                for (slot, s) in u.stops.iter_mut().zip(stops) {
+                    *slot = v3(s.color, s.position);
+                }
+            }
+            PatternQuery::SphereUv => u.mode = 11,
+            PatternQuery::CylinderUv { height } => {
+                u.mode = 12;
+                u.a[0] = *height;
+            }
+            PatternQuery::PlaneUv {
+                origin,
+                u_axis,
+                v_axis,
+            } => {
+                u.mode = 13;
+                u.a = v3(*origin, 0.0);
+                u.b = v3(*u_axis, 0.0);
+                u.c = v3(*v_axis, 0.0);
+            }
+            PatternQuery::TriangleUv { vertices, uvs } => {
+                u.mode = 14;
+                for (slot, v) in u.stops.iter_mut().zip(vertices) {
+                    *slot = v3(*v, 0.0);
+                }
+                for (slot, t) in u.stops[3..].iter_mut().zip(uvs) {
+                    *slot = v2(*t, 0.0, 0.0);
+                }
+            }
+            PatternQuery::Transform { to_texture } => {
+                u.mode = 15;
+                let (m, t) = (to_texture.matrix3, to_texture.translation);
+                u.a = v3(m.x_axis.into(), t.x);
+                u.b = v3(m.y_axis.into(), t.y);
+                u.c = v3(m.z_axis.into(), t.z);
+            }
+            PatternQuery::Image {
+                atlas,
+                entry,
+                filter,
+                wrap,
+            } => {
+                u.mode = 16;
+                u.a = atlas.entries[*entry].params();
+                u.b = [filter.id() as f32, wrap.id() as f32, 0.0, 0.0];
+            }
+        }
+        Ok(u)
+    }
+
+    /// The noise a pattern's turbulence uses, if any: it picks the shader's
+    /// noise features.
+    fn noise(&self) -> NoiseSettings {
+        match self {
+            PatternQuery::Wood { noise, .. } | PatternQuery::MarbleVeins { noise, .. } => *noise,
+            _ => NoiseSettings::default(),
+        }
+    }
+}
+
+/// Evaluates `query` at every point on the GPU: one vec4 each (see
+/// [`PatternQuery`] for what its components hold).
+pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Result<Vec<[f32; 4]>> {
+    let uniform = query.uniform(points.len() as u32)?;
+    let noise = query.noise();
+    points::run(
+        ctx,
+        Program::TextureHarness,
+        &FeatureSet::for_texture_library(&noise),
+        bytemuck::bytes_of(&uniform),
+        match query {
+            PatternQuery::Image { atlas, .. } => Some(atlas),
+            _ => None,
+        },
+        points,
+    )
+}

@@ -1,0 +1,328 @@
+//! Deciding what to build for a scene and installing it: the pipeline key
+//! (features, generated texture code, override constants, shader sources,
+//! kernel), builds on the worker thread, and writing an installed scene
+//! into the buffers (restarting the accumulation only when what is traced
+//! changed).
+
+use super::*;
+
+impl Renderer {
+    /// The trace pipeline of the key's kernel, and the size of its WGSL.
+    pub(super) fn build_trace_pipeline(
+        device: &wgpu::Device,
+        layouts: &TraceLayouts,
+        key: &PipelineKey,
+    ) -> Result<(TracePipeline, usize)> {
+        let source = assemble(Program::Trace, &key.features, &key.code)?;
+        let bytes = source.len();
+        let module = compile_wgsl(device, Program::Trace, source)?;
+        let pipeline = TracePipeline::build(
+            device,
+            layouts,
+            &module,
+            key.kernel,
+            &key.switches.constants(),
+        )?;
+        Ok((pipeline, bytes))
+    }
+
+    /// Traces with `kernel` from now on, waiting for its pipeline (for
+    /// headless renders and tests); an error, leaving the current kernel,
+    /// if the adapter cannot run it.
+    pub fn set_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        self.choose_kernel(ctx, kernel)?;
+        let scene = self.scene.clone();
+        self.set_scene(ctx, &scene)
+    }
+
+    /// Traces with `kernel` once its pipeline is built, without waiting
+    /// (the viewer's Kernel switch): the current one draws until then.
+    pub fn request_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        self.choose_kernel(ctx, kernel)?;
+        let scene = self.latest_requested_scene();
+        self.start_scene(ctx, &scene, true)
+    }
+
+    /// The scene of the build under way, else the one drawing.
+    fn latest_requested_scene(&self) -> Scene {
+        self.pending
+            .as_ref()
+            .map_or(&self.scene, |p| &p.target.scene)
+            .clone()
+    }
+
+    fn choose_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
+        if kernel == Kernel::Compute && !self.compute_supported {
+            kernel::resolve(ctx, kernel::KernelChoice::Compute)?;
+        }
+        self.kernel = kernel;
+        Ok(())
+    }
+
+    /// Geometry prepared off the render thread for the next scene set
+    /// (see [`PreparedGeometry`]): that scene's BVH is not built again.
+    pub fn provide_geometry(&mut self, prepared: PreparedGeometry) {
+        self.meshes.provide(prepared);
+    }
+
+    /// Applies an edited scene and waits for any shader it needs: for
+    /// headless renders and tests. If the build fails, the previous pipeline
+    /// and scene stay and the error is returned.
+    pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        // Waiting here, the first draw may as well compile on this device:
+        // no warm-up.
+        self.start_scene(ctx, scene, false)?;
+        match self.pending.take() {
+            Some(mut pending) => {
+                let built = pending.build.wait()?;
+                self.install(ctx, built, &mut pending);
+                Ok(())
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Applies an edited scene without waiting: for the viewer. Parameter
+    /// edits only rewrite buffers and show at the next frame. An edit that
+    /// changes the feature set or the texture trees' structure starts a
+    /// pipeline build on a worker thread; until [`Renderer::poll_build`]
+    /// reports it done, the old pipeline keeps rendering the old scene (with
+    /// the new camera). A later edit of the same structure joins that build.
+    pub fn request_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        self.start_scene(ctx, scene, true)
+    }
+
+    /// [`Renderer::request_scene`], warming the driver's shader cache on a
+    /// second device first if `warm_up` (and the adapter compiles at draw).
+    fn start_scene(&mut self, ctx: &GpuContext, scene: &Scene, warm_up: bool) -> Result<()> {
+        let features = self
+            .feature_override
+            .clone()
+            .unwrap_or_else(|| FeatureSet::for_scene(scene));
+        let target_scene = self
+            .pending
+            .as_ref()
+            .map_or(&self.scene, |p| &p.target.scene);
+        // Camera and light edits (every frame of a drag) leave the textures
+        // alone: regenerate them only when a material changed.
+        let textures = if target_scene.materials().eq(scene.materials()) {
+            None
+        } else {
+            Some(texture_codegen::generate(scene, &self.images)?)
+        };
+        let target = Target {
+            scene: scene.clone(),
+            params: textures.as_ref().map(|t| t.params.clone()),
+        };
+        let code = match (&textures, &self.pending) {
+            (Some(t), _) => t.wgsl.clone(),
+            (None, Some(p)) => p.key.code.clone(),
+            (None, None) => self.key.code.clone(),
+        };
+        let key = PipelineKey {
+            features,
+            code,
+            switches: RenderSwitches::of(scene),
+            sources: sources_generation(),
+            kernel: self.kernel,
+        };
+        if key == self.key {
+            self.pending = None;
+            self.apply(ctx, target);
+            return Ok(());
+        }
+        if let Some(pending) = &mut self.pending
+            && pending.key == key
+        {
+            // Keep the parameters of a regenerated tree, or those already
+            // waiting.
+            let params = target.params.or(pending.target.params.take());
+            pending.target = Target { params, ..target };
+            self.follow_camera(scene);
+            return Ok(());
+        }
+        let warm_context = if warm_up {
+            self.warm_up_context(ctx)
+        } else {
+            None
+        };
+        let warm_up = warm_context.map(|warm| {
+            let warm_up = ShaderWarmUp {
+                ctx: warm,
+                scene: scene.clone(),
+                images: self.images.clone(),
+                features: self.feature_override.clone(),
+                kernel: self.kernel,
+            };
+            Box::new(move || warm_up.run()) as WarmUp
+        });
+        let (device, layouts) = (ctx.device.clone(), self.trace_layouts.clone());
+        let build_key = key.clone();
+        let build = self.builder.start(warm_up, move || {
+            Self::build_trace_pipeline(&device, &layouts, &build_key)
+        });
+        self.pending = Some(PendingScene { build, key, target });
+        self.follow_camera(scene);
+        Ok(())
+    }
+
+    /// Whether a pipeline build is under way.
+    pub fn is_building(&self) -> bool {
+        self.pending.is_some()
+    }
+
+    /// Installs a finished build and its scene. Returns how long the build
+    /// took, or why it failed (the old pipeline and scene then stay); None
+    /// while nothing has finished.
+    pub fn poll_build(&mut self, ctx: &GpuContext) -> Option<Result<Duration>> {
+        let result = self.pending.as_ref()?.build.poll()?;
+        let mut pending = self.pending.take()?;
+        Some(result.map(|built| {
+            let took = built.took;
+            self.install(ctx, built, &mut pending);
+            took
+        }))
+    }
+
+    /// How long the last pipeline build took, from the edit to the new
+    /// pipeline (the Stats panel shows it).
+    pub fn last_build(&self) -> Option<Duration> {
+        self.last_build
+    }
+
+    fn install(&mut self, ctx: &GpuContext, built: BuiltPipeline, pending: &mut PendingScene) {
+        self.trace_pipeline = built.pipeline;
+        self.trace_shader_bytes = built.shader_bytes;
+        self.last_build = Some(built.took);
+        self.key = std::mem::take(&mut pending.key);
+        let target = Target {
+            scene: std::mem::take(&mut pending.target.scene),
+            params: pending.target.params.take(),
+        };
+        // A new pipeline draws a new image even for the same scene (a
+        // feature compiled out): the samples of the old one must go.
+        self.reset_accumulation();
+        self.apply(ctx, target);
+    }
+
+    /// Writes a scene whose pipeline is in place into the buffers.
+    fn apply(&mut self, ctx: &GpuContext, target: Target) {
+        if let Some(params) = &target.params {
+            ctx.queue
+                .write_buffer(&self.texture_param_buffer, 0, bytemuck::cast_slice(params));
+        }
+        let scene = &target.scene;
+        self.geometry.write(&ctx.queue, scene);
+        self.meshes.update(&ctx.device, scene);
+        // Display-only edits (exposure, auto exposure, tone map, the debug
+        // view) keep the samples.
+        if !self.scene.traces_like(scene) {
+            self.reset_accumulation();
+        }
+        self.scene = target.scene;
+    }
+
+    /// While a build is pending the old scene is drawn, but seen from the
+    /// new camera: orbiting stays live.
+    fn follow_camera(&mut self, scene: &Scene) {
+        if self.scene.camera != scene.camera {
+            self.scene.camera = scene.camera;
+            self.reset_accumulation();
+        }
+    }
+
+    /// The second device that warms the driver's shader cache, on CPU
+    /// adapters only (created at the first build; None if it cannot be).
+    fn warm_up_context(&mut self, ctx: &GpuContext) -> Option<Arc<GpuContext>> {
+        if !ctx.is_cpu() {
+            return None;
+        }
+        if self.warm_up.is_none() {
+            self.warm_up = ctx.sibling().ok().map(Arc::new);
+        }
+        self.warm_up.clone()
+    }
+
+    /// Builds the shader with `features` instead of the scene's own set
+    /// (`None` goes back to specialising per scene).
+    pub fn set_feature_override(
+        &mut self,
+        ctx: &GpuContext,
+        features: Option<FeatureSet>,
+    ) -> Result<()> {
+        self.feature_override = features;
+        let scene = self.scene.clone();
+        self.set_scene(ctx, &scene)
+    }
+
+    /// Builds the shader with `features` instead of the scene's own set,
+    /// without waiting (the viewer's feature-cost toggles). The set is
+    /// checked first: a feature the texture code calls cannot be left out,
+    /// and the error says so while the current shader stays.
+    pub fn request_feature_override(
+        &mut self,
+        ctx: &GpuContext,
+        features: Option<FeatureSet>,
+    ) -> Result<()> {
+        let code = self
+            .pending
+            .as_ref()
+            .map_or(&self.key.code, |p| &p.key.code);
+        if let Some(set) = &features {
+            let source = assemble(Program::Trace, set, code)?;
+            validate(&source).map_err(|e| {
+                anyhow::anyhow!("this scene's shader cannot be built with those features: {e}")
+            })?;
+        }
+        self.feature_override = features;
+        let scene = self.latest_requested_scene();
+        self.start_scene(ctx, &scene, true)
+    }
+
+    /// Goes back to specialising per scene at the next scene request,
+    /// without building anything now (the caller is about to request a
+    /// scene whose features changed).
+    pub fn forget_feature_override(&mut self) {
+        self.feature_override = None;
+    }
+
+    /// Replaces the images the scene's image textures read (loaded by
+    /// `ImageSet::load`): uploads their atlas and regenerates the texture
+    /// code, which holds where each image lies. A pending build is finished
+    /// first (its code assumed the old images).
+    pub fn set_images(&mut self, ctx: &GpuContext, images: ImageSet) -> Result<()> {
+        if let Some(mut pending) = self.pending.take() {
+            let built = pending.build.wait()?;
+            self.install(ctx, built, &mut pending);
+        }
+        let textures = texture_codegen::generate(&self.scene, &images)?;
+        if textures.wgsl != self.key.code {
+            let key = PipelineKey {
+                code: textures.wgsl,
+                ..self.key.clone()
+            };
+            (self.trace_pipeline, self.trace_shader_bytes) =
+                Self::build_trace_pipeline(&ctx.device, &self.trace_layouts, &key)?;
+            self.key = key;
+        }
+        ctx.queue.write_buffer(
+            &self.texture_param_buffer,
+            0,
+            bytemuck::cast_slice(&textures.params),
+        );
+        self.image_atlas_view = upload_atlas(ctx, images.atlas());
+        self.images = images;
+        self.reset_accumulation();
+        Ok(())
+    }
+
+    /// Replaces the environment image (None: a black 1×1 placeholder). One
+    /// larger than the GPU's textures is downscaled to fit (as
+    /// `session::load_environment` does with a note), never refused.
+    pub fn set_environment(&mut self, ctx: &GpuContext, env: Option<&EnvImage>) {
+        let env = env.map(|e| envmap::fit_within(e, ctx.device.limits().max_texture_dimension_2d));
+        self.env_view = upload_env(ctx, env.as_deref());
+        self.env_distribution = upload_env_distribution(ctx, env.as_deref());
+        self.reset_accumulation();
+    }
+}

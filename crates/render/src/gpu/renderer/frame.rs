@@ -1,0 +1,361 @@
+//! One frame's GPU work: the trace (a whole round, or the bands a budget
+//! allows, with a preview for a new accumulation), the meters (auto
+//! exposure, error) and the display pass onto any colour target.
+
+use super::*;
+
+impl Renderer {
+    /// Traces the rest of the first round and waits for it, if none is
+    /// complete yet (a preview may be on show): for screenshots, which
+    /// must have the full resolution.
+    pub fn complete_first_round(&mut self, ctx: &GpuContext) -> Result<()> {
+        if self.accumulation.frames() > 0 {
+            return Ok(());
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    }
+
+    /// The fraction of the round under way already traced (0 between
+    /// rounds): the panel's progress while a slow adapter traces in bands.
+    pub fn round_progress(&self) -> f32 {
+        self.accumulation.next_row() as f32 / self.render_size().1.max(1) as f32
+    }
+
+    pub fn resize(&mut self, ctx: &GpuContext, size: (u32, u32)) {
+        let size = (size.0.max(1), size.1.max(1));
+        if size != self.size {
+            self.size = size;
+            self.accumulation = Accumulation::new(&ctx.device, size, self.compute_supported);
+            self.reset_accumulation();
+        }
+    }
+
+    /// Traces at a fraction of the resolution (while the camera moves).
+    pub fn set_render_scale(&mut self, scale: f32) {
+        let scale = scale.clamp(0.1, 1.0);
+        if scale != self.render_scale {
+            self.render_scale = scale;
+            self.reset_accumulation();
+        }
+    }
+
+    pub fn reset_accumulation(&mut self) {
+        self.accumulation.reset();
+    }
+
+    /// Records one whole round: `samples_per_frame` more samples per pixel
+    /// (or the rest of the round under way), timed by `timestamps` if
+    /// given (the viewer's [`PassTimer`], the benchmarks' own query sets).
+    pub fn trace(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<PassTimestamps<'_>>,
+    ) -> TraceWork {
+        self.trace_within(ctx, encoder, TraceBudget::Round, timestamps)
+    }
+
+    /// Records about `budget` of tracing (see [`trace_bands::plan`]): the
+    /// round under way continues where it stopped, and a round completed
+    /// becomes the image. A new accumulation whose first round does not
+    /// fit in the budget first traces a preview whole, at the size that
+    /// fits (at most the interactive scale): the window shows the edit at
+    /// once, at a reduced resolution, then the full one.
+    pub fn trace_within(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        budget: TraceBudget,
+        timestamps: Option<PassTimestamps<'_>>,
+    ) -> TraceWork {
+        if !self.scene.render.accumulate && self.accumulation.next_row() == 0 {
+            // Each round starts anew; the preview was for the first.
+            let previewed = !self.accumulation.wants_preview();
+            self.accumulation.reset();
+            if previewed {
+                self.accumulation.skip_preview();
+            }
+        }
+        let full = self.render_size();
+        // Each pass: the region's size, the band's rows, whether a preview.
+        let mut passes: Vec<((u32, u32), std::ops::Range<u32>, bool)> = Vec::new();
+        let mut budget = budget;
+        if let TraceBudget::Pixels(pixels) = budget
+            && self.accumulation.wants_preview()
+        {
+            let round = u64::from(full.0) * u64::from(full.1);
+            if round > pixels {
+                let scale = ((pixels as f64 / round as f64).sqrt() as f32)
+                    .min(self.scene.render.interactive_scale);
+                let size = scaled(full, scale);
+                passes.push((size, 0..size.1, true));
+                budget = TraceBudget::Pixels(pixels.saturating_sub(pixel_count(size)));
+            } else {
+                self.accumulation.skip_preview();
+            }
+        }
+        let bands = trace_bands::plan(full.0, full.1, self.accumulation.next_row(), budget);
+        passes.extend(bands.into_iter().map(|rows| (full, rows, false)));
+        let mut work = TraceWork::default();
+        let count = passes.len();
+        for (index, (size, rows, preview)) in passes.into_iter().enumerate() {
+            if index > 0 && !preview && rows.start == 0 && !self.scene.render.accumulate {
+                // A later round of this call: it too starts anew.
+                self.accumulation.reset();
+                self.accumulation.skip_preview();
+            }
+            if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
+                self.non_finite.clear(encoder);
+            }
+            self.record_band(ctx, encoder, size, rows.clone(), (index, count), timestamps);
+            work.pixels += u64::from(size.0) * u64::from(rows.end - rows.start);
+            if preview {
+                // The preview draws the first round's samples at its own
+                // size: the frame index (the seed) stays, so the image
+                // that follows is the one a whole pass gives.
+                self.accumulation.show_preview(size);
+                continue;
+            }
+            self.accumulation.traced_to(rows.end);
+            if rows.end == size.1 {
+                self.accumulation
+                    .advance(self.scene.render.samples_per_frame.max(1), size);
+                self.frame_index = self.frame_index.wrapping_add(1);
+                work.rounds += 1;
+            }
+        }
+        self.non_finite
+            .record_readback(encoder, self.accumulation.generation());
+        work
+    }
+
+    /// Records the pass of one band of rows of a round over a region of
+    /// `size`: the frame uniform in its own slot, the bind groups of the
+    /// accumulation's current sets.
+    fn record_band(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        size: (u32, u32),
+        rows: std::ops::Range<u32>,
+        (index, count): (usize, usize),
+        timestamps: Option<PassTimestamps<'_>>,
+    ) {
+        let mut uniform: FrameUniform = scene_gpu::frame_uniform(
+            &self.scene,
+            size,
+            self.frame_index,
+            self.accumulation.samples(),
+        );
+        uniform.env_distribution_size = self.env_distribution.1;
+        let table = self.meshes.table();
+        uniform.light_count = table.lights.len() as u32;
+        uniform.light_total_power = table.total_power;
+        uniform.triangle_count = self.meshes.stats().triangles as u32;
+        uniform.band_start = rows.start;
+        uniform.band_end = rows.end;
+        let stride = frame_stride(&ctx.device);
+        let offset = self.frame_slot * stride;
+        self.frame_slot = (self.frame_slot + 1) % FRAME_SLOTS;
+        ctx.queue.write_buffer(
+            &self.frame_buffer,
+            offset,
+            bytemuck::cast_slice(&[uniform; 2]),
+        );
+        let (previous_mean, previous_spread) = self.accumulation.latest_views();
+        let frame = wgpu::BufferBinding {
+            buffer: &self.frame_buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(FRAME_BYTES),
+        };
+        let mut entries = vec![
+            bind(0, wgpu::BindingResource::Buffer(frame)),
+            bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
+            bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
+            bind(5, wgpu::BindingResource::TextureView(previous_mean)),
+            bind(16, wgpu::BindingResource::TextureView(previous_spread)),
+            bind(
+                18,
+                wgpu::BindingResource::TextureView(self.accumulation.latest_compensation_view()),
+            ),
+            bind(6, self.perm_buffer.as_entire_binding()),
+            bind(7, self.texture_param_buffer.as_entire_binding()),
+            bind(
+                8,
+                wgpu::BindingResource::TextureView(&self.image_atlas_view),
+            ),
+            bind(11, self.env_distribution.0.as_entire_binding()),
+            bind(
+                non_finite::BINDING,
+                self.non_finite.buffer().as_entire_binding(),
+            ),
+        ];
+        entries.extend(self.geometry.entries());
+        entries.extend(self.meshes.entries());
+        let scene_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("trace"),
+            layout: &self.trace_layouts.scene,
+            entries: &entries,
+        });
+        let outputs = matches!(self.trace_pipeline, TracePipeline::Compute(_)).then(|| {
+            let views = self.accumulation.write_views();
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("trace outputs"),
+                layout: &self.trace_layouts.outputs,
+                entries: &[
+                    bind(0, wgpu::BindingResource::TextureView(views[0])),
+                    bind(1, wgpu::BindingResource::TextureView(views[1])),
+                    bind(2, wgpu::BindingResource::TextureView(views[2])),
+                ],
+            })
+        });
+        BandPass {
+            pipeline: &self.trace_pipeline,
+            scene: &scene_group,
+            frame_offset: offset as u32,
+            outputs: outputs.as_ref(),
+            accumulation: &self.accumulation,
+            width: size.0,
+            rows,
+            height: size.1,
+            index,
+            count,
+        }
+        .record(encoder, timestamps);
+    }
+
+    /// Records the auto-exposure metering of the latest mean, unless the
+    /// result already comes from it.
+    pub(super) fn meter(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<&PassTimer>,
+    ) {
+        let render_size = self.shown_size();
+        let from = MeteredFrom {
+            shown: self.accumulation.shown_count(),
+            size: self.size,
+            render_size,
+        };
+        if self.metered_from != Some(from) {
+            self.auto_exposure.record(
+                ctx,
+                encoder,
+                self.accumulation.latest_views().0,
+                render_size,
+                timer.and_then(|t| t.compute_pass(Pass::AutoExposure)),
+            );
+            self.metered_from = Some(from);
+        }
+    }
+
+    /// Records the display pass: exposure and tone mapping of the latest mean
+    /// into `viewport` of `target`. The rest of the target is left as is.
+    /// With auto exposure the mean is metered first (a compute pass in the
+    /// same encoder, its result read on the GPU).
+    pub fn display(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &DisplayTarget<'_>,
+        timer: Option<&PassTimer>,
+    ) -> Result<()> {
+        let DisplayTarget {
+            view: target,
+            format,
+            viewport,
+            load,
+        } = *target;
+        if !self.display_pipelines.contains_key(&format) {
+            let p = fullscreen_pipeline(
+                &ctx.device,
+                "display",
+                &self.display_module,
+                &self.display_layout,
+                "fs_display",
+                &[format],
+                &[],
+            )?;
+            self.display_pipelines.insert(format, p);
+        }
+        let auto_exposure = self.scene.render.display.auto_exposure;
+        if auto_exposure {
+            self.meter(ctx, encoder, timer);
+        }
+        let render_size = self.shown_size();
+        let uniform = DisplayUniform {
+            exposure_scale: self.scene.render.display.exposure.exp2(),
+            tone_map: match self.scene.render.display.tone_map {
+                ToneMap::Aces => 0,
+                ToneMap::Reinhard => 1,
+                ToneMap::Clamp => 2,
+            },
+            encode_srgb: u32::from(!format.is_srgb()),
+            auto_exposure: u32::from(auto_exposure),
+            origin: [viewport.x, viewport.y],
+            scale: [
+                render_size.0 as f32 / viewport.width.max(1.0),
+                render_size.1 as f32 / viewport.height.max(1.0),
+            ],
+            show_non_finite: u32::from(self.scene.render.display.show_non_finite),
+            padding: 0,
+        };
+        ctx.queue
+            .write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("display"),
+            layout: &self.display_layout,
+            entries: &[
+                bind(0, self.display_buffer.as_entire_binding()),
+                bind(
+                    1,
+                    wgpu::BindingResource::TextureView(self.accumulation.latest_views().0),
+                ),
+                bind(2, self.auto_exposure.result().as_entire_binding()),
+                bind(
+                    3,
+                    wgpu::BindingResource::TextureView(self.accumulation.latest_views().1),
+                ),
+            ],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("display"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: timer.and_then(|t| t.render_pass(Pass::Display)),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_viewport(
+            viewport.x,
+            viewport.y,
+            viewport.width,
+            viewport.height,
+            0.0,
+            1.0,
+        );
+        pass.set_pipeline(&self.display_pipelines[&format]);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+
+    /// Starts the readbacks recorded in the encoder just submitted.
+    pub fn after_submit(&self) {
+        self.error_meter.after_submit();
+        self.non_finite.after_submit();
+    }
+}

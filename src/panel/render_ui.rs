@@ -1,0 +1,114 @@
+//! The Render section: samples, bounces, exposure and tone map, the
+//! anti-aliasing switches and the kernel.
+
+use super::*;
+
+pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
+    ui.add(slider(
+        &mut render.samples_per_frame,
+        1..=RenderSettings::MAX_SAMPLES_PER_FRAME,
+        "samples per frame",
+    ))
+    .on_hover_text("Jittered samples per pixel each frame: smoother, slower frames");
+    ui.checkbox(&mut render.accumulate, "accumulate")
+        .on_hover_text("Average frames while nothing changes; off shows each frame alone");
+    ui.checkbox(&mut render.display.auto_exposure, "auto exposure")
+        .on_hover_text(
+            "Meter the image every frame and expose its log-average luminance to middle grey \
+             (Reinhard's key, 0.18); off, the exposure slider alone sets it",
+        );
+    let (label, hint) = if render.display.auto_exposure {
+        (
+            "compensation",
+            "Stops added to the automatic exposure: + brighter, − darker than middle grey",
+        )
+    } else {
+        (
+            "exposure",
+            "Scales the radiance by 2^exposure before tone mapping",
+        )
+    };
+    let stops = RenderSettings::MAX_EXPOSURE_STOPS;
+    ui.add(slider(&mut render.display.exposure, -stops..=stops, label).suffix(" stops"))
+        .on_hover_text(hint);
+    ComboBox::new("tone map", "tone map")
+        .selected_text(render.display.tone_map.label())
+        .show_ui(ui, |ui| {
+            for t in ToneMap::ALL {
+                ui.selectable_value(&mut render.display.tone_map, t, t.label())
+                    .on_hover_text(tone_map_hint(t));
+            }
+        })
+        .response
+        .on_hover_text("How radiance is mapped to displayable [0, 1]");
+    ui.add(slider(
+        &mut render.interactive_scale,
+        0.1..=1.0,
+        "resolution while dragging",
+    ))
+    .on_hover_text("Resolution scale while the camera moves, to keep the view responsive");
+    ui.checkbox(&mut render.filter_checkers, "filter checkers")
+        .on_hover_text(
+            "Average checkerboards over each ray's footprint (closed form): no aliasing far away",
+        );
+    ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
+        .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
+    ui.checkbox(
+        &mut render.display.show_non_finite,
+        "show non-finite pixels",
+    )
+    .on_hover_text(
+        "Debug view: paint magenta every pixel where a path gave a NaN or infinite sample \
+             (the accumulation drops such samples; Stats counts them)",
+    );
+    if ui
+        .button("Screenshot (F12)")
+        .on_hover_text(
+            "Save the image without the UI into screenshots/: a tone-mapped PNG and a linear \
+             EXR",
+        )
+        .clicked()
+    {
+        actions.push(PanelAction::Screenshot);
+    }
+}
+
+/// What a tone map entry does, for its tooltip.
+pub(super) fn tone_map_hint(tone_map: ToneMap) -> &'static str {
+    match tone_map {
+        ToneMap::Aces => "Narkowicz's fit of the ACES filmic curve: soft highlights, more contrast",
+        ToneMap::Reinhard => "x / (1 + x) per channel: never clips, but flattens highlights",
+        ToneMap::Clamp => "Clamp to [0, 1]: the linear radiance untouched, highlights clip",
+    }
+}
+
+/// The Kernel switch: which kernel traces (both draw the same image), or
+/// `auto`, the faster on this adapter.
+pub(super) fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelAction>) {
+    use marbre_render::gpu::KernelChoice;
+    let name = |c: KernelChoice| match c {
+        KernelChoice::Auto => "auto (the faster)",
+        KernelChoice::Fragment => "fragment",
+        KernelChoice::Compute => "compute",
+    };
+    let mut choice = stats.kernel_choice;
+    egui::ComboBox::from_label("kernel")
+        .selected_text(name(choice))
+        .show_ui(ui, |ui| {
+            for c in [
+                KernelChoice::Auto,
+                KernelChoice::Fragment,
+                KernelChoice::Compute,
+            ] {
+                ui.selectable_value(&mut choice, c, name(c));
+            }
+        })
+        .response
+        .on_hover_text(
+            "The trace as a fragment shader or a compute kernel: the same image, at a speed that \
+             depends on the GPU; auto times both on the scene and remembers the faster",
+        );
+    if choice != stats.kernel_choice {
+        actions.push(PanelAction::SetKernel(choice));
+    }
+}

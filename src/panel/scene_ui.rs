@@ -1,0 +1,216 @@
+//! The scene sections: materials, meshes, the point light, the camera and
+//! its saved views.
+
+use super::*;
+
+/// One collapsible block per object (spheres, cylinders, polygons), then
+/// the ground. Only the first is open at start, so a scene with many
+/// objects still fits on screen.
+pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
+    let mut first = true;
+    let mut object =
+        |ui: &mut Ui, key: (&str, usize), title: String, body: &mut dyn FnMut(&mut Ui)| {
+            // Keyed by index: names come from the preset and need not be unique.
+            ui.push_id(key, |ui| {
+                CollapsingHeader::new(title)
+                    .id_salt("object")
+                    .default_open(std::mem::take(&mut first))
+                    .show(ui, |ui| body(ui));
+            });
+        };
+    for (i, sphere) in scene.spheres.iter_mut().enumerate() {
+        object(
+            ui,
+            ("sphere", i),
+            format!("sphere “{}”", sphere.name),
+            &mut |ui| material_ui(ui, &mut sphere.material),
+        );
+    }
+    for (i, cylinder) in scene.cylinders.iter_mut().enumerate() {
+        object(
+            ui,
+            ("cylinder", i),
+            format!("cylinder “{}”", cylinder.name),
+            &mut |ui| {
+                vec3_ui(
+                    ui,
+                    "base",
+                    &mut cylinder.base,
+                    0.01,
+                    "Centre of the bottom cap",
+                );
+                ui.add(slider(&mut cylinder.radius, 0.01..=10.0, "radius").logarithmic(true))
+                    .on_hover_text("Radius of the side and caps, in scene units");
+                ui.add(slider(&mut cylinder.height, 0.01..=10.0, "height").logarithmic(true))
+                    .on_hover_text(
+                        "Along +y; the side's v runs from 0 at the base to 1 at the top",
+                    );
+                material_ui(ui, &mut cylinder.material);
+            },
+        );
+    }
+    for (i, polygon) in scene.polygons.iter_mut().enumerate() {
+        object(
+            ui,
+            ("polygon", i),
+            format!("polygon “{}”", polygon.name),
+            &mut |ui| material_ui(ui, &mut polygon.material),
+        );
+    }
+    if let Some(ground) = &mut scene.ground {
+        object(ui, ("ground", 0), "ground".into(), &mut |ui| {
+            material_ui(ui, &mut ground.material)
+        });
+    }
+    for (i, mesh) in scene.meshes.iter_mut().enumerate() {
+        object(
+            ui,
+            ("mesh", i),
+            format!("mesh “{}”", mesh.name),
+            &mut |ui| mesh_ui(ui, mesh),
+        );
+    }
+}
+
+/// A mesh's placement and each of its MTL materials, editable like any
+/// other (a Cornell box wall can be marble); "reset" goes back to the file.
+pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) {
+    ui.label(format!(
+        "{} triangles from {}",
+        mesh.geometry.0.len(),
+        mesh.obj.display()
+    ));
+    let p = &mut mesh.placement;
+    vec3_ui(ui, "translate", &mut p.translate, 0.01, "Moves the mesh");
+    ui.add(slider(&mut p.rotate_y_degrees, -180.0..=180.0, "turn").suffix("°"))
+        .on_hover_text("Turns the mesh about the vertical axis (rebuilds the BVH)");
+    ui.add(slider(&mut p.scale, 0.01..=100.0, "scale").logarithmic(true))
+        .on_hover_text("Scales the mesh about its file's origin (rebuilds the BVH)");
+    for (k, m) in mesh.materials.iter_mut().enumerate() {
+        ui.push_id(("mesh material", k), |ui| {
+            CollapsingHeader::new(format!("material “{}”", m.name))
+                .id_salt("mesh material")
+                .show(ui, |ui| {
+                    if let Some(original) = &m.from_file
+                        && m.material != *original
+                        && ui
+                            .small_button("reset to the MTL file")
+                            .on_hover_text("Forget the edits: the file's values come back")
+                            .clicked()
+                    {
+                        m.material = original.clone();
+                    }
+                    material_ui(ui, &mut m.material);
+                });
+        });
+    }
+}
+
+pub(super) fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {
+    let mut enabled = light.is_some();
+    if ui
+        .checkbox(&mut enabled, "enabled")
+        .on_hover_text("An isotropic point light, besides the environment")
+        .changed()
+    {
+        *light = enabled.then(PointLight::default);
+    }
+    if let Some(l) = light {
+        vec3_ui(
+            ui,
+            "position",
+            &mut l.position,
+            0.05,
+            "Where the light is, in scene units",
+        );
+        labelled_color(ui, &mut l.color, "colour").on_hover_text("The light's colour");
+        ui.add(
+            slider(&mut l.intensity, 0.0..=10_000.0, "intensity")
+                .logarithmic(true)
+                .smallest_positive(0.1),
+        )
+        .on_hover_text("Radiant intensity in watts per steradian (times the colour)");
+    }
+}
+
+pub(super) fn camera_ui(ui: &mut Ui, scene: &mut Scene, actions: &mut Vec<PanelAction>) {
+    let camera = &mut scene.camera;
+    vec3_ui(
+        ui,
+        "target",
+        &mut camera.target,
+        0.05,
+        "The point the camera orbits and looks at",
+    );
+    ui.add(
+        slider(
+            &mut camera.distance,
+            OrbitCamera::MIN_DISTANCE..=1000.0,
+            "distance",
+        )
+        .logarithmic(true),
+    )
+    .on_hover_text("Distance from the target");
+    ui.add(slider(&mut camera.yaw_degrees, 0.0..=360.0, "yaw").suffix("°"))
+        .on_hover_text("Rotation about the vertical axis");
+    ui.add(slider(&mut camera.pitch_degrees, -89.0..=89.0, "pitch").suffix("°"))
+        .on_hover_text("Elevation above the horizontal");
+    ui.add(slider(&mut camera.fov_degrees, 10.0..=120.0, "field of view").suffix("°"))
+        .on_hover_text("Vertical field of view");
+    if ui
+        .button("Reset")
+        .on_hover_text("Back to the preset's camera")
+        .clicked()
+    {
+        actions.push(PanelAction::ResetCamera);
+    }
+    ui.weak("left drag: orbit · right/middle drag: pan · wheel: zoom");
+    views_ui(ui, scene);
+}
+
+/// The preset's saved views: recall (or keys 1–9), rename, delete, and
+/// save the current camera as a new one.
+pub(super) fn views_ui(ui: &mut Ui, scene: &mut Scene) {
+    let mut recall = None;
+    let mut remove = None;
+    for (i, view) in scene.views.iter_mut().enumerate() {
+        ui.push_id(("view", i), |ui| {
+            ui.horizontal(|ui| {
+                let key = if i < 9 {
+                    format!("{}", i + 1)
+                } else {
+                    "·".to_owned()
+                };
+                if ui
+                    .button(key)
+                    .on_hover_text("Go to this view (the number key does it too)")
+                    .clicked()
+                {
+                    recall = Some(i);
+                }
+                ui.text_edit_singleline(&mut view.name)
+                    .on_hover_text("The view's name, saved with the preset");
+                if ui
+                    .small_button("✕")
+                    .on_hover_text("Delete this view")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+            });
+        });
+    }
+    if let Some(i) = recall {
+        scene.recall_view(i);
+    }
+    if let Some(i) = remove {
+        scene.views.remove(i);
+    }
+    if ui
+        .button("Save view")
+        .on_hover_text("Keep the current camera in the preset; keys 1–9 recall the first nine")
+        .clicked()
+    {
+        scene.save_view();
+    }
+}
