@@ -146,7 +146,7 @@ def parse_ron(text):
 
 
 def camera_frame(camera):
-    """marbre's orbit camera (src/scene/camera.rs) as a position, a forward,
+    """marbre's orbit camera (crates/core/src/scene/camera.rs) as a position, a forward,
     right and up vector and a vertical field of view."""
     target = camera.get("target", [0.0, 0.8, 0.0])
     distance = camera.get("distance", 9.0)
@@ -212,7 +212,7 @@ def read_obj(path, placement):
     materials = {}
     for library in libraries:
         materials.update(read_mtl(os.path.join(os.path.dirname(path), library)))
-    # marbre's placement (src/scene/mesh.rs): scaled, turned about +y, moved.
+    # marbre's placement (crates/core/src/scene/mesh.rs): scaled, turned about +y, moved.
     scale = placement.get("scale", 1.0)
     angle = math.radians(placement.get("rotate_y_degrees", 0.0))
     move = placement.get("translate", [0.0, 0.0, 0.0])
@@ -233,7 +233,7 @@ def read_scene(preset_path):
     if scene.get("environment", {}).get("source") is not None:
         refused.append("environment")
     render = scene.get("render", {})
-    # Defaults as in src/scene/render_settings.rs and src/scene/transport.rs.
+    # Defaults as in crates/core/src/scene/render_settings.rs and crates/core/src/scene/transport.rs.
     transport = render.get("transport", {})
     if transport.get("integrator", "Path") != "Path":
         refused.append("integrator")
@@ -272,7 +272,7 @@ def mitsuba_scene(mi, setup, size, folder):
     cam = setup["camera"]
     # How the two count path length. marbre's max_bounces B counts
     # reflections: it samples the lights at the first B surfaces the path
-    # meets and adds the emission of the first B + 1 (shaders/trace.wgsl:
+    # meets and adds the emission of the first B + 1 (crates/render/shaders/trace.wgsl:
     # the loop stops at `bounces >= max_bounces` after adding emission).
     # Mitsuba's max_depth counts path segments from the camera (1: emitters
     # seen directly, 2: direct light): the same paths are max_depth = B + 1.
@@ -471,7 +471,7 @@ def measure(args, mi, np, setup, folder):
 
 def material_regions(np, setup, size):
     """Which material each pixel sees, by casting marbre's camera rays
-    (shaders/trace.wgsl: camera_ray) through the pixel's centre and four
+    (crates/render/shaders/trace.wgsl: camera_ray) through the pixel's centre and four
     points near its corners against the triangles: -1 where they disagree
     (an edge) or miss."""
     width, height = size
