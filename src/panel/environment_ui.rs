@@ -1,7 +1,11 @@
 //! The Environment section: the source (none, constant, lat-long map, cube
 //! faces or cross), its fields and its rotation.
 
-use super::*;
+use super::widgets::{labelled_color, slider};
+use super::{PanelAction, PanelState};
+use egui::{ComboBox, TextEdit, Ui};
+use marbre_core::scene::{EnvSource, Environment};
+use std::path::PathBuf;
 
 /// The environment sources in the order of the source dropdown.
 pub(super) const ENV_SOURCE_NAMES: [&str; 5] = [

@@ -18,23 +18,15 @@ mod stats;
 mod transport;
 mod widgets;
 
-use egui::emath::Numeric;
-use egui::{
-    CollapsingHeader, Color32, ComboBox, DragValue, Response, ScrollArea, Slider, SliderClamping,
-    TextEdit, Ui,
-};
+use egui::{ScrollArea, Ui};
 use environment_ui::environment_ui;
 use glam::Vec3;
-use marbre_core::scene::{
-    EnvSource, Environment, OrbitCamera, PointLight, RenderSettings, Scene, ToneMap,
-};
+use marbre_core::scene::{EnvSource, Scene};
 use marbre_render::gpu::NonFiniteCounts;
-use material_editor::material_ui;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
 use scene_ui::{camera_ui, materials_ui, point_light_ui};
 use stats::stats_ui;
-use std::ops::RangeInclusive;
 use std::path::PathBuf;
 use widgets::{color_button, labelled_color, section, slider, vec3_ui};
 
@@ -247,8 +239,10 @@ mod tests {
     use super::*;
     use environment_ui::cube_source_from;
     use marbre_core::noise::NoiseSettings;
+    use marbre_core::scene::{Environment, PointLight};
     use marbre_core::scene::{Ground, Sphere};
     use marbre_core::scene::{Pattern, Texture};
+    use material_editor::material_ui;
 
     fn marble_scene() -> Scene {
         let mut sphere = Sphere::default();

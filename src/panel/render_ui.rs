@@ -1,7 +1,10 @@
 //! The Render section: samples, bounces, exposure and tone map, the
 //! anti-aliasing switches and the kernel.
 
-use super::*;
+use super::widgets::slider;
+use super::{PanelAction, Stats};
+use egui::{ComboBox, Ui};
+use marbre_core::scene::{RenderSettings, ToneMap};
 
 pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
     ui.add(slider(

@@ -1,7 +1,11 @@
 //! The scene sections: materials, meshes, the point light, the camera and
 //! its saved views.
 
-use super::*;
+use super::PanelAction;
+use super::material_editor::material_ui;
+use super::widgets::{labelled_color, slider, vec3_ui};
+use egui::{CollapsingHeader, Ui};
+use marbre_core::scene::{OrbitCamera, PointLight, Scene};
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
 /// the ground. Only the first is open at start, so a scene with many

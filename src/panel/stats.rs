@@ -1,7 +1,9 @@
 //! The Stats section: what the app measured, shown as is, with the
 //! counters of dropped non-finite samples.
 
-use super::*;
+use super::Stats;
+use egui::{Color32, Ui};
+use marbre_render::gpu::NonFiniteCounts;
 
 pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {
     ui.label(format!("{:.1} fps", stats.fps));

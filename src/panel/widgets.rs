@@ -1,7 +1,10 @@
 //! Small widgets every section uses: a collapsing section, sliders that
 //! do not clamp what they show, colour buttons that write only on a change.
 
-use super::*;
+use egui::emath::Numeric;
+use egui::{CollapsingHeader, DragValue, Response, Slider, SliderClamping, Ui};
+use glam::Vec3;
+use std::ops::RangeInclusive;
 
 /// A top-level collapsible section, its open state keyed by its title.
 pub(super) fn section(ui: &mut Ui, title: &str, default_open: bool, body: impl FnOnce(&mut Ui)) {

@@ -480,9 +480,10 @@ impl Viewer {
 }
 
 /// The folder holding every WGSL file `--dev` reads: the source tree's
-/// `crates/`.
+/// `crates/` (resolved, so that messages name it plainly).
 fn dev_shader_dir() -> PathBuf {
-    PathBuf::from(shader_source::DEV_SOURCE_ROOT)
+    let dir = PathBuf::from(shader_source::DEV_SOURCE_ROOT);
+    dir.canonicalize().unwrap_or(dir)
 }
 
 /// The view to keep across a reload, unless the file moved the camera.

@@ -4,7 +4,23 @@
 //! into the buffers (restarting the accumulation only when what is traced
 //! changed).
 
-use super::*;
+use super::{Renderer, upload_env, upload_env_distribution};
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::kernel::Kernel;
+use crate::gpu::mesh_buffers::PreparedGeometry;
+use crate::gpu::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
+use crate::gpu::pipelines::{compile_wgsl, upload_atlas, validate};
+use crate::gpu::shader_source::{Program, assemble, sources_generation};
+use crate::gpu::trace_pass::{TraceLayouts, TracePipeline};
+use crate::gpu::{kernel, texture_codegen};
+use anyhow::Result;
+use marbre_core::envmap;
+use marbre_core::envmap::EnvImage;
+use marbre_core::scene::Scene;
+use marbre_core::texture::ImageSet;
+use std::sync::Arc;
+use std::time::Duration;
 
 impl Renderer {
     /// The trace pipeline of the key's kernel, and the size of its WGSL.
@@ -324,5 +340,82 @@ impl Renderer {
         self.env_view = upload_env(ctx, env.as_deref());
         self.env_distribution = upload_env_distribution(ctx, env.as_deref());
         self.reset_accumulation();
+    }
+}
+
+/// A scene waiting for its pipeline: what to write into the buffers once
+/// the pipeline is in place (the texture parameters if they changed).
+pub(super) struct Target {
+    pub(super) scene: Scene,
+    pub(super) params: Option<Vec<[f32; 4]>>,
+}
+
+/// What a trace pipeline is built from: two scenes with equal keys share
+/// one. The features and texture code make the module; the switches are
+/// its override constants.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(super) struct PipelineKey {
+    pub(super) features: FeatureSet,
+    pub(super) code: String,
+    pub(super) switches: RenderSwitches,
+    /// The shader files' generation (`marbre --dev` reloads them).
+    pub(super) sources: u64,
+    pub(super) kernel: Kernel,
+}
+
+/// The render settings the trace shader reads as override constants
+/// (declared in crates/render/shaders/textures.wgsl).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct RenderSwitches {
+    pub(super) filter_checkers: bool,
+    pub(super) clamp_octaves: bool,
+}
+
+impl RenderSwitches {
+    pub(super) fn of(scene: &Scene) -> Self {
+        Self {
+            filter_checkers: scene.render.filter_checkers,
+            clamp_octaves: scene.render.clamp_octaves,
+        }
+    }
+
+    fn constants(self) -> [(&'static str, f64); 2] {
+        [
+            ("filter_checkers", f64::from(u8::from(self.filter_checkers))),
+            ("clamp_octaves", f64::from(u8::from(self.clamp_octaves))),
+        ]
+    }
+}
+
+/// A pipeline build under way, with the key it is built for.
+pub(super) struct PendingScene {
+    pub(super) build: PipelineBuild,
+    pub(super) key: PipelineKey,
+    pub(super) target: Target,
+}
+
+/// What to draw once on a second device, so its compiled shader lands in
+/// the driver's disk cache before the real device first draws it
+/// (`pipeline_build` runs it on its worker before the build).
+pub(super) struct ShaderWarmUp {
+    pub(super) ctx: Arc<GpuContext>,
+    pub(super) scene: Scene,
+    pub(super) images: ImageSet,
+    pub(super) features: Option<FeatureSet>,
+    /// The kernel being built: each compiles its own entry point.
+    pub(super) kernel: Kernel,
+}
+
+impl ShaderWarmUp {
+    fn run(self) -> Result<()> {
+        let ctx = &*self.ctx;
+        let mut renderer = Renderer::with_kernel(ctx, &self.scene, None, (1, 1), self.kernel)?;
+        renderer.set_feature_override(ctx, self.features)?;
+        renderer.set_images(ctx, self.images)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.trace(ctx, &mut encoder, None);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
     }
 }

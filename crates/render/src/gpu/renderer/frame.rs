@@ -2,7 +2,20 @@
 //! allows, with a preview for a new accumulation), the meters (auto
 //! exposure, error) and the display pass onto any colour target.
 
-use super::*;
+use super::{
+    DisplayTarget, DisplayUniform, FRAME_BYTES, FRAME_SLOTS, MeteredFrom, Renderer, TraceWork,
+    bind, frame_stride, pixel_count, scaled,
+};
+use crate::gpu::accumulation::Accumulation;
+use crate::gpu::context::GpuContext;
+use crate::gpu::pass_timer::{Pass, PassTimer};
+use crate::gpu::pipelines::fullscreen_pipeline;
+use crate::gpu::scene_gpu::FrameUniform;
+use crate::gpu::trace_bands::TraceBudget;
+use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
+use crate::gpu::{non_finite, scene_gpu, trace_bands};
+use anyhow::Result;
+use marbre_core::scene::ToneMap;
 
 impl Renderer {
     /// Traces the rest of the first round and waits for it, if none is

@@ -11,32 +11,32 @@ mod build;
 mod frame;
 mod readback;
 
+use build::{PendingScene, PipelineKey, RenderSwitches};
+
 use super::accumulation::Accumulation;
-use super::auto_exposure::{AutoExposure, Metered};
+use super::auto_exposure::AutoExposure;
 use super::context::GpuContext;
-use super::error_meter::{self, ErrorEstimate, ErrorMeter};
+use super::error_meter::ErrorMeter;
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
 use super::kernel::{self, Kernel};
-use super::mesh_buffers::{MeshBuffers, MeshStats, PreparedGeometry};
-use super::non_finite::{self, NonFiniteCounter, NonFiniteCounts};
-use super::pass_timer::{Pass, PassTimer};
-use super::pipeline_build::{BuiltPipeline, PipelineBuild, PipelineBuilder, WarmUp};
+use super::mesh_buffers::{MeshBuffers, MeshStats};
+use super::non_finite::{self, NonFiniteCounter};
+use super::pipeline_build::PipelineBuilder;
 use super::pipelines::{
-    compile_wgsl, entry, float_texture, fullscreen_pipeline, permutation_table, shader_module,
-    storage, uniform, upload_atlas, upload_rgba16f, validate,
+    entry, float_texture, permutation_table, shader_module, storage, uniform, upload_atlas,
+    upload_rgba16f,
 };
-use super::readback::read_texture;
-use super::scene_gpu::{self, FrameUniform};
-use super::shader_source::{Program, assemble, sources_generation};
+use super::scene_gpu::FrameUniform;
+use super::shader_source::{Program, sources_generation};
 use super::texture_codegen;
-use super::trace_bands::{self, TraceBudget};
-use super::trace_pass::{BandPass, PassTimestamps, TraceLayouts, TracePipeline};
+use super::trace_bands::{self};
+use super::trace_pass::{TraceLayouts, TracePipeline};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use marbre_core::env_sampling::EnvDistribution;
 use marbre_core::envmap::{self, EnvImage};
-use marbre_core::scene::{Scene, ToneMap};
+use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -84,57 +84,6 @@ pub struct DisplayTarget<'a> {
     pub format: wgpu::TextureFormat,
     pub viewport: Viewport,
     pub load: wgpu::LoadOp<wgpu::Color>,
-}
-
-/// A scene waiting for its pipeline: what to write into the buffers once
-/// the pipeline is in place (the texture parameters if they changed).
-struct Target {
-    scene: Scene,
-    params: Option<Vec<[f32; 4]>>,
-}
-
-/// What a trace pipeline is built from: two scenes with equal keys share
-/// one. The features and texture code make the module; the switches are
-/// its override constants.
-#[derive(Debug, Clone, PartialEq, Default)]
-struct PipelineKey {
-    features: FeatureSet,
-    code: String,
-    switches: RenderSwitches,
-    /// The shader files' generation (`marbre --dev` reloads them).
-    sources: u64,
-    kernel: Kernel,
-}
-
-/// The render settings the trace shader reads as override constants
-/// (declared in crates/render/shaders/textures.wgsl).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct RenderSwitches {
-    filter_checkers: bool,
-    clamp_octaves: bool,
-}
-
-impl RenderSwitches {
-    fn of(scene: &Scene) -> Self {
-        Self {
-            filter_checkers: scene.render.filter_checkers,
-            clamp_octaves: scene.render.clamp_octaves,
-        }
-    }
-
-    fn constants(self) -> [(&'static str, f64); 2] {
-        [
-            ("filter_checkers", f64::from(u8::from(self.filter_checkers))),
-            ("clamp_octaves", f64::from(u8::from(self.clamp_octaves))),
-        ]
-    }
-}
-
-/// A pipeline build under way, with the key it is built for.
-struct PendingScene {
-    build: PipelineBuild,
-    key: PipelineKey,
-    target: Target,
 }
 
 pub struct Renderer {
@@ -477,32 +426,6 @@ fn scaled(size: (u32, u32), scale: f32) -> (u32, u32) {
 
 fn pixel_count(size: (u32, u32)) -> u64 {
     u64::from(size.0) * u64::from(size.1)
-}
-
-/// What to draw once on a second device, so its compiled shader lands in
-/// the driver's disk cache before the real device first draws it
-/// (`pipeline_build` runs it on its worker before the build).
-struct ShaderWarmUp {
-    ctx: Arc<GpuContext>,
-    scene: Scene,
-    images: ImageSet,
-    features: Option<FeatureSet>,
-    /// The kernel being built: each compiles its own entry point.
-    kernel: Kernel,
-}
-
-impl ShaderWarmUp {
-    fn run(self) -> Result<()> {
-        let ctx = &*self.ctx;
-        let mut renderer = Renderer::with_kernel(ctx, &self.scene, None, (1, 1), self.kernel)?;
-        renderer.set_feature_override(ctx, self.features)?;
-        renderer.set_images(ctx, self.images)?;
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.trace(ctx, &mut encoder, None);
-        ctx.queue.submit([encoder.finish()]);
-        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-        Ok(())
-    }
 }
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {

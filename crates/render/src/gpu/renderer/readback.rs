@@ -3,7 +3,15 @@
 //! displayed image, synchronously for tests and tools, or polled without
 //! stalling for the viewer.
 
-use super::*;
+use super::{DisplayTarget, Renderer, Viewport};
+use crate::gpu::auto_exposure::Metered;
+use crate::gpu::context::GpuContext;
+use crate::gpu::error_meter;
+use crate::gpu::error_meter::ErrorEstimate;
+use crate::gpu::non_finite::NonFiniteCounts;
+use crate::gpu::pass_timer::PassTimer;
+use crate::gpu::readback::read_texture;
+use anyhow::Result;
 
 impl Renderer {
     /// The linear radiance of the traced region (the running mean), RGBA f32.
