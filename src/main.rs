@@ -37,8 +37,9 @@ struct ViewerArgs {
     #[arg(long)]
     window_screenshot: Option<PathBuf>,
     /// Development mode: read the WGSL files from the source tree (each
-    /// beside its CPU twin under `crates/`) and rebuild the trace pipeline when one changes (a shader that fails
-    /// to build leaves the old pipeline, and the panel shows the error).
+    /// beside its CPU twin under `crates/`) and rebuild the trace pipeline
+    /// when one changes (a shader that fails to build leaves the old
+    /// pipeline, and the panel shows the error).
     #[arg(long)]
     dev: bool,
     /// The trace kernel: fragment, compute, or auto (the faster on this

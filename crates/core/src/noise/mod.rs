@@ -1,10 +1,10 @@
 //! CPU reference of every noise function the shaders evaluate.
 //!
-//! The WGSL in `shaders/noise_*.wgsl` and `crates/core/src/noise/fractal.wgsl` mirrors these
-//! functions operation for operation, so that the parity tests (GPU against CPU)
-//! and the `marbre noise --cpu` command can check the shader against a trusted
-//! implementation. The CPU side is the reference: when the two disagree, the
-//! shader is wrong.
+//! The WGSL beside each module (`hash.wgsl`, `gradient.wgsl`, `perlin.wgsl`,
+//! `fractal.wgsl`) mirrors these functions operation for operation, so that
+//! the parity tests (GPU against CPU) and the `marbre noise --cpu` command
+//! can check the shader against a trusted implementation. The CPU side is
+//! the reference: when the two disagree, the shader is wrong.
 
 pub mod fractal;
 pub mod gradient;

@@ -84,7 +84,7 @@ pub fn validate(source: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// naga's report headed by the file and line the error is at in `shaders/`:
+/// naga's report headed by the WGSL file and line the error is at:
 /// naga counts lines in the assembled module, which no one edits.
 fn located(source: &str, location: Option<naga::SourceLocation>, report: String) -> String {
     let position = location.and_then(|at| {
