@@ -1,10 +1,13 @@
 //! `marbre noise`: evaluates noise at points read from stdin, on the GPU (the
-//! real WGSL through the compute harness) or on the CPU reference.
+//! real WGSL through the compute harness, in f32) or on the CPU reference
+//! (in f64: Perlin's own Java is double precision, and far from the origin
+//! f32 has lost the noise's digits).
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use glam::Vec3;
-use marbre_core::noise::{self, FractalParams, HashKind, NoiseKind, NoiseSettings};
+use glam::DVec3;
+use marbre_core::noise::fractal::{FractalShape, fractal_sum_f64, noise_f64};
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use std::io::{BufRead, Write};
@@ -45,7 +48,8 @@ pub struct NoiseArgs {
     /// Print turbulence (a sum of |noise|) instead of one octave of noise.
     #[arg(long)]
     pub turbulence: bool,
-    /// Evaluate with the CPU reference instead of the shader.
+    /// Evaluate with the CPU reference (double precision, 12 decimals)
+    /// instead of the shader (single precision, 9 decimals).
     #[arg(long)]
     pub cpu: bool,
     /// Instead of reading points, draw the far-from-the-origin figure (the
@@ -88,8 +92,9 @@ impl NoiseArgs {
     }
 }
 
-/// Parses `x,y,z` lines (spaces allowed, blank lines and `#` comments skipped).
-pub fn parse_points(input: impl BufRead) -> Result<Vec<Vec3>> {
+/// Parses `x,y,z` lines (spaces allowed, blank lines and `#` comments
+/// skipped), in double precision.
+pub fn parse_points(input: impl BufRead) -> Result<Vec<DVec3>> {
     let mut points = Vec::new();
     for (i, line) in input.lines().enumerate() {
         let line = line.context("reading stdin")?;
@@ -97,7 +102,7 @@ pub fn parse_points(input: impl BufRead) -> Result<Vec<Vec3>> {
         if t.is_empty() || t.starts_with('#') {
             continue;
         }
-        let values: Vec<f32> = t
+        let values: Vec<f64> = t
             .split([',', ' ', '\t'])
             .filter(|s| !s.is_empty())
             .map(str::parse)
@@ -113,19 +118,19 @@ pub fn parse_points(input: impl BufRead) -> Result<Vec<Vec3>> {
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
             bail!("line {}: coordinates must be finite", i + 1);
         }
-        points.push(Vec3::new(x, y, z));
+        points.push(DVec3::new(x, y, z));
     }
     Ok(points)
 }
 
-/// The CPU reference for the same request.
-pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[Vec3]) -> Vec<f32> {
+/// The CPU reference for the same request, in double precision.
+pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[DVec3]) -> Vec<f64> {
     points
         .iter()
         .map(|&p| match what {
-            Evaluate::Fbm => noise::fbm(p, settings),
-            Evaluate::Turbulence => noise::turbulence(p, settings),
-            _ => noise::noise(p, settings.kind, settings.hash),
+            Evaluate::Fbm => fractal_sum_f64(p, settings, FractalShape::Signed),
+            Evaluate::Turbulence => fractal_sum_f64(p, settings, FractalShape::Absolute),
+            _ => noise_f64(p, settings.kind, settings.hash),
         })
         .collect()
 }
@@ -136,15 +141,89 @@ pub fn run(args: &NoiseArgs) -> Result<()> {
     }
     let points = parse_points(std::io::stdin().lock())?;
     let settings = args.settings();
-    let values = if args.cpu {
-        evaluate_cpu(&settings, args.what(), &points)
+    let mut out = std::io::stdout().lock();
+    if args.cpu {
+        for v in evaluate_cpu(&settings, args.what(), &points) {
+            writeln!(out, "{v:.12}")?;
+        }
     } else {
         let ctx = GpuContext::headless()?;
-        evaluate_scalar(&ctx, &settings, args.what(), &points)?
-    };
-    let mut out = std::io::stdout().lock();
-    for v in values {
-        writeln!(out, "{v:.9}")?;
+        let points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
+        for v in evaluate_scalar(&ctx, &settings, args.what(), &points)? {
+            writeln!(out, "{v:.9}")?;
+        }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use marbre_core::noise::improved_noise_f32;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: NoiseArgs,
+    }
+
+    /// `marbre noise` with these flags.
+    fn args(flags: &[&str]) -> NoiseArgs {
+        Cli::parse_from(std::iter::once("noise").chain(flags.iter().copied())).args
+    }
+
+    /// Perlin's Java reference points, `x y z value` (80 of them, the last
+    /// 16 at |c| up to 1e4), as `marbre noise` reads them: `x,y,z` lines.
+    fn reference() -> (Vec<DVec3>, Vec<f64>) {
+        let text = include_str!("../../core/tests/data/perlin/reference_points.txt");
+        let rows: Vec<Vec<f64>> = text
+            .lines()
+            .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        let input: String = rows
+            .iter()
+            .map(|r| format!("{},{},{}\n", r[0], r[1], r[2]))
+            .collect();
+        let points = parse_points(input.as_bytes()).unwrap();
+        (points, rows.iter().map(|r| r[3]).collect())
+    }
+
+    #[test]
+    fn the_cpu_reference_matches_perlins_java_far_from_the_origin() {
+        let (points, expected) = reference();
+        let args = args(&["--kind", "perlin", "--cpu"]);
+        let values = evaluate_cpu(&args.settings(), args.what(), &points);
+        for ((p, got), want) in points.iter().zip(&values).zip(&expected) {
+            assert!(
+                (got - want).abs() <= 1e-9,
+                "noise({p}) = {got}, Java {want}"
+            );
+        }
+        // Single precision is no reference out there: the same points in
+        // f32 miss Perlin's values by far more.
+        let worst_f32 = points
+            .iter()
+            .zip(&expected)
+            .filter(|(p, _)| p.abs().max_element() > 1000.0)
+            .map(|(p, want)| {
+                let p = p.as_vec3();
+                (f64::from(improved_noise_f32(p.x, p.y, p.z)) - want).abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(worst_f32 > 1e-4, "f32 is off by only {worst_f32:e}");
+    }
+
+    #[test]
+    fn fractal_sums_of_one_octave_are_the_noise_itself() {
+        let (points, _) = reference();
+        let args = args(&["--kind", "perlin", "--cpu", "--octaves", "1"]);
+        let noise = evaluate_cpu(&args.settings(), Evaluate::Noise, &points);
+        let fbm = evaluate_cpu(&args.settings(), Evaluate::Fbm, &points);
+        let turbulence = evaluate_cpu(&args.settings(), Evaluate::Turbulence, &points);
+        for ((n, f), t) in noise.iter().zip(&fbm).zip(&turbulence) {
+            assert_eq!(n, f);
+            assert_eq!(n.abs(), *t);
+        }
+    }
 }

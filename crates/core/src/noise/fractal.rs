@@ -1,7 +1,9 @@
 //! Fractal sums of a lattice noise: fBm, turbulence and marble.
 
-use super::{HashKind, NoiseKind, gradient::gradient_noise, perlin::improved_noise_f32};
-use glam::Vec3;
+use super::gradient::{gradient_noise, gradient_noise_f64};
+use super::perlin::{Real, improved_noise, improved_noise_f32};
+use super::{HashKind, NoiseKind};
+use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
 
@@ -67,11 +69,53 @@ pub struct NoiseSettings {
     pub fractal: FractalParams,
 }
 
-/// One octave of the chosen lattice noise.
+/// One octave of the chosen lattice noise, in f32 as the shader.
 pub fn noise(p: Vec3, kind: NoiseKind, hash: HashKind) -> f32 {
-    match kind {
-        NoiseKind::Gradient => gradient_noise(p, hash),
-        NoiseKind::Perlin => improved_noise_f32(p.x, p.y, p.z),
+    f32::lattice_noise(p.to_array(), kind, hash)
+}
+
+/// One octave in double precision: the CPU reference (`marbre noise
+/// --cpu`). Perlin's own Java is double precision, and far from the origin
+/// f32 has lost the noise's digits (6e-5 off his values at |p| ≈ 950).
+pub fn noise_f64(p: DVec3, kind: NoiseKind, hash: HashKind) -> f64 {
+    f64::lattice_noise(p.to_array(), kind, hash)
+}
+
+/// A precision the noise and its fractal sums are evaluated in: f32 (the
+/// shader's twin) or f64 (the reference).
+trait NoisePrecision: Real {
+    fn lattice_noise(p: [Self; 3], kind: NoiseKind, hash: HashKind) -> Self;
+    fn abs(self) -> Self;
+    fn min(self, other: Self) -> Self;
+}
+
+impl NoisePrecision for f32 {
+    fn lattice_noise(p: [f32; 3], kind: NoiseKind, hash: HashKind) -> f32 {
+        match kind {
+            NoiseKind::Gradient => gradient_noise(Vec3::from_array(p), hash),
+            NoiseKind::Perlin => improved_noise_f32(p[0], p[1], p[2]),
+        }
+    }
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+    fn min(self, other: f32) -> f32 {
+        f32::min(self, other)
+    }
+}
+
+impl NoisePrecision for f64 {
+    fn lattice_noise(p: [f64; 3], kind: NoiseKind, hash: HashKind) -> f64 {
+        match kind {
+            NoiseKind::Gradient => gradient_noise_f64(DVec3::from_array(p), hash),
+            NoiseKind::Perlin => improved_noise(p[0], p[1], p[2]),
+        }
+    }
+    fn abs(self) -> f64 {
+        f64::abs(self)
+    }
+    fn min(self, other: f64) -> f64 {
+        f64::min(self, other)
     }
 }
 
@@ -95,11 +139,11 @@ impl FractalShape {
         }
     }
 
-    fn apply(self, v: f32) -> f32 {
+    fn apply<T: NoisePrecision>(self, v: T) -> T {
         match self {
             FractalShape::Signed => v,
             FractalShape::Absolute => v.abs(),
-            FractalShape::Ridged => (1.0 - v.abs()) * (1.0 - v.abs()),
+            FractalShape::Ridged => (T::ONE - v.abs()) * (T::ONE - v.abs()),
         }
     }
 }
@@ -113,30 +157,49 @@ const WARP_OFFSETS: [Vec3; 3] = [
 
 /// `p` moved by the domain warp of `s` (unchanged without distortion).
 pub fn warped(p: Vec3, s: &NoiseSettings) -> Vec3 {
-    let amount = s.fractal.distortion;
-    if amount == 0.0 {
+    Vec3::from_array(warped_generic(p.to_array(), s))
+}
+
+fn warped_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings) -> [T; 3] {
+    let amount = T::from_f64(f64::from(s.fractal.distortion));
+    if s.fractal.distortion == 0.0 {
         return p;
     }
-    let q = p * s.fractal.frequency;
-    let [a, b, c] = WARP_OFFSETS.map(|o| noise(q + o, s.kind, s.hash));
-    p + amount * Vec3::new(a, b, c)
+    let frequency = T::from_f64(f64::from(s.fractal.frequency));
+    let q = p.map(|c| c * frequency);
+    let [a, b, c] = WARP_OFFSETS.map(|o| {
+        let o = o.to_array().map(|c| T::from_f64(f64::from(c)));
+        T::lattice_noise([q[0] + o[0], q[1] + o[1], q[2] + o[2]], s.kind, s.hash)
+    });
+    [p[0] + amount * a, p[1] + amount * b, p[2] + amount * c]
 }
 
 /// Sums `shape(noise)` over the octaves, at the warped point.
 pub fn fractal_sum(p: Vec3, s: &NoiseSettings, shape: FractalShape) -> f32 {
-    let p = warped(p, s);
+    fractal_sum_generic(p.to_array(), s, shape)
+}
+
+/// [`fractal_sum`] in double precision: the CPU reference.
+pub fn fractal_sum_f64(p: DVec3, s: &NoiseSettings, shape: FractalShape) -> f64 {
+    fractal_sum_generic(p.to_array(), s, shape)
+}
+
+fn fractal_sum_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings, shape: FractalShape) -> T {
+    let p = warped_generic(p, s);
     let f = &s.fractal;
-    let octaves = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES);
-    let whole = octaves.ceil() as u32;
-    let mut frequency = f.frequency;
-    let mut amplitude = f.amplitude;
-    let mut sum = 0.0;
+    let param = |v: f32| T::from_f64(f64::from(v));
+    let octaves = param(f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES));
+    let whole = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES).ceil() as u32;
+    let mut frequency = param(f.frequency);
+    let mut amplitude = param(f.amplitude);
+    let mut sum = T::ZERO;
     for i in 0..whole {
         // The last octave fades in with the fractional part of `octaves`.
-        let weight = (octaves - i as f32).min(1.0);
-        sum += weight * amplitude * shape.apply(noise(p * frequency, s.kind, s.hash));
-        frequency *= f.lacunarity;
-        amplitude *= f.persistence;
+        let weight = (octaves - T::from_i32(i as i32)).min(T::ONE);
+        let v = T::lattice_noise(p.map(|c| c * frequency), s.kind, s.hash);
+        sum = sum + weight * amplitude * shape.apply(v);
+        frequency = frequency * param(f.lacunarity);
+        amplitude = amplitude * param(f.persistence);
     }
     sum
 }

@@ -3,7 +3,8 @@
 //! `u = f²(3 − 2f)`.
 
 use super::hash::{HashKind, gradient_pcg, gradient_pcg_tiled, gradient_sin};
-use glam::{IVec3, Vec3};
+use super::perlin::Real;
+use glam::{DVec3, IVec3, Vec3};
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/gradient.wgsl");
@@ -21,27 +22,46 @@ fn corner_gradient(cell: IVec3, hash: HashKind) -> Vec3 {
     }
 }
 
-/// Gradient noise at `p`; zero at every lattice point.
+/// Gradient noise at `p`; zero at every lattice point. The f32 evaluation
+/// the shader performs.
 pub fn gradient_noise(p: Vec3, hash: HashKind) -> f32 {
-    let i = p.floor();
-    let f = p - i;
-    let cell = i.as_ivec3();
-    let u = f * f * (Vec3::splat(3.0) - 2.0 * f);
+    gradient_noise_generic(p.to_array(), hash)
+}
+
+/// Gradient noise in double precision: the CPU reference (`marbre noise
+/// --cpu`). The corner gradients are the same (they depend on the integer
+/// cell only); the offsets, dot products and interpolation keep f64's
+/// digits far from the origin.
+pub fn gradient_noise_f64(p: DVec3, hash: HashKind) -> f64 {
+    gradient_noise_generic(p.to_array(), hash)
+}
+
+/// Gradient noise in the precision `T`, operation for operation as
+/// `gradient.wgsl`.
+fn gradient_noise_generic<T: Real>(p: [T; 3], hash: HashKind) -> T {
+    let i = p.map(Real::floor);
+    let f = [p[0] - i[0], p[1] - i[1], p[2] - i[2]];
+    let cell = IVec3::from_array(i.map(Real::to_i32));
+    let (three, two) = (T::from_f64(3.0), T::from_f64(2.0));
+    let u = f.map(|f| f * f * (three - two * f));
     let corner = |dx: i32, dy: i32, dz: i32| {
         let c = IVec3::new(dx, dy, dz);
         // Wrapping, as WGSL's i32 addition: beyond 2³¹ the cell saturates
         // (f32 → i32 `as`, like the shader's conversion) and its +1
         // neighbour must not overflow.
-        corner_gradient(cell.wrapping_add(c), hash).dot(f - c.as_vec3())
+        let g = corner_gradient(cell.wrapping_add(c), hash).to_array();
+        let g = g.map(|v| T::from_f64(f64::from(v)));
+        let d = [dx, dy, dz].map(T::from_i32);
+        g[0] * (f[0] - d[0]) + g[1] * (f[1] - d[1]) + g[2] * (f[2] - d[2])
     };
-    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-    let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u.x);
-    let x10 = lerp(corner(0, 1, 0), corner(1, 1, 0), u.x);
-    let x01 = lerp(corner(0, 0, 1), corner(1, 0, 1), u.x);
-    let x11 = lerp(corner(0, 1, 1), corner(1, 1, 1), u.x);
-    let y0 = lerp(x00, x10, u.y);
-    let y1 = lerp(x01, x11, u.y);
-    lerp(y0, y1, u.z)
+    let lerp = |a: T, b: T, t: T| a + (b - a) * t;
+    let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u[0]);
+    let x10 = lerp(corner(0, 1, 0), corner(1, 1, 0), u[0]);
+    let x01 = lerp(corner(0, 0, 1), corner(1, 0, 1), u[0]);
+    let x11 = lerp(corner(0, 1, 1), corner(1, 1, 1), u[0]);
+    let y0 = lerp(x00, x10, u[1]);
+    let y1 = lerp(x01, x11, u[1]);
+    lerp(y0, y1, u[2])
 }
 
 #[cfg(test)]

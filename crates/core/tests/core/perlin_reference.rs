@@ -34,8 +34,13 @@ fn reference_points() -> Vec<[f64; 4]> {
 }
 
 #[test]
-fn fixture_has_64_points() {
-    assert_eq!(reference_points().len(), 64);
+fn fixture_has_80_points_16_of_them_far_out() {
+    let points = reference_points();
+    assert_eq!(points.len(), 80);
+    let far = points
+        .iter()
+        .filter(|p| p[..3].iter().any(|c| c.abs() > 1000.0));
+    assert!(far.count() >= 8, "the far points reach |c| > 1000");
 }
 
 #[test]
@@ -54,8 +59,9 @@ fn matches_java_reference_at_every_point() {
     }
     assert!(
         failures.is_empty(),
-        "{} of 64 points differ:\n{}",
+        "{} of {} points differ:\n{}",
         failures.len(),
+        reference_points().len(),
         failures.join("\n")
     );
 }

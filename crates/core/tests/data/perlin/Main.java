@@ -1,4 +1,4 @@
-// Prints ImprovedNoise.noise at 64 deterministic points as "x y z value",
+// Prints ImprovedNoise.noise at 80 deterministic points as "x y z value",
 // every double in full precision (Java's shortest round-trip repr).
 // Build and run:  javac -d /tmp/perlin ImprovedNoise.java Main.java
 //                 java -cp /tmp/perlin Main > reference_points.txt
@@ -34,6 +34,18 @@ public final class Main {
             s = s * 6364136223846793005L + 1442695040888963407L;
             double r = (double)(s >>> 11) / (double)(1L << 53);  // [0, 1)
             q[k] = (2.0 * r - 1.0) * scales[i % 3];
+         }
+         pts.add(q);
+      }
+      // 16 far from the origin (|c| < 1e3 and < 1e4), where single
+      // precision has lost the noise's digits: a reference must not.
+      double[] far = {1000.0, 10000.0};
+      for (int i = 0; pts.size() < 80; i++) {
+         double[] q = new double[3];
+         for (int k = 0; k < 3; k++) {
+            s = s * 6364136223846793005L + 1442695040888963407L;
+            double r = (double)(s >>> 11) / (double)(1L << 53);  // [0, 1)
+            q[k] = (2.0 * r - 1.0) * far[i % 2];
          }
          pts.add(q);
       }
