@@ -6,6 +6,7 @@
 //! the panel and to dropping a file on the window; [`dialogs_available`]
 //! says which route to take before anything hangs.
 
+use marbre_core::envmap::SUPPORTED_EXTENSIONS;
 use std::path::PathBuf;
 use std::sync::mpsc;
 
@@ -65,7 +66,7 @@ impl OpenDialog {
                 }
                 DialogPurpose::OpenEnvironment => dialog
                     .set_title("Open environment map")
-                    .add_filter("environment map", &["exr", "hdr", "png", "jpg", "jpeg"])
+                    .add_filter("environment map", &SUPPORTED_EXTENSIONS)
                     .pick_file(),
             };
             // The viewer may have closed: then nobody listens.

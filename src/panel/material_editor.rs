@@ -256,7 +256,9 @@ fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
         .unwrap_or_else(|| source.path.display().to_string());
     let response = ui
         .add(TextEdit::singleline(&mut typed).hint_text("images/picture.png"))
-        .on_hover_text("PNG, JPEG, HDR or EXR; relative to the preset file. Enter applies");
+        .on_hover_text(
+            "PNG, JPEG, HDR, EXR, PPM or PGM; relative to the preset file. Enter applies",
+        );
     if response.lost_focus() {
         source.path = PathBuf::from(typed.trim());
         ui.ctx().data_mut(|d| d.remove::<String>(id));

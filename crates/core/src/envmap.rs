@@ -43,7 +43,8 @@ pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/envma
 pub const F16_MAX: f32 = 65504.0;
 
 /// The extensions [`load`] understands (lower case, without the dot).
-pub const SUPPORTED_EXTENSIONS: [&str; 5] = ["exr", "hdr", "png", "jpg", "jpeg"];
+pub const SUPPORTED_EXTENSIONS: [&str; 8] =
+    ["exr", "hdr", "png", "jpg", "jpeg", "ppm", "pgm", "pnm"];
 
 /// A lat-long environment map in linear radiance.
 #[derive(Debug, Clone, PartialEq)]
@@ -432,6 +433,15 @@ pub fn decode_bytes(
         }
         "hdr" => decode_with_image(path, bytes, image::ImageFormat::Hdr, "Radiance HDR", decode)?,
         "png" => decode_with_image(path, bytes, image::ImageFormat::Png, "PNG", decode)?,
+        // The texture report's IMAGE format (P2, P3 in text; P5, P6 binary).
+        "ppm" | "pgm" | "pnm" => {
+            check_pnm_samples(bytes).map_err(|message| EnvMapError::Decode {
+                path: path.to_path_buf(),
+                format: "PPM/PGM",
+                message,
+            })?;
+            decode_with_image(path, bytes, image::ImageFormat::Pnm, "PPM/PGM", decode)?
+        }
         _ => decode_with_image(path, bytes, image::ImageFormat::Jpeg, "JPEG", decode)?,
     };
     if image.width == 0 || image.height == 0 || image.pixels.is_empty() {
@@ -876,6 +886,75 @@ fn decode_message(message: &str) -> String {
     } else {
         message.to_string()
     }
+}
+
+/// An error if a PGM or PPM file (P2, P3, P5, P6) holds a sample above its
+/// maxval, which the `image` decoder would clamp without a word: such a
+/// file was written wrong, and its picture is not the one meant. Other
+/// files, and headers the decoder will refuse itself, pass.
+fn check_pnm_samples(bytes: &[u8]) -> Result<(), String> {
+    let mut at = 0;
+    // The header: magic, width, height, maxval, each after white space or
+    // `#` comments, then one white-space byte before binary samples.
+    let mut token = || -> Option<&[u8]> {
+        loop {
+            while bytes.get(at).is_some_and(u8::is_ascii_whitespace) {
+                at += 1;
+            }
+            if bytes.get(at) != Some(&b'#') {
+                break;
+            }
+            while bytes.get(at).is_some_and(|&b| b != b'\n') {
+                at += 1;
+            }
+        }
+        let start = at;
+        while bytes.get(at).is_some_and(|b| !b.is_ascii_whitespace()) {
+            at += 1;
+        }
+        (at > start).then(|| &bytes[start..at])
+    };
+    let magic = token();
+    let number = |t: Option<&[u8]>| std::str::from_utf8(t?).ok()?.parse::<u64>().ok();
+    let text = match magic {
+        Some(b"P2" | b"P3") => true,
+        Some(b"P5" | b"P6") => false,
+        _ => return Ok(()),
+    };
+    let (Some(_), Some(_), Some(maxval)) = (number(token()), number(token()), number(token()))
+    else {
+        return Ok(());
+    };
+    let above = |index: usize, value: u64| {
+        format!("sample {index} is {value}, above the file's maxval {maxval}")
+    };
+    if text {
+        let mut index = 0;
+        while let Some(t) = token() {
+            match number(Some(t)) {
+                Some(v) if v > maxval => return Err(above(index, v)),
+                _ => index += 1,
+            }
+        }
+    } else if maxval < 255 {
+        let samples = bytes.get(at + 1..).unwrap_or_default();
+        if let Some((index, &v)) = samples
+            .iter()
+            .enumerate()
+            .find(|&(_, &v)| u64::from(v) > maxval)
+        {
+            return Err(above(index, v.into()));
+        }
+    } else if maxval > 255 && maxval < 65535 {
+        let samples = bytes.get(at + 1..).unwrap_or_default();
+        let values = samples
+            .chunks_exact(2)
+            .map(|b| u64::from(u16::from_be_bytes([b[0], b[1]])));
+        if let Some((index, v)) = values.enumerate().find(|&(_, v)| v > maxval) {
+            return Err(above(index, v));
+        }
+    }
+    Ok(())
 }
 
 /// The size a PNG file's header declares, if it is a PNG file with a
@@ -1571,5 +1650,78 @@ mod tests {
                 loaded.notes
             );
         }
+    }
+
+    /// The texture report's IMAGE files: PPM and PGM in text (P3, P2) and
+    /// binary (P6, P5), 8 and 16 bits, any maxval, read as sRGB codes.
+    #[test]
+    fn ppm_and_pgm_load_in_text_and_binary() {
+        let dir = tempfile::Builder::new().prefix("pnm").tempdir().unwrap();
+        let write = |name: &str, bytes: &[u8]| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            path
+        };
+        let linear = |path: &Path| load_with(path, IntegerDecode::Linear).unwrap().image;
+        // Two texels: red, then (0, 128/255, 255/255)·white in P3 text.
+        let p3 = linear(&write(
+            "a.ppm",
+            b"P3\n# a comment\n2 1\n255\n255 0 0  0 128 255\n",
+        ));
+        assert_eq!((p3.width, p3.height), (2, 1));
+        assert_eq!(p3.pixels[0], [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(p3.pixels[1], [0.0, 128.0 / 255.0, 1.0, 1.0]);
+        let mut p6 = b"P6 2 1 255\n".to_vec();
+        p6.extend([255, 0, 0, 0, 128, 255]);
+        assert_eq!(linear(&write("b.ppm", &p6)).pixels, p3.pixels, "P6 = P3");
+        let p2 = linear(&write("c.pgm", b"P2 1 2 15\n0\n15\n"));
+        assert_eq!(p2.pixels, [[0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0]]);
+        let p5 = linear(&write(
+            "d.pgm",
+            &[b"P5 2 1 65535\n".as_slice(), &[0x80, 0x00, 0xff, 0xff]].concat(),
+        ));
+        assert_eq!(p5.pixels[0][0], 32768.0 / 65535.0);
+        assert_eq!(p5.pixels[1], [1.0, 1.0, 1.0, 1.0]);
+        // sRGB codes by default, as for PNG: mid grey 188 is 0.5 linear.
+        let srgb = load(&write("e.pgm", b"P2 1 1 255\n188\n")).unwrap().image;
+        assert!(
+            (srgb.pixels[0][0] - 0.5029).abs() < 1e-3,
+            "{:?}",
+            srgb.pixels[0]
+        );
+    }
+
+    #[test]
+    fn bad_ppm_files_give_errors_naming_the_file_and_the_cause() {
+        let dir = tempfile::Builder::new()
+            .prefix("bad-pnm")
+            .tempdir()
+            .unwrap();
+        let error = |name: &str, bytes: &[u8]| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            let message = load(&path).unwrap_err().to_string();
+            assert!(message.contains(name), "{message}");
+            message
+        };
+        let truncated = error("cut.ppm", b"P6 4 4 255\n\x01\x02\x03");
+        assert!(truncated.contains("truncated"), "{truncated}");
+        let oversized = error("huge.ppm", b"P6 100000 100000 255\n");
+        assert!(oversized.contains("100000x100000"), "{oversized}");
+        for (name, bytes) in [
+            ("zero.pgm", b"P2 1 1 0\n0\n".as_slice()),
+            ("wide.pgm", b"P2 1 1 70000\n0\n".as_slice()),
+            ("over.pgm", b"P2 1 1 15\n16\n".as_slice()),
+            ("over.ppm", b"P6 1 1 100\n\x00\x65\x00".as_slice()),
+            ("magic.ppm", b"P9 1 1 255\n0 0 0\n".as_slice()),
+        ] {
+            let message = error(name, bytes);
+            assert!(message.contains("PPM/PGM"), "{message}");
+        }
+        let over = error("above.pgm", b"P2 2 1 15\n# two samples\n3 16\n");
+        assert!(
+            over.contains("sample 1 is 16, above the file's maxval 15"),
+            "{over}"
+        );
     }
 }
