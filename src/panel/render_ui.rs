@@ -82,6 +82,9 @@ pub(super) fn tone_map_hint(tone_map: ToneMap) -> &'static str {
         ToneMap::Aces => "Narkowicz's fit of the ACES filmic curve: soft highlights, more contrast",
         ToneMap::Reinhard => "x / (1 + x) per channel: never clips, but flattens highlights",
         ToneMap::Clamp => "Clamp to [0, 1]: the linear radiance untouched, highlights clip",
+        ToneMap::Exponential => {
+            "1 − exp(−x) per channel, Massal's photographic exposure: never clips, softer toe"
+        }
     }
 }
 

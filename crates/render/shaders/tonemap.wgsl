@@ -5,7 +5,7 @@ struct Display {
     // 2^exposure: the manual exposure, or with auto exposure the
     // compensation applied on top of the metered scale.
     exposure_scale: f32,
-    tone_map: u32,          // 0 ACES, 1 Reinhard, 2 clamp
+    tone_map: u32,          // 0 ACES, 1 Reinhard, 2 clamp, 3 1 - exp
     encode_srgb: u32,       // 1 when the target format does not encode
     auto_exposure: u32,     // 1: also scale by `metered.scale`
     // Maps a target pixel to an accumulation texel: texel = (pixel - origin) * scale.
@@ -51,6 +51,10 @@ fn tone_map(c: vec3f) -> vec3f {
         }
         case 1u: {
             return c / (1.0 + c);
+        }
+        case 3u: {
+            // Massal's exposure curve.
+            return 1.0 - exp(-c);
         }
         default: {
             return clamp(c, vec3f(0.0), vec3f(1.0));

@@ -11,16 +11,27 @@ pub enum ToneMap {
     Reinhard,
     /// Clamp to [0, 1]: what the linear radiance looks like untouched.
     Clamp,
+    /// `1 − exp(−x)`: Massal's photographic exposure curve. His tutorial
+    /// computes `1 − exp(e · c)` with a negative exposure `e` (−1 by
+    /// default); marbre scales the radiance by 2^stops first, so his `e`
+    /// is `log2(−e)` stops (0 for his default).
+    Exponential,
 }
 
 impl ToneMap {
-    pub const ALL: [ToneMap; 3] = [ToneMap::Aces, ToneMap::Reinhard, ToneMap::Clamp];
+    pub const ALL: [ToneMap; 4] = [
+        ToneMap::Aces,
+        ToneMap::Reinhard,
+        ToneMap::Clamp,
+        ToneMap::Exponential,
+    ];
 
     pub fn label(self) -> &'static str {
         match self {
             ToneMap::Aces => "ACES (filmic)",
             ToneMap::Reinhard => "Reinhard",
             ToneMap::Clamp => "clamp",
+            ToneMap::Exponential => "1 − exp (Massal)",
         }
     }
 }

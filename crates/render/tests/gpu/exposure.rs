@@ -280,3 +280,50 @@ fn exposure_edits_keep_the_samples() {
     r.set_scene(&ctx, &edited).unwrap();
     assert_eq!(r.accumulated_samples(), 0);
 }
+
+/// Every tone curve on the display pass against its formula on the CPU,
+/// at a manual exposure: ACES (Narkowicz's fit), Reinhard, clamp and
+/// Massal's 1 − exp(−x).
+#[test]
+fn each_tone_map_shows_its_curve() {
+    let Some(ctx) = gpu_or_skip("each_tone_map_shows_its_curve") else {
+        return;
+    };
+    let stops = 0.5_f32;
+    let curve = |tone_map: ToneMap, x: f32| match tone_map {
+        ToneMap::Aces => ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0),
+        ToneMap::Reinhard => x / (1.0 + x),
+        ToneMap::Clamp => x.clamp(0.0, 1.0),
+        ToneMap::Exponential => 1.0 - (-x).exp(),
+    };
+    let srgb = |c: f32| {
+        let s = if c <= 0.003_130_8 {
+            c * 12.92
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        s * 255.0
+    };
+    let mut scene = spheres_in_constant_light(1.0);
+    scene.render.display.exposure = stops;
+    let mut r = traced(&ctx, &scene, (24, 18), 2);
+    let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
+    let mut shown_by = Vec::new();
+    for tone_map in ToneMap::ALL {
+        scene.render.display.tone_map = tone_map;
+        r.set_scene(&ctx, &scene).unwrap();
+        let shown = r.read_display(&ctx).unwrap();
+        for (p, q) in pixels.iter().zip(shown.pixels()) {
+            for c in 0..3 {
+                let expected = srgb(curve(tone_map, p[c].max(0.0) * stops.exp2()));
+                assert!(
+                    (f32::from(q[c]) - expected).abs() <= 1.0,
+                    "{tone_map:?}: radiance {p:?} shows {q:?}, expected {expected}"
+                );
+            }
+        }
+        shown_by.push(shown);
+    }
+    // The curves differ where the image is bright enough to tell them apart.
+    assert!(max_difference(&shown_by[1], &shown_by[3]) > 5);
+}

@@ -307,6 +307,7 @@ impl Renderer {
                 ToneMap::Aces => 0,
                 ToneMap::Reinhard => 1,
                 ToneMap::Clamp => 2,
+                ToneMap::Exponential => 3,
             },
             encode_srgb: u32::from(!format.is_srgb()),
             auto_exposure: u32::from(auto_exposure),
