@@ -4,7 +4,7 @@
 use super::widgets::{labelled_color, slider};
 use super::{PanelAction, PanelState};
 use egui::{ComboBox, TextEdit, Ui};
-use marbre_core::scene::{EnvSource, Environment};
+use marbre_core::scene::{EnvSource, Environment, LdrImages};
 use std::path::PathBuf;
 
 /// The environment sources in the order of the source dropdown.
@@ -28,12 +28,34 @@ pub(super) fn environment_ui(
     } else {
         source_fields_ui(ui, &mut env.source, state, actions);
     }
+    if env.source.is_map() {
+        ldr_images_ui(ui, &mut env.ldr_images);
+    }
     ui.add(slider(&mut env.rotation_degrees, -180.0..=180.0, "rotation").suffix("°"))
         .on_hover_text("Turns the environment about the vertical axis");
     ui.add(slider(&mut env.intensity, 0.01..=100.0, "intensity").logarithmic(true))
         .on_hover_text("Multiplies the environment's radiance");
     ui.checkbox(&mut env.background_visible, "background visible")
         .on_hover_text("Show the environment behind the scene; it lights the scene either way");
+}
+
+/// How a map's 8- and 16-bit files become radiance (the map reloads on a
+/// change).
+fn ldr_images_ui(ui: &mut Ui, ldr: &mut LdrImages) {
+    ComboBox::from_label("8-bit images")
+        .selected_text(match ldr {
+            LdrImages::Srgb => "sRGB",
+            LdrImages::Exposed => "exposed (Massal)",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(ldr, LdrImages::Srgb, "sRGB")
+                .on_hover_text("The codes are sRGB, decoded to linear values in [0, 1]");
+            ui.selectable_value(ldr, LdrImages::Exposed, "exposed (Massal)")
+                .on_hover_text(
+                    "Massal's LDR maps: stored after his exposure curve, read back \
+                 by −ln(1.001 − c^2.2), white as 6.9; float files stay as they are",
+                );
+        });
 }
 
 /// The controls of the scene's current source.

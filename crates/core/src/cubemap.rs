@@ -77,7 +77,7 @@ use thiserror::Error;
 
 use crate::env_sampling::EnvDistribution;
 use crate::envmap::{self, EnvImage, EnvLoad, EnvMapError};
-use crate::scene::EnvSource;
+use crate::scene::{EnvSource, LdrImages};
 
 /// The widest lat-long image [`CubeMap::to_latlong`] makes (then 2048
 /// rows): faces above 1024 texels are resampled at this size, which bounds
@@ -484,8 +484,9 @@ impl CubeMap {
 
     /// Loads a horizontal-cross file in any format [`envmap::load`] reads,
     /// sanitised the same way.
-    pub fn load_cross(path: &Path) -> Result<CubeLoad, CubeMapError> {
-        let l = envmap::load(path)?;
+    /// An 8- or 16-bit file is read as `ldr` says.
+    pub fn load_cross(path: &Path, ldr: LdrImages) -> Result<CubeLoad, CubeMapError> {
+        let l = envmap::load_ldr(path, ldr)?;
         Ok(CubeLoad {
             cube: CubeMap::from_cross(&l.image, path)?,
             notes: l.notes,
@@ -495,12 +496,13 @@ impl CubeMap {
     /// Loads six face files, in [`Face::ALL`] order, each in any format
     /// [`envmap::load`] reads and sanitised the same way. Every face must be
     /// square and the same size as the first.
-    pub fn load_faces(paths: &[PathBuf; 6]) -> Result<CubeLoad, CubeMapError> {
+    /// 8- or 16-bit files are read as `ldr` says.
+    pub fn load_faces(paths: &[PathBuf; 6], ldr: LdrImages) -> Result<CubeLoad, CubeMapError> {
         let mut notes = Vec::new();
         let mut faces: [Vec<[f32; 3]>; 6] = Default::default();
         let mut first: Option<(Face, &Path, u32)> = None;
         for (face, path) in Face::ALL.into_iter().zip(paths) {
-            let l = envmap::load(path).map_err(|error| CubeMapError::Face {
+            let l = envmap::load_ldr(path, ldr).map_err(|error| CubeMapError::Face {
                 face: face.name(),
                 error,
             })?;
@@ -558,13 +560,14 @@ fn fill_corners(p: &mut [[f32; 3]], side: usize) {
 /// The lat-long image an environment source stands for, loaded and
 /// sanitised, with the loader's notes: a lat-long file as it is, a cube map
 /// resampled by [`CubeMap::to_latlong`] (one more note says so). `None` for
-/// a source without a map.
-pub fn load_source(source: &EnvSource) -> Result<Option<EnvLoad>, CubeMapError> {
+/// a source without a map. 8- or 16-bit files are read as `ldr` says (the
+/// scene's `environment.ldr_images`).
+pub fn load_source(source: &EnvSource, ldr: LdrImages) -> Result<Option<EnvLoad>, CubeMapError> {
     let cube = match source {
         EnvSource::None | EnvSource::Constant { .. } => return Ok(None),
-        EnvSource::LatLong { path } => return Ok(Some(envmap::load(path)?)),
-        EnvSource::CubeFaces { faces } => CubeMap::load_faces(faces)?,
-        EnvSource::CubeCross { path } => CubeMap::load_cross(path)?,
+        EnvSource::LatLong { path } => return Ok(Some(envmap::load_ldr(path, ldr)?)),
+        EnvSource::CubeFaces { faces } => CubeMap::load_faces(faces, ldr)?,
+        EnvSource::CubeCross { path } => CubeMap::load_cross(path, ldr)?,
     };
     let image = cube.cube.to_latlong();
     let mut notes = cube.notes;

@@ -35,6 +35,8 @@ use glam::{Vec2, Vec3};
 use half::f16;
 use thiserror::Error;
 
+use crate::scene::LdrImages;
+
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/envmap.wgsl");
 
@@ -397,6 +399,43 @@ pub fn load_with(path: &Path, decode: IntegerDecode) -> Result<EnvLoad, EnvMapEr
         cause,
     })?;
     decode_bytes(&bytes, path, decode)
+}
+
+/// [`load`], with the 8- and 16-bit codes read as `ldr` says: for
+/// [`LdrImages::Exposed`], Massal's `−ln(1.001 − c^2.2)` of each channel
+/// `c` = code / max, with a note; a float file (EXR, HDR) is left as it
+/// is, with a note saying so.
+pub fn load_ldr(path: &Path, ldr: LdrImages) -> Result<EnvLoad, EnvMapError> {
+    if ldr == LdrImages::Srgb {
+        return load(path);
+    }
+    let mut loaded = load_with(path, IntegerDecode::Linear)?;
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    if matches!(supported_extension(path)?.as_str(), "exr" | "hdr") {
+        loaded.notes.push(format!(
+            "{name}: a float image is radiance already; not un-exposed"
+        ));
+        return Ok(loaded);
+    }
+    for texel in &mut loaded.image.pixels {
+        for c in &mut texel[..3] {
+            *c = unexpose(*c);
+        }
+    }
+    loaded.notes.push(format!(
+        "{name}: un-exposed as Massal's LDR maps (−ln(1.001 − c^2.2))"
+    ));
+    Ok(loaded)
+}
+
+/// Massal's inverse of his exposure curve for a stored channel `c` in
+/// [0, 1]: `−ln(1.001 − c^2.2)`, in f64 so that white's 1.001 − 1 keeps
+/// its digits.
+pub fn unexpose(c: f32) -> f32 {
+    (-(1.001 - f64::from(c).powf(2.2)).ln()) as f32
 }
 
 /// The lower-case extension of `path`, if [`load`] reads it.
@@ -1723,5 +1762,44 @@ mod tests {
             over.contains("sample 1 is 16, above the file's maxval 15"),
             "{over}"
         );
+    }
+
+    /// Massal's LDR maps: each channel c = code / 255 read back by
+    /// −ln(1.001 − c^2.2) (his annex II), white as ln(1000); a float file
+    /// stays as it is, with a note.
+    #[test]
+    fn exposed_ldr_maps_are_read_back_by_massals_formula() {
+        let dir = tempfile::Builder::new()
+            .prefix("exposed")
+            .tempdir()
+            .unwrap();
+        let png = dir.path().join("sky.png");
+        image::RgbImage::from_raw(2, 1, vec![0, 128, 255, 255, 255, 255])
+            .unwrap()
+            .save(&png)
+            .unwrap();
+        let loaded = load_ldr(&png, LdrImages::Exposed).unwrap();
+        let massal = |code: f64| -(1.001 - (code / 255.0).powf(2.2)).ln();
+        for (got, code) in loaded.image.pixels[0][..3].iter().zip([0.0, 128.0, 255.0]) {
+            assert!(
+                (f64::from(*got) - massal(code)).abs() < 1e-6,
+                "{got} for {code}"
+            );
+        }
+        assert!((loaded.image.pixels[1][0] - 1000f32.ln()).abs() < 1e-4);
+        assert!(
+            loaded.notes.iter().any(|n| n.contains("un-exposed")),
+            "{:?}",
+            loaded.notes
+        );
+        assert_eq!(
+            load_ldr(&png, LdrImages::Srgb).unwrap().image,
+            load(&png).unwrap().image
+        );
+        let exr = dir.path().join("sky.exr");
+        exr::prelude::write_rgb_file(&exr, 1, 1, |_, _| (2.0f32, 0.5f32, 0.25f32)).unwrap();
+        let float = load_ldr(&exr, LdrImages::Exposed).unwrap();
+        assert_eq!(float.image.pixels[0], [2.0, 0.5, 0.25, 1.0]);
+        assert!(float.notes.iter().any(|n| n.contains("not un-exposed")));
     }
 }

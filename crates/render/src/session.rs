@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use marbre_core::cubemap;
 use marbre_core::envmap::{EnvImage, EnvLoad};
 use marbre_core::preset;
-use marbre_core::scene::{EnvSource, Scene};
+use marbre_core::scene::{EnvSource, LdrImages, Scene};
 use marbre_core::texture::ImageSet;
 use std::path::{Path, PathBuf};
 
@@ -99,10 +99,11 @@ fn prepare_scene_reporting(
 ) -> Result<LoadedScene> {
     report(LoadStage::Environment);
     // A cube map arrives resampled to lat-long (`cubemap::load_source`).
-    let env = cubemap::load_source(&scene.environment.source)?.map(|l| {
-        notes.extend(l.notes);
-        l.image
-    });
+    let env =
+        cubemap::load_source(&scene.environment.source, scene.environment.ldr_images)?.map(|l| {
+            notes.extend(l.notes);
+            l.image
+        });
     report(LoadStage::Meshes);
     marbre_core::obj_loader::load_meshes(&mut scene, &mut notes)?;
     // The meshes' materials arrive with their files: clamp them as the
@@ -136,16 +137,18 @@ impl LoadedScene {
     }
 }
 
-/// The environment `source` stands for, as `cubemap::load_source` loads it,
+/// The environment `source` stands for, as `cubemap::load_source` loads it
+/// (8- and 16-bit files read as `ldr` says),
 /// shrunk to fit a texture of at most `max_side` texels a side (the GPU's
 /// `max_texture_dimension_2d`, [`max_texture_side`]) with a note when it
 /// had to.
 pub fn load_environment(
     source: &EnvSource,
+    ldr: LdrImages,
     max_side: u32,
 ) -> Result<Option<EnvLoad>, cubemap::CubeMapError> {
     let name = source_name(source);
-    Ok(cubemap::load_source(source)?.map(|l| l.fit_within(max_side, &name)))
+    Ok(cubemap::load_source(source, ldr)?.map(|l| l.fit_within(max_side, &name)))
 }
 
 /// The largest texture side `ctx`'s device takes.

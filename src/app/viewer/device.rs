@@ -21,7 +21,11 @@ impl Viewer {
         // The environment's pixels live only on the GPU: read the file
         // again (a source that no longer loads falls back to none).
         let mut notes = Vec::new();
-        let env = match load_environment(&self.scene.environment.source, max_texture_side(&ctx)) {
+        let env = match load_environment(
+            &self.scene.environment.source,
+            self.scene.environment.ldr_images,
+            max_texture_side(&ctx),
+        ) {
             Ok(loaded) => loaded.map(|l| l.image),
             Err(e) => {
                 notes.push(format!("{e:#}"));

@@ -17,7 +17,7 @@ use crate::app::scene_loader::{ReadyScene, SceneLoad};
 use anyhow::{Context as _, Result};
 use marbre_core::envmap;
 use marbre_core::preset;
-use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
+use marbre_core::scene::{EnvSource, LdrImages, OrbitCamera, Scene};
 use marbre_core::texture::ImageSet;
 use marbre_render::gpu::shader_source;
 use marbre_render::session::{load_environment, load_images, load_scene, max_texture_side};
@@ -183,24 +183,30 @@ impl Viewer {
     }
 
     pub(super) fn load_environment(&mut self, path: &Path) {
-        self.load_environment_source(EnvSource::LatLong {
-            path: path.to_owned(),
-        });
+        let ldr = self.scene.environment.ldr_images;
+        self.load_environment_source(
+            EnvSource::LatLong {
+                path: path.to_owned(),
+            },
+            ldr,
+        );
     }
 
-    /// Loads a lat-long or cube map (a cube resampled to lat-long) and
-    /// installs it with `source`; on failure the scene stays as it was.
-    pub(super) fn load_environment_source(&mut self, source: EnvSource) {
+    /// Loads a lat-long or cube map (a cube resampled to lat-long), its 8-
+    /// and 16-bit files read as `ldr` says, and installs it with `source`;
+    /// on failure the scene stays as it was.
+    pub(super) fn load_environment_source(&mut self, source: EnvSource, ldr: LdrImages) {
         let what = source
             .paths()
             .iter()
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(", ");
-        match load_environment(&source, max_texture_side(&self.ctx)) {
+        match load_environment(&source, ldr, max_texture_side(&self.ctx)) {
             Ok(Some(l)) => {
                 let mut scene = self.scene.clone();
                 scene.environment.source = source;
+                scene.environment.ldr_images = ldr;
                 if let Err(e) = self.apply_scene(scene, Some(&l.image), None) {
                     self.panel.error(format!("{what}: {e:#}"));
                     return;

@@ -114,16 +114,17 @@ impl Viewer {
         image_rect: egui::Rect,
         dragging: bool,
     ) -> Result<bool> {
-        // A map (lat-long or cube) chosen in the panel needs its image
-        // loaded first.
-        if self.scene.environment.source.is_map()
-            && self.scene.environment.source != self.renderer.scene().environment.source
+        // A map (lat-long or cube) chosen in the panel, or read another
+        // way, needs its image loaded first; until it is in, the scene keeps
+        // the one drawn (a failed load leaves it so).
+        let (env, drawn) = (&self.scene.environment, &self.renderer.scene().environment);
+        if env.source.is_map() && (env.source != drawn.source || env.ldr_images != drawn.ldr_images)
         {
-            let source = std::mem::replace(
-                &mut self.scene.environment.source,
-                self.renderer.scene().environment.source.clone(),
-            );
-            self.load_environment_source(source);
+            let (drawn_source, drawn_ldr) = (drawn.source.clone(), drawn.ldr_images);
+            let env = &mut self.scene.environment;
+            let source = std::mem::replace(&mut env.source, drawn_source);
+            let ldr = std::mem::replace(&mut env.ldr_images, drawn_ldr);
+            self.load_environment_source(source, ldr);
         }
         // A structural edit that changes the scene's features ends any
         // feature-cost experiment: the new shader is specialised again.

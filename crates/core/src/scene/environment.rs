@@ -55,10 +55,26 @@ impl EnvSource {
     }
 }
 
+/// How the 8- and 16-bit images of a map (PNG, JPEG, PPM/PGM) become
+/// radiance. Float files (EXR, HDR) are radiance already either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum LdrImages {
+    /// The codes are sRGB: decoded exactly to linear values in [0, 1].
+    #[default]
+    Srgb,
+    /// Massal's tutorial (annex II): the image was stored after his
+    /// exposure curve `1 − exp(−x)`, so each channel `c` (code / max) is
+    /// taken to the power 2.2, then un-exposed by `−ln(1.001 − c)`: white
+    /// comes back as ln(1000) ≈ 6.9, bright enough to light a scene.
+    Exposed,
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Environment {
     pub source: EnvSource,
+    /// How an 8- or 16-bit map's codes become radiance.
+    pub ldr_images: LdrImages,
     /// Turns the map about the vertical axis, degrees.
     pub rotation_degrees: f32,
     /// Multiplies the radiance.
@@ -72,6 +88,7 @@ impl Default for Environment {
     fn default() -> Self {
         Self {
             source: EnvSource::None,
+            ldr_images: LdrImages::Srgb,
             rotation_degrees: 0.0,
             intensity: 1.0,
             background_visible: true,

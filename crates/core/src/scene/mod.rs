@@ -16,7 +16,7 @@ pub mod texture_tree;
 pub mod transport;
 
 pub use camera::{OrbitCamera, SavedView};
-pub use environment::{EnvSource, Environment};
+pub use environment::{EnvSource, Environment, LdrImages};
 pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};

@@ -13,7 +13,7 @@ mod corpus;
 
 use glam::Vec3;
 use marbre_core::envmap::{EnvImage, MAX_TEXELS};
-use marbre_core::scene::{EnvSource, Material, Mesh, Pattern, Scene, Sphere, Texture};
+use marbre_core::scene::{EnvSource, LdrImages, Material, Mesh, Pattern, Scene, Sphere, Texture};
 use marbre_core::texture::{ColorSpace, ImageSource, load_image};
 use marbre_render::session::{
     self, LoadedScene, load_environment, load_images, load_scene, prepare_scene,
@@ -239,6 +239,7 @@ fn environment(path: &Path) -> Result<marbre_core::envmap::EnvLoad, String> {
         &EnvSource::LatLong {
             path: path.to_owned(),
         },
+        LdrImages::Srgb,
         u32::MAX,
     )
     .map(|loaded| loaded.expect("a lat-long source has a map"))
@@ -380,7 +381,9 @@ fn an_environment_map_larger_than_the_gpu_allows_is_downscaled_with_a_note() {
     let dir = scratch("oversize");
     let path = write_two_tone_map(&dir);
     let source = EnvSource::LatLong { path: path.clone() };
-    let loaded = load_environment(&source, 16).unwrap().unwrap();
+    let loaded = load_environment(&source, LdrImages::Srgb, 16)
+        .unwrap()
+        .unwrap();
     assert_eq!((loaded.image.width, loaded.image.height), (16, 8));
     let note = format!(
         "{} is 64×32, larger than this GPU's max texture side 16: \

@@ -10,7 +10,7 @@ use crate::common;
 use glam::{Vec2, Vec3};
 use marbre_core::cubemap::{self, CubeMap, CubeMapError, Face};
 use marbre_core::envmap::{self, EnvImage};
-use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
+use marbre_core::scene::{EnvSource, LdrImages, OrbitCamera, Scene};
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -205,7 +205,7 @@ fn a_horizontal_cross_laid_out_by_hand_loads_to_the_right_faces() {
     let dir = TempDir::new("cross");
     let path = dir.path("hand-cross.exr");
     write_exr(&path, 4 * n, 3 * n, texel);
-    let loaded = CubeMap::load_cross(&path).unwrap();
+    let loaded = CubeMap::load_cross(&path, LdrImages::Srgb).unwrap();
     assert!(loaded.notes.is_empty(), "{:?}", loaded.notes);
     let cube = loaded.cube;
     assert_eq!(cube.size(), n);
@@ -573,7 +573,7 @@ fn six_face_files_load_in_order() {
     let dir = TempDir::new("faces");
     let paths = face_paths(&dir);
     write_faces(&paths, 4);
-    let cube = CubeMap::load_faces(&paths).unwrap().cube;
+    let cube = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap().cube;
     assert_eq!(cube.size(), 4);
     for face in Face::ALL {
         assert_eq!(
@@ -589,7 +589,7 @@ fn faces_of_unequal_sizes_are_refused_naming_both_files() {
     let paths = face_paths(&dir);
     write_faces(&paths, 4);
     write_exr(&paths[3], 8, 8, |_, _| [1.0; 3]);
-    let err = CubeMap::load_faces(&paths).unwrap_err();
+    let err = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap_err();
     assert!(matches!(err, CubeMapError::UnequalFaces { .. }), "{err:?}");
     let msg = err.to_string();
     eprintln!("{msg}");
@@ -605,7 +605,7 @@ fn a_non_square_face_is_refused_naming_the_file() {
     let paths = face_paths(&dir);
     write_faces(&paths, 4);
     write_exr(&paths[4], 4, 3, |_, _| [1.0; 3]);
-    let err = CubeMap::load_faces(&paths).unwrap_err();
+    let err = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap_err();
     assert!(matches!(err, CubeMapError::NotSquare { .. }), "{err:?}");
     let msg = err.to_string();
     eprintln!("{msg}");
@@ -620,7 +620,7 @@ fn a_cross_of_the_wrong_aspect_is_refused_naming_the_file() {
     for (w, h) in [(16, 16), (12, 8), (10, 7), (6, 3)] {
         let path = dir.path(&format!("cross-{w}x{h}.exr"));
         write_exr(&path, w, h, |_, _| [1.0; 3]);
-        let err = CubeMap::load_cross(&path).unwrap_err();
+        let err = CubeMap::load_cross(&path, LdrImages::Srgb).unwrap_err();
         assert!(matches!(err, CubeMapError::CrossAspect { .. }), "{err:?}");
         let msg = err.to_string();
         for needle in [
@@ -634,7 +634,13 @@ fn a_cross_of_the_wrong_aspect_is_refused_naming_the_file() {
     // 4:3 with square cells loads.
     let ok = dir.path("cross-ok.exr");
     write_exr(&ok, 8, 6, |_, _| [1.0; 3]);
-    assert_eq!(CubeMap::load_cross(&ok).unwrap().cube.size(), 2);
+    assert_eq!(
+        CubeMap::load_cross(&ok, LdrImages::Srgb)
+            .unwrap()
+            .cube
+            .size(),
+        2
+    );
 }
 
 #[test]
@@ -643,7 +649,7 @@ fn a_missing_face_file_is_refused_naming_the_face_and_the_file() {
     let paths = face_paths(&dir);
     write_faces(&paths, 4);
     std::fs::remove_file(&paths[1]).unwrap();
-    let err = CubeMap::load_faces(&paths).unwrap_err();
+    let err = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap_err();
     assert!(
         matches!(err, CubeMapError::Face { face: "-x", .. }),
         "{err:?}"
@@ -655,7 +661,7 @@ fn a_missing_face_file_is_refused_naming_the_face_and_the_file() {
     }
     assert_eq!(err.path(), paths[1]);
 
-    let err = CubeMap::load_cross(&dir.path("no-cross.exr")).unwrap_err();
+    let err = CubeMap::load_cross(&dir.path("no-cross.exr"), LdrImages::Srgb).unwrap_err();
     let msg = err.to_string();
     assert!(
         msg.contains("no-cross.exr") && msg.contains("cannot read"),
@@ -677,7 +683,7 @@ fn faces_are_sanitised_like_lat_long_maps() {
             [1.0; 3]
         }
     });
-    let loaded = CubeMap::load_faces(&paths).unwrap();
+    let loaded = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap();
     assert_eq!(
         loaded.cube.texel(Face::PosY, 0, 0),
         [0.0, 0.0, envmap::F16_MAX]
@@ -700,10 +706,17 @@ fn every_source_loads_to_a_lat_long_image() {
     let dir = TempDir::new("sources");
     let paths = face_paths(&dir);
     write_faces(&paths, 4);
-    assert!(cubemap::load_source(&EnvSource::None).unwrap().is_none());
-    let faces = cubemap::load_source(&EnvSource::CubeFaces {
-        faces: paths.clone(),
-    })
+    assert!(
+        cubemap::load_source(&EnvSource::None, LdrImages::Srgb)
+            .unwrap()
+            .is_none()
+    );
+    let faces = cubemap::load_source(
+        &EnvSource::CubeFaces {
+            faces: paths.clone(),
+        },
+        LdrImages::Srgb,
+    )
     .unwrap()
     .unwrap();
     assert_eq!((faces.image.width, faces.image.height), (16, 8));
@@ -711,18 +724,24 @@ fn every_source_loads_to_a_lat_long_image() {
     assert!((faces.image.texel(5, 0)[0] - 3.0).abs() < 1e-5);
     assert!((faces.image.texel(5, 7)[0] - 4.0).abs() < 1e-5);
     assert!(faces.notes.iter().any(|n| n.contains("resampled")));
-    let cross = cubemap::load_source(&EnvSource::CubeCross {
-        path: root().join(SHIPPED_CROSS),
-    })
+    let cross = cubemap::load_source(
+        &EnvSource::CubeCross {
+            path: root().join(SHIPPED_CROSS),
+        },
+        LdrImages::Srgb,
+    )
     .unwrap()
     .unwrap();
     assert_eq!(
         (cross.image.width, cross.image.height),
         (4 * SHIPPED_FACE_SIZE, 2 * SHIPPED_FACE_SIZE)
     );
-    let latlong = cubemap::load_source(&EnvSource::LatLong {
-        path: root().join(SHIPPED_SOURCE),
-    })
+    let latlong = cubemap::load_source(
+        &EnvSource::LatLong {
+            path: root().join(SHIPPED_SOURCE),
+        },
+        LdrImages::Srgb,
+    )
     .unwrap()
     .unwrap();
     assert_eq!((latlong.image.width, latlong.image.height), (512, 256));
@@ -766,7 +785,7 @@ fn the_shipped_cross_is_the_converted_studio_map() {
     let path = root().join(SHIPPED_CROSS);
     let bytes = std::fs::metadata(&path).unwrap().len();
     assert!(bytes < 1 << 20, "{bytes} bytes");
-    let loaded = CubeMap::load_cross(&path).unwrap();
+    let loaded = CubeMap::load_cross(&path, LdrImages::Srgb).unwrap();
     assert!(loaded.notes.is_empty(), "{:?}", loaded.notes);
     assert_eq!(loaded.cube.size(), SHIPPED_FACE_SIZE);
     let source = envmap::load(&root().join(SHIPPED_SOURCE)).unwrap().image;
@@ -818,12 +837,15 @@ fn the_cross_as_background_renders_what_the_cube_samples() {
     ) else {
         return;
     };
-    let cube = CubeMap::load_cross(&root().join(SHIPPED_CROSS))
+    let cube = CubeMap::load_cross(&root().join(SHIPPED_CROSS), LdrImages::Srgb)
         .unwrap()
         .cube;
-    let env = cubemap::load_source(&EnvSource::CubeCross {
-        path: root().join(SHIPPED_CROSS),
-    })
+    let env = cubemap::load_source(
+        &EnvSource::CubeCross {
+            path: root().join(SHIPPED_CROSS),
+        },
+        LdrImages::Srgb,
+    )
     .unwrap()
     .unwrap()
     .image;
