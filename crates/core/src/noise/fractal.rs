@@ -89,35 +89,28 @@ trait NoisePrecision: Real {
     fn min(self, other: Self) -> Self;
 }
 
-impl NoisePrecision for f32 {
-    fn lattice_noise(p: [f32; 3], kind: NoiseKind, hash: HashKind) -> f32 {
-        match kind {
-            NoiseKind::Gradient => gradient_noise(Vec3::from_array(p), hash),
-            NoiseKind::Perlin => improved_noise_f32(p[0], p[1], p[2]),
+/// The [`NoisePrecision`] of `$t`: its noises are `$gradient` (taking a
+/// `$vec`) and `$perlin`.
+macro_rules! noise_precision {
+    ($t:ty, $vec:ty, $gradient:path, $perlin:path) => {
+        impl NoisePrecision for $t {
+            fn lattice_noise(p: [$t; 3], kind: NoiseKind, hash: HashKind) -> $t {
+                match kind {
+                    NoiseKind::Gradient => $gradient(<$vec>::from_array(p), hash),
+                    NoiseKind::Perlin => $perlin(p[0], p[1], p[2]),
+                }
+            }
+            fn abs(self) -> $t {
+                <$t>::abs(self)
+            }
+            fn min(self, other: $t) -> $t {
+                <$t>::min(self, other)
+            }
         }
-    }
-    fn abs(self) -> f32 {
-        f32::abs(self)
-    }
-    fn min(self, other: f32) -> f32 {
-        f32::min(self, other)
-    }
+    };
 }
-
-impl NoisePrecision for f64 {
-    fn lattice_noise(p: [f64; 3], kind: NoiseKind, hash: HashKind) -> f64 {
-        match kind {
-            NoiseKind::Gradient => gradient_noise_f64(DVec3::from_array(p), hash),
-            NoiseKind::Perlin => improved_noise(p[0], p[1], p[2]),
-        }
-    }
-    fn abs(self) -> f64 {
-        f64::abs(self)
-    }
-    fn min(self, other: f64) -> f64 {
-        f64::min(self, other)
-    }
-}
+noise_precision!(f32, Vec3, gradient_noise, improved_noise_f32);
+noise_precision!(f64, DVec3, gradient_noise_f64, improved_noise);
 
 /// What each octave adds: the signed noise (fBm), its absolute value
 /// (turbulence), or `(1 - |noise|)²`, sharp ridges where noise crosses 0
