@@ -673,6 +673,10 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
                             "Perlin's improved noise (2002): permutation table, 12 edge \
                              gradients, quintic fade"
                         }
+                        NoiseKind::PerlinMassal => {
+                            "Perlin's improved noise with the gradients of Massal's \
+                             tutorial (his grad(), different at h = 13 and 14)"
+                        }
                     });
             }
         })

@@ -17,6 +17,8 @@ use std::path::PathBuf;
 pub enum KindArg {
     Gradient,
     Perlin,
+    /// Perlin's noise with the gradients of Massal's tutorial.
+    PerlinMassal,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -64,6 +66,7 @@ impl NoiseArgs {
             kind: match self.kind {
                 KindArg::Gradient => NoiseKind::Gradient,
                 KindArg::Perlin => NoiseKind::Perlin,
+                KindArg::PerlinMassal => NoiseKind::PerlinMassal,
             },
             hash: match self.hash {
                 HashArg::Pcg => HashKind::Pcg,

@@ -129,7 +129,8 @@ pub fn structural_edit(
                         if flip_kind {
                             noise.kind = match noise.kind {
                                 NoiseKind::Gradient => NoiseKind::Perlin,
-                                NoiseKind::Perlin => NoiseKind::Gradient,
+                                NoiseKind::Perlin => NoiseKind::PerlinMassal,
+                                NoiseKind::PerlinMassal => NoiseKind::Gradient,
                             };
                         } else {
                             noise.kind = NoiseKind::Gradient;

@@ -1,7 +1,9 @@
 //! Fractal sums of a lattice noise: fBm, turbulence and marble.
 
 use super::gradient::{gradient_noise, gradient_noise_f64};
-use super::perlin::{Real, improved_noise, improved_noise_f32};
+use super::perlin::{
+    Real, improved_noise, improved_noise_f32, improved_noise_massal, improved_noise_massal_f32,
+};
 use super::{HashKind, NoiseKind};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -90,14 +92,15 @@ trait NoisePrecision: Real {
 }
 
 /// The [`NoisePrecision`] of `$t`: its noises are `$gradient` (taking a
-/// `$vec`) and `$perlin`.
+/// `$vec`), `$perlin` and `$massal`.
 macro_rules! noise_precision {
-    ($t:ty, $vec:ty, $gradient:path, $perlin:path) => {
+    ($t:ty, $vec:ty, $gradient:path, $perlin:path, $massal:path) => {
         impl NoisePrecision for $t {
             fn lattice_noise(p: [$t; 3], kind: NoiseKind, hash: HashKind) -> $t {
                 match kind {
                     NoiseKind::Gradient => $gradient(<$vec>::from_array(p), hash),
                     NoiseKind::Perlin => $perlin(p[0], p[1], p[2]),
+                    NoiseKind::PerlinMassal => $massal(p[0], p[1], p[2]),
                 }
             }
             fn abs(self) -> $t {
@@ -109,8 +112,20 @@ macro_rules! noise_precision {
         }
     };
 }
-noise_precision!(f32, Vec3, gradient_noise, improved_noise_f32);
-noise_precision!(f64, DVec3, gradient_noise_f64, improved_noise);
+noise_precision!(
+    f32,
+    Vec3,
+    gradient_noise,
+    improved_noise_f32,
+    improved_noise_massal_f32
+);
+noise_precision!(
+    f64,
+    DVec3,
+    gradient_noise_f64,
+    improved_noise,
+    improved_noise_massal
+);
 
 /// What each octave adds: the signed noise (fBm), its absolute value
 /// (turbulence), or `(1 - |noise|)²`, sharp ridges where noise crosses 0

@@ -2,7 +2,9 @@
 
 struct NoiseParams {
     kind: u32,        // 0 gradient, 1 Perlin
-    hash: u32,        // 0 pcg3d, 1 sin, 2 pcg3d tiled every 256 cells
+    // Gradient noise: 0 pcg3d, 1 sin, 2 pcg3d tiled every 256 cells.
+    // Perlin: 3 for Massal's gradient table, else Perlin's.
+    hash: u32,
     octaves: f32,
     frequency: f32,
     amplitude: f32,
@@ -25,7 +27,7 @@ const MAX_OCTAVES: f32 = 16.0;
 fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 #if NOISE_PERLIN
     if kind == 1u {
-        return perlin_noise(p);
+        return perlin_noise(p, hash == 3u);
     }
 #endif
 #if NOISE_GRADIENT
@@ -111,7 +113,7 @@ fn fractal_sum_perlin(point: vec3f, n: NoiseParams) -> f32 {
     var amplitude = n.amplitude;
     var sum = 0.0;
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
-        let v = perlin_noise(p * frequency);
+        let v = perlin_noise(p * frequency, n.hash == 3u);
         sum += octave_term(v, n, octaves, i, amplitude);
         frequency *= n.lacunarity;
         amplitude *= n.persistence;

@@ -33,15 +33,24 @@ pub enum NoiseKind {
     /// gradients and a quintic fade. Its hash is the permutation table, so it
     /// ignores [`HashKind`].
     Perlin,
+    /// Perlin's improved noise with the gradient table of Massal's
+    /// tutorial (his `grad()`, which differs at h = 13 and 14); ignores
+    /// [`HashKind`] too.
+    PerlinMassal,
 }
 
 impl NoiseKind {
-    pub const ALL: [NoiseKind; 2] = [NoiseKind::Gradient, NoiseKind::Perlin];
+    pub const ALL: [NoiseKind; 3] = [
+        NoiseKind::Gradient,
+        NoiseKind::Perlin,
+        NoiseKind::PerlinMassal,
+    ];
 
     pub fn label(self) -> &'static str {
         match self {
             NoiseKind::Gradient => "gradient (lab)",
             NoiseKind::Perlin => "Perlin improved",
+            NoiseKind::PerlinMassal => "Perlin, Massal's grad",
         }
     }
 }

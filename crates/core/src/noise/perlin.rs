@@ -1,8 +1,9 @@
 //! Ken Perlin's improved noise (SIGGRAPH 2002), transcribed from his Java
 //! reference implementation.
 //!
-//! The gradient function is the reference's, not the tutorial's variant in the
-//! course material, which differs at h = 13 and 14.
+//! The gradient function is the reference's; Massal's tutorial (in the
+//! course material) has a variant that differs at h = 13 and 14, offered as
+//! [`Gradients::Massal`] (the noise kind `PerlinMassal`).
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/perlin.wgsl");
@@ -83,12 +84,24 @@ fn lerp<T: Real>(t: T, a: T, b: T) -> T {
     a + t * (b - a)
 }
 
-fn grad<T: Real>(hash: i32, x: T, y: T, z: T) -> T {
+/// Which of the two 12-direction gradient tables the corners use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Gradients {
+    /// Perlin's Java: `u = h<8 ? x : y`, `v = h<4 ? y : h==12||h==14 ? x : z`.
+    Perlin,
+    /// Massal's tutorial: `u = h<8||h==12||h==13 ? x : y`,
+    /// `v = h<4||h==12||h==13 ? y : z`: h = 13 gives y − x (Perlin's
+    /// z − y) and h = 14 gives y − z (Perlin's y − x).
+    Massal,
+}
+
+fn grad<T: Real>(hash: i32, x: T, y: T, z: T, table: Gradients) -> T {
     let h = hash & 15;
-    let u = if h < 8 { x } else { y };
-    let v = if h < 4 {
+    let massal = table == Gradients::Massal && (h == 12 || h == 13);
+    let u = if h < 8 || massal { x } else { y };
+    let v = if h < 4 || massal {
         y
-    } else if h == 12 || h == 14 {
+    } else if table == Gradients::Perlin && (h == 12 || h == 14) {
         x
     } else {
         z
@@ -98,6 +111,11 @@ fn grad<T: Real>(hash: i32, x: T, y: T, z: T) -> T {
 
 /// Improved noise at (x, y, z), generic over the precision.
 pub fn improved_noise_generic<T: Real>(x: T, y: T, z: T) -> T {
+    improved_noise_with(x, y, z, Gradients::Perlin)
+}
+
+/// Improved noise with the gradient table `table`.
+pub fn improved_noise_with<T: Real>(x: T, y: T, z: T, table: Gradients) -> T {
     let (fx, fy, fz) = (x.floor(), y.floor(), z.floor());
     let xi = fx.to_i32() & 255;
     let yi = fy.to_i32() & 255;
@@ -115,24 +133,28 @@ pub fn improved_noise_generic<T: Real>(x: T, y: T, z: T) -> T {
         w,
         lerp(
             v,
-            lerp(u, grad(perm(aa), x, y, z), grad(perm(ba), x - one, y, z)),
             lerp(
                 u,
-                grad(perm(ab), x, y - one, z),
-                grad(perm(bb), x - one, y - one, z),
+                grad(perm(aa), x, y, z, table),
+                grad(perm(ba), x - one, y, z, table),
+            ),
+            lerp(
+                u,
+                grad(perm(ab), x, y - one, z, table),
+                grad(perm(bb), x - one, y - one, z, table),
             ),
         ),
         lerp(
             v,
             lerp(
                 u,
-                grad(perm(aa + 1), x, y, z - one),
-                grad(perm(ba + 1), x - one, y, z - one),
+                grad(perm(aa + 1), x, y, z - one, table),
+                grad(perm(ba + 1), x - one, y, z - one, table),
             ),
             lerp(
                 u,
-                grad(perm(ab + 1), x, y - one, z - one),
-                grad(perm(bb + 1), x - one, y - one, z - one),
+                grad(perm(ab + 1), x, y - one, z - one, table),
+                grad(perm(bb + 1), x - one, y - one, z - one, table),
             ),
         ),
     )
@@ -146,6 +168,16 @@ pub fn improved_noise(x: f64, y: f64, z: f64) -> f64 {
 /// The f32 evaluation a shader performs.
 pub fn improved_noise_f32(x: f32, y: f32, z: f32) -> f32 {
     improved_noise_generic(x, y, z)
+}
+
+/// Massal's variant (his `grad()`), the f64 reference.
+pub fn improved_noise_massal(x: f64, y: f64, z: f64) -> f64 {
+    improved_noise_with(x, y, z, Gradients::Massal)
+}
+
+/// Massal's variant in f32, as the shader.
+pub fn improved_noise_massal_f32(x: f32, y: f32, z: f32) -> f32 {
+    improved_noise_with(x, y, z, Gradients::Massal)
 }
 
 #[cfg(test)]
@@ -170,8 +202,41 @@ mod tests {
             90.0, 9.0, -110.0,
         ];
         for (h, e) in expected.iter().enumerate() {
-            assert_eq!(grad(h as i32, 1.0, 10.0, 100.0), *e, "h = {h}");
+            assert_eq!(
+                grad(h as i32, 1.0, 10.0, 100.0, Gradients::Perlin),
+                *e,
+                "h = {h}"
+            );
         }
+    }
+
+    /// Massal's `grad()` transcribed from the tutorial, against the table.
+    #[test]
+    fn massals_gradients_are_his_tutorials() {
+        fn massal(hash: i32, x: f64, y: f64, z: f64) -> f64 {
+            let h = hash & 15;
+            let u = if h < 8 || h == 12 || h == 13 { x } else { y };
+            let v = if h < 4 || h == 12 || h == 13 { y } else { z };
+            (if (h & 1) == 0 { u } else { -u }) + (if (h & 2) == 0 { v } else { -v })
+        }
+        for h in 0..16 {
+            let (x, y, z) = (1.0, 10.0, 100.0);
+            assert_eq!(
+                grad(h, x, y, z, Gradients::Massal),
+                massal(h, x, y, z),
+                "h = {h}"
+            );
+            let same = grad(h, x, y, z, Gradients::Perlin) == massal(h, x, y, z);
+            assert_eq!(same, h != 13 && h != 14, "h = {h}: only 13 and 14 differ");
+        }
+        // So the noises differ where a corner hashes to 13 or 14.
+        let differ = (0..200)
+            .map(|i| f64::from(i) * 0.37)
+            .filter(|&t| {
+                improved_noise_massal(t, 1.3 * t, 0.7 * t) != improved_noise(t, 1.3 * t, 0.7 * t)
+            })
+            .count();
+        assert!(differ > 100, "{differ} of 200 points differ");
     }
 
     #[test]

@@ -24,7 +24,7 @@ use glam::Vec3;
 /// with the same period.
 pub fn period(noise: &NoiseSettings) -> Option<f64> {
     let lattice_repeats = match noise.kind {
-        NoiseKind::Perlin => true,
+        NoiseKind::Perlin | NoiseKind::PerlinMassal => true,
         NoiseKind::Gradient => noise.hash == HashKind::PcgTiled,
     };
     let f = &noise.fractal;

@@ -284,7 +284,7 @@ fn has_area_lights(scene: &Scene) -> bool {
 
 fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {
     let mut out = match (noise.kind, noise.hash) {
-        (NoiseKind::Perlin, _) => vec![Feature::NoisePerlin],
+        (NoiseKind::Perlin | NoiseKind::PerlinMassal, _) => vec![Feature::NoisePerlin],
         (NoiseKind::Gradient, HashKind::Pcg | HashKind::PcgTiled) => {
             vec![Feature::NoiseGradient, Feature::HashPcg]
         }

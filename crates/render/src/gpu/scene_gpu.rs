@@ -91,7 +91,11 @@ impl NoiseParamsGpu {
         let f = &n.fractal;
         Self {
             kind: noise_kind_id(n.kind),
-            hash: hash_id(n.hash),
+            hash: if n.kind == NoiseKind::PerlinMassal {
+                MASSAL_GRADIENTS
+            } else {
+                hash_id(n.hash)
+            },
             octaves: f.octaves,
             frequency: f.frequency,
             amplitude: f.amplitude,
@@ -154,9 +158,15 @@ pub struct SphereGpu {
 pub fn noise_kind_id(k: NoiseKind) -> u32 {
     match k {
         NoiseKind::Gradient => 0,
-        NoiseKind::Perlin => 1,
+        // One octave loop for both Perlin kinds; `hash` tells the tables
+        // apart (MASSAL_GRADIENTS).
+        NoiseKind::Perlin | NoiseKind::PerlinMassal => 1,
     }
 }
+
+/// The `hash` a Perlin signal with Massal's gradient table carries (Perlin's
+/// noise has no other use for it): `perlin_noise`'s `massal` in WGSL.
+pub const MASSAL_GRADIENTS: u32 = 3;
 
 pub fn hash_id(h: HashKind) -> u32 {
     match h {
@@ -176,7 +186,7 @@ pub fn material(m: &Material) -> MaterialGpu {
         signal_count: signals.len() as u32,
         first_perlin: signals
             .iter()
-            .position(|s| s.noise.kind == NoiseKind::Perlin)
+            .position(|s| s.noise.kind != NoiseKind::Gradient)
             .unwrap_or(signals.len()) as u32,
         bump_height: m.bump_height,
         emitted_luminance: marbre_core::lights::emitted_luminance(m),

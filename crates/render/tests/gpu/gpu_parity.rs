@@ -76,6 +76,7 @@ fn integer_hash_and_perlin_noise_match_the_cpu() {
     for (kind, hash) in [
         (NoiseKind::Gradient, HashKind::Pcg),
         (NoiseKind::Perlin, HashKind::Pcg),
+        (NoiseKind::PerlinMassal, HashKind::Pcg),
     ] {
         let s = settings(kind, hash);
         for what in MODES {

@@ -17,7 +17,7 @@ use crate::common;
 
 use glam::{DVec3, Vec2, Vec3};
 use marbre_core::noise::gradient::GRADIENT_NOISE_BOUND;
-use marbre_core::noise::perlin::{IMPROVED_NOISE_BOUND, improved_noise};
+use marbre_core::noise::perlin::{IMPROVED_NOISE_BOUND, improved_noise, improved_noise_massal};
 use marbre_core::noise::{self, FractalParams, FractalShape, HashKind, NoiseKind, NoiseSettings};
 use marbre_core::preset;
 use marbre_core::scene::{MappingSpace, Pattern, Property, Signal, SurfacePoint, TextureMapping};
@@ -113,7 +113,8 @@ fn cpu(s: &NoiseSettings, what: Evaluate, p: Vec3) -> f32 {
 fn noise_bound(kind: NoiseKind) -> f32 {
     match kind {
         NoiseKind::Gradient => GRADIENT_NOISE_BOUND,
-        NoiseKind::Perlin => IMPROVED_NOISE_BOUND as f32,
+        // Massal's table has edge gradients too: the same bound.
+        NoiseKind::Perlin | NoiseKind::PerlinMassal => IMPROVED_NOISE_BOUND as f32,
     }
 }
 
@@ -125,7 +126,7 @@ fn noise_bound(kind: NoiseKind) -> f32 {
 fn lipschitz(kind: NoiseKind) -> f32 {
     match kind {
         NoiseKind::Gradient => 10.0,
-        NoiseKind::Perlin => 8.5,
+        NoiseKind::Perlin | NoiseKind::PerlinMassal => 8.5,
     }
 }
 
@@ -487,6 +488,7 @@ fn gradient_tiled_f64(p: DVec3) -> f64 {
 fn reference_f64(s: &NoiseSettings) -> fn(DVec3) -> f64 {
     match s.kind {
         NoiseKind::Perlin => |p: DVec3| improved_noise(p.x, p.y, p.z),
+        NoiseKind::PerlinMassal => |p: DVec3| improved_noise_massal(p.x, p.y, p.z),
         NoiseKind::Gradient => gradient_tiled_f64,
     }
 }
