@@ -98,43 +98,23 @@ impl Default for DisplaySettings {
 }
 
 /// The render settings as presets write them: one flat record, as they
-/// always were, whatever the types in memory.
+/// always were, whatever the types in memory. Each field means what the
+/// field of the same name in [`RenderSettings`] or [`DisplaySettings`]
+/// says.
 #[derive(Serialize, Deserialize)]
 #[serde(default)]
 struct RenderSettingsFile {
-    /// Jittered samples traced per pixel each frame.
     samples_per_frame: u32,
-    /// Average frames while nothing changes; off shows each frame alone.
     accumulate: bool,
-    /// Exposure in stops: the radiance is scaled by 2^exposure. With
-    /// `auto_exposure` it is a compensation added to the automatic value.
     exposure: f32,
-    /// Expose by Reinhard's key: the image's log-average luminance is
-    /// brought to middle grey (0.18), `exposure` stops on top; metered on
-    /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
-    /// sets it: the manual override.
     auto_exposure: bool,
     tone_map: ToneMap,
-    /// Resolution scale used while the camera is being dragged, so the view
-    /// stays responsive; full resolution comes back when the mouse is still.
     interactive_scale: f32,
-    /// Path length: 1 is direct light only (point light and environment),
-    /// each more bounce adds one more reflection.
     max_bounces: u32,
-    /// Checkerboards averaged over each ray's footprint in closed form,
-    /// rather than point sampled (which aliases far away).
     filter_checkers: bool,
-    /// Fractal sums stop at the octaves the footprint resolves (pbrt's
-    /// rule), rather than summing detail finer than a pixel.
     clamp_octaves: bool,
-    /// A lat-long environment is also sampled in proportion to its
-    /// luminance at every bounce, combined with BSDF sampling by multiple
-    /// importance sampling (power heuristic); off, only BSDF sampling
-    /// finds it.
     env_importance: bool,
     transport: super::transport::TransportSettings,
-    /// Debug view: pixels where a path gave a NaN or infinite sample (which
-    /// the accumulation drops and counts) are painted magenta.
     show_non_finite: bool,
 }
 
