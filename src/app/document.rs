@@ -5,15 +5,16 @@
 //! orbiting is looking, not editing, so it never asks "save changes?". A
 //! camera saved on purpose goes in with the next Save.
 
-use marbre_core::preset::{self, Preset, PresetError};
+use marbre_core::preset::{self, Header, Preset, PresetError};
 use marbre_core::scene::Scene;
 use std::path::{Path, PathBuf};
 
 pub struct Document {
     /// The preset file: Save writes here.
     pub path: PathBuf,
-    /// The preset's description, kept so that saving does not lose it.
-    pub description: String,
+    /// The preset's description and colour encoding, kept so that saving
+    /// does not lose them.
+    pub header: Header,
     /// The scene as last loaded or saved; its camera is set to the one it
     /// is compared with, so that only the rest counts.
     saved: Scene,
@@ -24,10 +25,10 @@ pub struct Document {
 }
 
 impl Document {
-    pub fn new(path: &Path, description: String, scene: &Scene) -> Self {
+    pub fn new(path: &Path, header: Header, scene: &Scene) -> Self {
         Self {
             path: path.to_owned(),
-            description,
+            header,
             saved: scene.clone(),
             saved_text: std::fs::read_to_string(path).ok(),
         }
@@ -59,11 +60,7 @@ impl Document {
 
     /// The preset that saving `scene` writes.
     pub fn preset(&self, scene: &Scene) -> Preset {
-        Preset {
-            description: self.description.clone(),
-            scene: scene.clone(),
-            ..Preset::default()
-        }
+        Preset::with_header(&self.header, scene.clone())
     }
 
     /// Whether the file on disk now differs from what this document last
@@ -76,11 +73,12 @@ impl Document {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use marbre_core::scene::ColorEncoding;
 
     #[test]
     fn an_edit_makes_it_dirty_and_a_camera_move_does_not() {
         let scene = Scene::default();
-        let mut document = Document::new(Path::new("unsaved.ron"), String::new(), &scene);
+        let mut document = Document::new(Path::new("unsaved.ron"), Header::default(), &scene);
         let mut moved = scene.clone();
         moved.camera.distance *= 2.0;
         assert!(!document.is_dirty(&moved));
@@ -97,8 +95,16 @@ mod tests {
             .tempdir()
             .unwrap();
         let path = dir.path().join("scene.ron");
-        let scene = Scene::default();
-        let mut document = Document::new(&path, "a test".into(), &scene);
+        let mut scene = Scene::default();
+        scene.point_light = Some(marbre_core::scene::PointLight {
+            color: glam::Vec3::new(0.5, 0.25, 1.0),
+            ..Default::default()
+        });
+        let header = Header {
+            description: "a test".into(),
+            colors: ColorEncoding::Srgb,
+        };
+        let mut document = Document::new(&path, header, &scene);
         let mut edited = scene.clone();
         edited.render.display.exposure = 2.0;
         assert!(document.is_dirty(&edited));
@@ -107,6 +113,23 @@ mod tests {
         assert!(!document.changed_on_disk());
         let loaded = preset::load(&path).unwrap().preset;
         assert_eq!(loaded.description, "a test");
+        assert_eq!(
+            loaded.colors,
+            ColorEncoding::Srgb,
+            "the file keeps its encoding"
+        );
+        let light = loaded.scene.point_light.unwrap().color;
+        assert!(
+            (light - glam::Vec3::new(0.5, 0.25, 1.0))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.contains("color: (0.735357, 0.537"),
+            "written as sRGB: {text}"
+        );
         assert_eq!(loaded.scene.render.display.exposure, 2.0);
         std::fs::write(&path, "(description: \"edited outside\")").unwrap();
         assert!(document.changed_on_disk());

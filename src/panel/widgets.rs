@@ -4,6 +4,7 @@
 use egui::emath::Numeric;
 use egui::{CollapsingHeader, DragValue, Response, Slider, SliderClamping, Ui};
 use glam::Vec3;
+use marbre_core::scene::color_encoding::{srgb_decode, srgb_encode};
 use std::ops::RangeInclusive;
 
 /// A top-level collapsible section, its open state keyed by its title.
@@ -27,14 +28,41 @@ pub(super) fn slider<'a, Num: Numeric>(
         .text(text)
 }
 
-/// Edits a linear RGB colour, writing it back only when the user changed it:
-/// egui goes through HSVA, whose round trip is not bit-exact, and a spurious
-/// change would restart the accumulation every frame.
+/// Edits a linear RGB colour: egui's picker, then the three channels typed
+/// as display (sRGB-encoded) values, the way the course documents and other
+/// tools write colours (the report's brown wood is `0.54 0.27 0.0742`); the
+/// scene keeps the linear value. Written back only when the user changed
+/// it: egui goes through HSVA and the sRGB round trip is not bit-exact
+/// either, and a spurious change would restart the accumulation every frame.
 pub(super) fn color_button(ui: &mut Ui, color: &mut Vec3) -> Response {
     let mut rgb = color.to_array();
-    let response = ui.color_edit_button_rgb(&mut rgb);
+    let mut response = ui.color_edit_button_rgb(&mut rgb);
     if response.changed() {
         *color = Vec3::from_array(rgb);
+    }
+    let shown = color.map(srgb_encode);
+    let mut typed = shown;
+    for (prefix, c) in [
+        ("r ", &mut typed.x),
+        ("g ", &mut typed.y),
+        ("b ", &mut typed.z),
+    ] {
+        response |= ui
+            .add(
+                DragValue::new(c)
+                    .speed(0.005)
+                    .range(0.0..=f32::MAX)
+                    .max_decimals(4)
+                    .prefix(prefix),
+            )
+            .on_hover_text(
+                "Display (sRGB) value, 0 to 1, as the course documents write colours; \
+                 the renderer uses its linear value",
+            );
+    }
+    if typed != shown {
+        *color = typed.map(srgb_decode);
+        response.mark_changed();
     }
     response
 }

@@ -1,7 +1,7 @@
 //! Preset files: a [`Scene`] in RON, versioned, with precise errors.
 
 use crate::atomic_write::write_atomic;
-use crate::scene::Scene;
+use crate::scene::{ColorEncoding, Scene};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -16,7 +16,42 @@ pub const FORMAT_VERSION: u32 = 2;
 pub struct Preset {
     pub format_version: u32,
     pub description: String,
+    /// How the file writes its colours (`colors: Srgb`: display values, as
+    /// the course documents give them); the scene in memory is linear.
+    #[serde(skip_serializing_if = "is_linear")]
+    pub colors: ColorEncoding,
     pub scene: Scene,
+}
+
+fn is_linear(c: &ColorEncoding) -> bool {
+    *c == ColorEncoding::Linear
+}
+
+/// What a preset says about itself rather than about the scene: whoever
+/// edits the scene keeps it, so that saving writes it back unchanged.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Header {
+    pub description: String,
+    pub colors: ColorEncoding,
+}
+
+impl Preset {
+    pub fn header(&self) -> Header {
+        Header {
+            description: self.description.clone(),
+            colors: self.colors,
+        }
+    }
+
+    /// The preset holding `scene` with `header`.
+    pub fn with_header(header: &Header, scene: Scene) -> Self {
+        Self {
+            description: header.description.clone(),
+            colors: header.colors,
+            scene,
+            ..Self::default()
+        }
+    }
 }
 
 impl Default for Preset {
@@ -24,6 +59,7 @@ impl Default for Preset {
         Self {
             format_version: FORMAT_VERSION,
             description: String::new(),
+            colors: ColorEncoding::Linear,
             scene: Scene::default(),
         }
     }
@@ -106,6 +142,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         });
     }
     preset.format_version = FORMAT_VERSION;
+    preset.colors.decode_scene(&mut preset.scene);
     let folder = path.parent().unwrap_or(Path::new("."));
     for env in preset.scene.environment.source.paths_mut() {
         if env.is_relative() {
@@ -186,6 +223,7 @@ pub fn parse_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, PresetError> {
 /// written relative to the file's folder, so a preset folder can be moved.
 pub fn to_text(preset: &Preset, path: &Path) -> Result<String, PresetError> {
     let mut preset = preset.clone();
+    preset.colors.encode_scene(&mut preset.scene);
     let dir = absolute(path.parent().unwrap_or(Path::new(".")));
     let mut relative = |file: &mut PathBuf| {
         if let Some(rel) = pathdiff::diff_paths(absolute(file), &dir) {

@@ -152,10 +152,10 @@ impl Viewer {
             self.scene.camera = keep.camera;
         }
         self.edits.preset_camera = loaded.scene.camera;
-        let description = preset::load(path)
-            .map(|l| l.preset.description)
+        let header = preset::load(path)
+            .map(|l| l.preset.header())
             .unwrap_or_default();
-        self.edits.document = Document::new(path, description, &self.scene);
+        self.edits.document = Document::new(path, header, &self.scene);
         self.panel.preset_path = path.display().to_string();
         if let EnvSource::LatLong { path } = &self.scene.environment.source {
             self.panel.env_path = path.display().to_string();
@@ -378,12 +378,12 @@ impl Viewer {
         // The document is the original preset (Save writes there), compared
         // with what that file holds, so the recovered edits show unsaved.
         let original = preset::load(&offer.source).ok();
-        let description = original
+        let header = original
             .as_ref()
-            .map(|l| l.preset.description.clone())
+            .map(|l| l.preset.header())
             .unwrap_or_default();
         let saved = original.map_or_else(Scene::default, |l| l.preset.scene);
-        self.edits.document = Document::new(&offer.source, description, &saved);
+        self.edits.document = Document::new(&offer.source, header, &saved);
         self.panel.preset_path = offer.source.display().to_string();
         self.panel.info(format!(
             "recovered the unsaved changes to {} from {}",

@@ -250,19 +250,19 @@ impl Viewer {
         // has loaded.
         let scripted = options.exit_after_frames.is_some() || options.soak.is_some();
         let mut startup_notes = Vec::new();
-        let (loaded, description) = if scripted {
+        let (loaded, header) = if scripted {
             let loaded = load_before_first_frame(
                 &mut preset_path,
                 options.env.as_deref(),
                 may_fall_back,
                 &mut startup_notes,
             )?;
-            let description = preset::load(&preset_path)
-                .map(|l| l.preset.description)
+            let header = preset::load(&preset_path)
+                .map(|l| l.preset.header())
                 .unwrap_or_default();
-            (loaded, description)
+            (loaded, header)
         } else {
-            (LoadedScene::placeholder(), String::new())
+            (LoadedScene::placeholder(), Default::default())
         };
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
@@ -310,7 +310,7 @@ impl Viewer {
         let timer = PassTimer::new(&ctx);
         let preset_camera = loaded.scene.camera;
         let history = History::new(&loaded.scene);
-        let document = Document::new(&preset_path, description, &loaded.scene);
+        let document = Document::new(&preset_path, header, &loaded.scene);
         // A soak's thousands of edits are not the user's work: nothing of
         // it is autosaved or remembered.
         let config_dir = config_dir.filter(|_| options.soak.is_none());

@@ -6,6 +6,7 @@
 //! re-derivation.
 
 pub mod camera;
+pub mod color_encoding;
 pub mod environment;
 pub mod material;
 pub mod mesh;
@@ -16,6 +17,7 @@ pub mod texture_tree;
 pub mod transport;
 
 pub use camera::{OrbitCamera, SavedView};
+pub use color_encoding::ColorEncoding;
 pub use environment::{EnvSource, Environment, LdrImages};
 pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};

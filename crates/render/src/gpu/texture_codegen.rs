@@ -590,6 +590,25 @@ mod tests {
         }
     }
 
+    /// A colour typed as the texture report writes it, in a preset marked
+    /// `colors: Srgb`, reaches the shader's parameters as its linear value
+    /// (the sRGB EOTF of IEC 61966-2-1, evaluated here in f64).
+    #[test]
+    fn a_typed_srgb_colour_reaches_the_shader_linear() {
+        let text =
+            "(colors: Srgb, scene: (spheres: [(material: (diffuse: (0.54, 0.27, 0.0742)))]))";
+        let preset = marbre_core::preset::parse(text, std::path::Path::new("typed.ron"))
+            .unwrap()
+            .preset;
+        let params = generate_plain(&preset.scene).unwrap().params;
+        let eotf = |v: f64| ((v + 0.055) / 1.055).powf(2.4);
+        let expected = [eotf(0.54), eotf(0.27), eotf(0.0742)];
+        let found = params
+            .iter()
+            .any(|p| (0..3).all(|i| (f64::from(p[i]) - expected[i]).abs() < 1e-6));
+        assert!(found, "{expected:?} not among {:?}", &params[..4]);
+    }
+
     /// Numbers live in the parameter buffer: editing them keeps the code,
     /// so the pipeline is not rebuilt; a structural edit changes it.
     #[test]
