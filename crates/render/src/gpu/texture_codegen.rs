@@ -107,7 +107,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
             })
         });
         if reads_noise {
-            "material_signals(material, p, pw)"
+            "material_signals(material, p, pw, 0.0)"
         } else {
             "vec4f(0.0)"
         }

@@ -45,7 +45,7 @@ fn load(path: &Path) -> Preset {
 /// need not exist), so two spellings of the same file (`presets/../envmaps/x.exr`,
 /// `/tmp/x/../../work/main/envmaps/x.exr`) compare equal.
 fn resolved(mut p: Preset) -> Preset {
-    if let EnvSource::LatLong { path } = &mut p.scene.environment.source {
+    for path in p.scene.environment.source.paths_mut() {
         *path = existing_file(path);
     }
     for material in p.scene.materials_mut() {
@@ -148,6 +148,49 @@ fn every_shipped_preset_loads_without_notes() {
             );
         }
     }
+}
+
+/// Issue 20's list of features a user should find in a shipped preset
+/// without building them: the lab's fract(sin) hash, a colour ramp, a
+/// layer, a cube map, a mirror sphere and a coloured shadow (a see-through
+/// surface with a tinted transmission).
+#[test]
+fn the_shipped_presets_show_every_feature() {
+    let presets: Vec<Preset> = shipped_presets().iter().map(|p| load(p)).collect();
+    let materials = || {
+        presets
+            .iter()
+            .flat_map(|p| p.scene.materials().cloned().collect::<Vec<_>>())
+    };
+    let lab_hash = materials().any(|m| {
+        m.patterns()
+            .iter()
+            .any(|p| p.noise().is_some_and(|n| n.hash == HashKind::Sin))
+    });
+    let ramp = materials().any(|m| m.all_textures().iter().any(|t| t.has_ramp()));
+    let layers = materials().any(|m| !m.layers.is_empty());
+    let cube_map = presets.iter().any(|p| {
+        matches!(
+            p.scene.environment.source,
+            EnvSource::CubeCross { .. } | EnvSource::CubeFaces { .. }
+        )
+    });
+    let mirror_sphere = presets.iter().any(|p| {
+        p.scene
+            .spheres
+            .iter()
+            .any(|s| s.material.mirror == Texture::scalar(1.0))
+    });
+    let coloured_shadow = materials().any(|m| {
+        m.opacity.eval(glam::Vec3::ZERO, glam::Vec2::ZERO).x < 0.5
+            && m.transmission != Texture::color(glam::Vec3::ONE)
+    });
+    assert!(lab_hash, "no shipped preset uses the lab's fract(sin) hash");
+    assert!(ramp, "no shipped preset has a colour ramp");
+    assert!(layers, "no shipped preset has a layered material");
+    assert!(cube_map, "no shipped preset lights by a cube map");
+    assert!(mirror_sphere, "no shipped preset has a mirror sphere");
+    assert!(coloured_shadow, "no shipped preset casts a coloured shadow");
 }
 
 #[test]
