@@ -4,7 +4,7 @@
 use super::{color_button, labelled_color, slider, vec3_ui};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
-use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_core::scene::{
     Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
 };
@@ -718,23 +718,47 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
     )))
     .on_hover_text("Amplitude of the first octave (type any value in ±100)");
     limit(&mut f.amplitude, FractalParams::AMPLITUDE);
-    ui.add(slider(
-        &mut f.persistence,
-        FractalParams::PERSISTENCE,
-        "persistence",
-    ))
-    .on_hover_text(
-        "Amplitude ratio between successive octaves (0.5: each half as strong; \
+    ComboBox::new("progression", "octaves progress")
+        .selected_text(f.progression.label())
+        .show_ui(ui, |ui| {
+            for p in Progression::ALL {
+                ui.selectable_value(&mut f.progression, p, p.label())
+                    .on_hover_text(match p {
+                        Progression::Geometric => {
+                            "Octave i at frequency · lacunarityⁱ, weighted amplitude · \
+                             persistenceⁱ"
+                        }
+                        Progression::Linear => {
+                            "Massal's harmonics: level k at frequency · k, weighted \
+                             amplitude / k (his turbulence: 9 levels of |noise|)"
+                        }
+                    });
+            }
+        })
+        .response
+        .on_hover_text("How each octave's frequency and weight follow from the first's");
+    let geometric = f.progression == Progression::Geometric;
+    ui.add_enabled_ui(geometric, |ui| {
+        ui.add(slider(
+            &mut f.persistence,
+            FractalParams::PERSISTENCE,
+            "persistence",
+        ))
+        .on_hover_text(
+            "Amplitude ratio between successive octaves (0.5: each half as strong; \
              above 1 the finest octaves dominate)",
-    );
-    ui.add(typed_beyond(slider(
-        &mut f.lacunarity,
-        1.0..=4.0,
-        "lacunarity",
-    )))
-    .on_hover_text(
-        "Frequency ratio between successive octaves (2: each twice as fine; type up to 8)",
-    );
+        )
+        .on_disabled_hover_text("Unused: linear levels are weighted 1/k");
+        ui.add(typed_beyond(slider(
+            &mut f.lacunarity,
+            1.0..=4.0,
+            "lacunarity",
+        )))
+        .on_hover_text(
+            "Frequency ratio between successive octaves (2: each twice as fine; type up to 8)",
+        )
+        .on_disabled_hover_text("Unused: linear level k is at frequency · k");
+    });
     limit(&mut f.lacunarity, FractalParams::LACUNARITY);
     ui.add(typed_beyond(slider(
         &mut f.distortion,

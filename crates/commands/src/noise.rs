@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use marbre_core::noise::fractal::{FractalShape, fractal_sum_f64, noise_f64};
-use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings};
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use std::io::{BufRead, Write};
@@ -19,6 +19,12 @@ pub enum KindArg {
     Perlin,
     /// Perlin's noise with the gradients of Massal's tutorial.
     PerlinMassal,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ProgressionArg {
+    Geometric,
+    Linear,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -44,6 +50,11 @@ pub struct NoiseArgs {
     pub persistence: f32,
     #[arg(long, default_value_t = 2.0)]
     pub lacunarity: f32,
+    /// How the octaves progress: geometric (frequency · lacunarityⁱ,
+    /// amplitude · persistenceⁱ) or linear (Massal's harmonics: level k at
+    /// frequency · k, weighted amplitude / k).
+    #[arg(long, value_enum, default_value = "geometric")]
+    pub progression: ProgressionArg,
     /// Print the fractal sum (fBm) instead of one octave of noise.
     #[arg(long, conflicts_with = "turbulence")]
     pub fbm: bool,
@@ -79,6 +90,10 @@ impl NoiseArgs {
                 amplitude: self.amplitude,
                 persistence: self.persistence,
                 lacunarity: self.lacunarity,
+                progression: match self.progression {
+                    ProgressionArg::Geometric => Progression::Geometric,
+                    ProgressionArg::Linear => Progression::Linear,
+                },
                 ..Default::default()
             },
         }
@@ -227,6 +242,41 @@ mod tests {
         for ((n, f), t) in noise.iter().zip(&fbm).zip(&turbulence) {
             assert_eq!(n, f);
             assert_eq!(n.abs(), *t);
+        }
+    }
+
+    /// `--progression linear` with Massal's knobs is his turbulence, as the
+    /// panel's recipe (`NoiseSettings::massal`) computes it.
+    #[test]
+    fn linear_progression_flags_give_massals_turbulence() {
+        let args = args(&[
+            "--kind",
+            "perlin-massal",
+            "--progression",
+            "linear",
+            "--octaves",
+            "9",
+            "--frequency",
+            "0.05",
+            "--turbulence",
+            "--cpu",
+        ]);
+        assert_eq!(args.settings(), NoiseSettings::massal(0.05));
+        let points = [
+            DVec3::new(120.5, 33.25, 7.0),
+            DVec3::new(-40.0, 250.0, 99.9),
+        ];
+        let values = evaluate_cpu(&args.settings(), args.what(), &points);
+        for (p, got) in points.iter().zip(values) {
+            let his: f64 = (1..10)
+                .map(|level| {
+                    let f = f64::from(level) * f64::from(0.05_f32);
+                    marbre_core::noise::perlin::improved_noise_massal(f * p.x, f * p.y, f * p.z)
+                        .abs()
+                        / f64::from(level)
+                })
+                .sum();
+            assert!((got - his).abs() < 1e-12, "{p}: {got} vs {his}");
         }
     }
 }

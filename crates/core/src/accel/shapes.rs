@@ -114,6 +114,7 @@ pub fn bumpy_sphere(triangles: usize) -> IndexedMesh {
             persistence: 0.5,
             lacunarity: 2.0,
             distortion: 0.0,
+            progression: Default::default(),
         },
     };
     displaced_sphere(Vec3::ZERO, 1.0, rings, 2 * rings, |d| {

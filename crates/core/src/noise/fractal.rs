@@ -13,7 +13,9 @@ use std::ops::RangeInclusive;
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/noise/fractal.wgsl");
 
 /// The knobs of a fractal sum. Octave `i` is `amplitude · persistenceⁱ ·
-/// noise(p · frequency · lacunarityⁱ)`.
+/// noise(p · frequency · lacunarityⁱ)` in the geometric progression, and
+/// `amplitude / k · noise(p · frequency · k)` with k = i + 1 in the linear
+/// one ([`Progression`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct FractalParams {
@@ -29,6 +31,42 @@ pub struct FractalParams {
     /// this much times a vector of three decorrelated noises at the base
     /// frequency. 0 leaves `p` alone.
     pub distortion: f32,
+    /// How the octaves' frequencies and amplitudes progress; presets
+    /// written before it read as geometric, as they were.
+    pub progression: Progression,
+}
+
+/// How a fractal sum's octaves follow one another.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Progression {
+    /// Octave i at `frequency · lacunarityⁱ`, weighted `amplitude ·
+    /// persistenceⁱ` (Musgrave's fBm, the lab's sums).
+    #[default]
+    Geometric,
+    /// Massal's harmonics: level k = i + 1 at `frequency · k`, weighted
+    /// `amplitude / k`; lacunarity and persistence are unused. His
+    /// tutorial's turbulence is this with |noise|, 9 levels and frequency
+    /// 0.05 (`Σ_{level=1}^{9} |noise(level · 0.05 · p)| / level`).
+    Linear,
+}
+
+impl Progression {
+    pub const ALL: [Progression; 2] = [Progression::Geometric, Progression::Linear];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Progression::Geometric => "geometric (lacunarity)",
+            Progression::Linear => "linear (Massal)",
+        }
+    }
+
+    /// The id the shader switches on (`NoiseParams::progression`).
+    pub fn id(self) -> u32 {
+        match self {
+            Progression::Geometric => 0,
+            Progression::Linear => 1,
+        }
+    }
 }
 
 impl FractalParams {
@@ -58,6 +96,7 @@ impl Default for FractalParams {
             persistence: 0.5,
             lacunarity: 2.0,
             distortion: 0.0,
+            progression: Progression::Geometric,
         }
     }
 }
@@ -69,6 +108,25 @@ pub struct NoiseSettings {
     pub kind: NoiseKind,
     pub hash: HashKind,
     pub fractal: FractalParams,
+}
+
+impl NoiseSettings {
+    /// The noise of Massal's tutorial at `frequency` (his is 0.05, for a
+    /// scene measured in pixels): his noise (Perlin's with his `grad()`)
+    /// summed over 9 linear levels. Taken as |noise| it is his turbulence.
+    pub fn massal(frequency: f32) -> Self {
+        Self {
+            kind: NoiseKind::PerlinMassal,
+            hash: HashKind::default(),
+            fractal: FractalParams {
+                octaves: 9.0,
+                frequency,
+                amplitude: 1.0,
+                progression: Progression::Linear,
+                ..FractalParams::default()
+            },
+        }
+    }
 }
 
 /// One octave of the chosen lattice noise, in f32 as the shader.
@@ -85,7 +143,7 @@ pub fn noise_f64(p: DVec3, kind: NoiseKind, hash: HashKind) -> f64 {
 
 /// A precision the noise and its fractal sums are evaluated in: f32 (the
 /// shader's twin) or f64 (the reference).
-trait NoisePrecision: Real {
+trait NoisePrecision: Real + std::ops::Div<Output = Self> {
     fn lattice_noise(p: [Self; 3], kind: NoiseKind, hash: HashKind) -> Self;
     fn abs(self) -> Self;
     fn min(self, other: Self) -> Self;
@@ -204,6 +262,11 @@ fn fractal_sum_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings, shape: F
     for i in 0..whole {
         // The last octave fades in with the fractional part of `octaves`.
         let weight = (octaves - T::from_i32(i as i32)).min(T::ONE);
+        if f.progression == Progression::Linear {
+            let k = T::from_i32(i as i32 + 1);
+            frequency = param(f.frequency) * k;
+            amplitude = param(f.amplitude) / k;
+        }
         let v = T::lattice_noise(p.map(|c| c * frequency), s.kind, s.hash);
         sum = sum + weight * amplitude * shape.apply(v);
         frequency = frequency * param(f.lacunarity);
@@ -217,13 +280,20 @@ fn fractal_sum_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings, shape: F
 /// frequency f·Lⁱ, is kept while its period is more than two footprints
 /// (f·Lⁱ·width < 1/2), so n = (−1 − log2(f·width)) / log2(L); the last, partial
 /// octave fades in by smoothstep(0.3, 0.7) of its fraction. Never more than
-/// `octaves`; a zero width (no footprint) or L ≤ 1 keeps them all.
+/// `octaves`; a zero width (no footprint) or L ≤ 1 keeps them all. In the
+/// linear progression level i + 1 has frequency f·(i + 1), so the rule
+/// gives n = 1/(2·f·width) − 1.
 pub fn footprint_octaves(f: &FractalParams, width: f32) -> f32 {
     let octaves = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES);
-    if !(width > 0.0 && f.lacunarity > 1.0 && f.frequency > 0.0) {
+    let linear = f.progression == Progression::Linear;
+    if !(width > 0.0 && (f.lacunarity > 1.0 || linear) && f.frequency > 0.0) {
         return octaves;
     }
-    let n = ((-1.0 - (f.frequency * width).log2()) / f.lacunarity.log2()).max(0.0);
+    let n = if linear {
+        (0.5 / (f.frequency * width) - 1.0).max(0.0)
+    } else {
+        ((-1.0 - (f.frequency * width).log2()) / f.lacunarity.log2()).max(0.0)
+    };
     let whole = n.floor();
     let x = ((n - whole - 0.3) / 0.4).clamp(0.0, 1.0);
     (whole + x * x * (3.0 - 2.0 * x)).min(octaves)
@@ -385,6 +455,75 @@ mod tests {
             let expected = 0.75 * fbm(p, &lo) + 0.25 * fbm(p, &hi);
             assert!((fbm(p, &mid) - expected).abs() < 1e-5);
         }
+    }
+
+    /// Massal's turbulence, transcribed from his tutorial in f64 (his
+    /// `noise()` is Perlin's with his `grad()`, `improved_noise_massal`):
+    /// `for (level = 1; level < 10; level++) noiseCoef += (1.0f / level) *
+    /// fabsf(noise(level * 0.05 * x, …))`, over his pixel-sized scene. The
+    /// linear progression with 9 levels is his loop to rounding at the
+    /// frequency a preset stores (0.05 in f32), and within 5e-5 of his
+    /// exact 0.05 (f32's 0.05 is 7.5e-10 off, which moves level k's
+    /// argument by k · 640 · 7.5e-10 and the sum by at most Σ 8.5 · 640 ·
+    /// 7.5e-10 ≈ 4e-5); the f32 twin (the shader's) is as close.
+    #[test]
+    fn linear_turbulence_is_massals() {
+        fn his_turbulence(f: f64, x: f64, y: f64, z: f64) -> f64 {
+            let mut noise_coef = 0.0;
+            for level in 1..10 {
+                let level = f64::from(level);
+                noise_coef += (1.0 / level)
+                    * improved_noise_massal(level * f * x, level * f * y, level * f * z).abs();
+            }
+            noise_coef
+        }
+        let s = NoiseSettings::massal(0.05);
+        let stored = f64::from(s.fractal.frequency);
+        let mut spread = (f64::MAX, f64::MIN);
+        for k in 0..2000 {
+            let k = f64::from(k);
+            let p = DVec3::new(k * 0.713 % 640.0, k * 0.291 % 480.0, 30.0 + k * 0.057);
+            let got = fractal_sum_f64(p, &s, FractalShape::Absolute);
+            let same_frequency = his_turbulence(stored, p.x, p.y, p.z);
+            assert!(
+                (got - same_frequency).abs() < 1e-12,
+                "{p}: {got} vs {same_frequency}"
+            );
+            let expected = his_turbulence(0.05, p.x, p.y, p.z);
+            assert!((got - expected).abs() < 5e-5, "{p}: {got} vs {expected}");
+            let single = turbulence(p.as_vec3(), &s);
+            assert!(
+                (f64::from(single) - expected).abs() < 5e-5,
+                "{p}: f32 {single} vs {expected}"
+            );
+            spread = (spread.0.min(expected), spread.1.max(expected));
+        }
+        // Not a constant: the reference spans a real range.
+        assert!(spread.1 - spread.0 > 0.5, "{spread:?}");
+        // The geometric progression with the same knobs is another sum.
+        let geometric = NoiseSettings {
+            fractal: FractalParams {
+                progression: Progression::Geometric,
+                ..s.fractal
+            },
+            ..s
+        };
+        let p = Vec3::new(123.4, 56.7, 89.1);
+        assert!((turbulence(p, &geometric) - turbulence(p, &s)).abs() > 1e-3);
+    }
+
+    /// The footprint rule in the linear progression: level k has frequency
+    /// k·f, kept while k·f·width < 1/2, so n = 1/(2·f·width) − 1.
+    #[test]
+    fn linear_footprint_octaves_keep_the_levels_below_nyquist() {
+        let f = NoiseSettings::massal(2.0).fractal;
+        assert_eq!(footprint_octaves(&f, 0.0), 9.0);
+        assert_eq!(footprint_octaves(&f, 0.25), 0.0);
+        assert_eq!(footprint_octaves(&f, 0.125), 1.0);
+        assert_eq!(footprint_octaves(&f, 0.25 / 4.0), 3.0);
+        assert_eq!(footprint_octaves(&f, 1e-6), 9.0);
+        let mid = footprint_octaves(&f, 0.25 / 3.5);
+        assert!((mid - 2.5).abs() < 1e-4, "{mid}");
     }
 
     #[test]

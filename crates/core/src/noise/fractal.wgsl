@@ -19,7 +19,9 @@ struct NoiseParams {
     world: u32,
     // How much the signal's mapping enlarges a footprint.
     footprint_scale: f32,
-    _pad0: f32,
+    // 0 geometric (lacunarity, persistence), 1 linear (Massal's harmonics:
+    // level k = i + 1 at frequency · k, weighted amplitude / k).
+    progression: u32,
 }
 
 const MAX_OCTAVES: f32 = 16.0;
@@ -39,18 +41,32 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 
 #if FOOTPRINT
 // The octaves a footprint `width` wide resolves; twin of
-// noise::footprint_octaves (pbrt's rule, any lacunarity).
+// noise::footprint_octaves (pbrt's rule, any lacunarity or linear levels).
 fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
     let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
-    if !(width > 0.0 && n.lacunarity > 1.0 && n.frequency > 0.0) {
+    let linear = n.progression == 1u;
+    if !(width > 0.0 && (n.lacunarity > 1.0 || linear) && n.frequency > 0.0) {
         return octaves;
     }
-    let resolved = max((-1.0 - log2(n.frequency * width)) / log2(n.lacunarity), 0.0);
+    var resolved = 0.0;
+    if linear {
+        resolved = max(0.5 / (n.frequency * width) - 1.0, 0.0);
+    } else {
+        resolved = max((-1.0 - log2(n.frequency * width)) / log2(n.lacunarity), 0.0);
+    }
     let whole = floor(resolved);
     let x = clamp((resolved - whole - 0.3) / 0.4, 0.0, 1.0);
     return min(whole + x * x * (3.0 - 2.0 * x), octaves);
 }
 #endif
+
+// Octave i's frequency and amplitude, given the geometric progression's
+// running ones: the linear progression replaces them by frequency · k and
+// amplitude / k, k = i + 1.
+fn octave_scales(n: NoiseParams, i: u32, frequency: f32, amplitude: f32) -> vec2f {
+    let k = f32(i + 1u);
+    return select(vec2f(frequency, amplitude), vec2f(n.frequency * k, n.amplitude / k), n.progression == 1u);
+}
 
 // Octave i's share of the sum, in one place for both kinds' loops: the last,
 // fractional octave fades in, and the shape applies.
@@ -96,10 +112,11 @@ fn fractal_sum_gradient(point: vec3f, n: NoiseParams) -> f32 {
     var amplitude = n.amplitude;
     var sum = 0.0;
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
-        let v = gradient_noise(p * frequency, n.hash);
-        sum += octave_term(v, n, octaves, i, amplitude);
-        frequency *= n.lacunarity;
-        amplitude *= n.persistence;
+        let scales = octave_scales(n, i, frequency, amplitude);
+        let v = gradient_noise(p * scales.x, n.hash);
+        sum += octave_term(v, n, octaves, i, scales.y);
+        frequency = scales.x * n.lacunarity;
+        amplitude = scales.y * n.persistence;
     }
     return sum;
 }
@@ -113,10 +130,11 @@ fn fractal_sum_perlin(point: vec3f, n: NoiseParams) -> f32 {
     var amplitude = n.amplitude;
     var sum = 0.0;
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
-        let v = perlin_noise(p * frequency, n.hash == 3u);
-        sum += octave_term(v, n, octaves, i, amplitude);
-        frequency *= n.lacunarity;
-        amplitude *= n.persistence;
+        let scales = octave_scales(n, i, frequency, amplitude);
+        let v = perlin_noise(p * scales.x, n.hash == 3u);
+        sum += octave_term(v, n, octaves, i, scales.y);
+        frequency = scales.x * n.lacunarity;
+        amplitude = scales.y * n.persistence;
     }
     return sum;
 }

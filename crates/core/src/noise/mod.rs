@@ -13,8 +13,8 @@ pub mod perlin;
 pub mod rebase;
 
 pub use fractal::{
-    FractalParams, FractalShape, NoiseSettings, fbm, footprint_octaves, fractal_sum, marble, noise,
-    ridged, turbulence, warped,
+    FractalParams, FractalShape, NoiseSettings, Progression, fbm, footprint_octaves, fractal_sum,
+    marble, noise, ridged, turbulence, warped,
 };
 pub use gradient::gradient_noise;
 pub use hash::HashKind;

@@ -14,13 +14,13 @@
 //! exact, so a user never has to choose it; the lab's gradient noise with the
 //! plain pcg3d or sin hash does not repeat, and keeps its offset.
 
-use super::{HashKind, NoiseKind, NoiseSettings, hash::LATTICE_PERIOD};
+use super::{HashKind, NoiseKind, NoiseSettings, Progression, hash::LATTICE_PERIOD};
 use glam::Vec3;
 
 /// The period of the fractal sum in its input space, where it has one: the
 /// lattice repeats every 256 cells and each octave's frequency
 /// `frequency · lacunarityⁱ` is an integer multiple of the first (an integer
-/// lacunarity). The domain warp samples at the base frequency, so it repeats
+/// lacunarity, or the linear progression's `frequency · k`). The domain warp samples at the base frequency, so it repeats
 /// with the same period.
 pub fn period(noise: &NoiseSettings) -> Option<f64> {
     let lattice_repeats = match noise.kind {
@@ -28,7 +28,8 @@ pub fn period(noise: &NoiseSettings) -> Option<f64> {
         NoiseKind::Gradient => noise.hash == HashKind::PcgTiled,
     };
     let f = &noise.fractal;
-    let whole_lacunarity = f.lacunarity >= 1.0 && f.lacunarity.fract() == 0.0;
+    let whole_lacunarity = (f.lacunarity >= 1.0 && f.lacunarity.fract() == 0.0)
+        || f.progression == Progression::Linear;
     let frequency = f64::from(f.frequency);
     (lattice_repeats && whole_lacunarity && frequency > 0.0 && frequency.is_finite())
         .then(|| f64::from(LATTICE_PERIOD) / frequency)
@@ -54,7 +55,7 @@ pub fn rebase(offset: Vec3, noise: &NoiseSettings) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::noise::FractalParams;
+    use crate::noise::{FractalParams, FractalShape};
 
     fn settings(kind: NoiseKind, hash: HashKind, frequency: f32, lacunarity: f32) -> NoiseSettings {
         NoiseSettings {
@@ -87,6 +88,15 @@ mod tests {
             period(&settings(NoiseKind::Perlin, HashKind::Pcg, 0.0, 2.0)),
             None
         );
+        // Linear levels are whole multiples whatever the (unused) lacunarity.
+        let mut linear = settings(NoiseKind::PerlinMassal, HashKind::Pcg, 0.5, 2.1);
+        linear.fractal.progression = crate::noise::Progression::Linear;
+        assert_eq!(period(&linear), Some(512.0));
+        // And the sum does repeat: 9 levels, one period apart.
+        let p = glam::DVec3::new(3.7, -1.2, 0.4);
+        let shifted = p + glam::DVec3::new(512.0, -1024.0, 512.0);
+        let sum = |q| crate::noise::fractal::fractal_sum_f64(q, &linear, FractalShape::Absolute);
+        assert!((sum(p) - sum(shifted)).abs() < 1e-12);
     }
 
     /// 1e5 + 0.3 is 100000.296875 in f32; less the nearest whole number of

@@ -83,7 +83,8 @@ pub struct NoiseParamsGpu {
     pub world: u32,
     /// How much the signal's mapping enlarges a footprint.
     pub footprint_scale: f32,
-    pub _pad: f32,
+    /// [`marbre_core::noise::Progression::id`]: geometric or linear octaves.
+    pub progression: u32,
 }
 
 impl NoiseParamsGpu {
@@ -105,7 +106,7 @@ impl NoiseParamsGpu {
             distortion: f.distortion,
             world: 0,
             footprint_scale: 1.0,
-            _pad: 0.0,
+            progression: f.progression.id(),
         }
     }
 }

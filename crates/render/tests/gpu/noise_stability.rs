@@ -67,6 +67,7 @@ fn settings(kind: NoiseKind, hash: HashKind) -> NoiseSettings {
             persistence: 0.5,
             lacunarity: 2.0,
             distortion: 0.0,
+            progression: Default::default(),
         },
     }
 }
@@ -683,6 +684,7 @@ fn extremes() -> Vec<(&'static str, FractalParams)> {
                 persistence: *FractalParams::PERSISTENCE.end(),
                 lacunarity: *FractalParams::LACUNARITY.end(),
                 distortion: 0.0,
+                progression: Default::default(),
             },
         ),
     ]
@@ -994,6 +996,7 @@ mod properties {
                     persistence,
                     lacunarity,
                     distortion: 0.0,
+                    progression: Default::default(),
                 }
             })
     }
