@@ -519,7 +519,8 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
         .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])
         .on_hover_text("What blends between the two values across the surface");
     if index != pattern.index() {
-        // `with_index` carries the noise settings over, so tuning survives.
+        // `with_index` carries the noise settings over, so tuning survives
+        // (Massal's marble takes his recipe instead).
         *pattern = pattern.with_index(index);
     }
     match pattern {
@@ -652,6 +653,17 @@ fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
                 );
             ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"))
                 .on_hover_text("How far turbulence bends the veins (times the fractal sum)");
+            noise_ui(ui, noise);
+        }
+        Pattern::MassalMarble {
+            noise,
+            stripe_frequency,
+        } => {
+            ui.add(slider(stripe_frequency, 0.0..=32.0, "stripe frequency"))
+                .on_hover_text(
+                    "t = 0.5 + 0.5·sin((x + y) · stripe frequency + turbulence): Massal's \
+                     marble, his stripe frequency equal to the noise's",
+                );
             noise_ui(ui, noise);
         }
     }

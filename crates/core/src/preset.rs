@@ -322,6 +322,38 @@ mod tests {
         assert_eq!(loaded.preset.scene.spheres[0].name, "sphere");
     }
 
+    /// Massal's marble and the linear progression round-trip, and a noise
+    /// written before the progression existed reads as the geometric one.
+    #[test]
+    fn massal_marble_round_trips_and_old_noise_reads_geometric() {
+        use crate::noise::{NoiseSettings, Progression};
+        use crate::scene::Pattern;
+        let text = "(scene: (spheres: [(material: (diffuse: (pattern: Marble(\
+                    noise: (kind: Perlin, fractal: (octaves: 6.0, lacunarity: 2.0)), \
+                    stripe_frequency: 7.0))))]))";
+        let old = parse(text, Path::new("old.ron")).unwrap();
+        let noise = old.preset.scene.spheres[0]
+            .material
+            .diffuse
+            .pattern
+            .noise()
+            .copied();
+        assert_eq!(noise.unwrap().fractal.progression, Progression::Geometric);
+
+        let mut p = Preset::default();
+        p.scene.spheres.push(Default::default());
+        p.scene.spheres[0].material.diffuse.pattern = Pattern::MassalMarble {
+            noise: NoiseSettings::massal(0.05),
+            stripe_frequency: 0.05,
+        };
+        let text = to_text(&p, Path::new("x.ron")).unwrap();
+        assert!(text.contains("MassalMarble("), "{text}");
+        assert!(text.contains("progression: Linear"), "{text}");
+        let back = parse(&text, Path::new("x.ron")).unwrap();
+        assert_eq!(back.preset, p);
+        assert!(back.notes.is_empty(), "{:?}", back.notes);
+    }
+
     #[test]
     fn saved_env_paths_are_short_and_relative() {
         let mut p = Preset::default();

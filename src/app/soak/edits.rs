@@ -12,7 +12,7 @@
 
 use super::rng::Pcg32;
 use glam::{Vec2, Vec3};
-use marbre_core::noise::{FractalParams, HashKind, NoiseKind};
+use marbre_core::noise::{FractalParams, HashKind, NoiseKind, Progression};
 use marbre_core::scene::{
     Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Pattern, RenderSettings, Scene, Sphere,
     Texture, ToneMap,
@@ -56,9 +56,9 @@ impl Structural {
 /// The name of the sphere the soak adds, so that it removes only its own.
 const SOAK_SPHERE: &str = "soak sphere";
 
-/// The panel's pattern dropdown, without the image pattern (which needs a
-/// file).
-const PATTERNS: usize = 14;
+/// The panel's pattern dropdown, without the image pattern (index 14,
+/// which needs a file).
+const PATTERNS: usize = 15;
 
 /// Changes one value somewhere in the scene, as a slider drag would; false
 /// when the drawn edit would not have survived sanitising (nothing changed).
@@ -235,6 +235,9 @@ fn edit_pattern_parameter(rng: &mut Pcg32, pattern: &mut Pattern) {
         Pattern::Checker { size } => *size = rng.log_range(0.01, 10.0),
         Pattern::Marble {
             stripe_frequency, ..
+        }
+        | Pattern::MassalMarble {
+            stripe_frequency, ..
         } => *stripe_frequency = rng.range(0.0, 32.0),
         Pattern::Checker2d { size, phase } => {
             *size = Vec2::new(rng.log_range(0.01, 4.0), rng.log_range(0.01, 4.0));
@@ -292,7 +295,7 @@ fn edit_pattern_parameter(rng: &mut Pcg32, pattern: &mut Pattern) {
 
 /// One knob of a fractal sum over its slider's drag range.
 fn edit_fractal(rng: &mut Pcg32, f: &mut FractalParams) {
-    match rng.below(6) {
+    match rng.below(7) {
         0 => {
             f.octaves = rng.range(
                 *FractalParams::OCTAVES.start(),
@@ -308,6 +311,7 @@ fn edit_fractal(rng: &mut Pcg32, f: &mut FractalParams) {
             )
         }
         4 => f.lacunarity = rng.range(1.0, 4.0),
+        5 => f.progression = Progression::ALL[rng.below(Progression::ALL.len())],
         _ => f.distortion = rng.range(0.0, 4.0),
     }
 }
@@ -330,7 +334,10 @@ fn edit_render_settings(rng: &mut Pcg32, render: &mut RenderSettings) {
 /// the noise settings as the panel does; a mix gets the factor it needs,
 /// and any other pattern loses it.
 fn switch_pattern(rng: &mut Pcg32, texture: &mut Texture) {
-    let index = rng.below(PATTERNS);
+    let index = match rng.below(PATTERNS) {
+        14 => 15,
+        i => i,
+    };
     texture.pattern = texture.pattern.with_index(index);
     texture.factor = match texture.pattern {
         Pattern::Mix => Some(Box::new(Texture::scalar(rng.unit()))),

@@ -89,6 +89,14 @@ pub enum Pattern {
         frequency: f32,
         turbulence_amount: f32,
     },
+    /// Massal's tutorial's marble: `t = 0.5 + 0.5 · sin((x + y) ·
+    /// stripe_frequency + turbulence(p))`. His recipe is the default:
+    /// his noise in 9 linear levels ([`NoiseSettings::massal`]), the stripe
+    /// frequency equal to the noise's.
+    MassalMarble {
+        noise: NoiseSettings,
+        stripe_frequency: f32,
+    },
 }
 
 /// A fractal sum a pattern reads: the noise, what each octave adds, and
@@ -225,7 +233,7 @@ fn affine_rows(m: &Affine3A) -> [[f32; 4]; 3] {
 }
 
 impl Pattern {
-    pub const NAMES: [&'static str; 15] = [
+    pub const NAMES: [&'static str; 16] = [
         "constant",
         "checker 3D",
         "fBm",
@@ -241,7 +249,13 @@ impl Pattern {
         "ridged",
         "mix",
         "image",
+        "marble (Massal)",
     ];
+
+    /// The frequency of Massal's marble when chosen in the panel: his 0.05
+    /// was for spheres about 100 pixels in radius; scaled to marbre's unit
+    /// spheres, a stripe about a radius wide.
+    pub const MASSAL_MARBLE_FREQUENCY: f32 = 5.0;
 
     /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
     pub fn index(&self) -> usize {
@@ -261,6 +275,7 @@ impl Pattern {
             Pattern::Ridged { .. } => 12,
             Pattern::Mix => 13,
             Pattern::Image { .. } => 14,
+            Pattern::MassalMarble { .. } => 15,
         }
     }
 
@@ -313,6 +328,12 @@ impl Pattern {
                 filter: Default::default(),
                 wrap: Default::default(),
             },
+            // His recipe, not the previous pattern's noise: the marble is
+            // his only with his turbulence.
+            15 => Pattern::MassalMarble {
+                noise: NoiseSettings::massal(Self::MASSAL_MARBLE_FREQUENCY),
+                stripe_frequency: Self::MASSAL_MARBLE_FREQUENCY,
+            },
             _ => Pattern::Constant,
         }
     }
@@ -324,7 +345,8 @@ impl Pattern {
             | Pattern::Ridged { noise }
             | Pattern::Marble { noise, .. }
             | Pattern::Wood { noise, .. }
-            | Pattern::Veins { noise, .. } => Some(noise),
+            | Pattern::Veins { noise, .. }
+            | Pattern::MassalMarble { noise, .. } => Some(noise),
             _ => None,
         }
     }
@@ -336,7 +358,8 @@ impl Pattern {
             | Pattern::Ridged { noise }
             | Pattern::Marble { noise, .. }
             | Pattern::Wood { noise, .. }
-            | Pattern::Veins { noise, .. } => Some(noise),
+            | Pattern::Veins { noise, .. }
+            | Pattern::MassalMarble { noise, .. } => Some(noise),
             _ => None,
         }
     }
@@ -346,9 +369,10 @@ impl Pattern {
     pub fn signal(&self) -> Option<Signal> {
         let noise = *self.noise()?;
         let shape = match self {
-            Pattern::Turbulence { .. } | Pattern::Wood { .. } | Pattern::Veins { .. } => {
-                FractalShape::Absolute
-            }
+            Pattern::Turbulence { .. }
+            | Pattern::Wood { .. }
+            | Pattern::Veins { .. }
+            | Pattern::MassalMarble { .. } => FractalShape::Absolute,
             Pattern::Ridged { .. } => FractalShape::Ridged,
             _ => FractalShape::Signed,
         };
@@ -417,6 +441,12 @@ impl Pattern {
                     .max(0.0),
                 uv,
             ),
+            Pattern::MassalMarble {
+                stripe_frequency, ..
+            } => (
+                texture::massal_marble_stripes(p, stripe_frequency, signal),
+                uv,
+            ),
         }
     }
 
@@ -434,6 +464,14 @@ impl Pattern {
         {
             notes.push(format!("{what}: marble stripe frequency reset"));
             *stripe_frequency = 4.0;
+        }
+        if let Pattern::MassalMarble {
+            stripe_frequency, ..
+        } = self
+            && !stripe_frequency.is_finite()
+        {
+            notes.push(format!("{what}: Massal marble stripe frequency reset"));
+            *stripe_frequency = Self::MASSAL_MARBLE_FREQUENCY;
         }
         let mut positive = |name: &str, v: &mut f32, fallback: f32| {
             if !(v.is_finite() && *v > 1e-4) {

@@ -32,7 +32,7 @@ pub use checker::{Cell, checker_2d, checker_3d, filtered_checker_2d, filtered_ch
 pub use cutout::{cutout, cutout_area};
 pub use image_set::{ImageSet, ImageSource};
 pub use mapping::{TextureTransform, cylinder_uv, plane_uv, polygon_frame, sphere_uv, triangle_uv};
-pub use marble::marble_veins;
+pub use marble::{marble_veins, massal_marble, massal_marble_stripes};
 pub use ramp::{MAX_RAMP_STOPS, RampStop, luminance, ramp};
 pub use waves::{waves, waves_gradient};
 pub use wood::{default_axis, wood};

@@ -148,3 +148,11 @@ fn marble_veins(p: vec3f, axis: vec3f, frequency: f32, turbulence_amount: f32, n
     return max(sin(frequency * dot(axis, p) + turbulence_amount * turbulence(p, n)), 0.0);
 }
 #endif
+
+#if PATTERN_MASSAL_MARBLE
+// Massal's marble given the turbulence at p: 0.5 sin((x + y) f + T) + 0.5
+// (marble.rs's massal_marble_stripes).
+fn massal_marble(p: vec3f, stripe_frequency: f32, turbulence_value: f32) -> f32 {
+    return 0.5 * sin((p.x + p.y) * stripe_frequency + turbulence_value) + 0.5;
+}
+#endif

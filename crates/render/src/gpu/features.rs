@@ -27,6 +27,7 @@ pub enum Feature {
     PatternCutout,
     PatternWood,
     PatternVeins,
+    PatternMassalMarble,
     PatternWaves,
     PatternRidged,
     PatternMix,
@@ -43,7 +44,7 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 32] = [
+    pub const ALL: [Feature; 33] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -63,6 +64,7 @@ impl Feature {
         Feature::PatternCutout,
         Feature::PatternWood,
         Feature::PatternVeins,
+        Feature::PatternMassalMarble,
         Feature::PatternWaves,
         Feature::PatternRidged,
         Feature::PatternMix,
@@ -89,6 +91,7 @@ impl Feature {
                 | Feature::PatternCutout
                 | Feature::PatternWood
                 | Feature::PatternVeins
+                | Feature::PatternMassalMarble
                 | Feature::PatternWaves
         )
     }
@@ -115,6 +118,7 @@ impl Feature {
             Feature::PatternCutout => "PATTERN_CUTOUT",
             Feature::PatternWood => "PATTERN_WOOD",
             Feature::PatternVeins => "PATTERN_VEINS",
+            Feature::PatternMassalMarble => "PATTERN_MASSAL_MARBLE",
             Feature::PatternWaves => "PATTERN_WAVES",
             Feature::PatternRidged => "PATTERN_RIDGED",
             Feature::PatternMix => "PATTERN_MIX",
@@ -309,6 +313,7 @@ fn pattern_features(p: &Pattern) -> Vec<Feature> {
         Pattern::Cutout { .. } => vec![Feature::PatternCutout],
         Pattern::Wood { .. } => vec![Feature::PatternWood],
         Pattern::Veins { .. } => vec![Feature::PatternVeins],
+        Pattern::MassalMarble { .. } => vec![Feature::PatternMassalMarble],
         Pattern::Waves { .. } => vec![Feature::PatternWaves],
         Pattern::Ridged { .. } => vec![Feature::PatternRidged],
         Pattern::Mix => vec![Feature::PatternMix],

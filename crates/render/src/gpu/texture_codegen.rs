@@ -534,6 +534,12 @@ impl Generator<'_> {
                 let q = self.param([frequency, turbulence_amount, 0.0, 0.0]);
                 format!("max(sin({q}.x * {p}.x + {q}.y * {signal}), 0.0)")
             }
+            Pattern::MassalMarble {
+                stripe_frequency, ..
+            } => {
+                let q = self.param([stripe_frequency, 0.0, 0.0, 0.0]);
+                format!("massal_marble({p}, {q}.x, {signal})")
+            }
         };
         let _ = writeln!(body, "    let t{k} = {t};");
         if !texture.ramp.is_empty() {

@@ -78,6 +78,51 @@ fn layers_mix_and_math_render_the_cpu_reference() {
     });
 }
 
+/// Massal's marble through the generated WGSL (his turbulence as the
+/// material's signal, in linear levels): its blend factor thresholded at
+/// 0.505 by math steps (t − 0.5, × 100, clamped to [0.2, 0.8]: the GPU's
+/// 1e-5 from the CPU cannot cross the 6e-3 wide band) so that each
+/// pixel away from a stripe's edge has one value, which must be the CPU
+/// reference's (`Material::value`).
+#[test]
+fn massal_marble_renders_the_cpu_reference() {
+    let Some(ctx) = gpu_or_skip("massal_marble_renders_the_cpu_reference") else {
+        return;
+    };
+    let mut diffuse = Texture::blend(
+        Pattern::MassalMarble {
+            noise: marbre_core::noise::NoiseSettings::massal(1.5),
+            stripe_frequency: 1.5,
+        },
+        0.0,
+        1.0,
+    );
+    diffuse.ops = vec![
+        MathOp::Bias(-0.5),
+        MathOp::Scale(100.0),
+        MathOp::Clamp { min: 0.2, max: 0.8 },
+    ];
+    let mut scene = textured_ground_in_white_light(diffuse);
+    scene.camera = OrbitCamera {
+        target: Vec3::new(0.5, 0.0, -0.3),
+        distance: 4.0,
+        yaw_degrees: 10.0,
+        pitch_degrees: 75.0,
+        fov_degrees: 50.0,
+    };
+    let material = scene.ground.as_ref().unwrap().material.clone();
+    let (w, h) = (96, 64);
+    let pixels = render(&ctx, &scene, (w, h), 4);
+    assert_ground_matches(&scene, &pixels, (w, h), 0.3, |p, uv| {
+        material.value(Property::Diffuse, p, uv)
+    });
+    // Both sides of the threshold are on screen: the stripes are drawn.
+    let values: Vec<f32> = pixels.iter().map(|p| p[0]).collect();
+    let lo = values.iter().copied().fold(f32::MAX, f32::min);
+    let hi = values.iter().copied().fold(f32::MIN, f32::max);
+    assert!(hi > 2.0 * lo, "one tone only: {lo}..{hi}");
+}
+
 /// A sphere that is black but emits E, with opacity α, in a constant
 /// environment L, looked at through its centre: the ray meets the front
 /// surface (emission E, then nothing: black) with probability α, else

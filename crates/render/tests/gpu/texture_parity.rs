@@ -9,6 +9,7 @@
 
 use glam::{Vec2, Vec3};
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, turbulence};
+use marbre_core::scene::Pattern;
 use marbre_core::texture::{self, RampStop};
 use marbre_render::gpu::harness::texture::{PatternQuery, evaluate};
 use marbre_render::gpu::testing::gpu_or_skip;
@@ -302,6 +303,26 @@ fn wood_and_marble_match_the_cpu() {
         },
         |_| false,
     );
+
+    // Massal's marble with his recipe, at the viewer's default frequency
+    // and at his own 0.05 over his pixel-sized scene.
+    for (frequency, extent) in [(Pattern::MASSAL_MARBLE_FREQUENCY, 2.0), (0.05, 320.0)] {
+        let noise = NoiseSettings::massal(frequency);
+        let query = PatternQuery::MassalMarble {
+            stripe_frequency: frequency,
+            noise,
+        };
+        let pts = points(extent);
+        let gpu = evaluate(&ctx, &query, &pts).unwrap();
+        assert_parity(
+            "Massal's marble",
+            &gpu,
+            &pts,
+            1e-4,
+            |p| [texture::massal_marble(p, frequency, &noise), 0.0, 0.0, 0.0],
+            |_| false,
+        );
+    }
 }
 
 #[test]

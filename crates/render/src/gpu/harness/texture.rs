@@ -67,6 +67,11 @@ pub enum PatternQuery {
         turbulence_amount: f32,
         noise: NoiseSettings,
     },
+    /// Massal's marble, his turbulence taken with `noise`.
+    MassalMarble {
+        stripe_frequency: f32,
+        noise: NoiseSettings,
+    },
     /// Result: (∂h/∂u, ∂h/∂v, the unit waves' height).
     WavesGradient {
         frequency: f32,
@@ -201,6 +206,14 @@ impl PatternQuery {
                 u.a = v3(*axis, *frequency);
                 u.b[0] = *turbulence_amount;
             }
+            PatternQuery::MassalMarble {
+                stripe_frequency,
+                noise,
+            } => {
+                u.mode = 18;
+                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.a[0] = *stripe_frequency;
+            }
             PatternQuery::WavesGradient {
                 frequency,
                 amplitude,
@@ -282,7 +295,9 @@ impl PatternQuery {
     /// noise features.
     fn noise(&self) -> NoiseSettings {
         match self {
-            PatternQuery::Wood { noise, .. } | PatternQuery::MarbleVeins { noise, .. } => *noise,
+            PatternQuery::Wood { noise, .. }
+            | PatternQuery::MarbleVeins { noise, .. }
+            | PatternQuery::MassalMarble { noise, .. } => *noise,
             _ => NoiseSettings::default(),
         }
     }

@@ -65,6 +65,9 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         case 7u: {
             r.x = marble_veins(p, a.xyz, a.w, b.x, harness.noise);
         }
+        case 18u: {
+            r.x = massal_marble(p, a.x, turbulence(p, harness.noise));
+        }
         case 8u: {
             r = vec4f(waves_gradient(p.xy, a.x, a.y, b.xy), waves(p.xy, a.x, b.xy), 0.0);
         }
