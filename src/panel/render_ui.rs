@@ -4,7 +4,7 @@
 use super::widgets::slider;
 use super::{PanelAction, Stats};
 use egui::{ComboBox, Ui};
-use marbre_core::scene::{RenderSettings, ToneMap};
+use marbre_core::scene::{Metering, RenderSettings, ToneMap};
 
 pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
     ui.add(slider(
@@ -17,9 +17,32 @@ pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut 
         .on_hover_text("Average frames while nothing changes; off shows each frame alone");
     ui.checkbox(&mut render.display.auto_exposure, "auto exposure")
         .on_hover_text(
-            "Meter the image every frame and expose its log-average luminance to middle grey \
-             (Reinhard's key, 0.18); off, the exposure slider alone sets it",
+            "Meter the image every frame and expose it by the metering below; off, the \
+             exposure slider alone sets it",
         );
+    ui.add_enabled_ui(render.display.auto_exposure, |ui| {
+        ComboBox::new("metering", "metering")
+            .selected_text(render.display.metering.label())
+            .show_ui(ui, |ui| {
+                for m in Metering::ALL {
+                    ui.selectable_value(&mut render.display.metering, m, m.label())
+                        .on_hover_text(match m {
+                            Metering::Key => {
+                                "The log-average luminance brought to middle grey \
+                                 (Reinhard's key, 0.18)"
+                            }
+                            Metering::MassalRms => {
+                                "Massal's: the RMS luminance over a 256 × 256 grid, scaled \
+                                 by −ln(0.6)/L_rms, so that his 1 − exp tone map shows it \
+                                 as 0.4"
+                            }
+                        });
+                }
+            })
+            .response
+            .on_hover_text("What auto exposure measures")
+            .on_disabled_hover_text("Used with auto exposure on");
+    });
     let (label, hint) = if render.display.auto_exposure {
         (
             "compensation",

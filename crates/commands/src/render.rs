@@ -1,8 +1,9 @@
 //! `marbre render`: the viewer's renderer, offscreen.
 
 use anyhow::{Context, Result, bail};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use marbre_core::image_io;
+use marbre_core::scene::Metering;
 use marbre_render::gpu::auto_exposure;
 use marbre_render::gpu::error_meter::ErrorEstimate;
 use marbre_render::gpu::{GpuContext, KernelChoice, Renderer};
@@ -36,15 +37,24 @@ pub struct RenderArgs {
     /// Output: .png (tone-mapped, sRGB) or .exr (linear radiance, float).
     #[arg(short = 'o', long)]
     pub output: PathBuf,
-    /// Expose the PNG automatically (log-average luminance to middle grey),
-    /// the preset's exposure becoming a compensation; as the viewer's
-    /// "auto exposure". EXR output stays unscaled radiance.
-    #[arg(long)]
-    pub auto_exposure: bool,
+    /// Expose the PNG automatically, the preset's exposure becoming a
+    /// compensation; as the viewer's "auto exposure": by Reinhard's key
+    /// (`key`, the default: log-average luminance to middle grey) or
+    /// Massal's RMS luminance (`massal`). EXR output stays unscaled
+    /// radiance.
+    #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "key", value_name = "METERING")]
+    pub auto_exposure: Option<MeteringArg>,
     /// The trace kernel: fragment, compute, or auto (the faster of the
     /// two on this scene, timed first).
     #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
     pub kernel: KernelChoice,
+}
+
+/// `--auto-exposure`'s metering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MeteringArg {
+    Key,
+    Massal,
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -81,8 +91,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--target-error must be a positive number, like 0.01 for 1 %");
     }
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
-    if args.auto_exposure {
-        loaded.scene.render.display.auto_exposure = true;
+    if let Some(metering) = args.auto_exposure {
+        let display = &mut loaded.scene.render.display;
+        display.auto_exposure = true;
+        display.metering = match metering {
+            MeteringArg::Key => Metering::Key,
+            MeteringArg::Massal => Metering::MassalRms,
+        };
     }
     let ctx = GpuContext::headless()?;
     let loaded = loaded.fit_environment(max_texture_side(&ctx));
@@ -184,23 +199,85 @@ fn report_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstimate
 }
 
 /// Prints the exposure the PNG gets: the GPU's metering (what the display
-/// pass applies) and the CPU twin's log-average over the whole image.
+/// pass applies) and the CPU twin's average over the whole image.
 fn report_auto_exposure(ctx: &GpuContext, renderer: &mut Renderer) -> Result<()> {
     let metered = renderer.metering(ctx)?;
     let (_, _, pixels) = renderer.read_radiance(ctx)?;
-    let compensation = renderer.scene().render.display.exposure;
+    let display = renderer.scene().render.display;
+    let compensation = display.exposure;
+    let (what, metered_value, whole) = match display.metering {
+        Metering::Key => (
+            "log-average",
+            metered.log_average,
+            auto_exposure::log_average_luminance(&pixels),
+        ),
+        Metering::MassalRms => (
+            "Massal's RMS",
+            metered.rms,
+            auto_exposure::rms_luminance(&pixels),
+        ),
+    };
     eprintln!(
-        "auto exposure: {:+.2} stops{} (log-average luminance {:.4} over {} metered texels; \
+        "auto exposure: {:+.2} stops{} ({what} luminance {:.4} over {} metered texels; \
          {:.4} over the whole image)",
-        metered.stops,
+        metered.stops_for(display.metering),
         if compensation == 0.0 {
             String::new()
         } else {
             format!(", {compensation:+.2} stops of compensation on top")
         },
-        metered.log_average,
+        metered_value,
         metered.count,
-        auto_exposure::log_average_luminance(&pixels),
+        whole,
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+
+    fn auto_exposure(flags: &[&str]) -> Option<MeteringArg> {
+        let base = ["render", "--preset", "p.ron", "-o", "x.png"];
+        Cli::try_parse_from(base.iter().chain(flags))
+            .unwrap()
+            .args
+            .auto_exposure
+    }
+
+    /// The bare flag meters by the key as it always did; a value picks
+    /// Massal's RMS; without the flag the preset decides.
+    #[test]
+    fn auto_exposure_takes_an_optional_metering() {
+        assert_eq!(auto_exposure(&[]), None);
+        assert_eq!(auto_exposure(&["--auto-exposure"]), Some(MeteringArg::Key));
+        assert_eq!(
+            auto_exposure(&["--auto-exposure", "--size", "8x8"]),
+            Some(MeteringArg::Key)
+        );
+        assert_eq!(
+            auto_exposure(&["--auto-exposure", "massal"]),
+            Some(MeteringArg::Massal)
+        );
+        assert_eq!(
+            auto_exposure(&["--auto-exposure=key"]),
+            Some(MeteringArg::Key)
+        );
+        let bad = Cli::try_parse_from([
+            "render",
+            "--preset",
+            "p",
+            "-o",
+            "x.png",
+            "--auto-exposure=rms",
+        ]);
+        assert!(bad.is_err());
+    }
 }

@@ -7,7 +7,7 @@ struct Display {
     exposure_scale: f32,
     tone_map: u32,          // 0 ACES, 1 Reinhard, 2 clamp, 3 1 - exp
     encode_srgb: u32,       // 1 when the target format does not encode
-    auto_exposure: u32,     // 1: also scale by `metered.scale`
+    auto_exposure: u32,     // 1: also scale by `metered.scale`, 2: by `metered.rms_scale`
     // Maps a target pixel to an accumulation texel: texel = (pixel - origin) * scale.
     origin: vec2f,
     scale: vec2f,
@@ -22,6 +22,10 @@ struct Metered {
     stops: f32,
     scale: f32,
     count: u32,
+    rms: f32,
+    rms_stops: f32,
+    rms_scale: f32,
+    padding: u32,
 }
 
 @group(0) @binding(0) var<uniform> display: Display;
@@ -69,7 +73,13 @@ fn fs_display(@builtin(position) position: vec4f) -> @location(0) vec4f {
     if display.show_non_finite != 0u && textureLoad(spread, texel, 0).a > 0.0 {
         return MAGENTA;
     }
-    let scale = display.exposure_scale * select(1.0, metered.scale, display.auto_exposure != 0u);
+    var metered_scale = 1.0;
+    if display.auto_exposure == 1u {
+        metered_scale = metered.scale;
+    } else if display.auto_exposure == 2u {
+        metered_scale = metered.rms_scale;
+    }
+    let scale = display.exposure_scale * metered_scale;
     let c = max(textureLoad(radiance, texel, 0).rgb * scale, vec3f(0.0));
     var mapped = tone_map(c);
     if display.encode_srgb != 0u {

@@ -14,8 +14,8 @@ use super::rng::Pcg32;
 use glam::{Vec2, Vec3};
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, Progression};
 use marbre_core::scene::{
-    Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Pattern, RenderSettings, Scene, Sphere,
-    Texture, ToneMap,
+    Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Metering, Pattern, RenderSettings,
+    Scene, Sphere, Texture, ToneMap,
 };
 
 /// The structural edits: each changes what the shader is built from.
@@ -320,12 +320,13 @@ fn edit_fractal(rng: &mut Pcg32, f: &mut FractalParams) {
 /// of their sliders (see the module's comment).
 fn edit_render_settings(rng: &mut Pcg32, render: &mut RenderSettings) {
     let stops = RenderSettings::MAX_EXPOSURE_STOPS;
-    match rng.below(6) {
+    match rng.below(7) {
         0 => render.display.exposure = rng.range(-stops, stops),
         1 => render.display.tone_map = ToneMap::ALL[rng.below(ToneMap::ALL.len())],
         2 => render.samples_per_frame = 1 + rng.below(4) as u32,
         3 => render.max_bounces = 1 + rng.below(6) as u32,
         4 => render.display.auto_exposure = !render.display.auto_exposure,
+        5 => render.display.metering = Metering::ALL[rng.below(Metering::ALL.len())],
         _ => render.interactive_scale = rng.range(0.1, 1.0),
     }
 }

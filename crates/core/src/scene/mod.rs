@@ -23,7 +23,7 @@ pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
-pub use render_settings::{DisplaySettings, RenderSettings, ToneMap};
+pub use render_settings::{DisplaySettings, Metering, RenderSettings, ToneMap};
 pub use texture_tree::{Child, MathOp, Texture};
 pub use transport::{Integrator, Strategy, TransportSettings};
 

@@ -36,6 +36,32 @@ impl ToneMap {
     }
 }
 
+/// How auto exposure meters the image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Metering {
+    /// Reinhard et al.'s key: the log-average luminance brought to middle
+    /// grey (0.18).
+    #[default]
+    Key,
+    /// Massal's tutorial (annex I): the RMS luminance L = √(0.2126·⟨r²⟩ +
+    /// 0.715160·⟨g²⟩ + 0.072169·⟨b²⟩) over a grid of at most 256 × 256
+    /// samples, scaled by −ln(0.6)/L, so that through his `1 − exp(−x)`
+    /// ([`ToneMap::Exponential`]) the RMS luminance shows as 0.4; below
+    /// L = 0.001 his default exposure (scale 1).
+    MassalRms,
+}
+
+impl Metering {
+    pub const ALL: [Metering; 2] = [Metering::Key, Metering::MassalRms];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Metering::Key => "key (Reinhard)",
+            Metering::MassalRms => "RMS (Massal)",
+        }
+    }
+}
+
 /// What is traced and how the result is shown. The display part is its
 /// own type: an edit there keeps the accumulated samples, and
 /// [`RenderSettings::traces_like`] compares the rest.
@@ -80,6 +106,8 @@ pub struct DisplaySettings {
     /// the GPU every frame (`gpu::auto_exposure`). Off, `exposure` alone
     /// sets it: the manual override.
     pub auto_exposure: bool,
+    /// What auto exposure meters: Reinhard's key, or Massal's RMS.
+    pub metering: Metering,
     pub tone_map: ToneMap,
     /// Debug view: pixels where a path gave a NaN or infinite sample (which
     /// the accumulation drops and counts) are painted magenta.
@@ -91,6 +119,7 @@ impl Default for DisplaySettings {
         Self {
             exposure: 0.0,
             auto_exposure: false,
+            metering: Metering::Key,
             tone_map: ToneMap::Aces,
             show_non_finite: false,
         }
@@ -116,6 +145,8 @@ struct RenderSettingsFile {
     env_importance: bool,
     transport: super::transport::TransportSettings,
     show_non_finite: bool,
+    /// `DisplaySettings::metering`; presets written before it read Key.
+    auto_exposure_metering: Metering,
 }
 
 impl From<RenderSettingsFile> for RenderSettings {
@@ -132,6 +163,7 @@ impl From<RenderSettingsFile> for RenderSettings {
             display: DisplaySettings {
                 exposure: f.exposure,
                 auto_exposure: f.auto_exposure,
+                metering: f.auto_exposure_metering,
                 tone_map: f.tone_map,
                 show_non_finite: f.show_non_finite,
             },
@@ -154,6 +186,7 @@ impl From<RenderSettings> for RenderSettingsFile {
             env_importance: r.env_importance,
             transport: r.transport,
             show_non_finite: r.display.show_non_finite,
+            auto_exposure_metering: r.display.metering,
         }
     }
 }
@@ -280,6 +313,16 @@ mod tests {
         let auto: RenderSettings = ron::from_str("(auto_exposure: true, exposure: -1.0)").unwrap();
         assert!(auto.display.auto_exposure);
         assert_eq!(auto.display.exposure, -1.0);
+        // Both meter by Reinhard's key, as they did before Massal's RMS.
+        assert_eq!(old.display.metering, Metering::Key);
+        assert_eq!(auto.display.metering, Metering::Key);
+        let massal: RenderSettings =
+            ron::from_str("(auto_exposure: true, auto_exposure_metering: MassalRms)").unwrap();
+        assert!(massal.display.auto_exposure);
+        assert_eq!(massal.display.metering, Metering::MassalRms);
+        let text = ron::to_string(&massal).unwrap();
+        assert!(text.contains("auto_exposure_metering:MassalRms"), "{text}");
+        assert_eq!(ron::from_str::<RenderSettings>(&text).unwrap(), massal);
     }
 
     /// The display settings live in their own type in memory, but a preset
@@ -311,6 +354,7 @@ mod tests {
         shown.display = DisplaySettings {
             exposure: 3.0,
             auto_exposure: true,
+            metering: Metering::MassalRms,
             tone_map: ToneMap::Clamp,
             show_non_finite: true,
         };

@@ -1,7 +1,11 @@
 //! Auto exposure by Reinhard et al. 2002's key ("Photographic tone
 //! reproduction for digital images"): the log-average luminance
 //! L_avg = exp(mean(log(δ + L))) of the image, and the exposure
-//! log2(key / L_avg) that brings it to middle grey.
+//! log2(key / L_avg) that brings it to middle grey. Beside it, Massal's
+//! (his tutorial's annex I): the RMS luminance L_rms = √(Σ w_c · mean(c²))
+//! and the scale −ln(0.6) / L_rms, which his `1 − exp(−x)` curve shows as
+//! 0.4. One pass meters both; the display picks one
+//! ([`marbre_core::scene::Metering`]).
 //!
 //! [`AutoExposure`] meters the accumulation target on the GPU
 //! (`crates/render/src/gpu/auto_exposure.wgsl`): one workgroup reads a grid of texels
@@ -17,6 +21,7 @@ use super::readback::read_buffer;
 use super::shader_source::Program;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
+use marbre_core::scene::Metering;
 use wgpu::util::DeviceExt;
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
@@ -29,6 +34,13 @@ pub const KEY: f32 = 0.18;
 pub const DELTA: f32 = 1e-4;
 /// The automatic exposure is clamped to ±this many stops.
 pub const MAX_STOPS: f32 = 20.0;
+/// Massal's luminance weights of the mean squares (his code's: Rec. 709's
+/// red, the precise green and blue).
+pub const MASSAL_WEIGHTS: [f32; 3] = [0.2126, 0.715_16, 0.072_169];
+/// Massal's target: exp(−scale · L_rms) = 0.6, so 1 − exp shows L_rms as 0.4.
+pub const MASSAL_TARGET: f32 = 0.6;
+/// Below this RMS luminance Massal keeps his default exposure (scale 1).
+pub const MASSAL_MIN_RMS: f32 = 0.001;
 
 /// What the metering pass writes (`Metered` in crates/render/src/gpu/auto_exposure.wgsl
 /// and crates/render/shaders/tonemap.wgsl).
@@ -43,17 +55,33 @@ pub struct Metered {
     pub scale: f32,
     /// Texels that counted: finite, none of their channels negative.
     pub count: u32,
+    /// Massal's RMS luminance √(Σ w_c · mean(c²)) over the same texels; 0
+    /// with none.
+    pub rms: f32,
+    /// Massal's exposure in stops, log2(−ln 0.6 / rms) clamped to
+    /// ±[`MAX_STOPS`]; 0 (his default, scale 1) at rms ≤ 0.001.
+    pub rms_stops: f32,
+    /// 2^rms_stops, the factor the display pass applies with his metering.
+    pub rms_scale: f32,
+    /// Keeps the struct a multiple of 16 bytes, as a uniform.
+    pub padding: u32,
 }
 
 impl Metered {
-    /// The exposure for a log-average luminance met over `count` texels.
-    pub fn from_log_average(log_average: f32, count: u32) -> Self {
+    /// The exposures for a log-average and an RMS luminance met over
+    /// `count` texels.
+    pub fn from_averages(log_average: f32, rms: f32, count: u32) -> Self {
         let stops = exposure_stops(log_average);
+        let rms_stops = massal_stops(rms);
         Self {
             log_average,
             stops,
             scale: stops.exp2(),
             count,
+            rms,
+            rms_stops,
+            rms_scale: rms_stops.exp2(),
+            padding: 0,
         }
     }
 
@@ -64,6 +92,18 @@ impl Metered {
             stops: 0.0,
             scale: 1.0,
             count: 0,
+            rms: 0.0,
+            rms_stops: 0.0,
+            rms_scale: 1.0,
+            padding: 0,
+        }
+    }
+
+    /// The metered exposure in stops the display applies with `metering`.
+    pub fn stops_for(&self, metering: Metering) -> f32 {
+        match metering {
+            Metering::Key => self.stops,
+            Metering::MassalRms => self.rms_stops,
         }
     }
 }
@@ -80,6 +120,27 @@ pub fn exposure_stops(log_average: f32) -> f32 {
     }
 }
 
+/// Massal's exposure in stops for an RMS luminance: log2(−ln(0.6) / L_rms)
+/// (his `exposure = logf(0.6f) / mediumLuminance`, negated as marbre
+/// scales by a positive factor), clamped to ±[`MAX_STOPS`]; at L_rms ≤
+/// 0.001 (or NaN) his default exposure −1, that is 0 stops.
+pub fn massal_stops(rms: f32) -> f32 {
+    if rms > MASSAL_MIN_RMS {
+        (-MASSAL_TARGET.ln() / rms)
+            .log2()
+            .clamp(-MAX_STOPS, MAX_STOPS)
+    } else {
+        0.0
+    }
+}
+
+/// Σ w_c · c² of a texel: its share of Massal's mean square.
+fn massal_square(p: &[f32; 4]) -> f64 {
+    (0..3)
+        .map(|c| f64::from(MASSAL_WEIGHTS[c]) * f64::from(p[c]) * f64::from(p[c]))
+        .sum()
+}
+
 /// Rec. 709 luminance of a texel if it counts: every channel finite and
 /// non-negative, and the luminance itself finite.
 fn metered_luminance(p: &[f32; 4]) -> Option<f32> {
@@ -93,18 +154,24 @@ fn metered_luminance(p: &[f32; 4]) -> Option<f32> {
 
 /// The CPU twin of the metering pass over every pixel given.
 pub fn meter(pixels: &[[f32; 4]]) -> Metered {
-    let (sum, count) = pixels
+    let (sum, squares, count) = pixels
         .iter()
-        .filter_map(metered_luminance)
-        .fold((0.0_f64, 0_u32), |(s, n), l| {
-            (s + f64::from((DELTA + l).ln()), n + 1)
+        .filter_map(|p| Some((metered_luminance(p)?, massal_square(p))))
+        .fold((0.0_f64, 0.0_f64, 0_u32), |(s, q, n), (l, square)| {
+            (s + f64::from((DELTA + l).ln()), q + square, n + 1)
         });
-    let mean = if count == 0 {
-        f64::from(DELTA.ln())
+    let (mean, mean_square) = if count == 0 {
+        (f64::from(DELTA.ln()), 0.0)
     } else {
-        sum / f64::from(count)
+        (sum / f64::from(count), squares / f64::from(count))
     };
-    Metered::from_log_average(mean.exp() as f32, count)
+    Metered::from_averages(mean.exp() as f32, mean_square.sqrt() as f32, count)
+}
+
+/// Massal's RMS luminance √(Σ w_c · mean(c²)) over the pixels, skipping
+/// those [`log_average_luminance`] skips; 0 with none left.
+pub fn rms_luminance(pixels: &[[f32; 4]]) -> f32 {
+    meter(pixels).rms
 }
 
 /// Reinhard's log-average luminance exp(mean(log(δ + L))) over the pixels
@@ -265,6 +332,82 @@ mod tests {
         assert!(log_average_luminance(&pixels) < 1.01);
     }
 
+    /// Massal's annex I transcribed: the mean of each channel's square
+    /// over his grid, `mediumLuminance = sqrtf(0.2126f * red + 0.715160f *
+    /// green + 0.072169f * blue)` and `exposure = logf(0.6f) /
+    /// mediumLuminance` (−1 below 0.001), in f64 on a known image; then
+    /// his curve `1 − exp(exposure · c)` of each pixel against marbre's
+    /// scale and `1 − exp(−x)`.
+    #[test]
+    fn massal_rms_exposure_is_his_formula() {
+        fn his_exposure(pixels: &[[f32; 4]]) -> f64 {
+            let weight = 1.0 / pixels.len() as f64;
+            let mut medium = [0.0_f64; 3];
+            for p in pixels {
+                for c in 0..3 {
+                    medium[c] += weight * f64::from(p[c]) * f64::from(p[c]);
+                }
+            }
+            let medium_luminance =
+                (0.2126 * medium[0] + 0.715160 * medium[1] + 0.072169 * medium[2]).sqrt();
+            if medium_luminance > 0.001 {
+                0.6_f64.ln() / medium_luminance
+            } else {
+                -1.0
+            }
+        }
+        // A 64 × 48 gradient with a bright corner: his RMS is pulled up by
+        // the corner (squares), unlike the log-average.
+        let pixels: Vec<[f32; 4]> = (0..64 * 48)
+            .map(|i| {
+                let (x, y) = ((i % 64) as f32 / 63.0, (i / 64) as f32 / 47.0);
+                let corner = if x > 0.9 && y > 0.9 { 20.0 } else { 0.0 };
+                [
+                    0.05 + 2.0 * x + corner,
+                    0.3 * y + corner,
+                    0.1 + 0.5 * x * y,
+                    1.0,
+                ]
+            })
+            .collect();
+        let m = meter(&pixels);
+        let e = his_exposure(&pixels);
+        assert!(e < 0.0, "{e}");
+        assert!(
+            rel(m.rms_scale, -e as f32) < 1e-5,
+            "scale {} vs −e {}",
+            m.rms_scale,
+            -e
+        );
+        for p in pixels.iter().step_by(37) {
+            for c in 0..3 {
+                let his = 1.0 - (e * f64::from(p[c])).exp();
+                let ours = 1.0 - (-(p[c] * m.rms_scale)).exp();
+                assert!(
+                    (f64::from(ours) - his).abs() < 1e-5,
+                    "{p:?}: {ours} vs {his}"
+                );
+            }
+        }
+        // The two meterings differ on this image.
+        assert!((m.rms_stops - m.stops).abs() > 0.5, "{m:?}");
+        // A grey image of luminance L: RMS L, and L shows as 0.4.
+        let grey_pixels = vec![grey(0.25); 10];
+        let g = meter(&grey_pixels);
+        let weights: f32 = MASSAL_WEIGHTS.iter().sum();
+        assert!(rel(g.rms, 0.25 * weights.sqrt()) < 1e-6, "{g:?}");
+        assert!(rel(1.0 - (-g.rms * g.rms_scale).exp(), 0.4) < 1e-5);
+        // Below 0.001 his default −1: scale 1; black likewise.
+        for l in [0.0, 5e-4] {
+            let m = meter(&[grey(l); 4]);
+            assert_eq!((m.rms_stops, m.rms_scale), (0.0, 1.0), "{l}: {m:?}");
+            assert_eq!(his_exposure(&[grey(l); 4]), -1.0);
+        }
+        assert_eq!(massal_stops(f32::NAN), 0.0);
+        assert_eq!(massal_stops(1e30), -MAX_STOPS);
+        assert_eq!(meter(&[]).rms, 0.0);
+    }
+
     #[test]
     fn non_finite_and_negative_pixels_are_skipped() {
         let clean = [grey(0.2), grey(0.8), [0.1, 0.3, 0.05, 1.0]];
@@ -282,6 +425,8 @@ mod tests {
         assert_eq!(b.count, 3);
         assert!(rel(a.log_average, b.log_average) < 1e-6, "{a:?} vs {b:?}");
         assert!(b.log_average.is_finite() && b.scale.is_finite());
+        assert!(rel(a.rms, b.rms) < 1e-6, "{a:?} vs {b:?}");
+        assert!(b.rms_scale.is_finite());
     }
 
     #[test]
@@ -328,6 +473,12 @@ mod tests {
             format!("const DELTA: f32 = {DELTA:e};"),
             format!("const KEY: f32 = {KEY};"),
             format!("const MAX_STOPS: f32 = {MAX_STOPS:.1};"),
+            format!(
+                "const MASSAL_WEIGHTS: vec3f = vec3f({}, {}, {});",
+                MASSAL_WEIGHTS[0], MASSAL_WEIGHTS[1], MASSAL_WEIGHTS[2]
+            ),
+            format!("const MASSAL_TARGET: f32 = {MASSAL_TARGET};"),
+            format!("const MASSAL_MIN_RMS: f32 = {MASSAL_MIN_RMS};"),
         ] {
             assert!(source.contains(&line), "shader lacks `{line}`");
         }

@@ -3,9 +3,10 @@
 
 use crate::common::*;
 use glam::Vec3;
-use marbre_core::scene::{PointLight, Scene, ToneMap};
+use marbre_core::scene::{Metering, PointLight, Scene, ToneMap};
 use marbre_render::gpu::auto_exposure::{
-    AutoExposure, DELTA, KEY, exposure_stops, log_average_luminance, meter,
+    AutoExposure, DELTA, KEY, exposure_stops, log_average_luminance, massal_stops, meter,
+    rms_luminance,
 };
 use marbre_render::gpu::metering_grid::grid_pixels;
 use marbre_render::gpu::testing::gpu_or_skip;
@@ -110,6 +111,18 @@ fn gpu_log_average_matches_the_cpu_twin() {
         // The grid stands for the whole image.
         let whole = log_average_luminance(&pixels);
         assert!((cpu - whole).abs() < 0.05 * whole, "{cpu} vs {whole}");
+        // Massal's RMS luminance and exposure from the same texels.
+        let rms = rms_luminance(&metered);
+        assert!(
+            (gpu.rms - rms).abs() < 1e-4 * rms,
+            "{size:?}: {gpu:?} vs {rms}"
+        );
+        assert!((gpu.rms_stops - massal_stops(rms)).abs() < 2e-4, "{gpu:?}");
+        assert!((gpu.rms_scale - gpu.rms_stops.exp2()).abs() < 1e-4 * gpu.rms_scale);
+        assert!(
+            (gpu.rms_stops - gpu.stops).abs() > 0.1,
+            "the two differ: {gpu:?}"
+        );
     }
 }
 
@@ -188,6 +201,19 @@ fn metering_skips_non_finite_and_negative_texels() {
     assert_eq!(cpu, meter(&expected));
     assert!(near(got.log_average, cpu.log_average), "{got:?} vs {cpu:?}");
     assert!((got.stops - cpu.stops).abs() < 1e-3, "{got:?} vs {cpu:?}");
+    // Massal's RMS over the same known texels: his sum of weighted squares.
+    let his_rms = (expected
+        .iter()
+        .map(|p| {
+            0.2126 * p[0] as f64 * p[0] as f64
+                + 0.715160 * p[1] as f64 * p[1] as f64
+                + 0.072169 * p[2] as f64 * p[2] as f64
+        })
+        .sum::<f64>()
+        / expected.len() as f64)
+        .sqrt() as f32;
+    assert!(near(got.rms, his_rms), "{got:?} vs {his_rms}");
+    assert!(near(got.rms_scale, -(0.6_f32.ln()) / his_rms), "{got:?}");
 
     // A region: the top-left 13×7 texels only.
     let region = (13, 7);
@@ -210,6 +236,8 @@ fn metering_skips_non_finite_and_negative_texels() {
         assert!(near(got.log_average, DELTA), "{got:?}");
         assert!((got.stops - black_stops).abs() < 1e-3, "{got:?}");
         assert!(got.scale.is_finite());
+        // Massal's default exposure below an RMS of 0.001: scale 1.
+        assert_eq!((got.rms, got.rms_stops, got.rms_scale), (0.0, 0.0, 1.0));
     }
 }
 
@@ -254,6 +282,59 @@ fn displayed_pixels_are_the_radiance_at_the_metered_exposure() {
             }
         }
     }
+}
+
+/// Massal's auto exposure with his curve is his whole display: each
+/// pixel shows 1 − exp(e · c) with e = ln(0.6) / L_rms, L_rms metered by
+/// the GPU and recomputed here from the radiance (sRGB encoded, within one
+/// 8-bit level); and switching the metering is display-only.
+#[test]
+fn massal_auto_exposure_shows_his_exposure_curve() {
+    let Some(ctx) = gpu_or_skip("massal_auto_exposure_shows_his_exposure_curve") else {
+        return;
+    };
+    let size = (40, 30);
+    let mut scene = spheres_in_constant_light(3.0);
+    scene.render.display.auto_exposure = true;
+    scene.render.display.metering = Metering::MassalRms;
+    scene.render.display.tone_map = ToneMap::Exponential;
+    let mut r = traced(&ctx, &scene, size, 2);
+    let shown = r.read_display(&ctx).unwrap();
+    let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
+    let weights = [0.2126_f64, 0.715160, 0.072169];
+    let mean_square: f64 = pixels
+        .iter()
+        .map(|p| {
+            (0..3)
+                .map(|c| weights[c] * f64::from(p[c]).powi(2))
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / pixels.len() as f64;
+    let e = 0.6_f64.ln() / mean_square.sqrt();
+    let encode = |c: f32| {
+        let c = (1.0 - (e * f64::from(c.max(0.0))).exp()) as f32;
+        let s = if c <= 0.003_130_8 {
+            c * 12.92
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        s * 255.0
+    };
+    for (p, q) in pixels.iter().zip(shown.pixels()) {
+        for c in 0..3 {
+            let expected = encode(p[c]);
+            assert!(
+                (f32::from(q[c]) - expected).abs() <= 1.0,
+                "radiance {p:?} shows {q:?}, expected {expected} (e = {e})"
+            );
+        }
+    }
+    scene.render.display.metering = Metering::Key;
+    r.set_scene(&ctx, &scene).unwrap();
+    assert_eq!(r.accumulated_samples(), 2);
+    let by_key = r.read_display(&ctx).unwrap();
+    assert!(max_difference(&shown, &by_key) > 10, "the metering shows");
 }
 
 /// Toggling auto exposure and moving the exposure are display-only: the

@@ -15,7 +15,7 @@ use crate::gpu::trace_bands::TraceBudget;
 use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
 use crate::gpu::{non_finite, scene_gpu, trace_bands};
 use anyhow::Result;
-use marbre_core::scene::ToneMap;
+use marbre_core::scene::{Metering, ToneMap};
 
 impl Renderer {
     /// Traces the rest of the first round and waits for it, if none is
@@ -310,7 +310,11 @@ impl Renderer {
                 ToneMap::Exponential => 3,
             },
             encode_srgb: u32::from(!format.is_srgb()),
-            auto_exposure: u32::from(auto_exposure),
+            auto_exposure: match (auto_exposure, self.scene.render.display.metering) {
+                (false, _) => 0,
+                (true, Metering::Key) => 1,
+                (true, Metering::MassalRms) => 2,
+            },
             origin: [viewport.x, viewport.y],
             scale: [
                 render_size.0 as f32 / viewport.width.max(1.0),

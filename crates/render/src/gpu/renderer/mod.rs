@@ -49,6 +49,8 @@ struct DisplayUniform {
     exposure_scale: f32,
     tone_map: u32,
     encode_srgb: u32,
+    /// 0: manual exposure; 1: times the key's metered scale; 2: times
+    /// Massal's RMS scale.
     auto_exposure: u32,
     origin: [f32; 2],
     scale: [f32; 2],
