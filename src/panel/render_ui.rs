@@ -1,12 +1,26 @@
-//! The Render section: samples, bounces, exposure and tone map, the
-//! anti-aliasing switches and the kernel.
+//! The Render section: the view, samples, bounces, exposure and tone map,
+//! the anti-aliasing switches and the kernel.
 
 use super::widgets::slider;
 use super::{PanelAction, Stats};
 use egui::{ComboBox, Ui};
-use marbre_core::scene::{Metering, RenderSettings, ToneMap};
+use marbre_core::scene::{Metering, RenderSettings, ToneMap, View};
 
 pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
+    ComboBox::new("view", "view")
+        .selected_text(render.view.label())
+        .show_ui(ui, |ui| {
+            for v in View::ALL {
+                ui.selectable_value(&mut render.view, v, v.label())
+                    .on_hover_text(view_hint(v));
+            }
+        })
+        .response
+        .on_hover_text(
+            "What each pixel records: the lit image, or the first surface the camera ray \
+             meets (the Monte Carlo lab's first exercises); views are shown as they are, \
+             without exposure or tone map",
+        );
     ui.add(slider(
         &mut render.samples_per_frame,
         1..=RenderSettings::MAX_SAMPLES_PER_FRAME,
@@ -96,6 +110,23 @@ pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut 
         .clicked()
     {
         actions.push(PanelAction::Screenshot);
+    }
+}
+
+/// What a view shows, for its tooltip.
+fn view_hint(view: View) -> &'static str {
+    match view {
+        View::Lit => "The radiance, lit as the Light transport section says",
+        View::HitMask => "White where the camera ray meets a surface, black where it escapes",
+        View::Primitive => {
+            "One flat colour per sphere, cylinder, polygon, the ground and each mesh triangle"
+        }
+        View::Normal => "The shading normal, facing the camera, as 0.5 + 0.5·n",
+        View::Albedo => "The diffuse reflectance of the first surface",
+        View::Depth => {
+            "t / (t + d): the distance t along the ray against the camera's distance d to its \
+             target (0.5 there, white where the ray escapes)"
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 use super::slider;
 use egui::{ComboBox, Ui};
 use marbre_core::lights::LightSelection;
-use marbre_core::scene::{Integrator, RenderSettings, Strategy, TransportSettings};
+use marbre_core::scene::{Integrator, LightPoints, RenderSettings, Strategy, TransportSettings};
 
 pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
     let t = &mut render.transport;
@@ -53,6 +53,20 @@ pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
             "How each light sample picks its light: every light (triangle, sphere, point) \
              equally, or in proportion to its power",
         );
+    ComboBox::new("light points", "light points")
+        .selected_text(t.light_points.label())
+        .show_ui(ui, |ui| {
+            for p in LightPoints::ALL {
+                ui.selectable_value(&mut t.light_points, p, p.label());
+            }
+        })
+        .response
+        .on_hover_text(
+            "Where each light sample lies on its light: a random point (correct), the \
+             centroid of each light (the lab's exercise 3: hard shadows), or the same \
+             points for every pixel (exercise 4: bands that never average away); the fixed \
+             points turn MIS into light sampling",
+        );
     ComboBox::new("strategy", "direct light")
         .selected_text(t.strategy.label())
         .show_ui(ui, |ui| {
@@ -63,7 +77,9 @@ pub fn transport_ui(ui: &mut Ui, render: &mut RenderSettings) {
         .response
         .on_hover_text(
             "Sample the lights, follow the BSDF, or both weighted by multiple importance \
-             sampling (balance or power heuristic); the environment map follows the same rule",
+             sampling (balance or power heuristic); or follow directions uniform over the \
+             hemisphere (the BSDF's diffuse lobe, pdf 1/2π: noisier); the environment map \
+             follows the same rule",
         );
     ui.checkbox(&mut render.env_importance, "sample the environment map")
         .on_hover_text(

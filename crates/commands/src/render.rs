@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use marbre_core::image_io;
-use marbre_core::scene::Metering;
+use marbre_core::scene::{LightPoints, Metering, Strategy, View};
 use marbre_render::gpu::auto_exposure;
 use marbre_render::gpu::error_meter::ErrorEstimate;
 use marbre_render::gpu::{GpuContext, KernelChoice, Renderer};
@@ -48,6 +48,42 @@ pub struct RenderArgs {
     /// two on this scene, timed first).
     #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
     pub kernel: KernelChoice,
+    /// What each sample records instead of the preset's view: lit (the
+    /// radiance), hit-mask, primitive, normal, albedo or depth. A view's
+    /// EXR holds its values as they are; its PNG shows them clamped to
+    /// [0, 1], unexposed, sRGB-encoded.
+    #[arg(long, value_parser = parse_view)]
+    pub view: Option<View>,
+    /// Where light samples lie on their light instead of the preset's
+    /// rule: random, centroid (one fixed point per light) or fixed-set (the
+    /// same light-samples points for every pixel).
+    #[arg(long, value_parser = parse_light_points)]
+    pub light_points: Option<LightPoints>,
+    /// The direct-light strategy instead of the preset's: light, bsdf,
+    /// mis-balance, mis-power or hemisphere (BSDF sampling with the
+    /// diffuse lobe uniform over the hemisphere).
+    #[arg(long, value_parser = parse_strategy)]
+    pub strategy: Option<Strategy>,
+}
+
+/// The value of `all` called `s` by `name`, or the list of names.
+fn parse_named<T: Copy>(s: &str, all: &[T], name: fn(T) -> &'static str) -> Result<T, String> {
+    all.iter().copied().find(|&v| name(v) == s).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
+        format!("`{s}` is not one of {}", names.join(", "))
+    })
+}
+
+fn parse_view(s: &str) -> Result<View, String> {
+    parse_named(s, &View::ALL, View::name)
+}
+
+fn parse_light_points(s: &str) -> Result<LightPoints, String> {
+    parse_named(s, &LightPoints::ALL, LightPoints::name)
+}
+
+fn parse_strategy(s: &str) -> Result<Strategy, String> {
+    parse_named(s, &Strategy::ALL, Strategy::name)
 }
 
 /// `--auto-exposure`'s metering.
@@ -99,6 +135,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             MeteringArg::Massal => Metering::MassalRms,
         };
     }
+    let render = &mut loaded.scene.render;
+    render.view = args.view.unwrap_or(render.view);
+    render.transport.light_points = args.light_points.unwrap_or(render.transport.light_points);
+    render.transport.strategy = args.strategy.unwrap_or(render.transport.strategy);
     let ctx = GpuContext::headless()?;
     let loaded = loaded.fit_environment(max_texture_side(&ctx));
     for note in &loaded.notes {
@@ -125,7 +165,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     bar.finish();
     // EXR output is the radiance, unscaled: only a PNG is exposed.
-    if loaded.scene.render.display.auto_exposure && matches!(format, image_io::ImageFormat::Png) {
+    if loaded.scene.render.shown_display().auto_exposure
+        && matches!(format, image_io::ImageFormat::Png)
+    {
         report_auto_exposure(&ctx, &mut renderer)?;
     }
     match format {

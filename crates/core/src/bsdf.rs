@@ -19,6 +19,9 @@ pub struct Surface {
     /// GGX α = roughness², kept above 1e-3 (see [`Surface::alpha_for`]).
     pub alpha: f32,
     pub mirror: f32,
+    /// Sample the diffuse lobe uniformly over the hemisphere (pdf 1 / 2π)
+    /// instead of by cosine (`Strategy::Hemisphere`); the value is the same.
+    pub uniform_diffuse: bool,
 }
 
 impl Surface {
@@ -57,6 +60,19 @@ pub fn specular_probability(s: &Surface) -> f32 {
     g / (d + g)
 }
 
+/// The density of the uniform hemisphere: 1 / 2π per steradian.
+pub const UNIFORM_HEMISPHERE_PDF: f32 = 0.5 * FRAC_1_PI;
+
+/// The diffuse lobe's sampling density at cos θi = `n_i` > 0: by cosine,
+/// or uniform over the hemisphere.
+pub fn diffuse_pdf(n_i: f32, uniform: bool) -> f32 {
+    if uniform {
+        UNIFORM_HEMISPHERE_PDF
+    } else {
+        n_i * FRAC_1_PI
+    }
+}
+
 /// `eval_bsdf`'s result.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfEval {
@@ -81,7 +97,8 @@ pub fn eval_bsdf(s: &Surface, n: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
     let d = ggx_d(n_h * n_h, n.cross(h).length_squared(), s.alpha);
     let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
     let ps = specular_probability(s);
-    let pdf = (1.0 - ps) * n_i * FRAC_1_PI + ps * d * n_h / (4.0 * wo.dot(h).max(1e-8));
+    let pdf = (1.0 - ps) * diffuse_pdf(n_i, s.uniform_diffuse)
+        + ps * d * n_h / (4.0 * wo.dot(h).max(1e-8));
     BsdfEval {
         f_cos: s.diffuse * FRAC_1_PI * n_i + spec,
         pdf,
@@ -127,8 +144,11 @@ pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
     // digits where cos θ is near 1 (a narrow lobe).
     let a2 = s.alpha * s.alpha;
     let ggx = (1.0 - u1) + a2 * u1;
+    // The uniform hemisphere's cos θ = 1 − u, sin²θ = u (2 − u).
     let (cos_t, sin_t) = if specular {
         (((1.0 - u1) / ggx).sqrt(), (a2 * u1 / ggx).sqrt())
+    } else if s.uniform_diffuse {
+        (1.0 - u1, (u1 * (2.0 - u1)).max(0.0).sqrt())
     } else {
         ((1.0 - u1).max(0.0).sqrt(), u1.sqrt())
     };
@@ -145,5 +165,123 @@ pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
         } else {
             (1.0 - s.mirror) * e.pdf
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lambert(albedo: f32, uniform_diffuse: bool) -> Surface {
+        Surface {
+            diffuse: Vec3::splat(albedo),
+            specular: Vec3::ZERO,
+            alpha: 1.0,
+            mirror: 0.0,
+            uniform_diffuse,
+        }
+    }
+
+    /// Stratified uniform numbers: an n × n grid of cells, jittered by a
+    /// fixed LCG, for (cos θ, φ); the lobe and mirror numbers at 0.5.
+    fn stratified(n: u32) -> impl Iterator<Item = [f32; 4]> {
+        let mut state = 12345u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1664525).wrapping_add(1013904223);
+            (state >> 8) as f32 / 16777216.0
+        };
+        (0..n * n).map(move |k| {
+            let (i, j) = (k % n, k / n);
+            [
+                0.5,
+                (i as f32 + next()) / n as f32,
+                (j as f32 + next()) / n as f32,
+                0.5,
+            ]
+        })
+    }
+
+    /// The uniform hemisphere's pdf is 1 / 2π over the whole hemisphere:
+    /// its integral (midpoint rule in cos θ and φ, where dω = d(cos θ) dφ)
+    /// is 1, and the cosine lobe's too.
+    #[test]
+    fn the_uniform_hemisphere_pdf_integrates_to_one() {
+        let n = Vec3::new(0.3, 0.9, 0.2).normalize();
+        let frame = basis(n);
+        let wo = n;
+        for uniform in [true, false] {
+            let s = lambert(0.5, uniform);
+            let steps = 200;
+            let mut total = 0.0f64;
+            for i in 0..steps {
+                let cos_t = (i as f32 + 0.5) / steps as f32;
+                let sin_t = (1.0 - cos_t * cos_t).sqrt();
+                for j in 0..steps {
+                    let phi = 2.0 * PI * (j as f32 + 0.5) / steps as f32;
+                    let wi = frame * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+                    let cell = (1.0 / steps as f64) * (2.0 * std::f64::consts::PI / steps as f64);
+                    total += f64::from(eval_bsdf(&s, n, wo, wi).pdf) * cell;
+                }
+            }
+            assert!(
+                (total - 1.0).abs() < 1e-4,
+                "uniform {uniform}: ∫ pdf = {total}"
+            );
+        }
+    }
+
+    /// Each uniform sample has pdf 1 / 2π, cos θ uniform in [0, 1] (mean
+    /// 1/2, not the cosine lobe's 2/3) and weight f cos / pdf = 2ρ cos θ.
+    #[test]
+    fn uniform_samples_have_the_hemisphere_density_and_weight() {
+        let n = Vec3::Y;
+        let s = lambert(0.6, true);
+        let mut mean_cos = 0.0f64;
+        let count = 64 * 64;
+        for u in stratified(64) {
+            let b = sample_bsdf(&s, n, n, u);
+            let cos_t = b.wi.dot(n);
+            assert!(b.valid && cos_t >= 0.0);
+            assert!(
+                (b.pdf - UNIFORM_HEMISPHERE_PDF).abs() < 1e-7,
+                "pdf {}",
+                b.pdf
+            );
+            assert!((b.weight.x - 1.2 * cos_t).abs() < 1e-5, "{b:?}");
+            mean_cos += f64::from(cos_t) / f64::from(count);
+        }
+        assert!((mean_cos - 0.5).abs() < 1e-3, "mean cos θ {mean_cos}");
+    }
+
+    /// The lab's Q4 in closed form: estimating a Lambert surface's
+    /// reflectance ∫ f cos dω = ρ under uniform light, cosine sampling's
+    /// weight is ρ exactly (no variance), the uniform hemisphere's 2ρ cos θ,
+    /// of mean ρ and variance ρ² (4 E[cos²θ] − 1) = ρ²/3.
+    #[test]
+    fn uniform_sampling_has_the_closed_form_variance_on_lambert() {
+        let rho = 0.6f64;
+        let n = Vec3::Y;
+        let moments = |uniform: bool| {
+            let s = lambert(rho as f32, uniform);
+            let weights: Vec<f64> = stratified(64)
+                .map(|u| f64::from(sample_bsdf(&s, n, n, u).weight.x))
+                .collect();
+            let mean = weights.iter().sum::<f64>() / weights.len() as f64;
+            let var =
+                weights.iter().map(|w| (w - mean).powi(2)).sum::<f64>() / weights.len() as f64;
+            (mean, var)
+        };
+        let (cos_mean, cos_var) = moments(false);
+        let (uni_mean, uni_var) = moments(true);
+        assert!(
+            (cos_mean - rho).abs() < 1e-5 && cos_var < 1e-10,
+            "{cos_mean} {cos_var}"
+        );
+        assert!((uni_mean - rho).abs() < 1e-3, "uniform mean {uni_mean}");
+        let expected = rho * rho / 3.0;
+        assert!(
+            (uni_var - expected).abs() < 0.01 * expected,
+            "variance {uni_var}, expected {expected}"
+        );
     }
 }

@@ -16,6 +16,9 @@ struct SurfacePoint {
     // The colour of the light that passes through (where opacity < 1).
     transmission: vec3f,
     emission: vec3f,
+    // Sample the diffuse lobe uniformly over the hemisphere (pdf 1 / 2π)
+    // instead of by cosine (Rust: Strategy::Hemisphere); same value.
+    uniform_diffuse: bool,
 }
 
 // GGX D(h) from cos²θh and sin²θh given apart. The textbook denominator
@@ -43,6 +46,13 @@ fn specular_probability(s: SurfacePoint) -> f32 {
     return g / (d + g);
 }
 
+const UNIFORM_HEMISPHERE_PDF: f32 = 0.15915494;
+
+// The diffuse lobe's sampling density at cos θi = n_i > 0.
+fn diffuse_pdf(n_i: f32, uniform: bool) -> f32 {
+    return select(n_i * INV_PI, UNIFORM_HEMISPHERE_PDF, uniform);
+}
+
 struct BsdfEval {
     f_cos: vec3f,    // f(wo, wi)·cos θi for the non-mirror part
     pdf: f32,        // the sampling pdf of wi (solid angle), lobe mixture
@@ -62,7 +72,7 @@ fn eval_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> BsdfEval {
     let d = ggx_d(n_h * n_h, dot(n_x_h, n_x_h), s.alpha);
     let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
     let ps = specular_probability(s);
-    let pdf = (1.0 - ps) * n_i * INV_PI + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
+    let pdf = (1.0 - ps) * diffuse_pdf(n_i, s.uniform_diffuse) + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
     return BsdfEval(s.diffuse * INV_PI * n_i + spec, pdf);
 }
 
@@ -110,8 +120,11 @@ fn sample_bsdf_with(s: SurfacePoint, n: vec3f, wo: vec3f, u: vec4f) -> BsdfSampl
     // digits where cos θ is near 1 (a narrow lobe).
     let a2 = s.alpha * s.alpha;
     let ggx = (1.0 - u1) + a2 * u1;
-    let cos_t = select(sqrt(max(0.0, 1.0 - u1)), sqrt((1.0 - u1) / ggx), specular);
-    let sin_t = select(sqrt(u1), sqrt(a2 * u1 / ggx), specular);
+    // The uniform hemisphere's cos θ = 1 − u, sin²θ = u (2 − u).
+    let cos_diffuse = select(sqrt(max(0.0, 1.0 - u1)), 1.0 - u1, s.uniform_diffuse);
+    let sin_diffuse = select(sqrt(u1), sqrt(max(0.0, u1 * (2.0 - u1))), s.uniform_diffuse);
+    let cos_t = select(cos_diffuse, sqrt((1.0 - u1) / ggx), specular);
+    let sin_t = select(sin_diffuse, sqrt(a2 * u1 / ggx), specular);
     let phi = TWO_PI * u2;
     let local = basis(n) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t);
     let wi = select(local, reflect(-wo, local), specular);

@@ -77,24 +77,45 @@ fn sphere_light_pdf(index: u32, x: vec3f, y: vec3f) -> f32 {
 }
 #endif
 
-fn sample_light(x: vec3f) -> LightSample {
+// Where light samples lie on their light (Rust: scene::LightPoints).
+const LIGHT_POINTS_CENTROID: u32 = 1u;
+const LIGHT_POINTS_FIXED_SET: u32 = 2u;
+// The fixed set's seed: any constant, the same for every pixel and frame.
+const FIXED_SET_SEED: u32 = 0x51ED270Bu;
+
+// The three numbers of light sample `k` of a shading point: the light's
+// choice, then two for the point on it. Always drawn from the pixel's
+// sequence, so every mode leaves the rest of the path's numbers as they
+// were; the fixed set then replaces them by numbers of k alone.
+fn light_numbers(k: u32) -> vec3f {
+    let u = vec3f(rand(), rand(), rand());
+    if frame.light_points == LIGHT_POINTS_FIXED_SET {
+        return vec3f(pcg3d(vec3u(k, FIXED_SET_SEED, 0u)) >> vec3u(8u)) * (1.0 / 16777216.0);
+    }
+    return u;
+}
+
+// Light sample `k` of the shading point `x`.
+fn sample_light(x: vec3f, k: u32) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
     out.delta = false;
+    let u = light_numbers(k);
 #if AREA_LIGHT
-    let index = choose_light(rand());
+    let index = choose_light(u.x);
     let pmf = light_pmf(index);
     let light = lights[index];
 #else
-    // The point light is the only light: no table to read. The choice's
-    // random number is still drawn, so the sequence matches a shader that
-    // reads the table.
-    _ = rand();
+    // The point light is the only light: no table to read.
     let pmf = 1.0;
     let light = Light(0u, 0u, 1.0, 1.0);
 #endif
-    let u1 = rand();
-    let u2 = rand();
+    // The centroid mode's fixed point: the middle of the sphere's cone (the
+    // point facing x) or the triangle's barycentre (1/3, 1/3, 1/3), which
+    // √u1 = 2/3, u2 = 1/2 give below.
+    let centroid = frame.light_points == LIGHT_POINTS_CENTROID;
+    let u1 = select(u.y, select(0.0, 4.0 / 9.0, light.kind == 2u), centroid);
+    let u2 = select(u.z, 0.5, centroid);
 #if POINT_LIGHT
     if light.kind == 0u {
         let to_light = frame.light_pos - x;

@@ -42,7 +42,7 @@ pub fn mis_heuristic(a: f32, b: f32, strategy: Strategy) -> f32 {
 pub fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32, strategy: Strategy) -> f32 {
     match strategy {
         Strategy::Light => 1.0,
-        Strategy::Bsdf => 0.0,
+        Strategy::Bsdf | Strategy::Hemisphere => 0.0,
         _ => mis_heuristic(light_pdf, bsdf_pdf, strategy),
     }
 }
@@ -51,7 +51,7 @@ pub fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32, strategy: Strategy) ->
 /// which light sampling finds with density `light_pdf` (0 where it cannot:
 /// such light is always BSDF sampling's alone).
 pub fn bsdf_sample_weight(bsdf_pdf: f32, light_pdf: f32, strategy: Strategy) -> f32 {
-    if light_pdf <= 0.0 || strategy == Strategy::Bsdf {
+    if light_pdf <= 0.0 || strategy.directions_only() {
         return 1.0;
     }
     if strategy == Strategy::Light {

@@ -7,6 +7,15 @@
 const STRATEGY_LIGHT: u32 = 0u;
 const STRATEGY_BSDF: u32 = 1u;
 const STRATEGY_MIS_BALANCE: u32 = 2u;
+// BSDF sampling alone, its diffuse lobe uniform over the hemisphere
+// (bsdf.wgsl's uniform_diffuse).
+const STRATEGY_HEMISPHERE: u32 = 4u;
+
+// Whether direction sampling alone finds the light (Rust:
+// Strategy::directions_only).
+fn directions_only(strategy: u32) -> bool {
+    return strategy == STRATEGY_BSDF || strategy == STRATEGY_HEMISPHERE;
+}
 
 // The weight of a sample drawn with density `a` against the other
 // strategy's density `b` for the same direction, under the chosen
@@ -40,7 +49,7 @@ fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
     if frame.strategy == STRATEGY_LIGHT {
         return 1.0;
     }
-    if frame.strategy == STRATEGY_BSDF {
+    if directions_only(frame.strategy) {
         return 0.0;
     }
     return mis_heuristic(light_pdf, bsdf_pdf);
@@ -50,7 +59,7 @@ fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
 // light sampling finds with density `light_pdf` (0 where it cannot: such
 // light is always BSDF sampling's alone).
 fn bsdf_sample_weight(bsdf_pdf: f32, light_pdf: f32) -> f32 {
-    if light_pdf <= 0.0 || frame.strategy == STRATEGY_BSDF {
+    if light_pdf <= 0.0 || directions_only(frame.strategy) {
         return 1.0;
     }
     if frame.strategy == STRATEGY_LIGHT {

@@ -55,6 +55,13 @@ struct Frame {
     // (gpu/trace_rounds.rs).
     band_start: u32,
     band_end: u32,
+    // What each sample records (view.wgsl; Rust: scene::View).
+    view: u32,
+    // Where light samples lie on their light (lights.wgsl; Rust:
+    // scene::LightPoints).
+    light_points: u32,
+    // The depth view's d in t / (t + d): the camera's distance to its target.
+    depth_scale: f32,
 }
 
 const MAX_SIGNALS: u32 = 4u;

@@ -22,6 +22,7 @@ fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
     s.opacity = clamp(textures.opacity, 0.0, 1.0);
     s.transmission = clamp(textures.transmission, vec3f(0.0), vec3f(1.0));
     s.emission = max(textures.emission, vec3f(0.0));
+    s.uniform_diffuse = frame.strategy == STRATEGY_HEMISPHERE;
 #if BUMP
     s.n = bumped_shading_normal(hit, fp, signals, -d);
 #else

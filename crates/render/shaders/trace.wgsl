@@ -47,7 +47,7 @@ fn direct_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let origin = offset_ray(hit.p, hit.n);
     var sum = vec3f(0.0);
     for (var k = 0u; k < count; k++) {
-        let light = sample_light(hit.p);
+        let light = sample_light(hit.p, k);
         if light.pdf > 0.0 && dot(light.wi, hit.n) > 0.0 {
             let e = eval_bsdf(s, s.n, wo, light.wi);
             var weight = 1.0;
@@ -166,11 +166,19 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // Where the path last scattered: light sampling's density for the
     // emitter a bounce reaches is measured from there.
     var scatter_point = frame.cam_pos;
+    if frame.view != VIEW_LIT && hit.t >= NO_HIT {
+        return view_escaped();
+    }
     if hit.t < NO_HIT && frame.max_bounces > 0u {
         loop {
             let width = cone_width + frame.pixel_spread * hit.t;
             cone_width = width;
             let s = surface_at(hit, width, d);
+            // A view records the camera ray's first hit (the loop's first
+            // pass), whatever its opacity, and ends the path there.
+            if frame.view != VIEW_LIT {
+                return view_at_hit(hit, s);
+            }
             let wo = -d;
 #if OPACITY
             // Draws only where the surface has holes, so an opaque scene
@@ -211,7 +219,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
                 }
 #endif
 #if ENV_SAMPLING
-                if frame.env_sampling != 0u && frame.strategy != STRATEGY_BSDF {
+                if frame.env_sampling != 0u && !directions_only(frame.strategy) {
                     radiance += throughput * env_light(hit, s, wo);
                 }
 #endif
@@ -273,7 +281,7 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
         var l = trace_path(vec2f(pixel) + jitter);
         // The optional firefly clamp (biased; off by default).
         let brightest = max(l.x, max(l.y, l.z));
-        if frame.sample_clamp > 0.0 && brightest > frame.sample_clamp {
+        if frame.sample_clamp > 0.0 && brightest > frame.sample_clamp && frame.view == VIEW_LIT {
             l *= frame.sample_clamp / brightest;
         }
         // A non-finite sample never reaches the accumulation target: it is

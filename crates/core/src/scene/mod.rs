@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod pattern;
 pub mod primitives;
 pub mod render_settings;
+pub mod render_view;
 pub mod texture_tree;
 pub mod transport;
 
@@ -24,8 +25,9 @@ pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
 pub use render_settings::{DisplaySettings, Metering, RenderSettings, ToneMap};
+pub use render_view::View;
 pub use texture_tree::{Child, MathOp, Texture};
-pub use transport::{Integrator, Strategy, TransportSettings};
+pub use transport::{Integrator, LightPoints, Strategy, TransportSettings};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};

@@ -90,6 +90,9 @@ pub struct RenderSettings {
     /// finds it.
     pub env_importance: bool,
     pub transport: super::transport::TransportSettings,
+    /// What each sample records: the lit image or a view of the first
+    /// hit (hit mask, primitive, normal, albedo, depth).
+    pub view: super::render_view::View,
     /// How the accumulated radiance is shown.
     pub display: DisplaySettings,
 }
@@ -147,6 +150,7 @@ struct RenderSettingsFile {
     show_non_finite: bool,
     /// `DisplaySettings::metering`; presets written before it read Key.
     auto_exposure_metering: Metering,
+    view: super::render_view::View,
 }
 
 impl From<RenderSettingsFile> for RenderSettings {
@@ -160,6 +164,7 @@ impl From<RenderSettingsFile> for RenderSettings {
             clamp_octaves: f.clamp_octaves,
             env_importance: f.env_importance,
             transport: f.transport,
+            view: f.view,
             display: DisplaySettings {
                 exposure: f.exposure,
                 auto_exposure: f.auto_exposure,
@@ -187,6 +192,7 @@ impl From<RenderSettings> for RenderSettingsFile {
             transport: r.transport,
             show_non_finite: r.display.show_non_finite,
             auto_exposure_metering: r.display.metering,
+            view: r.view,
         }
     }
 }
@@ -216,6 +222,7 @@ impl RenderSettings {
             clamp_octaves,
             env_importance,
             transport,
+            view,
             display: _,
         } = *self;
         (
@@ -227,6 +234,7 @@ impl RenderSettings {
             clamp_octaves,
             env_importance,
             transport,
+            view,
         ) == (
             other.samples_per_frame,
             other.accumulate,
@@ -236,7 +244,26 @@ impl RenderSettings {
             other.clamp_octaves,
             other.env_importance,
             other.transport,
+            other.view,
         )
+    }
+
+    /// The display settings the display pass applies: the preset's for the
+    /// lit image; a view's values shown as they are (no exposure, clamped
+    /// to [0, 1], the sRGB encoding of a PNG aside), so a hit mask is
+    /// white and black on screen as in its EXR.
+    pub fn shown_display(&self) -> DisplaySettings {
+        if self.view.is_data() {
+            DisplaySettings {
+                exposure: 0.0,
+                auto_exposure: false,
+                tone_map: ToneMap::Clamp,
+                show_non_finite: self.display.show_non_finite,
+                metering: self.display.metering,
+            }
+        } else {
+            self.display
+        }
     }
 
     pub(crate) fn sanitize(&mut self, notes: &mut Vec<String>) {
@@ -295,6 +322,7 @@ impl Default for RenderSettings {
             clamp_octaves: true,
             env_importance: true,
             transport: Default::default(),
+            view: Default::default(),
             display: DisplaySettings::default(),
         }
     }
@@ -302,6 +330,7 @@ impl Default for RenderSettings {
 
 #[cfg(test)]
 mod tests {
+    use super::super::View;
     use super::*;
 
     #[test]
@@ -365,6 +394,29 @@ mod tests {
         let mut traced = base;
         traced.transport.light_samples += 1;
         assert!(!base.traces_like(&traced));
+        let mut traced = base;
+        traced.view = View::Depth;
+        assert!(!base.traces_like(&traced));
+        let mut traced = base;
+        traced.transport.light_points = super::super::LightPoints::FixedSet;
+        assert!(!base.traces_like(&traced));
+    }
+
+    #[test]
+    fn views_read_lit_from_old_presets_and_show_unexposed() {
+        let old: RenderSettings = ron::from_str("(exposure: 1.5)").unwrap();
+        assert_eq!(old.view, View::Lit);
+        assert_eq!(old.shown_display(), old.display);
+        let mask: RenderSettings =
+            ron::from_str("(exposure: 1.5, auto_exposure: true, view: HitMask)").unwrap();
+        assert_eq!(mask.view, View::HitMask);
+        let shown = mask.shown_display();
+        assert_eq!((shown.exposure, shown.auto_exposure), (0.0, false));
+        assert_eq!(shown.tone_map, ToneMap::Clamp);
+        assert_eq!(
+            ron::from_str::<RenderSettings>(&ron::to_string(&mask).unwrap()).unwrap(),
+            mask
+        );
     }
 
     #[test]

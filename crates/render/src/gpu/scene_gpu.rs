@@ -62,7 +62,13 @@ pub struct FrameUniform {
     /// kernel reads them; the fragment kernel's scissor matches).
     pub band_start: u32,
     pub band_end: u32,
-    pub _pad: [u32; 3],
+    /// `scene::View::id`: what each sample records.
+    pub view: u32,
+    /// `scene::LightPoints::id`: where light samples lie on their light.
+    pub light_points: u32,
+    /// The depth view's d in t / (t + d): the camera's distance to its
+    /// target.
+    pub depth_scale: f32,
 }
 
 /// `NoiseParams` of `crates/core/src/noise/fractal.wgsl`.
@@ -344,14 +350,16 @@ pub fn frame_uniform(
         },
         light_total_power: 0.0,
         light_samples: scene.render.transport.light_samples.max(1),
-        strategy: scene.render.transport.strategy.id(),
+        strategy: scene.render.transport.effective_strategy().id(),
         russian_roulette_from: scene.render.transport.russian_roulette_from,
         triangle_count: 0,
         opaque_one: 1.0,
         sample_clamp: scene.render.transport.sample_clamp.unwrap_or(0.0),
         band_start: 0,
         band_end: render_size.1.max(1),
-        _pad: [0; 3],
+        view: scene.render.view.id(),
+        light_points: scene.render.transport.light_points.id(),
+        depth_scale: scene.camera.distance.max(f32::MIN_POSITIVE),
     }
 }
 

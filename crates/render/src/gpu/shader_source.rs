@@ -21,6 +21,7 @@ mod renderer_files {
     pub const SURFACE: WgslFile = wgsl_file!("crates/render/shaders/surface.wgsl");
     pub const ENV_LOOKUP: WgslFile = wgsl_file!("crates/render/shaders/env_lookup.wgsl");
     pub const BUMP: WgslFile = wgsl_file!("crates/render/shaders/bump.wgsl");
+    pub const VIEW: WgslFile = wgsl_file!("crates/render/shaders/view.wgsl");
     pub const TRACE: WgslFile = wgsl_file!("crates/render/shaders/trace.wgsl");
     pub const TONEMAP: WgslFile = wgsl_file!("crates/render/shaders/tonemap.wgsl");
 }
@@ -48,6 +49,7 @@ const SOURCES: &[WgslFile] = &[
     bsdf::WGSL,
     r::SURFACE,
     r::ENV_LOOKUP,
+    r::VIEW,
     r::TRACE,
     super::accumulation::WGSL,
     harness::accumulation::WGSL,
@@ -160,7 +162,7 @@ impl Program {
                 if features.contains(Feature::EnvSampling) {
                     out.push(env_sampling::WGSL);
                 }
-                out.extend([r::FULLSCREEN, super::accumulation::WGSL, r::TRACE]);
+                out.extend([r::FULLSCREEN, super::accumulation::WGSL, r::VIEW, r::TRACE]);
                 if features.contains(Feature::Bump) {
                     out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP]);
                 }

@@ -421,6 +421,7 @@ fn bsdf_case(diffuse: f32, specular: f32, roughness: f32, incidence_degrees: f64
                 specular: Vec3::splat(specular),
                 alpha: Surface::alpha_for(roughness),
                 mirror: 0.0,
+                uniform_diffuse: false,
             },
             n: n.as_vec3(),
             wo: wo.as_vec3(),
@@ -430,7 +431,8 @@ fn bsdf_case(diffuse: f32, specular: f32, roughness: f32, incidence_degrees: f64
 
 /// GGX alone at three roughnesses (0.05: a lobe a few mrad wide; 1: the
 /// widest) and three incidences (normal, 45°, 89°: near grazing), the
-/// lobe mixture, and the cosine lobe alone.
+/// lobe mixture, and the cosine lobe alone; the last two again with the
+/// diffuse lobe uniform over the hemisphere.
 fn bsdf_cases() -> Vec<BsdfCase> {
     let mut cases = Vec::new();
     for roughness in [0.05, 0.3, 1.0] {
@@ -440,6 +442,16 @@ fn bsdf_cases() -> Vec<BsdfCase> {
     }
     cases.push(bsdf_case(0.5, 0.4, 0.3, 60.0));
     cases.push(bsdf_case(0.8, 0.0, 0.5, 30.0));
+    // The diffuse lobe uniform over the hemisphere (Strategy::Hemisphere),
+    // alone and in the mixture.
+    for mut case in [
+        bsdf_case(0.8, 0.0, 0.5, 30.0),
+        bsdf_case(0.5, 0.4, 0.3, 60.0),
+    ] {
+        case.setup.surface.uniform_diffuse = true;
+        case.name += ", uniform hemisphere";
+        cases.push(case);
+    }
     cases
 }
 
@@ -523,6 +535,23 @@ fn bsdf_chi2_rejects_the_pdf_of_another_roughness() {
             &result,
         );
     }
+}
+
+/// Negative control: uniform hemisphere samples of a Lambert surface
+/// against the cosine lobe's pdf.
+#[test]
+fn bsdf_chi2_rejects_the_cosine_pdf_for_uniform_samples() {
+    let case = bsdf_case(0.8, 0.0, 0.5, 30.0);
+    let mut uniform = case.setup;
+    uniform.surface.uniform_diffuse = true;
+    let domain = bsdf_domain(&case.setup);
+    let grid = Grid {
+        domain: &domain,
+        res: BSDF_RES,
+    };
+    let pdf = cpu_bsdf_pdfs(&case.setup, &grid.nodes());
+    let result = chi2(&grid, &cpu_bsdf_samples(&uniform), &pdf);
+    assert_rejected("uniform sampled, cosine claimed", &result);
 }
 
 fn gpu_bsdf_chi2(ctx: &GpuContext, harness: &SamplingHarness, case: &BsdfCase) -> Chi2 {

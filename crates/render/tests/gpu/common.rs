@@ -258,3 +258,25 @@ pub fn presets_in(folder: &str) -> Vec<std::path::PathBuf> {
     out.sort();
     out
 }
+
+/// A mesh scene from triangles made in the test (no OBJ file), one
+/// material; counter-clockwise faces are the front (and emit).
+pub fn mesh_of(triangles: Vec<[Vec3; 3]>, material: Material) -> marbre_core::scene::Mesh {
+    let count = triangles.len();
+    marbre_core::scene::Mesh {
+        name: "test mesh".into(),
+        materials: vec![marbre_core::scene::MeshMaterial {
+            name: "only".into(),
+            material,
+            from_file: None,
+        }],
+        geometry: marbre_core::scene::mesh::Geometry(std::sync::Arc::new(
+            marbre_core::scene::TriangleMesh {
+                positions: triangles,
+                uvs: vec![[glam::Vec2::ZERO; 3]; count],
+                materials: vec![0; count],
+            },
+        )),
+        ..Default::default()
+    }
+}

@@ -437,6 +437,7 @@ fn bsdf_setups() -> Vec<BsdfSetup> {
                         specular: Vec3::splat(specular),
                         alpha: Surface::alpha_for(roughness),
                         mirror,
+                        uniform_diffuse: false,
                     },
                     n,
                     wo,
@@ -570,6 +571,7 @@ fn bsdf_setup() -> impl Strategy<Value = BsdfSetup> {
                     specular: Vec3::splat(specular),
                     alpha: Surface::alpha_for(roughness),
                     mirror,
+                    uniform_diffuse: false,
                 },
                 n,
                 wo,
@@ -660,7 +662,7 @@ proptest! {
     ) {
         let alpha = Surface::alpha_for(roughness);
         let setup = BsdfSetup {
-            surface: Surface { diffuse: Vec3::ZERO, specular: Vec3::ONE, alpha, mirror: 0.0 },
+            surface: Surface { diffuse: Vec3::ZERO, specular: Vec3::ONE, alpha, mirror: 0.0, uniform_diffuse: false },
             n,
             wo: n,
         };

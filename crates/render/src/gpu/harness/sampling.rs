@@ -40,7 +40,8 @@ struct SamplingFrame {
     diffuse: [f32; 3],
     mirror: f32,
     specular: [f32; 3],
-    _pad0: f32,
+    /// 1: the surface samples its diffuse lobe uniformly.
+    uniform_diffuse: u32,
     normal: [f32; 3],
     _pad1: f32,
     wo: [f32; 3],
@@ -168,6 +169,7 @@ impl SamplingHarness {
             diffuse: s.diffuse.into(),
             mirror: s.mirror,
             specular: s.specular.into(),
+            uniform_diffuse: u32::from(s.uniform_diffuse),
             normal: setup.n.into(),
             wo: setup.wo.into(),
             ..Default::default()

@@ -18,6 +18,7 @@ struct SamplingFrame {
     diffuse: vec3f,
     mirror: f32,
     specular: vec3f,
+    uniform_diffuse: u32,
     normal: vec3f,
     wo: vec3f,
 }
@@ -44,6 +45,7 @@ fn harness_surface() -> SurfacePoint {
     s.opacity = 1.0;
     s.transmission = vec3f(0.0);
     s.emission = vec3f(0.0);
+    s.uniform_diffuse = frame.uniform_diffuse != 0u;
     return s;
 }
 

@@ -296,14 +296,16 @@ impl Renderer {
             )?;
             self.display_pipelines.insert(format, p);
         }
-        let auto_exposure = self.scene.render.display.auto_exposure;
+        // A view's values are shown as they are (RenderSettings::shown_display).
+        let shown = self.scene.render.shown_display();
+        let auto_exposure = shown.auto_exposure;
         if auto_exposure {
             self.meter(ctx, encoder, timer);
         }
         let render_size = self.shown_size();
         let uniform = DisplayUniform {
-            exposure_scale: self.scene.render.display.exposure.exp2(),
-            tone_map: match self.scene.render.display.tone_map {
+            exposure_scale: shown.exposure.exp2(),
+            tone_map: match shown.tone_map {
                 ToneMap::Aces => 0,
                 ToneMap::Reinhard => 1,
                 ToneMap::Clamp => 2,
@@ -320,7 +322,7 @@ impl Renderer {
                 render_size.0 as f32 / viewport.width.max(1.0),
                 render_size.1 as f32 / viewport.height.max(1.0),
             ],
-            show_non_finite: u32::from(self.scene.render.display.show_non_finite),
+            show_non_finite: u32::from(shown.show_non_finite),
             padding: 0,
         };
         ctx.queue
