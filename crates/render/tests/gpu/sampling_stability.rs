@@ -320,9 +320,9 @@ fn expected_heuristic(a: f32, b: f32, strategy: MisStrategy) -> f64 {
 
 /// Weights are finite and in [0, 1]; the heuristic matches f64 within
 /// `tolerance`; and the weights of the strategies that can draw a
-/// direction (density > 0) sum to 1 wherever one can (Bsdf alone
-/// ignores light sampling's share by design, so there only where the
-/// BSDF can).
+/// direction (density > 0) sum to 1 wherever one can (Bsdf and
+/// Hemisphere, direction sampling alone, ignore light sampling's share by
+/// design, so there only where the BSDF can).
 fn check_weights(
     a: f32,
     b: f32,
@@ -354,7 +354,7 @@ fn check_weights(
             }
         }
     }
-    let can_light = a > 0.0 && strategy != MisStrategy::Bsdf;
+    let can_light = a > 0.0 && !strategy.directions_only();
     if can_light || b > 0.0 {
         let sum = if a > 0.0 { f64::from(light) } else { 0.0 }
             + if b > 0.0 { f64::from(bsdf) } else { 0.0 };
