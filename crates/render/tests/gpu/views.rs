@@ -221,7 +221,7 @@ fn views_are_displayed_unexposed() {
         exposure: 3.0,
         auto_exposure: false,
         tone_map: ToneMap::Aces,
-        show_non_finite: false,
+        ..DisplaySettings::default()
     };
     let mut r = Renderer::new(&ctx, &scene, None, size).unwrap();
     accumulate(&ctx, &mut r, 4, |_| {}).unwrap();
