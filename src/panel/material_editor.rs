@@ -1,12 +1,14 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
+use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_core::scene::{
     Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
+    UvFrame,
 };
 use marbre_core::texture::{
     ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop,
@@ -72,6 +74,10 @@ fn property_ui_info(property: Property) -> (ValueKind, &'static str) {
             "Colour of the light passing through where opacity < 1: tints the view through and the shadow"
         }
         Property::Emission => "Light the surface gives off (times the strength below)",
+        Property::DiffuseTransmission => {
+            "Diffuse transmission (N3D's TD): light reaching the other side leaves this side \
+             scattered evenly, times this colour (a lampshade, paper); keep diffuse + this ≤ 1"
+        }
     };
     (kind, hint)
 }
@@ -294,6 +300,19 @@ fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
         ui.selectable_value(&mut m.space, MappingSpace::World, "world")
             .on_hover_text("Objects move through the 3D pattern");
     });
+    uv_frame_ui(
+        ui,
+        &mut m.frame,
+        "3D frame",
+        "The report's ATX3D: 3D patterns read the point's coordinates along an origin and \
+         axes u, v (the third axis is their cross product, of length √(|u|·|v|)), before \
+         the transform below",
+        UvFrame {
+            origin: Vec3::ZERO,
+            u_axis: Vec3::X,
+            v_axis: Vec3::Y,
+        },
+    );
     let t = &mut m.transform;
     vec3_ui(
         ui,

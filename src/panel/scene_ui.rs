@@ -3,9 +3,9 @@
 
 use super::PanelAction;
 use super::material_editor::material_ui;
-use super::widgets::{labelled_color, slider, vec3_ui};
+use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_ui};
 use egui::{CollapsingHeader, Ui};
-use marbre_core::scene::{OrbitCamera, PointLight, Scene};
+use marbre_core::scene::{Ground, OrbitCamera, PointLight, Scene};
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
 /// the ground. Only the first is open at start, so a scene with many
@@ -63,6 +63,15 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
     }
     if let Some(ground) = &mut scene.ground {
         object(ui, ("ground", 0), "ground".into(), &mut |ui| {
+            let default = Ground::default().frame();
+            uv_frame_ui(
+                ui,
+                &mut ground.uv_frame,
+                "uv frame",
+                "The report's APTX: 2D textures read (u, v) along an origin and two axes \
+                 (oblique ones too) instead of world (x, z)",
+                default,
+            );
             material_ui(ui, &mut ground.material)
         });
     }

@@ -4,6 +4,7 @@
 use egui::emath::Numeric;
 use egui::{CollapsingHeader, DragValue, Response, Slider, SliderClamping, Ui};
 use glam::Vec3;
+use marbre_core::scene::UvFrame;
 use marbre_core::scene::color_encoding::{srgb_decode, srgb_encode};
 use std::ops::RangeInclusive;
 
@@ -86,4 +87,50 @@ pub(super) fn vec3_ui(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, hint: 
         }
         ui.label(label);
     });
+}
+
+/// A texture frame (the report's ATX, APTX, ATX3D): ticked, its origin and
+/// two axes as vector fields; unticked, None. A frame that spans no plane
+/// is shown with the reason (the renderer reads it as no frame).
+pub(super) fn uv_frame_ui(
+    ui: &mut Ui,
+    frame: &mut Option<UvFrame>,
+    label: &str,
+    hint: &str,
+    default: UvFrame,
+) {
+    let mut on = frame.is_some();
+    if ui.checkbox(&mut on, label).on_hover_text(hint).changed() {
+        *frame = on.then_some(default);
+    }
+    let Some(f) = frame else {
+        return;
+    };
+    vec3_ui(
+        ui,
+        "origin",
+        &mut f.origin,
+        0.01,
+        "The frame's origin: (0, 0)",
+    );
+    vec3_ui(
+        ui,
+        "u axis",
+        &mut f.u_axis,
+        0.01,
+        "The point at u = 1 lies this far from the origin",
+    );
+    vec3_ui(
+        ui,
+        "v axis",
+        &mut f.v_axis,
+        0.01,
+        "The point at v = 1 lies this far from the origin (oblique to u if you like)",
+    );
+    if let Some(problem) = f.problem() {
+        ui.colored_label(
+            ui.visuals().warn_fg_color,
+            format!("unusable frame: {problem}"),
+        );
+    }
 }

@@ -48,6 +48,7 @@ pub fn grazing_ground(diffuse: Texture) -> Scene {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: Material {
                 diffuse,
                 specular: Texture::color(Vec3::ZERO),

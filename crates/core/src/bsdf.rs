@@ -1,5 +1,6 @@
 //! CPU twin of `crates/core/src/bsdf.wgsl`: Lambert plus GGX (Smith, separable)
-//! with an optional perfect mirror, its value and sampling density
+//! with an optional perfect mirror and a diffuse transmission lobe (N3D's
+//! TD: Lambert on the other side of the surface), its value and sampling density
 //! together, and its sampling from four uniform numbers. Written line for
 //! line after the shader so the chi² and property tests can check the
 //! sampler against its pdf on the CPU, and the GPU against the CPU.
@@ -22,6 +23,9 @@ pub struct Surface {
     /// Sample the diffuse lobe uniformly over the hemisphere (pdf 1 / 2π)
     /// instead of by cosine (`Strategy::Hemisphere`); the value is the same.
     pub uniform_diffuse: bool,
+    /// The diffuse transmission TD: f = TD/π between directions on
+    /// opposite sides of the surface.
+    pub diffuse_transmission: Vec3,
 }
 
 impl Surface {
@@ -50,14 +54,19 @@ pub fn smith_g1(n_v: f32, a: f32) -> f32 {
     2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt())
 }
 
-/// The chance of sampling the GGX lobe rather than the diffuse one.
-pub fn specular_probability(s: &Surface) -> f32 {
+/// The chances of sampling each continuous lobe, by albedo: (GGX,
+/// transmission); the diffuse lobe takes the rest. A black surface splits
+/// evenly between GGX and diffuse, as before transmission existed, so an
+/// opaque surface keeps its samples.
+pub fn lobe_probabilities(s: &Surface) -> (f32, f32) {
     let d = luminance(s.diffuse);
     let g = luminance(s.specular);
-    if d + g <= 0.0 {
-        return 0.5;
+    let t = luminance(s.diffuse_transmission);
+    let sum = d + g + t;
+    if sum <= 0.0 {
+        return (0.5, 0.0);
     }
-    g / (d + g)
+    (g / sum, t / sum)
 }
 
 /// The density of the uniform hemisphere: 1 / 2π per steradian.
@@ -82,22 +91,30 @@ pub struct BsdfEval {
     pub pdf: f32,
 }
 
-/// The value and the sampling pdf of the continuous lobes.
+/// The value and the sampling pdf of the continuous lobes. `n` faces `wo`;
+/// `wi` on its side meets the reflecting lobes, `wi` across it the
+/// transmission lobe alone.
 pub fn eval_bsdf(s: &Surface, n: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
     let n_i = n.dot(wi);
     let n_o = n.dot(wo);
-    if n_i <= 0.0 || n_o <= 0.0 {
+    if n_i == 0.0 || n_o <= 0.0 {
         return BsdfEval {
             f_cos: Vec3::ZERO,
             pdf: 0.0,
+        };
+    }
+    let (ps, pt) = lobe_probabilities(s);
+    if n_i < 0.0 {
+        return BsdfEval {
+            f_cos: s.diffuse_transmission * FRAC_1_PI * -n_i,
+            pdf: pt * diffuse_pdf(-n_i, s.uniform_diffuse),
         };
     }
     let h = (wi + wo).normalize();
     let n_h = n.dot(h).max(0.0);
     let d = ggx_d(n_h * n_h, n.cross(h).length_squared(), s.alpha);
     let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
-    let ps = specular_probability(s);
-    let pdf = (1.0 - ps) * diffuse_pdf(n_i, s.uniform_diffuse)
+    let pdf = (1.0 - ps - pt) * diffuse_pdf(n_i, s.uniform_diffuse)
         + ps * d * n_h / (4.0 * wo.dot(h).max(1e-8));
     BsdfEval {
         f_cos: s.diffuse * FRAC_1_PI * n_i + spec,
@@ -132,11 +149,15 @@ pub struct BsdfSample {
 }
 
 /// A direction drawn from the BSDF with the four uniform numbers the shader
-/// draws in this order: mirror or not, cos θ, φ, which lobe.
+/// draws in this order: mirror or not, cos θ, φ, which lobe (GGX below its
+/// chance, then transmission, then diffuse).
 pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
     let mirror = u[0] < s.mirror;
     let (u1, u2) = (u[1], u[2]);
-    let specular = u[3] < specular_probability(s);
+    let (ps, pt) = lobe_probabilities(s);
+    let specular = u[3] < ps;
+    // The transmission lobe is the diffuse one mirrored through the plane.
+    let transmit = !specular && u[3] < ps + pt;
     // GGX's cos²θ = (1 − u) / (1 + (α² − 1) u) and sin²θ = α² u / (same),
     // the denominator summed as (1 − u) + α² u: both numerators then add
     // up to it and h stays unit length (1 + (α² − 1) u cancels for u near
@@ -153,7 +174,8 @@ pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
         ((1.0 - u1).max(0.0).sqrt(), u1.sqrt())
     };
     let phi = 2.0 * PI * u2;
-    let local = basis(n) * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+    let side = if transmit { -1.0 } else { 1.0 };
+    let local = basis(n) * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), side * cos_t);
     let wi = if specular { reflect(-wo, local) } else { local };
     let e = eval_bsdf(s, n, wo, wi);
     BsdfSample {
@@ -179,6 +201,7 @@ mod tests {
             alpha: 1.0,
             mirror: 0.0,
             uniform_diffuse,
+            diffuse_transmission: Vec3::ZERO,
         }
     }
 

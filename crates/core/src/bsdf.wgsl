@@ -1,4 +1,5 @@
-// Lambert + GGX (Smith, separable) with an optional perfect mirror.
+// Lambert + GGX (Smith, separable) with an optional perfect mirror and a
+// diffuse transmission lobe (N3D's TD: Lambert on the other side).
 // Sampling picks a lobe by its albedo, and weights by the mixture pdf, so the
 // estimator stays unbiased whichever lobe dominates. Twin of bsdf.rs;
 // the surface these functions read is built by surface_at (surface.wgsl),
@@ -19,6 +20,9 @@ struct SurfacePoint {
     // Sample the diffuse lobe uniformly over the hemisphere (pdf 1 / 2π)
     // instead of by cosine (Rust: Strategy::Hemisphere); same value.
     uniform_diffuse: bool,
+    // The diffuse transmission TD: f = TD/π between directions on opposite
+    // sides of the surface.
+    diffuse_transmission: vec3f,
 }
 
 // GGX D(h) from cos²θh and sin²θh given apart. The textbook denominator
@@ -37,13 +41,18 @@ fn smith_g1(n_v: f32, a: f32) -> f32 {
     return 2.0 * n_v / (n_v + sqrt(a2 + (1.0 - a2) * n_v * n_v));
 }
 
-fn specular_probability(s: SurfacePoint) -> f32 {
+// The chances of sampling each continuous lobe, by albedo: (GGX,
+// transmission); the diffuse lobe takes the rest. A black surface splits
+// evenly between GGX and diffuse, so an opaque surface keeps its samples.
+fn lobe_probabilities(s: SurfacePoint) -> vec2f {
     let d = luminance(s.diffuse);
     let g = luminance(s.specular);
-    if d + g <= 0.0 {
-        return 0.5;
+    let t = luminance(s.diffuse_transmission);
+    let sum = d + g + t;
+    if sum <= 0.0 {
+        return vec2f(0.5, 0.0);
     }
-    return g / (d + g);
+    return vec2f(g, t) / sum;
 }
 
 const UNIFORM_HEMISPHERE_PDF: f32 = 0.15915494;
@@ -60,19 +69,26 @@ struct BsdfEval {
 
 // The value and the sampling pdf together: they share the half vector and
 // D(h), and code is paid for whether used or not on SIMD (see trace.wgsl).
+// `n` faces `wo`; `wi` on its side meets the reflecting lobes, `wi` across
+// it the transmission lobe alone.
 fn eval_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f, wi: vec3f) -> BsdfEval {
     let n_i = dot(n, wi);
     let n_o = dot(n, wo);
-    if n_i <= 0.0 || n_o <= 0.0 {
+    if n_i == 0.0 || n_o <= 0.0 {
         return BsdfEval(vec3f(0.0), 0.0);
+    }
+    let p = lobe_probabilities(s);
+    let ps = p.x;
+    let pt = p.y;
+    if n_i < 0.0 {
+        return BsdfEval(s.diffuse_transmission * INV_PI * -n_i, pt * diffuse_pdf(-n_i, s.uniform_diffuse));
     }
     let h = normalize(wi + wo);
     let n_h = max(dot(n, h), 0.0);
     let n_x_h = cross(n, h);
     let d = ggx_d(n_h * n_h, dot(n_x_h, n_x_h), s.alpha);
     let spec = s.specular * d * smith_g1(n_i, s.alpha) * smith_g1(n_o, s.alpha) / (4.0 * n_o);
-    let ps = specular_probability(s);
-    let pdf = (1.0 - ps) * diffuse_pdf(n_i, s.uniform_diffuse) + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
+    let pdf = (1.0 - ps - pt) * diffuse_pdf(n_i, s.uniform_diffuse) + ps * d * n_h / (4.0 * max(dot(wo, h), 1e-8));
     return BsdfEval(s.diffuse * INV_PI * n_i + spec, pdf);
 }
 
@@ -106,12 +122,16 @@ fn sample_bsdf(s: SurfacePoint, n: vec3f, wo: vec3f) -> BsdfSample {
 }
 
 // sample_bsdf with its four uniform numbers given (the sampling harness
-// passes them): mirror or not, cos θ, φ, which lobe.
+// passes them): mirror or not, cos θ, φ, which lobe (GGX below its chance,
+// then transmission, then diffuse).
 fn sample_bsdf_with(s: SurfacePoint, n: vec3f, wo: vec3f, u: vec4f) -> BsdfSample {
     let mirror = u.x < s.mirror;
     let u1 = u.y;
     let u2 = u.z;
-    let specular = u.w < specular_probability(s);
+    let p = lobe_probabilities(s);
+    let specular = u.w < p.x;
+    // The transmission lobe is the diffuse one mirrored through the plane.
+    let transmit = !specular && u.w < p.x + p.y;
     // GGX half vectors have pdf D(h) cos θh; the diffuse lobe is cosine-weighted.
     // GGX's cos²θ = (1 − u) / (1 + (α² − 1) u) and sin²θ = α² u / (same),
     // the denominator summed as (1 − u) + α² u: both numerators then add
@@ -126,7 +146,8 @@ fn sample_bsdf_with(s: SurfacePoint, n: vec3f, wo: vec3f, u: vec4f) -> BsdfSampl
     let cos_t = select(cos_diffuse, sqrt((1.0 - u1) / ggx), specular);
     let sin_t = select(sin_diffuse, sqrt(a2 * u1 / ggx), specular);
     let phi = TWO_PI * u2;
-    let local = basis(n) * vec3f(sin_t * cos(phi), sin_t * sin(phi), cos_t);
+    let side = select(1.0, -1.0, transmit);
+    let local = basis(n) * vec3f(sin_t * cos(phi), sin_t * sin(phi), side * cos_t);
     let wi = select(local, reflect(-wo, local), specular);
     let e = eval_bsdf(s, n, wo, wi);
     var out: BsdfSample;

@@ -7,8 +7,8 @@ struct Hit {
     p: vec3f,
     n: vec3f,            // geometric normal, facing the ray's origin side
     texture_point: vec3f,
-    // The primitive's 2D texture coordinates: lat-long on a sphere, world
-    // (x, z) on the ground. Only computed where a 2D pattern reads them.
+    // The primitive's 2D texture coordinates: lat-long on a sphere, the
+    // ground's frame (world (x, z) without one) on the ground. Only computed where a 2D pattern reads them.
     uv: vec2f,
 #if TANGENTS
     // ∂p/∂u and ∂p/∂v: how the surface moves with its (u, v), for bumps
@@ -204,10 +204,10 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
             hit.p = vec3f(o.x + t * d.x, frame.ground_height, o.z + t * d.z);
             hit.n = vec3f(0.0, 1.0, 0.0);
             hit.texture_point = vec3f(hit.p.x, 0.0, hit.p.z);
-            hit.uv = vec2f(hit.p.x, hit.p.z);
+            hit.uv = plane_uv(hit.p, frame.ground_uv_origin, frame.ground_uv_u, frame.ground_uv_v);
 #if TANGENTS
-            hit.dp_du = vec3f(1.0, 0.0, 0.0);
-            hit.dp_dv = vec3f(0.0, 0.0, 1.0);
+            hit.dp_du = frame.ground_uv_u;
+            hit.dp_dv = frame.ground_uv_v;
 #endif
             hit.material = frame.sphere_count + frame.cylinder_count + frame.polygon_count;
             hit.shape = SHAPE_GROUND;

@@ -62,6 +62,11 @@ struct Frame {
     light_points: u32,
     // The depth view's d in t / (t + d): the camera's distance to its target.
     depth_scale: f32,
+    // The ground's (u, v) frame (Rust: Ground::frame): world (x, z) is the
+    // frame at the origin on +x and +z.
+    ground_uv_origin: vec3f,
+    ground_uv_u: vec3f,
+    ground_uv_v: vec3f,
 }
 
 const MAX_SIGNALS: u32 = 4u;

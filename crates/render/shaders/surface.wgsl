@@ -23,6 +23,7 @@ fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
     s.transmission = clamp(textures.transmission, vec3f(0.0), vec3f(1.0));
     s.emission = max(textures.emission, vec3f(0.0));
     s.uniform_diffuse = frame.strategy == STRATEGY_HEMISPHERE;
+    s.diffuse_transmission = clamp(textures.diffuse_transmission, vec3f(0.0), vec3f(1.0));
 #if BUMP
     s.n = bumped_shading_normal(hit, fp, signals, -d);
 #else

@@ -17,6 +17,7 @@ struct SurfaceTextures {
     opacity: f32,
     transmission: vec3f,
     emission: vec3f,
+    diffuse_transmission: vec3f,
 }
 
 // The render switches (Rust: gpu::renderer::RenderSwitches), as override

@@ -38,17 +38,31 @@ fn camera_ray(pixel: vec2f) -> vec3f {
     return normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up);
 }
 
+// Which side of the surface a direction `wi` leaves on: 1 along the
+// geometric normal `n`, -1 against it (through the surface, where the
+// diffuse transmission lobe sends it), 0 where `n` and the shading normal
+// `s_n` disagree about the side (the direction would leak through the
+// surface, or cross it unseen by the BSDF). Shadow and bounce rays are
+// offset to that side.
+fn leaving_side(wi: vec3f, n: vec3f, s_n: vec3f) -> f32 {
+    let side = dot(wi, n);
+    let reflected = select(0.0, 1.0, side > 0.0);
+    let transmitted = select(0.0, -1.0, side < 0.0);
+    return select(reflected, transmitted, dot(wi, s_n) < 0.0);
+}
+
 #if POINT_LIGHT || AREA_LIGHT
 // Direct light from the light table: `frame.light_samples` points, each on
 // a light chosen anew, their shadow rays through see-through surfaces,
 // each weighted against BSDF sampling's chance of the same direction.
+// Lights behind the surface reach it through its diffuse transmission.
 fn direct_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let count = frame.light_samples;
-    let origin = offset_ray(hit.p, hit.n);
     var sum = vec3f(0.0);
     for (var k = 0u; k < count; k++) {
         let light = sample_light(hit.p, k);
-        if light.pdf > 0.0 && dot(light.wi, hit.n) > 0.0 {
+        let side = leaving_side(light.wi, hit.n, s.n);
+        if light.pdf > 0.0 && side != 0.0 {
             let e = eval_bsdf(s, s.n, wo, light.wi);
             var weight = 1.0;
             if !light.delta {
@@ -57,7 +71,7 @@ fn direct_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
             if weight > 0.0 && any(e.f_cos != vec3f(0.0)) {
                 // Stop short of the sampled point, which lies on the light.
                 let t_max = select(light.distance * (1.0 - 1e-4), light.distance, light.delta);
-                let through = visibility(origin, light.wi, t_max);
+                let through = visibility(offset_ray(hit.p, side * hit.n), light.wi, t_max);
                 sum += through * e.f_cos * light.radiance * (weight / light.pdf);
             }
         }
@@ -72,7 +86,8 @@ fn direct_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
 // escape at the next bounce takes the other weight.
 fn env_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     let sample = sample_env(rand(), rand());
-    if sample.pdf <= 0.0 || dot(sample.wi, hit.n) <= 0.0 {
+    let side = leaving_side(sample.wi, hit.n, s.n);
+    if sample.pdf <= 0.0 || side == 0.0 {
         return vec3f(0.0);
     }
     let e = eval_bsdf(s, s.n, wo, sample.wi);
@@ -80,7 +95,7 @@ fn env_light(hit: Hit, s: SurfacePoint, wo: vec3f) -> vec3f {
     if weight <= 0.0 || all(e.f_cos == vec3f(0.0)) {
         return vec3f(0.0);
     }
-    let through = visibility(offset_ray(hit.p, hit.n), sample.wi, NO_HIT);
+    let through = visibility(offset_ray(hit.p, side * hit.n), sample.wi, NO_HIT);
     return through * (1.0 - s.mirror) * e.f_cos * environment(sample.wi) * weight / sample.pdf;
 }
 #endif
@@ -224,7 +239,8 @@ fn trace_path(pixel: vec2f) -> vec3f {
                 }
 #endif
                 let bs = sample_bsdf(s, s.n, wo);
-                if !bs.valid || dot(bs.wi, hit.n) <= 0.0 {
+                let side = leaving_side(bs.wi, hit.n, s.n);
+                if !bs.valid || side == 0.0 {
                     alive = false;
                     break;
                 }
@@ -232,7 +248,7 @@ fn trace_path(pixel: vec2f) -> vec3f {
                 last_bsdf_pdf = bs.pdf;
                 scatter_point = hit.p;
                 d = bs.wi;
-                origin = offset_ray(hit.p, hit.n);
+                origin = offset_ray(hit.p, side * hit.n);
                 bounces++;
                 // Russian roulette: past a few bounces a path goes on with
                 // the chance of its throughput, and the survivors carry

@@ -63,6 +63,7 @@ pub fn glossy_two_lights() -> Scene {
         ],
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: Material {
                 diffuse: Texture::color(Vec3::splat(0.05)),
                 specular: Texture::color(Vec3::splat(0.9)),
@@ -110,6 +111,7 @@ pub fn environment_lit(env: &Path) -> Scene {
         ],
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(0.5),
         }),
         point_light: None,

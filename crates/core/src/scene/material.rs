@@ -16,11 +16,12 @@ pub enum Property {
     Opacity,
     Transmission,
     Emission,
+    DiffuseTransmission,
 }
 
 impl Property {
     /// In the order the generated shader returns them (`SurfaceTextures`).
-    pub const ALL: [Property; 7] = [
+    pub const ALL: [Property; 8] = [
         Property::Diffuse,
         Property::Specular,
         Property::Roughness,
@@ -28,6 +29,7 @@ impl Property {
         Property::Opacity,
         Property::Transmission,
         Property::Emission,
+        Property::DiffuseTransmission,
     ];
 
     pub fn name(self) -> &'static str {
@@ -39,6 +41,7 @@ impl Property {
             Property::Opacity => "opacity",
             Property::Transmission => "transmission",
             Property::Emission => "emission",
+            Property::DiffuseTransmission => "diffuse_transmission",
         }
     }
 
@@ -46,13 +49,18 @@ impl Property {
     pub fn is_color(self) -> bool {
         matches!(
             self,
-            Property::Diffuse | Property::Specular | Property::Transmission | Property::Emission
+            Property::Diffuse
+                | Property::Specular
+                | Property::Transmission
+                | Property::Emission
+                | Property::DiffuseTransmission
         )
     }
 }
 
 /// A Lambert diffuse lobe plus a GGX specular lobe, an optional perfect
-/// mirror, opacity (holes, without refraction), emission and bump. Every
+/// mirror, a diffuse transmission lobe, opacity (holes, without
+/// refraction), emission and bump. Every
 /// property is a texture; in a preset a constant one may be written as its
 /// value (`roughness: 0.4`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -81,6 +89,15 @@ pub struct Material {
     #[serde(with = "property_serde")]
     pub emission: Texture,
     pub emission_strength: f32,
+    /// N3D's diffuse transmission TD: a Lambert lobe on the other side of
+    /// the surface, so light arriving on one side leaves the other side
+    /// scattered diffusely with this reflectance (f = TD/π across the
+    /// surface; a translucent sheet, a lampshade). Black (the default) is
+    /// none. Diffuse + TD should stay ≤ 1 per channel for the surface to
+    /// conserve energy: the renderer clamps each to [0, 1] but leaves their
+    /// sum to the author.
+    #[serde(with = "property_serde")]
+    pub diffuse_transmission: Texture,
     /// A height field over the surface (its first channel) that tilts the
     /// shading normal: bump mapping. Constant: no bump.
     #[serde(with = "property_serde")]
@@ -103,6 +120,7 @@ impl Default for Material {
             transmission: Texture::color(Vec3::ONE),
             emission: Texture::color(Vec3::ZERO),
             emission_strength: 1.0,
+            diffuse_transmission: Texture::color(Vec3::ZERO),
             bump: Texture::scalar(0.0),
             bump_height: 0.0,
             layers: Vec::new(),
@@ -155,6 +173,11 @@ pub struct Layer {
         skip_serializing_if = "Option::is_none"
     )]
     pub emission: Option<Texture>,
+    #[serde(
+        with = "optional_property_serde",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub diffuse_transmission: Option<Texture>,
 }
 
 impl Default for Layer {
@@ -169,6 +192,7 @@ impl Default for Layer {
             opacity: None,
             transmission: None,
             emission: None,
+            diffuse_transmission: None,
         }
     }
 }
@@ -188,6 +212,7 @@ impl Layer {
             Property::Opacity => &mut self.opacity,
             Property::Transmission => &mut self.transmission,
             Property::Emission => &mut self.emission,
+            Property::DiffuseTransmission => &mut self.diffuse_transmission,
         }
     }
 
@@ -200,6 +225,7 @@ impl Layer {
             Property::Opacity => &self.opacity,
             Property::Transmission => &self.transmission,
             Property::Emission => &self.emission,
+            Property::DiffuseTransmission => &self.diffuse_transmission,
         }
     }
 
@@ -215,6 +241,7 @@ impl Layer {
                 &mut self.opacity,
                 &mut self.transmission,
                 &mut self.emission,
+                &mut self.diffuse_transmission,
             ]
             .into_iter()
             .flatten(),
@@ -243,6 +270,7 @@ impl Material {
             Property::Opacity => &self.opacity,
             Property::Transmission => &self.transmission,
             Property::Emission => &self.emission,
+            Property::DiffuseTransmission => &self.diffuse_transmission,
         }
     }
 
@@ -255,6 +283,7 @@ impl Material {
             Property::Opacity => &mut self.opacity,
             Property::Transmission => &mut self.transmission,
             Property::Emission => &mut self.emission,
+            Property::DiffuseTransmission => &mut self.diffuse_transmission,
         }
     }
 
@@ -350,6 +379,10 @@ impl Material {
             (format!("{what} opacity"), &mut self.opacity),
             (format!("{what} transmission"), &mut self.transmission),
             (format!("{what} emission"), &mut self.emission),
+            (
+                format!("{what} diffuse transmission"),
+                &mut self.diffuse_transmission,
+            ),
             (format!("{what} bump"), &mut self.bump),
         ];
         for layer in &mut self.layers {

@@ -57,6 +57,11 @@ impl Default for Sphere {
 #[serde(default)]
 pub struct Ground {
     pub height: f32,
+    /// The (u, v) frame of its 2D textures (the texture report's APTX):
+    /// None reads world (x, z); a frame gives the point's coordinates on its
+    /// axes, oblique ones included, exactly as a polygon's `uv_frame`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uv_frame: Option<UvFrame>,
     pub material: Material,
 }
 
@@ -64,8 +69,29 @@ impl Default for Ground {
     fn default() -> Self {
         Self {
             height: 0.0,
+            uv_frame: None,
             material: Material::default(),
         }
+    }
+}
+
+impl Ground {
+    /// The frame the renderer uses: `uv_frame`, or world (x, z) as the
+    /// frame at the origin on +x and +z (for which the shader's plane
+    /// solve gives x and z exactly).
+    pub fn frame(&self) -> UvFrame {
+        self.uv_frame.unwrap_or(UvFrame {
+            origin: Vec3::ZERO,
+            u_axis: Vec3::X,
+            v_axis: Vec3::Z,
+        })
+    }
+
+    /// The (u, v) of the ground point `p`: the CPU twin of the ground's
+    /// hit in `intersect.wgsl`.
+    pub fn uv(&self, p: Vec3) -> glam::Vec2 {
+        let f = self.frame();
+        crate::texture::plane_uv(p, f.origin, f.u_axis, f.v_axis)
     }
 }
 
@@ -269,6 +295,12 @@ impl Scene {
             if !g.height.is_finite() {
                 notes.push("ground: non-finite height set to 0".into());
                 g.height = 0.0;
+            }
+            if let Some(problem) = g.uv_frame.as_ref().and_then(UvFrame::problem) {
+                notes.push(format!(
+                    "ground: uv frame refused ({problem}); world (x, z) used"
+                ));
+                g.uv_frame = None;
             }
             g.material.sanitize("ground", &mut notes);
         }

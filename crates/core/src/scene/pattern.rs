@@ -5,6 +5,7 @@
 //! The functions themselves live in the texture library (`crate::texture`);
 //! this is the scene's record of which one and with what parameters.
 
+use super::primitives::UvFrame;
 use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum, rebase::rebase};
 use crate::texture;
 use glam::{Affine3A, Vec2, Vec3};
@@ -124,7 +125,7 @@ impl Signal {
     /// whole periods of the noise (`noise::rebase`): the same sum in exact
     /// arithmetic, taken near the origin where f32 resolves it.
     fn noise_space_map(&self) -> Affine3A {
-        let mut m = self.mapping.unwrap_or_default().transform.to_texture();
+        let mut m = self.mapping.unwrap_or_default().point_map();
         m.translation = rebase(m.translation.into(), &self.noise).into();
         m
     }
@@ -167,20 +168,60 @@ pub enum MappingSpace {
 
 /// Blender's Texture Coordinate and Mapping nodes in one: a texture with a
 /// mapping, and its whole subtree, read the surface's coordinates afresh
-/// (3D from `space`, 2D from the primitive) through `transform`; (u, v) are
-/// transformed as the point (u, v, 0).
+/// (3D from `space`, then `frame`, 2D from the primitive) through
+/// `transform`; (u, v) are transformed as the point (u, v, 0).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct TextureMapping {
     pub space: MappingSpace,
+    /// The texture report's ATX3D: the 3D texture point is the coordinates
+    /// (a, b, c) of the surface point in this frame, p = origin + a·u + b·v
+    /// + c·w, before `transform`. The report gives only u and v; w is
+    /// their normalised cross product scaled by √(|u|·|v|), so a frame
+    /// whose axes have one length stays isotropic (a cube of the texture
+    /// stays a cube) and an oblique or stretched one scales its third axis
+    /// by the geometric mean. (u, v) are not affected. A degenerate frame
+    /// is refused by `Scene::sanitize` (and reads as no frame meanwhile).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<UvFrame>,
     pub transform: texture::TextureTransform,
 }
 
 impl TextureMapping {
     pub fn point(&self, at: &SurfacePoint) -> Vec3 {
-        self.transform
-            .to_texture()
-            .transform_point3(self.space_point(at))
+        self.point_map().transform_point3(self.space_point(at))
+    }
+
+    /// The map from the frame's coordinates (a, b, c) to space: the columns
+    /// u, v, w and the origin. None for a frame that spans no volume.
+    pub fn frame_to_space(frame: &UvFrame) -> Option<Affine3A> {
+        frame.problem()?;
+        let (u, v) = (frame.u_axis, frame.v_axis);
+        let w = u.cross(v).normalize() * (u.length() * v.length()).sqrt();
+        let m = Affine3A::from_cols(u.into(), v.into(), w.into(), frame.origin.into());
+        (m.matrix3.determinant().is_finite()).then_some(m)
+    }
+
+    /// The affine map from surface points (in `space`) to 3D texture
+    /// points: the frame's coordinates, then `transform`.
+    pub fn point_map(&self) -> Affine3A {
+        let into_frame = self
+            .frame
+            .as_ref()
+            .and_then(Self::frame_to_space)
+            .map_or(Affine3A::IDENTITY, |m| m.inverse());
+        self.transform.to_texture() * into_frame
+    }
+
+    /// Refuses a frame that spans no volume (zero or parallel axes, a
+    /// non-finite coordinate), with a note naming `what`.
+    pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>) {
+        if let Some(problem) = self.frame.as_ref().and_then(UvFrame::problem) {
+            notes.push(format!(
+                "{what}: mapping frame refused ({problem}); the surface point is read without it"
+            ));
+            self.frame = None;
+        }
     }
 
     /// The surface point in the coordinates this mapping reads.
@@ -199,25 +240,31 @@ impl TextureMapping {
     }
 
     /// How much the map enlarges a footprint: along u, along v (the map
-    /// of (u, v, 0)) and in 3D, each the longest image of a unit vector
-    /// among the axes (a bound that never under-filters a uniform scale).
+    /// of (u, v, 0)) and in 3D (the frame included), each the longest
+    /// image of a unit vector among the axes (a bound that never
+    /// under-filters a uniform scale).
     pub fn footprint_scale(&self) -> [f32; 3] {
         let l = self.transform.to_texture().matrix3;
-        let (x, y, z) = (
-            Vec3::from(l.x_axis),
-            Vec3::from(l.y_axis),
-            Vec3::from(l.z_axis),
-        );
+        let p = self.point_map().matrix3;
         [
-            x.truncate().length(),
-            y.truncate().length(),
-            x.length().max(y.length()).max(z.length()),
+            Vec3::from(l.x_axis).truncate().length(),
+            Vec3::from(l.y_axis).truncate().length(),
+            p.x_axis
+                .length()
+                .max(p.y_axis.length())
+                .max(p.z_axis.length()),
         ]
     }
 
-    /// The three rows of the affine map, as the shader reads them:
-    /// `p' = (dot(r0.xyz, p) + r0.w, …)`.
+    /// The three rows of the 3D point's affine map, as the shader reads
+    /// them: `p' = (dot(r0.xyz, p) + r0.w, …)`.
     pub fn rows(&self) -> [[f32; 4]; 3] {
+        affine_rows(&self.point_map())
+    }
+
+    /// The rows of the (u, v) map: [`TextureMapping::rows`] unless a frame
+    /// moves the 3D point alone.
+    pub fn uv_rows(&self) -> [[f32; 4]; 3] {
         affine_rows(&self.transform.to_texture())
     }
 }

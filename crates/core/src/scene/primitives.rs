@@ -47,6 +47,24 @@ pub struct UvFrame {
     pub v_axis: Vec3,
 }
 
+impl UvFrame {
+    /// Why the frame spans no plane, if it does not: a non-finite
+    /// coordinate, or axes that are zero or parallel (the same test as
+    /// `texture::plane_uv`'s, which would give (0, 0) everywhere).
+    pub fn problem(&self) -> Option<String> {
+        if !(self.origin.is_finite() && self.u_axis.is_finite() && self.v_axis.is_finite()) {
+            return Some("a non-finite origin or axis".into());
+        }
+        let (u, v) = (self.u_axis, self.v_axis);
+        let (uu, uv, vv) = (u.dot(u), u.dot(v), v.dot(v));
+        let det = uu * vv - uv * uv;
+        if !(uu > 0.0 && vv > 0.0 && det.is_finite() && det > 1e-12 * uu * vv) {
+            return Some(format!("the axes u = {u} and v = {v} are zero or parallel"));
+        }
+        None
+    }
+}
+
 /// A flat convex polygon. Its (u, v) follow `uv_frame` if given, else the
 /// report's default: the first vertex, the first edge, and the last edge
 /// made orthogonal to it (`texture::polygon_frame`).

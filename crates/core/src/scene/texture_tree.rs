@@ -475,6 +475,9 @@ impl Texture {
     /// their `a` value).
     pub(crate) fn sanitize(&mut self, what: &str, notes: &mut Vec<String>, depth: usize) {
         self.pattern.sanitize(what, notes);
+        if let Some(mapping) = &mut self.mapping {
+            mapping.sanitize(what, notes);
+        }
         self.sanitize_ramp(what, notes);
         for (name, child) in [("a", &mut self.a), ("b", &mut self.b)] {
             let path = format!("{what}.{name}");

@@ -8,7 +8,8 @@ use marbre_core::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use marbre_core::scene::pattern::MAX_SIGNALS;
 use marbre_core::scene::primitives::MAX_POLYGON_VERTICES;
 use marbre_core::scene::{
-    EnvSource, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace, Material, Scene,
+    EnvSource, Ground, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace,
+    Material, Scene,
 };
 
 #[repr(C)]
@@ -69,6 +70,13 @@ pub struct FrameUniform {
     /// The depth view's d in t / (t + d): the camera's distance to its
     /// target.
     pub depth_scale: f32,
+    /// The ground's (u, v) frame (`Ground::frame`; world x, z without one).
+    pub ground_uv_origin: [f32; 3],
+    pub _pad_ground0: f32,
+    pub ground_uv_u: [f32; 3],
+    pub _pad_ground1: f32,
+    pub ground_uv_v: [f32; 3],
+    pub _pad_ground2: f32,
 }
 
 /// `NoiseParams` of `crates/core/src/noise/fractal.wgsl`.
@@ -302,6 +310,10 @@ pub fn frame_uniform(
         EnvSource::Constant { radiance } => radiance.to_array(),
         _ => [0.0; 3],
     };
+    let ground_frame = scene
+        .ground
+        .as_ref()
+        .map_or_else(|| Ground::default().frame(), Ground::frame);
     FrameUniform {
         cam_pos: cam.position.to_array(),
         tan_half_fov: cam.tan_half_fov,
@@ -360,6 +372,12 @@ pub fn frame_uniform(
         view: scene.render.view.id(),
         light_points: scene.render.transport.light_points.id(),
         depth_scale: scene.camera.distance.max(f32::MIN_POSITIVE),
+        ground_uv_origin: ground_frame.origin.to_array(),
+        _pad_ground0: 0.0,
+        ground_uv_u: ground_frame.u_axis.to_array(),
+        _pad_ground1: 0.0,
+        ground_uv_v: ground_frame.v_axis.to_array(),
+        _pad_ground2: 0.0,
     }
 }
 
@@ -372,7 +390,7 @@ mod tests {
     #[test]
     fn struct_sizes_match_the_wgsl_layout() {
         // Sizes computed by hand from crates/render/shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 224);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 272);
         assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
         assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
         assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);

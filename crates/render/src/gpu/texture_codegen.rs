@@ -87,7 +87,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     wgsl.push_str(&generator.code);
     write!(
         wgsl,
-        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(1.0), vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
+        "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(1.0), vec3f(0.0), vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
     )?;
     // Shadow rays read opacity and transmission alone, light samples
     // emission alone; each evaluates the noise signals only if one of its
@@ -254,7 +254,7 @@ impl Generator<'_> {
             + "            return (1.0 - clamp(opacity.x, 0.0, 1.0)) * clamp(transmission, vec3f(0.0), vec3f(1.0));\n";
         let _ = writeln!(
             cases.textures,
-            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, transmission, emission * {strength}.x);"
+            "            out = SurfaceTextures(diffuse, specular, roughness.x, mirror.x, opacity.x, transmission, emission * {strength}.x, diffuse_transmission);"
         );
         cases
     }
@@ -380,6 +380,13 @@ impl Generator<'_> {
         let site = match &texture.mapping {
             Some(mapping) => {
                 let [r0, r1, r2] = mapping.rows().map(|row| self.param(row));
+                // A frame moves the 3D point alone: (u, v) then read the
+                // transform's own rows.
+                let [u0, u1, u2] = if mapping.frame.is_some() {
+                    mapping.uv_rows().map(|row| self.param(row))
+                } else {
+                    [r0.clone(), r1.clone(), r2.clone()]
+                };
                 let point = match mapping.space {
                     MappingSpace::Object => "p",
                     MappingSpace::World => "pw",
@@ -388,7 +395,7 @@ impl Generator<'_> {
                 let scale = self.param([su, sv, s3, 0.0]);
                 let _ = writeln!(
                     body,
-                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {r0}, {r1}, {r2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z, fp.axes * {scale}.z);"
+                    "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {u0}, {u1}, {u2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z, fp.axes * {scale}.z);"
                 );
                 mapped = Site {
                     p: format!("p{k}"),

@@ -422,6 +422,7 @@ fn bsdf_case(diffuse: f32, specular: f32, roughness: f32, incidence_degrees: f64
                 alpha: Surface::alpha_for(roughness),
                 mirror: 0.0,
                 uniform_diffuse: false,
+                diffuse_transmission: Vec3::ZERO,
             },
             n: n.as_vec3(),
             wo: wo.as_vec3(),

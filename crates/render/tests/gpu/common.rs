@@ -109,6 +109,7 @@ pub fn textured_ground_in_white_light(diffuse: Texture) -> Scene {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: Material {
                 diffuse,
                 ..lambert(0.5)
@@ -188,6 +189,7 @@ pub fn spheres_in_constant_light(radiance: f32) -> Scene {
     let mut scene = Scene {
         ground: Some(Ground {
             height: -1.0,
+            uv_frame: None,
             material: lambert(0.3),
         }),
         ..Scene::default()

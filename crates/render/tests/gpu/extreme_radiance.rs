@@ -112,6 +112,7 @@ fn a_ground_under_the_esplanade_sun_gets_the_closed_form_radiance() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(ALBEDO),
         }),
         camera: OrbitCamera {
@@ -166,6 +167,7 @@ fn an_emitter_of_a_million_lights_the_ground_as_the_closed_form_says() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(ALBEDO),
         }),
         camera: OrbitCamera {

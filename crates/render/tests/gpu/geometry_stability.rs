@@ -1051,6 +1051,7 @@ fn a_grazingly_lit_ground_matches_the_closed_form_and_keeps_its_shadow() {
         let mut scene = Scene {
             ground: Some(Ground {
                 height: 0.0,
+                uv_frame: None,
                 material: lambert(albedo as f32),
             }),
             point_light: Some(PointLight {
@@ -1465,6 +1466,7 @@ fn emitters_too_small_to_sample_render_finite() {
         let mut scene = Scene {
             ground: Some(Ground {
                 height: 0.0,
+                uv_frame: None,
                 material: lambert(0.5),
             }),
             ..Scene::default()

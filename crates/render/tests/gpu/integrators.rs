@@ -191,7 +191,9 @@ fn lights_scene() -> Scene {
         ],
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(0.6),
+            ..Ground::default()
         }),
         point_light: Some(PointLight {
             position: Vec3::new(0.0, 3.0, 2.0),
@@ -309,6 +311,7 @@ fn mis_is_within_ten_percent_of_the_better_strategy() {
     scene.spheres.truncate(2);
     scene.ground = Some(Ground {
         height: 0.0,
+        uv_frame: None,
         material: Material {
             diffuse: Texture::color(Vec3::splat(0.05)),
             specular: Texture::color(Vec3::splat(0.9)),
@@ -396,6 +399,7 @@ fn a_see_through_sheet_casts_a_shadow_of_its_colour() {
         polygons: vec![sheet],
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(0.5),
         }),
         point_light: Some(PointLight {
@@ -555,6 +559,7 @@ fn uniform_hemisphere_sampling_agrees_in_mean_with_more_variance() {
         ground: Some(Ground {
             height: 0.0,
             material: lambert(0.6),
+            ..Ground::default()
         }),
         camera: OrbitCamera {
             target: Vec3::new(0.0, 0.5, 0.0),

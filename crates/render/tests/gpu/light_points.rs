@@ -24,6 +24,7 @@ fn lit_ground(triangles: Vec<[Vec3; 3]>, points: LightPoints) -> Scene {
         ground: Some(Ground {
             height: 0.0,
             material: lambert(RHO),
+            ..Ground::default()
         }),
         meshes: vec![mesh_of(
             triangles,

@@ -70,6 +70,7 @@ fn sphere_on_ground_both_ways() -> (Scene, Scene) {
     let mut with = lat_long_scene(true);
     with.ground = Some(Ground {
         height: 0.0,
+        uv_frame: None,
         material: lambert(0.5),
     });
     with.environment.background_visible = false;

@@ -508,6 +508,7 @@ fn offset_signal(noise: NoiseSettings, offset: Vec3) -> Signal {
         noise,
         shape: FractalShape::Signed,
         mapping: Some(TextureMapping {
+            frame: None,
             space: MappingSpace::Object,
             transform: TextureTransform {
                 translate: offset,

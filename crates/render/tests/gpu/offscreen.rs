@@ -75,6 +75,7 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(albedo),
         }),
         ..Scene::default()
@@ -351,6 +352,7 @@ fn waves_bump_tilts_the_shading_normal_as_the_closed_form() {
         let mut scene = Scene {
             ground: Some(Ground {
                 height: 0.0,
+                uv_frame: None,
                 material,
             }),
             ..Scene::default()
@@ -397,6 +399,7 @@ fn accumulation_reduces_noise() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(0.8),
         }),
         ..Scene::default()

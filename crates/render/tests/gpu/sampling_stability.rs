@@ -438,6 +438,7 @@ fn bsdf_setups() -> Vec<BsdfSetup> {
                         alpha: Surface::alpha_for(roughness),
                         mirror,
                         uniform_diffuse: false,
+                        diffuse_transmission: Vec3::ZERO,
                     },
                     n,
                     wo,
@@ -544,7 +545,8 @@ fn env_map() -> impl Strategy<Value = EnvImage> {
 }
 
 /// A surface seen along `wo`, up to grazing (cos θo ≥ 1e-4), with any
-/// roughness, lobe weights and mirror share.
+/// roughness, lobe weights (diffuse transmission included) and mirror
+/// share.
 fn bsdf_setup() -> impl Strategy<Value = BsdfSetup> {
     (
         unit_vector(),
@@ -553,30 +555,34 @@ fn bsdf_setup() -> impl Strategy<Value = BsdfSetup> {
         0.0f32..=1.0,
         0.0f32..=1.0,
         0.0f32..=1.0,
+        0.0f32..=1.0,
     )
-        .prop_map(|(n, w, roughness, diffuse, specular, mirror)| {
-            let w = if w.dot(n) < 0.0 {
-                w - 2.0 * w.dot(n) * n
-            } else {
-                w
-            };
-            let wo = if w.dot(n) < 1e-4 {
-                (w + 1e-3 * n).normalize()
-            } else {
-                w.normalize()
-            };
-            BsdfSetup {
-                surface: Surface {
-                    diffuse: Vec3::splat(diffuse),
-                    specular: Vec3::splat(specular),
-                    alpha: Surface::alpha_for(roughness),
-                    mirror,
-                    uniform_diffuse: false,
-                },
-                n,
-                wo,
-            }
-        })
+        .prop_map(
+            |(n, w, roughness, diffuse, specular, mirror, transmission)| {
+                let w = if w.dot(n) < 0.0 {
+                    w - 2.0 * w.dot(n) * n
+                } else {
+                    w
+                };
+                let wo = if w.dot(n) < 1e-4 {
+                    (w + 1e-3 * n).normalize()
+                } else {
+                    w.normalize()
+                };
+                BsdfSetup {
+                    surface: Surface {
+                        diffuse: Vec3::splat(diffuse),
+                        specular: Vec3::splat(specular),
+                        alpha: Surface::alpha_for(roughness),
+                        mirror,
+                        diffuse_transmission: Vec3::splat(transmission),
+                        uniform_diffuse: false,
+                    },
+                    n,
+                    wo,
+                }
+            },
+        )
 }
 
 /// ∫ pdf dω over a hemisphere grid (24 × 24 cells, 25 Gauss–Legendre
@@ -662,7 +668,7 @@ proptest! {
     ) {
         let alpha = Surface::alpha_for(roughness);
         let setup = BsdfSetup {
-            surface: Surface { diffuse: Vec3::ZERO, specular: Vec3::ONE, alpha, mirror: 0.0, uniform_diffuse: false },
+            surface: Surface { diffuse: Vec3::ZERO, specular: Vec3::ONE, alpha, mirror: 0.0, diffuse_transmission: Vec3::ZERO, uniform_diffuse: false },
             n,
             wo: n,
         };

@@ -190,6 +190,7 @@ fn a_half_opaque_sphere_lets_a_quarter_of_the_light_through() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: lambert(0.5),
         }),
         point_light: Some(PointLight {
@@ -260,6 +261,7 @@ fn noise_bump_renders_the_cpu_finite_difference_normal() {
     let mut scene = Scene {
         ground: Some(Ground {
             height: 0.0,
+            uv_frame: None,
             material: material.clone(),
         }),
         point_light: Some(PointLight {
@@ -446,6 +448,7 @@ fn mapped_textures_render_the_cpu_reference() {
         Vec3::new(0.8, 0.6, 0.3),
     );
     wood.mapping = Some(TextureMapping {
+        frame: None,
         space: MappingSpace::World,
         transform: TextureTransform {
             translate: Vec3::new(0.2, 0.0, 0.0),
@@ -459,6 +462,7 @@ fn mapped_textures_render_the_cpu_reference() {
         Vec3::new(0.9, 0.9, 0.9),
     );
     cubes.mapping = Some(TextureMapping {
+        frame: None,
         space: MappingSpace::Object,
         transform: TextureTransform {
             translate: Vec3::new(0.25, 0.1, 0.0),
@@ -549,6 +553,7 @@ fn image_texture_renders_the_cpu_reference() {
         color_space: Default::default(),
     });
     diffuse.mapping = Some(TextureMapping {
+        frame: None,
         space: MappingSpace::Object,
         transform: TextureTransform {
             scale: Vec3::new(0.5, 0.5, 1.0),

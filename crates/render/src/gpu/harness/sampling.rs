@@ -46,6 +46,8 @@ struct SamplingFrame {
     _pad1: f32,
     wo: [f32; 3],
     _pad2: f32,
+    diffuse_transmission: [f32; 3],
+    _pad3: f32,
 }
 
 /// What the harness runs (the shader's `MODE_*`).
@@ -172,6 +174,7 @@ impl SamplingHarness {
             uniform_diffuse: u32::from(s.uniform_diffuse),
             normal: setup.n.into(),
             wo: setup.wo.into(),
+            diffuse_transmission: s.diffuse_transmission.into(),
             ..Default::default()
         }
     }

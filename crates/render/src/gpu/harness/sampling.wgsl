@@ -21,6 +21,7 @@ struct SamplingFrame {
     uniform_diffuse: u32,
     normal: vec3f,
     wo: vec3f,
+    diffuse_transmission: vec3f,
 }
 
 @group(0) @binding(0) var<uniform> frame: SamplingFrame;
@@ -46,6 +47,7 @@ fn harness_surface() -> SurfacePoint {
     s.transmission = vec3f(0.0);
     s.emission = vec3f(0.0);
     s.uniform_diffuse = frame.uniform_diffuse != 0u;
+    s.diffuse_transmission = frame.diffuse_transmission;
     return s;
 }
 
