@@ -307,4 +307,114 @@ mod tests {
             "variance {uni_var}, expected {expected}"
         );
     }
+
+    /// A surface of Lambert `diffuse`, diffuse transmission `td` and no
+    /// specular (whose albedo has no closed form).
+    fn translucent(diffuse: Vec3, td: Vec3) -> Surface {
+        Surface {
+            diffuse,
+            specular: Vec3::ZERO,
+            alpha: Surface::alpha_for(0.5),
+            mirror: 0.0,
+            diffuse_transmission: td,
+            uniform_diffuse: false,
+        }
+    }
+
+    /// The sphere of directions in `n × n` cells equal in solid angle
+    /// (uniform in cos θ about +z and in φ): each cell's centre and its
+    /// solid angle.
+    fn sphere_cells(n: usize) -> impl Iterator<Item = (Vec3, f32)> {
+        let d_omega = 4.0 * PI / (n * n) as f32;
+        (0..n * n).map(move |k| {
+            let cos_t = -1.0 + 2.0 * ((k / n) as f32 + 0.5) / n as f32;
+            let phi = 2.0 * PI * ((k % n) as f32 + 0.5) / n as f32;
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            (
+                Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t),
+                d_omega,
+            )
+        })
+    }
+
+    /// Over the whole sphere, f·|cos| integrates to diffuse + TD (the
+    /// reflected and the transmitted albedo) and the sampling pdf to 1,
+    /// at normal and oblique incidence; the transmitted half alone to TD.
+    #[test]
+    fn diffuse_and_transmission_integrate_to_their_albedos() {
+        let s = translucent(Vec3::new(0.2, 0.3, 0.1), Vec3::new(0.5, 0.1, 0.4));
+        for wo in [Vec3::Z, Vec3::new(0.8, 0.0, 0.6)] {
+            let (mut albedo, mut through, mut pdf) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+            for (wi, d_omega) in sphere_cells(400) {
+                let e = eval_bsdf(&s, Vec3::Z, wo, wi);
+                albedo += e.f_cos * d_omega;
+                if wi.z < 0.0 {
+                    through += e.f_cos * d_omega;
+                }
+                pdf += e.pdf * d_omega;
+            }
+            let expected = s.diffuse + s.diffuse_transmission;
+            assert!(
+                (albedo - expected).abs().max_element() < 1e-4,
+                "{albedo} vs {expected}"
+            );
+            assert!(
+                (through - s.diffuse_transmission).abs().max_element() < 1e-4,
+                "{through}"
+            );
+            assert!((pdf - 1.0).abs() < 1e-4, "∫ pdf = {pdf}");
+        }
+    }
+
+    /// Sampling: the transmission lobe is chosen with the chance of its
+    /// share of the albedo and its directions lie across the surface; with
+    /// grey lobes chosen by albedo every sample weighs exactly diffuse +
+    /// TD, and each sample's pdf is the one `eval_bsdf` gives it.
+    #[test]
+    fn sampling_picks_the_transmission_lobe_by_its_albedo() {
+        let s = translucent(Vec3::splat(0.2), Vec3::splat(0.6));
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let n = 200_000;
+        let mut across = 0usize;
+        for _ in 0..n {
+            let b = sample_bsdf(
+                &s,
+                Vec3::Z,
+                wo,
+                [uniform(), uniform(), uniform(), uniform()],
+            );
+            if !b.valid {
+                continue;
+            }
+            let e = eval_bsdf(&s, Vec3::Z, wo, b.wi);
+            assert!((b.pdf - e.pdf).abs() <= 1e-5 * e.pdf, "{b:?} vs {e:?}");
+            across += usize::from(b.wi.z < 0.0);
+            assert!(
+                (b.weight - Vec3::splat(0.8)).abs().max_element() < 1e-5,
+                "{b:?}"
+            );
+        }
+        let share = across as f64 / n as f64;
+        assert!(
+            (share - 0.75).abs() < 0.005,
+            "transmitted share {share}, expected 0.75"
+        );
+    }
+
+    /// Without TD nothing crosses: a direction across the surface has no
+    /// value and no density, so opaque surfaces are unchanged.
+    #[test]
+    fn without_transmission_nothing_crosses() {
+        let s = translucent(Vec3::splat(0.8), Vec3::ZERO);
+        let e = eval_bsdf(&s, Vec3::Z, Vec3::Z, Vec3::new(0.0, 0.6, -0.8));
+        assert_eq!((e.f_cos, e.pdf), (Vec3::ZERO, 0.0));
+        assert_eq!(lobe_probabilities(&s), (0.0, 0.0));
+    }
 }

@@ -531,6 +531,7 @@ mod tests {
         assert_eq!(m.roughness, Texture::scalar(0.3));
         assert_eq!(m.mirror, Texture::scalar(0.25));
         assert_eq!(m.opacity, Texture::scalar(1.0));
+        assert_eq!(m.diffuse_transmission, Texture::color(Vec3::ZERO));
         assert!(!m.has_opacity() && !m.has_emission());
     }
 

@@ -461,6 +461,67 @@ mod tests {
         assert!(notes.len() >= 3, "{notes:?}");
     }
 
+    /// The ground's (u, v): world (x, z) without a frame; with an oblique
+    /// frame (the report's APTX), the coefficients of the point on its
+    /// axes, at points built from known coefficients.
+    #[test]
+    fn the_ground_reads_uv_from_its_frame() {
+        let mut ground = Ground::default();
+        assert_eq!(
+            ground.uv(Vec3::new(1.5, 0.0, -2.25)),
+            glam::Vec2::new(1.5, -2.25)
+        );
+        let frame = UvFrame {
+            origin: Vec3::new(1.0, 0.0, -0.5),
+            u_axis: Vec3::new(2.0, 0.0, 0.5),
+            v_axis: Vec3::new(-0.5, 0.0, 1.5),
+        };
+        ground.uv_frame = Some(frame);
+        for (a, b) in [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (0.25, 0.75),
+            (-3.0, 2.5),
+        ] {
+            let p = frame.origin + a * frame.u_axis + b * frame.v_axis;
+            let uv = ground.uv(p);
+            assert!(
+                (uv - glam::Vec2::new(a, b)).abs().max_element() < 1e-5,
+                "({a}, {b}): {uv}"
+            );
+        }
+    }
+
+    /// A ground frame whose axes are parallel, zero or not finite is
+    /// refused with a note, leaving world (x, z).
+    #[test]
+    fn a_degenerate_ground_frame_is_refused() {
+        for (u, v) in [
+            (Vec3::X, Vec3::X * 3.0),
+            (Vec3::ZERO, Vec3::Z),
+            (Vec3::X, Vec3::new(f32::NAN, 0.0, 1.0)),
+        ] {
+            let mut scene = Scene {
+                ground: Some(Ground {
+                    uv_frame: Some(UvFrame {
+                        origin: Vec3::ZERO,
+                        u_axis: u,
+                        v_axis: v,
+                    }),
+                    ..Ground::default()
+                }),
+                ..Default::default()
+            };
+            let notes = scene.sanitize();
+            assert_eq!(scene.ground.unwrap().uv_frame, None);
+            assert!(
+                notes.iter().any(|n| n.contains("ground: uv frame refused")),
+                "{notes:?}"
+            );
+        }
+    }
+
     #[test]
     fn a_scene_at_the_limit_keeps_every_sphere() {
         let mut scene = Scene {

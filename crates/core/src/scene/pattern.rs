@@ -195,7 +195,9 @@ impl TextureMapping {
     /// The map from the frame's coordinates (a, b, c) to space: the columns
     /// u, v, w and the origin. None for a frame that spans no volume.
     pub fn frame_to_space(frame: &UvFrame) -> Option<Affine3A> {
-        frame.problem()?;
+        if frame.problem().is_some() {
+            return None;
+        }
         let (u, v) = (frame.u_axis, frame.v_axis);
         let w = u.cross(v).normalize() * (u.length() * v.length()).sqrt();
         let m = Affine3A::from_cols(u.into(), v.into(), w.into(), frame.origin.into());
@@ -633,4 +635,118 @@ fn sanitize_fractal(f: &mut FractalParams, what: &str, notes: &mut Vec<String>) 
         FractalParams::DISTORTION,
         d.distortion,
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Scene, Sphere, Texture};
+
+    fn frame() -> UvFrame {
+        UvFrame {
+            origin: Vec3::new(0.3, -0.2, 0.1),
+            u_axis: Vec3::new(0.8, 0.3, 0.0),
+            v_axis: Vec3::new(0.2, 1.2, 0.4),
+        }
+    }
+
+    /// ATX3D: the texture point of origin + a·u + b·v + c·w is (a, b, c),
+    /// w being u × v normalised to length √(|u|·|v|); the transform then
+    /// applies to (a, b, c); (u, v) ignore the frame.
+    #[test]
+    fn a_mapping_frame_gives_the_coordinates_on_its_axes() {
+        let f = frame();
+        let w =
+            f.u_axis.cross(f.v_axis).normalize() * (f.u_axis.length() * f.v_axis.length()).sqrt();
+        let mut mapping = TextureMapping {
+            frame: Some(f),
+            ..TextureMapping::default()
+        };
+        let at = |p: Vec3| SurfacePoint::new(p, Vec2::new(0.25, 0.5));
+        for abc in [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::Z,
+            Vec3::new(-1.5, 0.25, 2.0),
+        ] {
+            let p = f.origin + abc.x * f.u_axis + abc.y * f.v_axis + abc.z * w;
+            let got = mapping.point(&at(p));
+            assert!((got - abc).abs().max_element() < 1e-5, "{abc}: {got}");
+        }
+        mapping.transform.translate = Vec3::new(1.0, 2.0, 3.0);
+        let p = f.origin + 0.5 * f.u_axis;
+        let got = mapping.point(&at(p));
+        assert!(
+            (got - Vec3::new(-0.5, -2.0, -3.0)).abs().max_element() < 1e-5,
+            "{got}"
+        );
+        assert_eq!(mapping.uv(&at(p)), Vec2::new(-0.75, -1.5));
+    }
+
+    /// Equal orthogonal axes keep the texture isotropic: the third axis
+    /// has their length, so a cube of texture stays a cube.
+    #[test]
+    fn an_isotropic_frame_stays_isotropic() {
+        let mapping = TextureMapping {
+            frame: Some(UvFrame {
+                origin: Vec3::ZERO,
+                u_axis: Vec3::new(0.0, 0.0, 2.0),
+                v_axis: Vec3::new(2.0, 0.0, 0.0),
+            }),
+            ..TextureMapping::default()
+        };
+        let m = mapping.point_map().matrix3;
+        for axis in [m.x_axis, m.y_axis, m.z_axis] {
+            assert!((axis.length() - 0.5).abs() < 1e-6, "{axis}");
+        }
+        assert_eq!(
+            mapping
+                .point(&SurfacePoint::new(Vec3::Y * 2.0, Vec2::ZERO))
+                .z,
+            1.0
+        );
+    }
+
+    /// A frame that spans no volume is refused by `Scene::sanitize` with a
+    /// note naming the texture, and until then reads as no frame: finite.
+    #[test]
+    fn a_degenerate_mapping_frame_is_refused_and_never_gives_nan() {
+        for (u, v) in [
+            (Vec3::X, Vec3::X * -2.0),
+            (Vec3::ZERO, Vec3::Y),
+            (Vec3::X, Vec3::splat(f32::INFINITY)),
+            (Vec3::splat(1e30), Vec3::new(1e30, -1e30, 0.0)),
+        ] {
+            let degenerate = TextureMapping {
+                frame: Some(UvFrame {
+                    origin: Vec3::ZERO,
+                    u_axis: u,
+                    v_axis: v,
+                }),
+                ..TextureMapping::default()
+            };
+            let p = degenerate.point(&SurfacePoint::new(Vec3::new(1.0, 2.0, 3.0), Vec2::ZERO));
+            assert_eq!(p, Vec3::new(1.0, 2.0, 3.0), "{u} {v}");
+            assert!(degenerate.rows().iter().flatten().all(|x| x.is_finite()));
+            let mut texture = Texture::blend(Pattern::Checker { size: 0.5 }, Vec3::ZERO, Vec3::ONE);
+            texture.mapping = Some(degenerate);
+            let mut sphere = Sphere::default();
+            sphere.material.diffuse = texture;
+            let mut scene = Scene {
+                spheres: vec![sphere],
+                ..Scene::default()
+            };
+            let notes = scene.sanitize();
+            assert_eq!(
+                scene.spheres[0].material.diffuse.mapping.unwrap().frame,
+                None
+            );
+            assert!(
+                notes.iter().any(|n| n.contains("sphere `sphere` diffuse")
+                    && n.contains("mapping frame refused")),
+                "{notes:?}"
+            );
+        }
+    }
 }
