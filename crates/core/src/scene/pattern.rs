@@ -175,8 +175,8 @@ pub enum MappingSpace {
 pub struct TextureMapping {
     pub space: MappingSpace,
     /// The texture report's ATX3D: the 3D texture point is the coordinates
-    /// (a, b, c) of the surface point in this frame, p = origin + a·u + b·v
-    /// + c·w, before `transform`. The report gives only u and v; w is
+    /// (a, b, c) of the surface point in this frame,
+    /// p = origin + a·u + b·v + c·w, before `transform`. The report gives only u and v; w is
     /// their normalised cross product scaled by √(|u|·|v|), so a frame
     /// whose axes have one length stays isotropic (a cube of the texture
     /// stays a cube) and an oblique or stretched one scales its third axis
