@@ -651,6 +651,7 @@ proptest! {
         let mut setup = setup;
         setup.surface.diffuse = Vec3::splat(0.7);
         setup.surface.specular = Vec3::ZERO;
+        setup.surface.diffuse_transmission = Vec3::ZERO;
         let total = hemisphere_integral(&setup, 10.0);
         prop_assert!((total - 1.0).abs() < 1e-4, "∫ pdf dω = {total}");
     }
