@@ -15,6 +15,7 @@ pub mod lights;
 pub mod mis;
 pub mod noise;
 pub mod obj_loader;
+pub mod obj_scene;
 pub mod obj_syntax;
 pub mod preset;
 pub mod scene;

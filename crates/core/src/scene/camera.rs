@@ -29,6 +29,10 @@ impl Default for OrbitCamera {
     }
 }
 
+/// The fraction of the image's half-height (and half-width) a framed box
+/// may reach: [`OrbitCamera::framing`] leaves the rest as a margin.
+const FRAMING_FILL: f32 = 0.9;
+
 /// A named camera the preset keeps (the lab's saved orbiter): keys 1–9
 /// recall the first nine.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -76,6 +80,39 @@ impl OrbitCamera {
             up,
             forward,
             tan_half_fov: (self.fov_degrees.clamp(1.0, 170.0).to_radians() * 0.5).tan(),
+        }
+    }
+
+    /// The camera turned as `self` (yaw, pitch, field of view) that looks
+    /// at the centre of the box `lo`..`hi` from the nearest distance at
+    /// which all eight corners fall inside the central 90 % of an image of
+    /// width / height `aspect` (so the box is whole, centred, with a thin
+    /// margin). Each corner gives the distance at which it touches the
+    /// image's edge; the farthest of these wins.
+    pub fn framing(&self, lo: Vec3, hi: Vec3, aspect: f32) -> OrbitCamera {
+        let centre = (lo + hi) * 0.5;
+        let half = (hi - lo) * 0.5;
+        let f = OrbitCamera {
+            target: centre,
+            ..*self
+        }
+        .frame();
+        let tan_y = f.tan_half_fov * FRAMING_FILL;
+        let tan_x = tan_y * aspect.max(1e-3);
+        let mut distance = Self::MIN_DISTANCE;
+        for corner in 0..8 {
+            let pick = |bit: u32| if corner & (1 << bit) == 0 { -1.0 } else { 1.0 };
+            let p = half * Vec3::new(pick(0), pick(1), pick(2));
+            // The corner's depth is `distance + p·forward`; it is inside
+            // the image when |p·right| ≤ depth·tan_x and |p·up| ≤ depth·tan_y.
+            let ahead = p.dot(f.forward);
+            let needed = (p.dot(f.right).abs() / tan_x).max(p.dot(f.up).abs() / tan_y) - ahead;
+            distance = distance.max(needed);
+        }
+        OrbitCamera {
+            target: centre,
+            distance,
+            ..*self
         }
     }
 
