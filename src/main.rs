@@ -27,6 +27,11 @@ struct ViewerArgs {
     /// Preset to open (default: presets/default.ron).
     #[arg(long)]
     preset: Option<PathBuf>,
+    /// OBJ file to open as a new, unsaved scene: framed by the camera,
+    /// with its MTL materials, and a default light if no material emits
+    /// (Save then asks where to write the preset; the OBJ is never written).
+    #[arg(long, value_name = "FILE", conflicts_with = "preset", value_parser = parse_obj_path)]
+    obj: Option<PathBuf>,
     /// Environment map to use instead of the preset's.
     #[arg(long)]
     env: Option<PathBuf>,
@@ -78,6 +83,22 @@ enum Command {
     Soak(soak::SoakArgs),
 }
 
+/// `--obj`'s file: one ending in `.obj` (any case), which the viewer
+/// opens as a mesh wherever it comes from (and reopens at the next start).
+fn parse_obj_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    {
+        Ok(path)
+    } else {
+        Err(format!(
+            "{text}: not an OBJ file (the name must end in .obj)"
+        ))
+    }
+}
+
 fn main() -> ExitCode {
     marbre::heap::limit_arenas();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
@@ -92,6 +113,7 @@ fn main() -> ExitCode {
         Some(Command::Soak(args)) => soak::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {
             preset: cli.viewer.preset,
+            obj: cli.viewer.obj,
             env: cli.viewer.env,
             exit_after_frames: cli.viewer.exit_after_frames,
             window_screenshot: cli.viewer.window_screenshot,

@@ -4,6 +4,14 @@
 //! The camera is left out of that comparison, as it is of the undo history:
 //! orbiting is looking, not editing, so it never asks "save changes?". A
 //! camera saved on purpose goes in with the next Save.
+//!
+//! A scene opened from an OBJ file is a new preset that has no file yet:
+//! its document's path is the OBJ (what it was opened from, watched for
+//! outside edits, reopened at the next start), and Save never writes
+//! there. It asks where instead, suggesting `<name>.ron` beside the OBJ
+//! ([`Document::save_as_suggestion`]), as Blender's Save does for an
+//! imported file never saved; [`Document::save`] refuses to write a preset
+//! over an OBJ or MTL file whatever the route.
 
 use marbre_core::preset::{self, Header, Preset, PresetError};
 use marbre_core::scene::Scene;
@@ -41,9 +49,30 @@ impl Document {
         *scene != self.saved
     }
 
+    /// Whether the document is a preset file Save writes to; false for a
+    /// scene opened from an OBJ file and not saved as a preset yet.
+    pub fn has_preset_file(&self) -> bool {
+        has_extension(&self.path, &["ron"])
+    }
+
+    /// Where Save as suggests writing: the preset itself, or for a scene
+    /// opened from an OBJ file `<name>.ron` beside it.
+    pub fn save_as_suggestion(&self) -> PathBuf {
+        self.path.with_extension("ron")
+    }
+
     /// Saves `scene` to `path` atomically; from then on the document is
-    /// that file, clean.
+    /// that file, clean. An OBJ or MTL file is never overwritten.
     pub fn save(&mut self, scene: &Scene, path: &Path) -> Result<(), PresetError> {
+        if has_extension(path, &["obj", "mtl"]) {
+            return Err(PresetError::Write {
+                path: path.to_owned(),
+                cause: std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "a preset is never written over an OBJ or MTL file; save it as a .ron file",
+                ),
+            });
+        }
         let preset = self.preset(scene);
         let text = preset::to_text(&preset, path)?;
         marbre_core::atomic_write::write_atomic(path, text.as_bytes()).map_err(|cause| {
@@ -68,6 +97,13 @@ impl Document {
     pub fn changed_on_disk(&self) -> bool {
         std::fs::read_to_string(&self.path).ok() != self.saved_text
     }
+}
+
+/// Whether `path` ends in one of `extensions` (lower case), in any case.
+fn has_extension(path: &Path, extensions: &[&str]) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| extensions.contains(&e.to_ascii_lowercase().as_str()))
 }
 
 #[cfg(test)]
@@ -133,5 +169,34 @@ mod tests {
         assert_eq!(loaded.scene.render.display.exposure, 2.0);
         std::fs::write(&path, "(description: \"edited outside\")").unwrap();
         assert!(document.changed_on_disk());
+    }
+
+    /// A scene opened from an OBJ file has no preset file: Save as
+    /// suggests a .ron beside it, and no route writes over the OBJ.
+    #[test]
+    fn a_scene_opened_from_an_obj_never_overwrites_it() {
+        let dir = tempfile::Builder::new()
+            .prefix("document-obj")
+            .tempdir()
+            .unwrap();
+        let obj = dir.path().join("Cube.OBJ");
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        std::fs::write(&obj, text).unwrap();
+        let scene = Scene::default();
+        let mut document = Document::new(&obj, Header::default(), &scene);
+        assert!(!document.has_preset_file());
+        assert!(!document.is_dirty(&scene), "nothing to lose yet");
+        assert_eq!(document.save_as_suggestion(), dir.path().join("Cube.ron"));
+        let e = document.save(&scene, &obj).unwrap_err().to_string();
+        assert!(e.contains("Cube.OBJ") && e.contains("never written"), "{e}");
+        let mtl = dir.path().join("cube.mtl");
+        assert!(document.save(&scene, &mtl).is_err());
+        assert!(!mtl.exists());
+        assert_eq!(std::fs::read_to_string(&obj).unwrap(), text);
+        let preset = document.save_as_suggestion();
+        document.save(&scene, &preset).unwrap();
+        assert!(document.has_preset_file());
+        assert_eq!(document.path, preset);
+        assert_eq!(std::fs::read_to_string(&obj).unwrap(), text);
     }
 }

@@ -48,9 +48,12 @@ impl OpenDialog {
                 dialog = dialog.set_directory(dir);
             }
             let chosen = match purpose {
+                // An OBJ file opens as a new scene around the mesh.
                 DialogPurpose::OpenPreset => dialog
-                    .set_title("Open preset")
+                    .set_title("Open preset or OBJ file")
+                    .add_filter("marbre preset or OBJ mesh", &["ron", "obj"])
                     .add_filter("marbre preset", &["ron"])
+                    .add_filter("OBJ mesh", &["obj"])
                     .pick_file(),
                 DialogPurpose::SavePresetAs => {
                     let name = start

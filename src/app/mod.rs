@@ -42,6 +42,9 @@ use winit::window::{Window, WindowId};
 #[derive(Debug, Clone, Default)]
 pub struct ViewerOptions {
     pub preset: Option<PathBuf>,
+    /// An OBJ file to open as a new scene instead of a preset
+    /// (`marbre_core::obj_scene`).
+    pub obj: Option<PathBuf>,
     pub env: Option<PathBuf>,
     pub exit_after_frames: Option<u64>,
     pub window_screenshot: Option<PathBuf>,

@@ -18,7 +18,7 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
                 .hint_text("presets/scene.ron")
                 .desired_width(f32::INFINITY),
         )
-        .on_hover_text("Preset file (RON) used by Load and Save as; Enter loads it");
+        .on_hover_text("Preset file (RON) used by Load and Save as; Enter loads it (an .obj opens as a new scene)");
     if std::mem::take(&mut state.focus_preset_path) {
         field.request_focus();
     }
@@ -36,7 +36,9 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         }
         if ui
             .button("Open…")
-            .on_hover_text("Pick a preset in a file dialog (Ctrl+O)")
+            .on_hover_text(
+                "Pick a preset, or an OBJ file to open as a new scene, in a file dialog (Ctrl+O)",
+            )
             .clicked()
         {
             actions.push(PanelAction::BrowsePreset);
@@ -47,7 +49,7 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         if ui
             .button("Save")
             .on_hover_text(
-                "Overwrite the preset file the scene was loaded from or last saved to (Ctrl+S)",
+                "Overwrite the preset file the scene was loaded from or last saved to (Ctrl+S); a scene opened from an OBJ file asks where",
             )
             .clicked()
         {

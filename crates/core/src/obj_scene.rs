@@ -53,7 +53,10 @@ pub fn scene_from_obj(path: &Path, aspect: f32) -> Result<ObjScene, ObjError> {
 pub fn scene_around(path: &Path, loaded: LoadedObj, aspect: f32) -> ObjScene {
     let mut notes = loaded.notes;
     // The loader never returns a mesh without triangles.
-    let (lo, hi) = loaded.triangles.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    let (lo, hi) = loaded
+        .triangles
+        .bounds()
+        .unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let name = path
         .file_stem()
         .map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned());
@@ -157,7 +160,10 @@ mod tests {
             let corners = project(&camera, aspect, lo, hi);
             for &(x, y, depth) in &corners {
                 assert!(depth > 0.0, "{corners:?}");
-                assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "aspect {aspect}: {corners:?}");
+                assert!(
+                    x.abs() <= 1.0 && y.abs() <= 1.0,
+                    "aspect {aspect}: {corners:?}"
+                );
             }
             // A sensible distance: the box fills most of the image along
             // its tighter axis rather than being a speck.
@@ -208,7 +214,8 @@ mod tests {
     /// distance (3.9).
     #[test]
     fn the_cornell_box_opens_like_its_preset() {
-        let path = Path::new(crate::REPO).join("presets/scenes/cornell-box/CornellBox-Original.obj");
+        let path =
+            Path::new(crate::REPO).join("presets/scenes/cornell-box/CornellBox-Original.obj");
         let opened = scene_from_obj(&path, 16.0 / 9.0).unwrap();
         assert!(opened.notes.is_empty(), "{:?}", opened.notes);
         let scene = opened.scene;

@@ -92,20 +92,61 @@ pub fn prepare_scene(scene: Scene, notes: Vec<String>) -> Result<LoadedScene> {
     prepare_scene_reporting(scene, notes, &mut |_| {})
 }
 
+/// The scene [`marbre_core::obj_scene`] makes around the OBJ file at
+/// `obj_path` (framed for an image of width / height `aspect`), with
+/// `env_override` in place of its environment if given, and what it reads
+/// loaded: what the viewer opens from an OBJ file. `report` is called as
+/// each stage starts (the meshes first: there is no preset to read).
+pub fn load_obj_reporting(
+    obj_path: &Path,
+    aspect: f32,
+    env_override: Option<&Path>,
+    report: &mut dyn FnMut(LoadStage),
+) -> Result<LoadedScene> {
+    report(LoadStage::Meshes);
+    let opened = marbre_core::obj_scene::scene_from_obj(obj_path, aspect)?;
+    let mut scene = opened.scene;
+    if let Some(env) = env_override {
+        scene.environment.source = EnvSource::LatLong {
+            path: env.to_owned(),
+        };
+    }
+    let mut notes = opened.notes;
+    let env = load_scene_environment(&scene, &mut notes)?;
+    finish_scene(scene, env, notes, report)
+}
+
 fn prepare_scene_reporting(
     mut scene: Scene,
     mut notes: Vec<String>,
     report: &mut dyn FnMut(LoadStage),
 ) -> Result<LoadedScene> {
     report(LoadStage::Environment);
+    let env = load_scene_environment(&scene, &mut notes)?;
+    report(LoadStage::Meshes);
+    marbre_core::obj_loader::load_meshes(&mut scene, &mut notes)?;
+    finish_scene(scene, env, notes, report)
+}
+
+/// The environment image `scene` names, its notes added to `notes`.
+fn load_scene_environment(scene: &Scene, notes: &mut Vec<String>) -> Result<Option<EnvImage>> {
     // A cube map arrives resampled to lat-long (`cubemap::load_source`).
-    let env =
+    Ok(
         cubemap::load_source(&scene.environment.source, scene.environment.ldr_images)?.map(|l| {
             notes.extend(l.notes);
             l.image
-        });
-    report(LoadStage::Meshes);
-    marbre_core::obj_loader::load_meshes(&mut scene, &mut notes)?;
+        }),
+    )
+}
+
+/// The last stages of a load, once the meshes are in: clamping what they
+/// brought, and the images.
+fn finish_scene(
+    mut scene: Scene,
+    env: Option<EnvImage>,
+    mut notes: Vec<String>,
+    report: &mut dyn FnMut(LoadStage),
+) -> Result<LoadedScene> {
     // The meshes' materials arrive with their files: clamp them as the
     // preset's own were.
     notes.extend(scene.sanitize());

@@ -1,6 +1,7 @@
-//! Files in and out of the viewer: presets and environment maps (typed,
-//! dropped, picked in a dialog or from the recent list), saves, hot reload,
-//! and the answers to the prompts that guard unsaved edits.
+//! Files in and out of the viewer: presets, OBJ files (each opened as a
+//! new scene) and environment maps (typed, dropped, picked in a dialog or
+//! from the recent list), saves, hot reload, and the answers to the
+//! prompts that guard unsaved edits.
 //!
 //! Every load builds the new scene aside and installs it only if all of it
 //! loaded, so a bad file leaves the scene on screen as it was and says why
@@ -13,10 +14,10 @@ use crate::app::file_watch::{FileWatch, is_same_file};
 use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
-use crate::app::scene_loader::{ReadyScene, SceneLoad};
+use crate::app::scene_loader::{FileKind, ReadyScene, SceneKind, SceneLoad};
 use anyhow::{Context as _, Result};
 use marbre_core::envmap;
-use marbre_core::preset;
+use marbre_core::preset::{self, Header};
 use marbre_core::scene::{EnvSource, LdrImages, OrbitCamera, Scene};
 use marbre_core::texture::ImageSet;
 use marbre_render::gpu::shader_source;
@@ -25,19 +26,17 @@ use std::path::{Path, PathBuf};
 
 impl Viewer {
     /// A file dropped on the window or picked from the recent list: a
-    /// `.ron` is a preset, anything else an environment map.
+    /// `.ron` is a preset, an `.obj` a new scene around the mesh, anything
+    /// else an environment map ([`FileKind`]).
     pub(super) fn load_dropped(&mut self, path: &Path) {
-        let is_preset = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
-        if is_preset {
-            self.request_load_preset(path);
-        } else {
-            self.load_environment(path);
+        match FileKind::of(path) {
+            FileKind::Preset | FileKind::Obj => self.request_load_preset(path),
+            FileKind::Environment => self.load_environment(path),
         }
     }
 
-    /// Loads `path`, first asking what to do with unsaved edits.
+    /// Loads `path` (a preset, or an OBJ file as a new scene), first
+    /// asking what to do with unsaved edits.
     pub(super) fn request_load_preset(&mut self, path: &Path) {
         if self.edits.document.is_dirty(&self.scene) {
             self.edits.prompt = Some(Prompt::LoadPreset(path.to_owned()));
@@ -46,8 +45,9 @@ impl Viewer {
         }
     }
 
-    /// Starts loading the preset at `path` on a worker thread; the scene
-    /// on screen stays until it has all loaded ([`Viewer::poll_loading`]).
+    /// Starts loading the preset (or OBJ file) at `path` on a worker
+    /// thread; the scene on screen stays until it has all loaded
+    /// ([`Viewer::poll_loading`]).
     pub(super) fn load_preset(&mut self, path: &Path) {
         self.start_loading(path, None);
     }
@@ -55,7 +55,9 @@ impl Viewer {
     /// Starts a load; `keep_view` is the camera to keep if the file's own
     /// camera is the one the preset had (a reload after an outside edit).
     fn start_loading(&mut self, path: &Path, keep_view: Option<KeepView>) {
-        let load = SceneLoad::start(path, None, max_texture_side(&self.ctx));
+        let (w, h) = self.renderer.size();
+        let kind = scene_kind(path, w as f32 / h.max(1) as f32);
+        let load = SceneLoad::start(path, kind, None, max_texture_side(&self.ctx));
         self.incoming.loading = Some((load, keep_view));
     }
 
@@ -63,7 +65,8 @@ impl Viewer {
     /// line's `--env`; until it is in, input is held ([`StartupLoad`]).
     pub(super) fn start_startup_load(&mut self, path: &Path, may_fall_back: bool) {
         let env = self.options.env.as_deref();
-        let load = SceneLoad::start(path, env, max_texture_side(&self.ctx));
+        let kind = scene_kind(path, super::startup_aspect(&self.window));
+        let load = SceneLoad::start(path, kind, env, max_texture_side(&self.ctx));
         self.incoming.loading = Some((load, None));
         self.panel.preset_path = path.display().to_string();
         let startup = self
@@ -152,15 +155,24 @@ impl Viewer {
             self.scene.camera = keep.camera;
         }
         self.edits.preset_camera = loaded.scene.camera;
-        let header = preset::load(path)
-            .map(|l| l.preset.header())
-            .unwrap_or_default();
-        self.edits.document = Document::new(path, header, &self.scene);
-        self.panel.preset_path = path.display().to_string();
+        self.edits.document = Document::new(path, scene_header(path), &self.scene);
         if let EnvSource::LatLong { path } = &self.scene.environment.source {
             self.panel.env_path = path.display().to_string();
         }
         self.panel.info(format!("loaded {}", path.display()));
+        if self.edits.document.has_preset_file() {
+            self.panel.preset_path = path.display().to_string();
+        } else {
+            // The path field holds where Save as writes, as Save suggests.
+            let suggestion = self.edits.document.save_as_suggestion();
+            self.panel.preset_path = suggestion.display().to_string();
+            self.panel.info(format!(
+                "{} is a new preset, not saved yet: Save asks where (suggesting {}); the \
+                 OBJ file is never written",
+                path.display(),
+                suggestion.display()
+            ));
+        }
         for note in loaded.notes {
             self.panel.info(note);
         }
@@ -169,14 +181,11 @@ impl Viewer {
         Ok(())
     }
 
-    /// Remembers `path` in the recent files, and a preset as the one to
-    /// open next time (saved at once, so a crash keeps them).
+    /// Remembers `path` in the recent files, and a preset or OBJ file as
+    /// the one to open next time (saved at once, so a crash keeps them).
     pub(super) fn opened(&mut self, path: &Path) {
         self.settings.remember(path);
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("ron"))
-        {
+        if FileKind::of(path) != FileKind::Environment {
             self.settings.last_preset = self.settings.recent_files.first().cloned();
         }
         self.save_settings();
@@ -261,6 +270,29 @@ impl Viewer {
         }
     }
 
+    /// Save: to the preset file; a scene opened from an OBJ file has none
+    /// yet, so Save asks where (the dialog, or the typed path where none
+    /// can open) and returns false: whatever waited on the save (a load,
+    /// quitting) waits for the user to save and ask again.
+    pub(super) fn save_document(&mut self) -> bool {
+        if self.edits.document.has_preset_file() {
+            let path = self.edits.document.path.clone();
+            return self.save_preset(&path);
+        }
+        self.panel.preset_path = self
+            .edits
+            .document
+            .save_as_suggestion()
+            .display()
+            .to_string();
+        self.panel.info(format!(
+            "{} is not a preset: choose where to save the scene as one",
+            self.edits.document.path.display()
+        ));
+        self.open_dialog(DialogPurpose::SavePresetAs);
+        false
+    }
+
     /// Saves the scene to `path` (atomically); returns whether it saved.
     pub(super) fn save_preset(&mut self, path: &Path) -> bool {
         match self.edits.document.save(&self.scene, path) {
@@ -297,7 +329,8 @@ impl Viewer {
         }
         let start = match purpose {
             DialogPurpose::OpenEnvironment => self.settings.recent_files.first().cloned(),
-            _ => Some(self.edits.document.path.clone()),
+            DialogPurpose::OpenPreset => Some(self.edits.document.path.clone()),
+            DialogPurpose::SavePresetAs => Some(self.edits.document.save_as_suggestion()),
         };
         self.incoming.dialog = Some(OpenDialog::open(purpose, start));
     }
@@ -326,17 +359,16 @@ impl Viewer {
         let Some(prompt) = self.edits.prompt.take() else {
             return;
         };
-        let path = self.edits.document.path.clone();
         match (prompt, answer) {
             (_, Answer::Cancel) | (Prompt::ReloadFromDisk, Answer::SaveFirst) => {}
             (Prompt::LoadPreset(next), Answer::SaveFirst) => {
-                if self.save_preset(&path) {
+                if self.save_document() {
                     self.load_preset(&next);
                 }
             }
             (Prompt::LoadPreset(next), Answer::Proceed) => self.load_preset(&next),
             (Prompt::Quit, Answer::SaveFirst) => {
-                if self.save_preset(&path) {
+                if self.save_document() {
                     self.quit();
                 }
             }
@@ -482,6 +514,33 @@ impl Viewer {
             }
             Err(e) => self.panel.error(format!("cannot reload shaders: {e:#}")),
         }
+    }
+}
+
+/// How `path` loads as a scene: an `.obj` alone, framed for an image of
+/// width / height `aspect`; anything else as a preset.
+fn scene_kind(path: &Path, aspect: f32) -> SceneKind {
+    match FileKind::of(path) {
+        FileKind::Obj => SceneKind::Obj { aspect },
+        FileKind::Preset | FileKind::Environment => SceneKind::Preset,
+    }
+}
+
+/// The header a document keeps for the preset it may be saved as: the
+/// preset's own, or for an OBJ file where it came from, its colours linear
+/// as the MTL file's are.
+pub(super) fn scene_header(path: &Path) -> Header {
+    match FileKind::of(path) {
+        FileKind::Obj => Header {
+            description: format!(
+                "Opened from {}",
+                path.file_name().unwrap_or_default().to_string_lossy()
+            ),
+            ..Header::default()
+        },
+        FileKind::Preset | FileKind::Environment => preset::load(path)
+            .map(|l| l.preset.header())
+            .unwrap_or_default(),
     }
 }
 

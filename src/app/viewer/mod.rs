@@ -22,7 +22,7 @@ use super::history::History;
 use super::kernel_choice::KernelChooser;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
-use super::scene_loader::SceneLoad;
+use super::scene_loader::{FileKind, SceneKind, SceneLoad, load_reporting};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::soak::SoakDriver;
@@ -30,7 +30,6 @@ use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::panel::{self, PanelAction, PanelState};
 use anyhow::{Context as _, Result};
-use marbre_core::preset;
 use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
 use marbre_render::gpu::pass_timer::PassTimer;
 use marbre_render::gpu::{GpuContext, NonFiniteCounts, Renderer};
@@ -193,16 +192,22 @@ fn held_until_loaded(event: &WindowEvent) -> bool {
     )
 }
 
-/// A scripted run's scene, loaded before the first frame: the preset at
-/// `path`, or if it fails and `may_fall_back`, the default one (`path`
-/// then names it, and `notes` says why).
+/// A scripted run's scene, loaded before the first frame: the preset (or
+/// OBJ file, framed for `aspect`) at `path`, or if it fails and
+/// `may_fall_back`, the default preset (`path` then names it, and `notes`
+/// says why).
 fn load_before_first_frame(
     path: &mut PathBuf,
+    aspect: f32,
     env: Option<&Path>,
     may_fall_back: bool,
     notes: &mut Vec<String>,
 ) -> Result<LoadedScene> {
-    match load_scene(path, env) {
+    let kind = match FileKind::of(path) {
+        FileKind::Obj => SceneKind::Obj { aspect },
+        FileKind::Preset | FileKind::Environment => SceneKind::Preset,
+    };
+    match load_reporting(path, kind, env, &mut |_| {}) {
         Ok(loaded) => Ok(loaded),
         Err(e) if may_fall_back => {
             notes.push(format!("{e:#}; opening the default preset instead"));
@@ -213,10 +218,10 @@ fn load_before_first_frame(
     }
 }
 
-/// The preset to open: the command line's, else the last one (if it still
-/// exists), else the default.
+/// The preset (or OBJ file) to open: the command line's, else the last
+/// one (if it still exists), else the default.
 fn startup_preset(options: &ViewerOptions, settings: &Settings) -> PathBuf {
-    if let Some(path) = &options.preset {
+    if let Some(path) = options.preset.as_ref().or(options.obj.as_ref()) {
         return path.clone();
     }
     settings
@@ -224,6 +229,21 @@ fn startup_preset(options: &ViewerOptions, settings: &Settings) -> PathBuf {
         .clone()
         .filter(|p| p.is_file())
         .unwrap_or_else(default_preset)
+}
+
+/// The image's width / height in a window that shows the panel and the
+/// Quality strip at their opening sizes: what an OBJ file opened at start
+/// is framed for, before the first frame has laid the image out.
+fn startup_aspect(window: &Window) -> f32 {
+    let size = window.inner_size();
+    let scale = window.scale_factor() as f32;
+    let (w, h) = (size.width as f32, size.height as f32);
+    let (image_w, image_h) = (w - PANEL_WIDTH * scale, h - QUALITY_HEIGHT * scale);
+    if image_w >= 1.0 && image_h >= 1.0 {
+        image_w / image_h
+    } else {
+        w / h.max(1.0)
+    }
 }
 
 /// The default preset: in the working folder (a checkout, as the README
@@ -244,7 +264,8 @@ impl Viewer {
         config_dir: Option<PathBuf>,
     ) -> Result<Self> {
         let mut preset_path = startup_preset(&options, &settings);
-        let may_fall_back = options.preset.is_none() && preset_path != default_preset();
+        let may_fall_back =
+            options.preset.is_none() && options.obj.is_none() && preset_path != default_preset();
         // A scripted run counts its frames from the first, so its scene must
         // be there; a person gets the window at once and the scene when it
         // has loaded.
@@ -253,14 +274,12 @@ impl Viewer {
         let (loaded, header) = if scripted {
             let loaded = load_before_first_frame(
                 &mut preset_path,
+                startup_aspect(&window),
                 options.env.as_deref(),
                 may_fall_back,
                 &mut startup_notes,
             )?;
-            let header = preset::load(&preset_path)
-                .map(|l| l.preset.header())
-                .unwrap_or_default();
-            (loaded, header)
+            (loaded, files::scene_header(&preset_path))
         } else {
             (LoadedScene::placeholder(), Default::default())
         };
@@ -311,6 +330,9 @@ impl Viewer {
         let preset_camera = loaded.scene.camera;
         let history = History::new(&loaded.scene);
         let document = Document::new(&preset_path, header, &loaded.scene);
+        if !document.has_preset_file() {
+            panel.preset_path = document.save_as_suggestion().display().to_string();
+        }
         // A soak's thousands of edits are not the user's work: nothing of
         // it is autosaved or remembered.
         let config_dir = config_dir.filter(|_| options.soak.is_none());
@@ -529,7 +551,7 @@ impl Viewer {
             match action {
                 PanelAction::LoadPreset(p) => self.request_load_preset(&p),
                 PanelAction::SavePreset => {
-                    self.save_preset(&self.edits.document.path.clone());
+                    self.save_document();
                 }
                 PanelAction::SavePresetAs(p) => {
                     self.save_preset(&p);
@@ -580,7 +602,7 @@ impl Viewer {
                 Shortcut::Undo => self.step_history(true),
                 Shortcut::Redo => self.step_history(false),
                 Shortcut::Save => {
-                    self.save_preset(&self.edits.document.path.clone());
+                    self.save_document();
                 }
                 Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
                 Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
