@@ -37,9 +37,11 @@ const LIGHT_DIRECTION: Vec3 = Vec3::new(0.6, 1.0, 0.8);
 const LIGHT_DISTANCE_RADII: f32 = 3.0;
 /// The irradiance the default light gives at the mesh's centre, facing it:
 /// a white Lambertian surface (albedo 0.8) facing it then has radiance
-/// 0.8 · 3 / π ≈ 0.76, bright but not clipped at the default exposure.
-const LIGHT_IRRADIANCE: f32 = 3.0;
-/// The fill sky's radiance: a tenth of the key light's irradiance / π.
+/// 0.8 · 2 / π ≈ 0.51, bright but far from clipped at the default
+/// exposure (3 looked washed out on saturated MTL colours).
+const LIGHT_IRRADIANCE: f32 = 2.0;
+/// The fill sky's radiance: its irradiance on an upward face, π · 0.1,
+/// is about a sixth of the key light's.
 const FILL_RADIANCE: f32 = 0.1;
 
 /// Reads the OBJ file at `path` (and its MTL) into a scene framed for an
