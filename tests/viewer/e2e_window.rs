@@ -36,20 +36,20 @@ use std::time::{Duration, Instant};
 use crate::REPO;
 
 /// The side panel's left edge at the default window size.
-const PANEL_LEFT: i32 = 900;
+pub(crate) const PANEL_LEFT: i32 = 900;
 /// Height of a folded section header, in pixels.
 const HEADER_STEP: i32 = 23;
 /// How long one step may take to show: a preset load builds a shader
 /// (seconds on lavapipe), and each frame takes about a second.
-const STEP_TIMEOUT: Duration = Duration::from_secs(60);
+pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// Mean luma (0..1) and mean blue-minus-red of the image's central
 /// quarter, and the luma of its top-left corner (background).
 #[derive(Debug, Clone, Copy)]
-struct Look {
-    centre_luma: f64,
-    centre_blue_excess: f64,
-    corner_luma: f64,
+pub(crate) struct Look {
+    pub(crate) centre_luma: f64,
+    pub(crate) centre_blue_excess: f64,
+    pub(crate) corner_luma: f64,
 }
 
 fn look(path: &Path) -> Look {
@@ -93,15 +93,15 @@ fn pngs(folder: &Path) -> Vec<PathBuf> {
     found
 }
 
-struct Session<'a> {
+pub(crate) struct Session<'a> {
     x: &'a xvfb::Xvfb,
-    window: String,
+    pub(crate) window: String,
     screenshots: PathBuf,
     dir: &'a TempDir,
 }
 
 impl Session<'_> {
-    fn run(&self, args: &[&str]) {
+    pub(crate) fn run(&self, args: &[&str]) {
         let out = xdotool(self.x, args);
         assert!(
             out.status.success(),
@@ -110,11 +110,11 @@ impl Session<'_> {
         );
     }
 
-    fn focus(&self) {
+    pub(crate) fn focus(&self) {
         self.run(&["windowfocus", "--sync", &self.window]);
     }
 
-    fn click(&self, x: i32, y: i32) {
+    pub(crate) fn click(&self, x: i32, y: i32) {
         self.run(&["mousemove", &x.to_string(), &y.to_string(), "click", "1"]);
         std::thread::sleep(Duration::from_millis(1500));
     }
@@ -146,7 +146,7 @@ impl Session<'_> {
 
     /// Presses F12 until a screenshot satisfies `wanted`, returning its
     /// look; fails after [`STEP_TIMEOUT`] with the last look seen.
-    fn wait_for(&self, what: &str, wanted: impl Fn(&Look) -> bool) -> Look {
+    pub(crate) fn wait_for(&self, what: &str, wanted: impl Fn(&Look) -> bool) -> Look {
         let start = Instant::now();
         let mut last = None;
         while start.elapsed() < STEP_TIMEOUT {
@@ -177,7 +177,7 @@ impl Session<'_> {
 }
 
 /// Starts the viewer on `preset` and finds its window.
-fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard, Session<'a>) {
+pub(crate) fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard, Session<'a>) {
     let cwd = dir.subdir("cwd");
     let args: Vec<OsString> = vec!["--preset".into(), preset.into()];
     let child = spawn_marbre(x, dir, &cwd, &args);
@@ -200,7 +200,7 @@ fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard,
 }
 
 /// Neither a panic nor a GPU error the viewer did not catch in its log.
-fn assert_clean_log(dir: &TempDir) {
+pub(crate) fn assert_clean_log(dir: &TempDir) {
     let log = marbre_log(dir);
     for bad in ["panicked", "uncaptured GPU error", "Validation Error"] {
         assert!(!log.contains(bad), "marbre's log has {bad:?}:\n{log}");

@@ -285,3 +285,150 @@ pub fn grab_window(x: &Xvfb, window: &str) -> image::RgbImage {
     };
     grab().unwrap_or_else(|e| panic!("reading window {window}'s pixels: {e}"))
 }
+
+/// Drops the file `path` on window `window` (an id as xdotool prints it)
+/// as a file manager does, by the XDND protocol (version 5): this
+/// connection owns `XdndSelection` and offers `text/uri-list`, sends
+/// `XdndEnter` and `XdndPosition` (at the window's centre), hands the URI
+/// over when the window asks for it (winit asks on the position), waits
+/// for `XdndStatus`, then sends `XdndDrop` and waits for `XdndFinished`.
+/// winit turns that into `WindowEvent::DroppedFile`. xdotool has no drag
+/// with data, and Xvfb runs no file manager.
+pub fn drop_file(x: &Xvfb, window: &str, path: &Path) {
+    use x11rb::connection::Connection;
+    use x11rb::protocol::Event;
+    use x11rb::protocol::xproto::{
+        ClientMessageEvent, ConnectionExt, CreateWindowAux, EventMask, PropMode,
+        SELECTION_NOTIFY_EVENT, SelectionNotifyEvent, WindowClass,
+    };
+    use x11rb::wrapper::ConnectionExt as _;
+
+    let send = || -> Result<(), Box<dyn std::error::Error>> {
+        let target: u32 = window.trim().parse()?;
+        let (conn, screen) = x11rb::connect(Some(&x.display))?;
+        let root = conn.setup().roots[screen].root;
+        let atom = |name: &str| -> Result<u32, Box<dyn std::error::Error>> {
+            Ok(conn.intern_atom(false, name.as_bytes())?.reply()?.atom)
+        };
+        let [selection, enter, position, status, drop, finished, copy, uri_list] = [
+            "XdndSelection",
+            "XdndEnter",
+            "XdndPosition",
+            "XdndStatus",
+            "XdndDrop",
+            "XdndFinished",
+            "XdndActionCopy",
+            "text/uri-list",
+        ]
+        .map(atom);
+        let (selection, enter, position, status) = (selection?, enter?, position?, status?);
+        let (drop, finished, copy, uri_list) = (drop?, finished?, copy?, uri_list?);
+        let source = conn.generate_id()?;
+        conn.create_window(
+            0,
+            source,
+            root,
+            0,
+            0,
+            1,
+            1,
+            0,
+            WindowClass::INPUT_ONLY,
+            0,
+            &CreateWindowAux::new(),
+        )?;
+        conn.set_selection_owner(source, selection, x11rb::CURRENT_TIME)?;
+        let geometry = conn.get_geometry(target)?.reply()?;
+        let centre = conn
+            .translate_coordinates(
+                target,
+                root,
+                (geometry.width / 2) as i16,
+                (geometry.height / 2) as i16,
+            )?
+            .reply()?;
+        let message = |kind: u32, data: [u32; 5]| -> Result<(), Box<dyn std::error::Error>> {
+            let event = ClientMessageEvent::new(32, target, kind, data);
+            conn.send_event(false, target, EventMask::NO_EVENT, event)?
+                .check()?;
+            Ok(())
+        };
+        // Version 5, at most three types (no XdndTypeList), the first ours.
+        message(enter, [source, 5 << 24, uri_list, 0, 0])?;
+        let at = ((centre.dst_x as u32) << 16) | (centre.dst_y as u16 as u32);
+        message(position, [source, 0, at, x11rb::CURRENT_TIME, copy])?;
+        let uri = format!("file://{}\r\n", percent_encode(path));
+        let deadline = Instant::now() + Duration::from_secs(60);
+        let (mut accepted, mut served, mut dropped) = (false, false, false);
+        while Instant::now() < deadline {
+            let Some(event) = conn.poll_for_event()? else {
+                std::thread::sleep(Duration::from_millis(20));
+                continue;
+            };
+            match event {
+                Event::SelectionRequest(request) if request.selection == selection => {
+                    conn.change_property8(
+                        PropMode::REPLACE,
+                        request.requestor,
+                        request.property,
+                        uri_list,
+                        uri.as_bytes(),
+                    )?;
+                    let notify = SelectionNotifyEvent {
+                        response_type: SELECTION_NOTIFY_EVENT,
+                        sequence: 0,
+                        time: request.time,
+                        requestor: request.requestor,
+                        selection: request.selection,
+                        target: request.target,
+                        property: request.property,
+                    };
+                    conn.send_event(false, request.requestor, EventMask::NO_EVENT, notify)?
+                        .check()?;
+                    served = true;
+                }
+                Event::ClientMessage(reply) if reply.type_ == status => {
+                    if reply.data.as_data32()[1] & 1 == 0 {
+                        return Err("the window refused the drag (XdndStatus)".into());
+                    }
+                    accepted = true;
+                }
+                Event::ClientMessage(reply) if reply.type_ == finished => {
+                    return if reply.data.as_data32()[1] & 1 == 1 {
+                        Ok(())
+                    } else {
+                        Err("the window refused the drop (XdndFinished)".into())
+                    };
+                }
+                _ => {}
+            }
+            // The data is the window's before the drop reaches it: the
+            // selection notice was sent first.
+            if accepted && served && !dropped {
+                message(drop, [source, 0, x11rb::CURRENT_TIME, 0, 0])?;
+                dropped = true;
+            }
+        }
+        Err(format!(
+            "no XdndFinished within 60 s (status received: {accepted}, data served: {served})"
+        )
+        .into())
+    };
+    send().unwrap_or_else(|e| panic!("dropping {} on window {window}: {e}", path.display()));
+}
+
+/// `path` as a file URI's path: bytes other than unreserved ones and `/`
+/// percent-encoded (winit decodes them).
+fn percent_encode(path: &Path) -> String {
+    use std::os::unix::ffi::OsStrExt;
+    path.as_os_str()
+        .as_bytes()
+        .iter()
+        .map(|&b| match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' | b'/' => {
+                (b as char).to_string()
+            }
+            _ => format!("%{b:02X}"),
+        })
+        .collect()
+}
