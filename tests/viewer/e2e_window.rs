@@ -177,7 +177,11 @@ impl Session<'_> {
 }
 
 /// Starts the viewer on `preset` and finds its window.
-pub(crate) fn open<'a>(x: &'a xvfb::Xvfb, dir: &'a TempDir, preset: &Path) -> (xvfb::Guard, Session<'a>) {
+pub(crate) fn open<'a>(
+    x: &'a xvfb::Xvfb,
+    dir: &'a TempDir,
+    preset: &Path,
+) -> (xvfb::Guard, Session<'a>) {
     let cwd = dir.subdir("cwd");
     let args: Vec<OsString> = vec!["--preset".into(), preset.into()];
     let child = spawn_marbre(x, dir, &cwd, &args);

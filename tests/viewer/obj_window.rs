@@ -31,7 +31,10 @@ fn the_cornell_box_opens_from_its_obj_file_alone() {
     cornell_box_in_the_window(
         "cornell-obj",
         "fragment",
-        ["--obj", "presets/scenes/cornell-box/CornellBox-Original.obj"],
+        [
+            "--obj",
+            "presets/scenes/cornell-box/CornellBox-Original.obj",
+        ],
     );
 }
 
@@ -98,8 +101,14 @@ fn a_dropped_obj_becomes_the_scene_and_save_leaves_it_alone() {
         .preset;
     untouched();
     assert_eq!(saved.scene.meshes.len(), 1);
-    assert_eq!(saved.scene.meshes[0].obj, obj, "the preset refers to the OBJ");
-    assert_eq!(saved.scene.point_light, None, "the box's own lamp lights it");
+    assert_eq!(
+        saved.scene.meshes[0].obj, obj,
+        "the preset refers to the OBJ"
+    );
+    assert_eq!(
+        saved.scene.point_light, None,
+        "the box's own lamp lights it"
+    );
     let text = std::fs::read_to_string(&preset).unwrap();
     assert!(
         text.contains("obj: \"CornellBox-Original.obj\""),

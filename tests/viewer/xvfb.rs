@@ -310,7 +310,16 @@ pub fn drop_file(x: &Xvfb, window: &str, path: &Path) {
         let atom = |name: &str| -> Result<u32, Box<dyn std::error::Error>> {
             Ok(conn.intern_atom(false, name.as_bytes())?.reply()?.atom)
         };
-        let [selection, enter, position, status, drop, finished, copy, uri_list] = [
+        let [
+            selection,
+            enter,
+            position,
+            status,
+            drop,
+            finished,
+            copy,
+            uri_list,
+        ] = [
             "XdndSelection",
             "XdndEnter",
             "XdndPosition",
