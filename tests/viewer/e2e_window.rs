@@ -36,7 +36,7 @@ use std::time::{Duration, Instant};
 use crate::REPO;
 
 /// The side panel's left edge at the default window size.
-pub(crate) const PANEL_LEFT: i32 = 900;
+const PANEL_LEFT: i32 = 900;
 /// Height of a folded section header, in pixels.
 const HEADER_STEP: i32 = 23;
 /// How long one step may take to show: a preset load builds a shader

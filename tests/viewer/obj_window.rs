@@ -14,7 +14,7 @@
 //!   file when it is not an OBJ file.
 
 use crate::REPO;
-use crate::e2e_window::{PANEL_LEFT, STEP_TIMEOUT, assert_clean_log, open};
+use crate::e2e_window::{STEP_TIMEOUT, assert_clean_log, open};
 use crate::window::cornell_box_in_the_window;
 use crate::xvfb::{
     TempDir, assert_success, display_or_skip, drop_file, marbre_log, request_close, serial,
@@ -89,9 +89,16 @@ fn a_dropped_obj_becomes_the_scene_and_save_leaves_it_alone() {
     untouched();
     assert!(!preset.exists(), "Save wrote {} unasked", preset.display());
 
-    // The path field holds the suggestion, `<name>.ron` beside the OBJ:
-    // Save as writes it.
-    session.click(PANEL_LEFT + 106, 81);
+    // The path field holds the suggestion, `<name>.ron` beside the OBJ,
+    // and has the focus: Tab past Load, Open…, Recent and Save to Save as
+    // (the panel's width follows its content, so the keyboard finds the
+    // button where a fixed position might not), and Enter presses it. One
+    // key a frame: egui moves the focus once per frame.
+    for _ in 0..5 {
+        session.run(&["key", "Tab"]);
+        std::thread::sleep(Duration::from_millis(800));
+    }
+    session.run(&["key", "Return"]);
     let deadline = Instant::now() + STEP_TIMEOUT;
     while !preset.exists() && Instant::now() < deadline {
         std::thread::sleep(Duration::from_millis(200));
