@@ -43,23 +43,25 @@ pub(super) fn color_button(ui: &mut Ui, color: &mut Vec3) -> Response {
     }
     let shown = color.map(srgb_encode);
     let mut typed = shown;
-    for (prefix, c) in [
-        ("r ", &mut typed.x),
-        ("g ", &mut typed.y),
-        ("b ", &mut typed.z),
+    // Narrow fields, so that a colour row keeps within the panel's width.
+    ui.spacing_mut().interact_size.x = 30.0;
+    ui.spacing_mut().item_spacing.x = 3.0;
+    for (channel, c) in [
+        ("red", &mut typed.x),
+        ("green", &mut typed.y),
+        ("blue", &mut typed.z),
     ] {
         response |= ui
             .add(
                 DragValue::new(c)
                     .speed(0.005)
                     .range(0.0..=f32::MAX)
-                    .max_decimals(4)
-                    .prefix(prefix),
+                    .max_decimals(3),
             )
-            .on_hover_text(
-                "Display (sRGB) value, 0 to 1, as the course documents write colours; \
-                 the renderer uses its linear value",
-            );
+            .on_hover_text(format!(
+                "{channel}, as a display (sRGB) value, 0 to 1, the way the course documents \
+                 write colours; the renderer uses its linear value"
+            ));
     }
     if typed != shown {
         *color = typed.map(srgb_decode);
