@@ -20,6 +20,7 @@ pub mod obj_syntax;
 pub mod preset;
 pub mod scene;
 pub mod texture;
+pub mod tx;
 pub mod wgsl;
 
 /// The repository's root, where the shipped presets, images and env maps

@@ -1,0 +1,189 @@
+//! The TX language's syntax tree: what a TX text says, before it is
+//! lowered onto a material. Numbers are kept as written (colours are
+//! display values, sRGB-encoded), optional parameters as present or absent,
+//! so that printing a parsed text and parsing it again gives an equal tree.
+
+/// An `r g b` triple as written: display (sRGB-encoded) values.
+pub type Rgb = [f32; 3];
+
+/// A coefficient of N3D's `BaseAttributs`, the surface properties a
+/// texture sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Attr {
+    /// `CD`: the diffuse colour.
+    Cd,
+    /// `CS`: the specular colour.
+    Cs,
+    /// `CR`: the perfect mirror's coefficient.
+    Cr,
+    /// `CT`: the transmission coefficient (the light passing through).
+    Ct,
+    /// `TD`: the diffuse transmission coefficient.
+    Td,
+}
+
+impl Attr {
+    pub const ALL: [Attr; 5] = [Attr::Cd, Attr::Cs, Attr::Cr, Attr::Ct, Attr::Td];
+
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Attr::Cd => "CD",
+            Attr::Cs => "CS",
+            Attr::Cr => "CR",
+            Attr::Ct => "CT",
+            Attr::Td => "TD",
+        }
+    }
+
+    pub fn from_keyword(word: &str) -> Option<Attr> {
+        Attr::ALL.into_iter().find(|a| a.keyword() == word)
+    }
+}
+
+/// A `BaseAttributs` list: each coefficient at most once, in the order
+/// written.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Attrs(pub Vec<(Attr, Rgb)>);
+
+impl Attrs {
+    pub fn get(&self, attr: Attr) -> Option<Rgb> {
+        self.0.iter().find(|(a, _)| *a == attr).map(|(_, c)| *c)
+    }
+}
+
+/// One texture of the report's §2.3, closed by its own `FTX`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Tex {
+    /// `UNI attrs FTX`: the attributes everywhere (`UNI FTX` sets nothing).
+    Uni(Attrs),
+    /// `QUAD t1 t2 [GU gu] [GV gv] [DEPHASAGE de] FTX`: a checker of
+    /// 1/gu × 1/gv cells, `t1` in the even ones; each cell is a whole
+    /// texture space for its texture.
+    Quad {
+        even: Box<Tex>,
+        odd: Box<Tex>,
+        gu: Option<f32>,
+        gv: Option<f32>,
+        phase: Option<f32>,
+    },
+    /// `TUILE DMORTIER d DPENTE p NIV3D n centre mortar-attrs FTX`.
+    Tuile {
+        mortar_half_width: f32,
+        slope_width: f32,
+        level: f32,
+        centre: Box<Tex>,
+        mortar: Attrs,
+    },
+    /// `MULT t1 … tn FTX`: the textures applied in order.
+    Mult(Vec<Tex>),
+    /// `IMAGE file attrs FTX`: the image times each attribute's colour.
+    Image { file: String, attrs: Attrs },
+    /// `DECOUPAGE inside outside NBCOTE n [RAYON r] FTX`.
+    Decoupage {
+        inside: Box<Tex>,
+        outside: Box<Tex>,
+        sides: u32,
+        radius: Option<f32>,
+    },
+    /// `NOISE CD1 r g b FREQ f AMPL a FTX`.
+    Noise { color: Rgb, frequency: f32, amplitude: f32 },
+    /// `TURBULENCE CD1 r g b FREQ f AMPL a FTX`.
+    Turbulence { color: Rgb, frequency: f32, amplitude: f32 },
+    /// `BOIS FONCE r g b PALE r g b [RAYON r] [TURB t] FTX`.
+    Bois {
+        dark: Rgb,
+        pale: Rgb,
+        ring_width: Option<f32>,
+        turbulence: Option<f32>,
+    },
+    /// `MARBRE CD1 r g b CD2 r g b FREQ f TURB t FREQTURB ft FTX`.
+    Marbre {
+        dominant: Rgb,
+        veins: Rgb,
+        frequency: f32,
+        turbulence: f32,
+        turbulence_frequency: f32,
+    },
+    /// `BRIQUE brick mortar size_u [size_v] FTX`.
+    Brique {
+        brick: Box<Tex>,
+        mortar: Box<Tex>,
+        size_u: f32,
+        size_v: Option<f32>,
+    },
+    /// `VAGUE frequency amplitude FTX`: sines tilting the normal.
+    Vague { frequency: f32, amplitude: f32 },
+}
+
+/// Which application frame: `ATX … FATX` (a polygon's (u, v)), `APTX …
+/// FAPTX` (a plane's) or `ATX3D … FATX3D` (the 3D texture space).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameKind {
+    Polygon,
+    Plane,
+    Space,
+}
+
+impl FrameKind {
+    pub const ALL: [FrameKind; 3] = [FrameKind::Polygon, FrameKind::Plane, FrameKind::Space];
+
+    pub fn opening(self) -> &'static str {
+        match self {
+            FrameKind::Polygon => "ATX",
+            FrameKind::Plane => "APTX",
+            FrameKind::Space => "ATX3D",
+        }
+    }
+
+    pub fn closing(self) -> &'static str {
+        match self {
+            FrameKind::Polygon => "FATX",
+            FrameKind::Plane => "FAPTX",
+            FrameKind::Space => "FATX3D",
+        }
+    }
+}
+
+/// An application frame: `origin u v`, nine numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub origin: [f32; 3],
+    pub u: [f32; 3],
+    pub v: [f32; 3],
+}
+
+/// A TX text at the attribute level: optional frames, then the texture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Document {
+    pub polygon_frame: Option<Frame>,
+    pub plane_frame: Option<Frame>,
+    pub space_frame: Option<Frame>,
+    pub texture: Tex,
+}
+
+impl Document {
+    pub fn new(texture: Tex) -> Self {
+        Self {
+            polygon_frame: None,
+            plane_frame: None,
+            space_frame: None,
+            texture,
+        }
+    }
+
+    pub fn frame(&self, kind: FrameKind) -> Option<&Frame> {
+        match kind {
+            FrameKind::Polygon => self.polygon_frame.as_ref(),
+            FrameKind::Plane => self.plane_frame.as_ref(),
+            FrameKind::Space => self.space_frame.as_ref(),
+        }
+    }
+
+    pub fn frame_mut(&mut self, kind: FrameKind) -> &mut Option<Frame> {
+        match kind {
+            FrameKind::Polygon => &mut self.polygon_frame,
+            FrameKind::Plane => &mut self.plane_frame,
+            FrameKind::Space => &mut self.space_frame,
+        }
+    }
+}
