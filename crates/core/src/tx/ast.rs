@@ -86,9 +86,17 @@ pub enum Tex {
         radius: Option<f32>,
     },
     /// `NOISE CD1 r g b FREQ f AMPL a FTX`.
-    Noise { color: Rgb, frequency: f32, amplitude: f32 },
+    Noise {
+        color: Rgb,
+        frequency: f32,
+        amplitude: f32,
+    },
     /// `TURBULENCE CD1 r g b FREQ f AMPL a FTX`.
-    Turbulence { color: Rgb, frequency: f32, amplitude: f32 },
+    Turbulence {
+        color: Rgb,
+        frequency: f32,
+        amplitude: f32,
+    },
     /// `BOIS FONCE r g b PALE r g b [RAYON r] [TURB t] FTX`.
     Bois {
         dark: Rgb,

@@ -70,7 +70,8 @@ mod tests {
     #[test]
     fn words_and_numbers_carry_their_line_and_column() {
         let t = tokenize("TX QUAD\n  UNI CD 0.8 -1 .5 FTX\n\tIMAGE a.ppm 1e400");
-        let at: Vec<(Tok, usize, usize)> = t.into_iter().map(|t| (t.tok, t.line, t.column)).collect();
+        let at: Vec<(Tok, usize, usize)> =
+            t.into_iter().map(|t| (t.tok, t.line, t.column)).collect();
         let w = |s: &str| Tok::Word(s.into());
         assert_eq!(
             at,

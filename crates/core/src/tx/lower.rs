@@ -164,11 +164,20 @@ pub fn space_mapping(f: &Frame) -> TextureMapping {
 
 /// Every attribute of `doc` lowered onto `base`, image files resolved
 /// against `base_dir`.
-pub fn lower_document(doc: &Document, base: &Material, base_dir: &Path) -> Result<Lowered, TxError> {
+pub fn lower_document(
+    doc: &Document,
+    base: &Material,
+    base_dir: &Path,
+) -> Result<Lowered, TxError> {
     let mut material = base.clone();
     for channel in Channel::ALL {
-        *channel.texture_mut(&mut material) =
-            lower_channel(doc, channel, channel.texture(base), base_dir, Colors::Linear)?;
+        *channel.texture_mut(&mut material) = lower_channel(
+            doc,
+            channel,
+            channel.texture(base),
+            base_dir,
+            Colors::Linear,
+        )?;
     }
     if sets(&doc.texture, Channel::Bump) {
         material.bump_height = BUMP_HEIGHT;
@@ -285,7 +294,9 @@ fn positive(value: f32, what: &str) -> Result<f32, TxError> {
     if value > 0.0 {
         Ok(value)
     } else {
-        Err(TxError::Lower(format!("{what} must be positive, not {value}")))
+        Err(TxError::Lower(format!(
+            "{what} must be positive, not {value}"
+        )))
     }
 }
 
@@ -379,7 +390,11 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
                 bevel: slope_width.max(0.0),
             };
             if ctx.channel == Channel::Bump {
-                blend(pattern, Child::Scalar(0.0), Child::Scalar(level(*niv3d, "TUILE's NIV3D")?))
+                blend(
+                    pattern,
+                    Child::Scalar(0.0),
+                    Child::Scalar(level(*niv3d, "TUILE's NIV3D")?),
+                )
             } else {
                 let joint = match attr.and_then(|x| mortar.get(x)) {
                     Some(c) => leaf(c, ctx),
@@ -442,7 +457,10 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
         } => blend(
             Pattern::Wood {
                 noise: wood_settings(),
-                ring_width: positive(ring_width.unwrap_or(BOIS_DEFAULT_RING_WIDTH), "BOIS's RAYON")?,
+                ring_width: positive(
+                    ring_width.unwrap_or(BOIS_DEFAULT_RING_WIDTH),
+                    "BOIS's RAYON",
+                )?,
                 turbulence_amount: turbulence.unwrap_or(BOIS_DEFAULT_TURBULENCE),
             },
             leaf(*dark, ctx),

@@ -101,7 +101,13 @@ pub fn apply_to_property(
     let mut lowered = Vec::new();
     for &channel in &channels {
         let base = channel.texture(material);
-        lowered.push(lower_channel(&doc, channel, base, base_dir, Colors::Linear)?);
+        lowered.push(lower_channel(
+            &doc,
+            channel,
+            base,
+            base_dir,
+            Colors::Linear,
+        )?);
     }
     for (channel, texture) in channels.into_iter().zip(lowered) {
         *channel.texture_mut(material) = texture;

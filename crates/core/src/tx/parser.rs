@@ -15,8 +15,9 @@ const MAX_NESTING: usize = 64;
 
 /// Parses a TX text: optional `ATX`, `APTX`, `ATX3D` frames, then `TX
 /// texture FTX` (the `TX` may be left out, as in most of the report's
-/// examples; the outermost texture's `FTX` closes the `TX` too, and may be
-/// left out at the very end, as in its NOISE and TURBULENCE examples).
+/// examples; the outermost texture's `FTX` closes the `TX` too, and after
+/// NOISE or TURBULENCE may be left out at the very end, as in the report's
+/// examples of those two).
 pub fn parse(text: &str) -> Result<Document, TxError> {
     let mut p = Parser {
         toks: tokenize(text),
@@ -26,7 +27,10 @@ pub fn parse(text: &str) -> Result<Document, TxError> {
     let mut frames: Vec<(FrameKind, Frame)> = Vec::new();
     while let Some(kind) = p.peek_word().and_then(frame_kind) {
         if frames.iter().any(|(k, _)| *k == kind) {
-            return Err(p.error_here(&format!("each frame once ({} was given before)", kind.opening())));
+            return Err(p.error_here(&format!(
+                "each frame once ({} was given before)",
+                kind.opening()
+            )));
         }
         p.pos += 1;
         let frame = Frame {
@@ -34,7 +38,10 @@ pub fn parse(text: &str) -> Result<Document, TxError> {
             u: p.rgb(&format!("the u vector of {}", kind.opening()))?,
             v: p.rgb(&format!("the v vector of {}", kind.opening()))?,
         };
-        p.expect_word(kind.closing(), &format!("{} closing {}", kind.closing(), kind.opening()))?;
+        p.expect_word(
+            kind.closing(),
+            &format!("{} closing {}", kind.closing(), kind.opening()),
+        )?;
         frames.push((kind, frame));
     }
     if p.peek_word() == Some("TX") {
@@ -42,7 +49,12 @@ pub fn parse(text: &str) -> Result<Document, TxError> {
     }
     let texture = p.texture(0)?;
     if let Some(t) = p.peek() {
-        return Err(TxError::syntax(t.line, t.column, "the end of the text", &t.describe()));
+        return Err(TxError::syntax(
+            t.line,
+            t.column,
+            "the end of the text",
+            &t.describe(),
+        ));
     }
     let mut doc = Document::new(texture);
     for (kind, frame) in frames {
@@ -58,7 +70,12 @@ fn frame_kind(word: &str) -> Option<FrameKind> {
 /// Where a message about the end of the text points: just after its last
 /// character.
 fn end_position(text: &str) -> (usize, usize) {
-    match text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()).last() {
+    match text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .last()
+    {
         Some((i, l)) => (i + 1, l.trim_end().chars().count() + 1),
         None => (1, 1),
     }
@@ -117,10 +134,13 @@ impl Parser {
         ])
     }
 
-    /// The `FTX` closing `name`; at the outermost level it may be missing
-    /// at the very end of the text.
+    /// The `FTX` closing `name`. The report's NOISE and TURBULENCE
+    /// examples end without it: after those two, whose parameters are all
+    /// required (so a cut text cannot read as a whole one), the outermost
+    /// `FTX` may be missing at the very end of the text.
     fn close(&mut self, name: &str, depth: usize) -> Result<(), TxError> {
-        if depth == 0 && self.peek().is_none() {
+        let unambiguous = name == "NOISE" || name == "TURBULENCE";
+        if depth == 0 && unambiguous && self.peek().is_none() {
             return Ok(());
         }
         self.expect_word("FTX", &format!("FTX closing {name}"))
@@ -239,7 +259,10 @@ impl Parser {
             }
             "BOIS" => {
                 self.pos += 1;
-                let (dark, pale) = (self.colour_param("FONCE", "BOIS")?, self.colour_param("PALE", "BOIS")?);
+                let (dark, pale) = (
+                    self.colour_param("FONCE", "BOIS")?,
+                    self.colour_param("PALE", "BOIS")?,
+                );
                 let [ring_width, turbulence] = self.params("BOIS", &["RAYON", "TURB"], &[])?;
                 Tex::Bois {
                     dark,
@@ -315,7 +338,10 @@ impl Parser {
 
     /// `keyword r g b`.
     fn colour_param(&mut self, keyword: &str, owner: &str) -> Result<Rgb, TxError> {
-        self.expect_word(keyword, &format!("{keyword} (the colour {owner} needs next)"))?;
+        self.expect_word(
+            keyword,
+            &format!("{keyword} (the colour {owner} needs next)"),
+        )?;
         self.rgb(&format!("{owner}'s {keyword}"))
     }
 

@@ -6,8 +6,7 @@
 use super::TxError;
 use super::ast::{Attr, Attrs, Document, Frame, Rgb, Tex};
 use super::lower::{
-    Channel, brick_mortar, marble_settings, noise_settings, turbulence_settings,
-    wood_settings,
+    Channel, brick_mortar, marble_settings, noise_settings, turbulence_settings, wood_settings,
 };
 use crate::scene::{Child, ColorEncoding, MathOp, Pattern, Texture, TextureMapping};
 use glam::Vec3;
@@ -165,7 +164,9 @@ impl Raiser {
         let image_scale = matches!(t.pattern, Pattern::Image { .. })
             && matches!(t.ops.as_slice(), [] | [MathOp::Scale(_)]);
         if !t.ops.is_empty() && !image_scale {
-            return Err(no_form("a math step (scale, bias, abs, invert, clamp, power)"));
+            return Err(no_form(
+                "a math step (scale, bias, abs, invert, clamp, power)",
+            ));
         }
         let name = Pattern::NAMES[t.pattern.index()];
         let same = |a: &crate::noise::NoiseSettings, b: crate::noise::NoiseSettings, what: &str| {
@@ -190,9 +191,9 @@ impl Raiser {
                 mortar_half_width,
                 bevel,
             } => {
-                let mortar = self
-                    .typed(&t.a)
-                    .ok_or_else(|| no_form("a tile whose mortar is a texture (TUILE's mortar is coefficients)"))?;
+                let mortar = self.typed(&t.a).ok_or_else(|| {
+                    no_form("a tile whose mortar is a texture (TUILE's mortar is coefficients)")
+                })?;
                 Tex::Tuile {
                     mortar_half_width,
                     slope_width: bevel,
@@ -283,7 +284,10 @@ impl Raiser {
                 }
             }
             Pattern::Image { filter, wrap } => {
-                let source = t.image.as_ref().ok_or_else(|| no_form("an image without a file"))?;
+                let source = t
+                    .image
+                    .as_ref()
+                    .ok_or_else(|| no_form("an image without a file"))?;
                 let file = source.path.to_string_lossy().into_owned();
                 if filter != Default::default()
                     || wrap != Default::default()

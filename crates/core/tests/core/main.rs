@@ -3,3 +3,4 @@
 
 mod fuzz_regressions;
 mod perlin_reference;
+mod tx_report;
