@@ -66,27 +66,27 @@ impl Property {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Material {
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::diffuse")]
     pub diffuse: Texture,
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::specular")]
     pub specular: Texture,
     /// GGX roughness (perceptual; α = roughness²), 0 (polished) to 1.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::roughness")]
     pub roughness: Texture,
     /// Fraction of light reflected by a perfect mirror, 0 to 1.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::mirror")]
     pub mirror: Texture,
     /// 1 is solid; below, a ray passes straight through with probability
     /// `1 - opacity` (a cutout's holes), and shadows thin accordingly.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::opacity")]
     pub opacity: Texture,
     /// The colour of the light that passes through where opacity < 1 (MTL's
     /// `Tf`, N3D's transmission coefficients): white keeps it unchanged, a
     /// colour tints what is seen through the surface and its shadow.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::transmission")]
     pub transmission: Texture,
     /// Emitted radiance is this colour times `emission_strength`.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::emission")]
     pub emission: Texture,
     pub emission_strength: f32,
     /// N3D's diffuse transmission TD: a Lambert lobe on the other side of
@@ -96,11 +96,11 @@ pub struct Material {
     /// none. Diffuse + TD should stay ≤ 1 per channel for the surface to
     /// conserve energy: the renderer clamps each to [0, 1] but leaves their
     /// sum to the author.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::diffuse_transmission")]
     pub diffuse_transmission: Texture,
     /// A height field over the surface (its first channel) that tilts the
     /// shading normal: bump mapping. Constant: no bump.
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::bump")]
     pub bump: Texture,
     /// The height, in scene units, of a bump value of 1.
     pub bump_height: f32,
@@ -136,7 +136,7 @@ impl Default for Material {
 pub struct Layer {
     pub name: String,
     /// Where the layer lies, 0 to 1 (first channel).
-    #[serde(with = "property_serde")]
+    #[serde(with = "property_serde::mask")]
     pub mask: Texture,
     #[serde(
         with = "optional_property_serde",
@@ -421,10 +421,18 @@ impl Material {
 }
 
 /// A property texture in a preset: a constant one is written as its value
-/// (`0.4`, `(0.8, 0.1, 0.1)`), any other as a texture; both read back.
+/// (`0.4`, `(0.8, 0.1, 0.1)`), any other as a texture; both read back. A
+/// property with a TX coefficient may also be written as TX text
+/// (`diffuse: "TX QUAD … FTX"`): the property takes that coefficient's tree
+/// over the default material's value (CD for diffuse, CT's opacity or
+/// transmission, TUILE and VAGUE for the bump). Its colours are in the
+/// preset's `colors` encoding and its image paths relative to the preset,
+/// like the rest of the file. It is saved as a tree.
 mod property_serde {
-    use super::super::texture_tree::{Child, Texture};
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use super::super::texture_tree::{Child, ChildVisitor, Texture};
+    use super::Material;
+    use crate::tx::{self, Channel};
+    use serde::{Deserializer, Serialize, Serializer};
 
     pub fn serialize<S: Serializer>(texture: &Texture, s: S) -> Result<S::Ok, S::Error> {
         match texture.as_constant() {
@@ -433,8 +441,53 @@ mod property_serde {
         }
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Texture, D::Error> {
-        Ok(Texture::from(Child::deserialize(d)?))
+    /// A property's value, or TX text lowered onto `channel` (none: the
+    /// property has no TX coefficient, and text is refused naming it).
+    fn deserialize_as<'de, D: Deserializer<'de>>(
+        d: D,
+        channel: Option<Channel>,
+        name: &str,
+    ) -> Result<Texture, D::Error> {
+        let read = |text: &str| match channel {
+            Some(channel) => {
+                let base = Material::default();
+                tx::lower_preset_property(text, channel, channel.texture(&base))
+                    .map(|t| Child::Texture(Box::new(t)))
+                    .map_err(|e| e.to_string())
+            }
+            None => Err(format!(
+                "{name} has no TX coefficient; write it as a value or a texture"
+            )),
+        };
+        Ok(Texture::from(
+            d.deserialize_any(ChildVisitor { text: Some(&read) })?,
+        ))
+    }
+
+    macro_rules! fields {
+        ($($field:ident => $channel:expr),* $(,)?) => {$(
+            pub mod $field {
+                pub use super::serialize;
+                pub fn deserialize<'de, D: serde::Deserializer<'de>>(
+                    d: D,
+                ) -> Result<super::Texture, D::Error> {
+                    super::deserialize_as(d, $channel, stringify!($field))
+                }
+            }
+        )*};
+    }
+
+    fields! {
+        diffuse => Some(super::Channel::Diffuse),
+        specular => Some(super::Channel::Specular),
+        roughness => None,
+        mirror => Some(super::Channel::Mirror),
+        opacity => Some(super::Channel::Opacity),
+        transmission => Some(super::Channel::Transmission),
+        emission => None,
+        diffuse_transmission => Some(super::Channel::DiffuseTransmission),
+        bump => Some(super::Channel::Bump),
+        mask => None,
     }
 }
 

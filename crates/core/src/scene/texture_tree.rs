@@ -81,31 +81,49 @@ impl Serialize for Child {
 
 impl<'de> Deserialize<'de> for Child {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct ChildVisitor;
-        impl<'de> serde::de::Visitor<'de> for ChildVisitor {
-            type Value = Child;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a number, an (r, g, b) colour, or a (pattern: …, a: …, b: …) texture")
-            }
-            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Child, E> {
-                Ok(Child::Scalar(v as f32))
-            }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Child, A::Error> {
-                Vec3::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
-                    .map(Child::Color)
-            }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Child, A::Error> {
-                Texture::deserialize(serde::de::value::MapAccessDeserializer::new(map))
-                    .map(|t| Child::Texture(Box::new(t)))
-            }
+        d.deserialize_any(ChildVisitor { text: None })
+    }
+}
+
+/// Reads TX text where a property's texture may be written as it (see
+/// `scene::material`): the text → the child, or a message.
+pub(crate) type TextReader<'a> = &'a dyn Fn(&str) -> Result<Child, String>;
+
+/// Reads a [`Child`] in any of its forms, and TX text where `text` is set.
+pub(crate) struct ChildVisitor<'a> {
+    pub text: Option<TextReader<'a>>,
+}
+
+impl<'de> serde::de::Visitor<'de> for ChildVisitor<'_> {
+    type Value = Child;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a number, an (r, g, b) colour, or a (pattern: …, a: …, b: …) texture")?;
+        if self.text.is_some() {
+            f.write_str(", or TX text (\"TX … FTX\")")?;
         }
-        d.deserialize_any(ChildVisitor)
+        Ok(())
+    }
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Child, E> {
+        Ok(Child::Scalar(v as f32))
+    }
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Child, E> {
+        Ok(Child::Scalar(v as f32))
+    }
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Child, E> {
+        Ok(Child::Scalar(v as f32))
+    }
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Child, E> {
+        match self.text {
+            Some(read) => read(v).map_err(E::custom),
+            None => Err(E::invalid_type(serde::de::Unexpected::Str(v), &self)),
+        }
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Child, A::Error> {
+        Vec3::deserialize(serde::de::value::SeqAccessDeserializer::new(seq)).map(Child::Color)
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Child, A::Error> {
+        Texture::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+            .map(|t| Child::Texture(Box::new(t)))
     }
 }
 

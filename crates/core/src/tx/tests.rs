@@ -618,3 +618,66 @@ proptest! {
         }
     }
 }
+
+fn preset_with(material: &str) -> String {
+    format!("(format_version: 2, colors: Srgb, scene: (spheres: [(material: ({material}))]))")
+}
+
+/// A preset may write a property as TX text: the property takes that
+/// coefficient's tree; colours follow the preset's `colors` (here display
+/// values, decoded once) and images resolve against the preset's folder.
+#[test]
+fn a_preset_property_written_as_tx_lowers_like_the_text() {
+    let text = preset_with(
+        r#"diffuse: "TX QUAD UNI CD 0.8 0 0 FTX UNI CD 0 0 0.8 FTX GU 0.25 GV 0.25 FTX", specular: "IMAGE logo.ppm CS 1 1 1 FTX", opacity: "DECOUPAGE UNI CT 1 1 1 FTX UNI FTX NBCOTE 0 RAYON 0.4 FTX""#,
+    );
+    let loaded = crate::preset::parse(&text, Path::new("/presets/report/x.ron")).unwrap();
+    let m = &loaded.preset.scene.spheres[0].material;
+    let doc = parse("QUAD UNI CD 0.8 0 0 FTX UNI CD 0 0 0.8 FTX GU 0.25 GV 0.25 FTX").unwrap();
+    let direct = lower_channel(
+        &doc,
+        Channel::Diffuse,
+        &crate::scene::Material::default().diffuse,
+        Path::new(""),
+        Colors::Linear,
+    )
+    .unwrap();
+    assert!(approx_same(&m.diffuse, &direct), "{:?}", m.diffuse);
+    assert_eq!(
+        m.specular.image.as_ref().unwrap().path,
+        Path::new("/presets/report/logo.ppm")
+    );
+    assert_eq!(
+        m.opacity,
+        Texture::blend(
+            Pattern::Cutout {
+                sides: 0,
+                radius: 0.4
+            },
+            1.0,
+            0.0
+        )
+    );
+}
+
+#[test]
+fn a_tx_error_in_a_preset_names_the_file_and_the_place_in_the_text() {
+    let text = preset_with(r#"diffuse: "TX QUAD UNI CD 0.8 0 FTX UNI FTX FTX""#);
+    let e = crate::preset::parse(&text, Path::new("presets/bad.ron"))
+        .unwrap_err()
+        .to_string();
+    for part in [
+        "presets/bad.ron",
+        "diffuse",
+        "TX line 1, column 22",
+        "third of three",
+        "`FTX`",
+    ] {
+        assert!(e.contains(part), "{part}: {e}");
+    }
+    let text = preset_with(r#"roughness: "UNI FTX""#);
+    let e = crate::preset::parse(&text, Path::new("p.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("roughness has no TX coefficient"), "{e}");
+}
