@@ -4,7 +4,9 @@
 
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
-use marbre_commands::{accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render};
+use marbre_commands::{
+    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render, tx,
+};
 use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -64,6 +66,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Evaluate noise at `x,y,z` lines read from stdin, one value per line.
     Noise(noise::NoiseArgs),
+    /// Render a TX text (the IFT528 report's texture language) on the
+    /// report's preview scene, print it back, or render a gallery.
+    Tx(tx::TxArgs),
     /// Accuracy against time: one knob at a time (samples, bounces, light
     /// selection, strategies, environment sampling, octaves, filtering,
     /// hash, shader), each variant's error against a cached high-spp
@@ -106,6 +111,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Noise(args)) => noise::run(&args),
+        Some(Command::Tx(args)) => tx::run(&args),
         Some(Command::Bench(args)) => accuracy_bench::run(&args),
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),

@@ -8,3 +8,4 @@ pub mod noise_figure;
 pub mod presets_bench;
 pub mod references;
 pub mod render;
+pub mod tx;

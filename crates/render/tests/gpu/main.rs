@@ -32,4 +32,5 @@ mod sampling_stability;
 mod sampling_support;
 mod texture_graph;
 mod texture_parity;
+mod tx;
 mod views;
