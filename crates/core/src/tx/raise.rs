@@ -315,6 +315,7 @@ impl Raiser {
             Pattern::Checker { .. }
             | Pattern::Ridged { .. }
             | Pattern::Marble { .. }
+            | Pattern::MassalMarble { .. }
             | Pattern::Waves { .. }
             | Pattern::Mix => {
                 return Err(no_form(&format!(
