@@ -193,7 +193,6 @@ fn lights_scene() -> Scene {
             height: 0.0,
             uv_frame: None,
             material: lambert(0.6),
-            ..Ground::default()
         }),
         point_light: Some(PointLight {
             position: Vec3::new(0.0, 3.0, 2.0),
