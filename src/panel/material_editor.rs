@@ -1,6 +1,7 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
+use super::tx_ui::{has_tx_section, tx_ui};
 use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
@@ -21,6 +22,9 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
     for property in Property::ALL {
         let (kind, hint) = property_ui_info(property);
         texture_ui(ui, property.name(), hint, m.texture_mut(property), kind, 1);
+        if has_tx_section(property) {
+            ui.indent(("tx", property.name()), |ui| tx_ui(ui, m, property));
+        }
         if property == Property::Emission {
             ui.add(
                 slider(

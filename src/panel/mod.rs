@@ -16,6 +16,7 @@ mod render_ui;
 mod scene_ui;
 mod stats;
 mod transport;
+mod tx_ui;
 mod widgets;
 
 use egui::{ScrollArea, Ui};

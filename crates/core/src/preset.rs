@@ -118,7 +118,12 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     let mut unknown = Vec::new();
     let mut note_unknown = |field: serde_ignored::Path| unknown.push(field_path(&field));
     let tracked = serde_ignored::Deserializer::new(&mut de, &mut note_unknown);
-    let parsed: Result<Preset, _> = serde_path_to_error::deserialize(tracked);
+    let tx_colors = match declared_colors(text) {
+        ColorEncoding::Linear => crate::tx::Colors::Linear,
+        ColorEncoding::Srgb => crate::tx::Colors::AsTyped,
+    };
+    let parsed: Result<Preset, _> =
+        crate::tx::with_preset_colors(tx_colors, || serde_path_to_error::deserialize(tracked));
     let mut preset = match parsed {
         Ok(p) => p,
         Err(e) => {
@@ -170,6 +175,18 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         .collect();
     notes.extend(preset.scene.sanitize());
     Ok(Loaded { preset, notes })
+}
+
+/// The `colors` a preset's text declares, read ahead of the rest: TX text
+/// inside the scene lowers its colours by it. Text that does not parse
+/// says linear; the full parse then reports the error.
+fn declared_colors(text: &str) -> ColorEncoding {
+    #[derive(Deserialize)]
+    struct Declared {
+        #[serde(default)]
+        colors: ColorEncoding,
+    }
+    ron::from_str::<Declared>(text).map_or(ColorEncoding::Linear, |d| d.colors)
 }
 
 /// A field's path as `serde_path_to_error` writes it in errors

@@ -115,15 +115,35 @@ pub fn apply_to_property(
     Ok(())
 }
 
+thread_local! {
+    /// How TX text inside the preset being read lowers its colours (set by
+    /// [`with_preset_colors`] around the preset's deserialisation, which
+    /// has no other way to hand it down to a field).
+    static PRESET_TX_COLORS: std::cell::Cell<Colors> = const { std::cell::Cell::new(Colors::Linear) };
+}
+
+/// Runs `f` (a preset's deserialisation) with TX text lowering its colours
+/// as `colors` says: TX colours are display values, so in a linear preset
+/// they are decoded as they are read ([`Colors::Linear`]); in an sRGB one
+/// the preset decodes every colour afterwards and they are kept as typed
+/// ([`Colors::AsTyped`]), so that neither is decoded twice.
+pub fn with_preset_colors<R>(colors: Colors, f: impl FnOnce() -> R) -> R {
+    let before = PRESET_TX_COLORS.with(|c| c.replace(colors));
+    let out = f();
+    PRESET_TX_COLORS.with(|c| c.set(before));
+    out
+}
+
 /// One property's tree from the TX text a preset holds in its place:
-/// colours as typed (the preset's `colors` decodes them), image paths as
-/// written (the preset resolves them against its folder).
+/// colours decoded from display values once (see [`with_preset_colors`]),
+/// image paths as written (the preset resolves them against its folder).
 pub fn lower_preset_property(
     text: &str,
     channel: Channel,
     base: &crate::scene::Texture,
 ) -> Result<crate::scene::Texture, TxError> {
-    lower_channel(&parse(text)?, channel, base, Path::new(""), Colors::AsTyped)
+    let colors = PRESET_TX_COLORS.with(|c| c.get());
+    lower_channel(&parse(text)?, channel, base, Path::new(""), colors)
 }
 
 #[cfg(test)]

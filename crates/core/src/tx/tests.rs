@@ -4,7 +4,7 @@
 
 use super::*;
 use crate::scene::{Child, ColorEncoding, MathOp, Pattern, Texture};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use proptest::prelude::*;
 
 /// (text, line, column, a phrase the expectation holds).
@@ -658,6 +658,36 @@ fn a_preset_property_written_as_tx_lowers_like_the_text() {
             0.0
         )
     );
+}
+
+/// TX colours are display values whatever the preset around them: in a
+/// linear preset (no `colors` field) they are decoded as they are read, in
+/// an sRGB one by the preset afterwards, never twice; the RON colour
+/// beside them keeps its own preset's meaning.
+#[test]
+fn tx_colours_are_display_values_in_linear_and_srgb_presets_alike() {
+    let material = r#"diffuse: "UNI CD 0.54 0.27 0.0742 FTX", specular: (0.5, 0.5, 0.5)"#;
+    let srgb = crate::preset::parse(&preset_with(material), Path::new("s.ron")).unwrap();
+    let linear_text = format!("(format_version: 2, scene: (spheres: [(material: ({material}))]))");
+    let linear = crate::preset::parse(&linear_text, Path::new("l.ron")).unwrap();
+    let eotf = |v: f64| ((v + 0.055) / 1.055).powf(2.4) as f32;
+    let expected = Vec3::new(eotf(0.54), eotf(0.27), eotf(0.0742));
+    for loaded in [&srgb, &linear] {
+        let diffuse = loaded.preset.scene.spheres[0]
+            .material
+            .diffuse
+            .eval(Vec3::ZERO, Vec2::ZERO);
+        assert!((diffuse - expected).abs().max_element() < 1e-6, "{diffuse}");
+    }
+    let specular = |l: &crate::preset::Loaded| {
+        l.preset.scene.spheres[0]
+            .material
+            .specular
+            .eval(Vec3::ZERO, Vec2::ZERO)
+            .x
+    };
+    assert_eq!(specular(&linear), 0.5);
+    assert!((specular(&srgb) - eotf(0.5)).abs() < 1e-6);
 }
 
 #[test]
