@@ -362,3 +362,59 @@ pub fn approx_same(a: &Texture, b: &Texture) -> bool {
     let (sb, vb) = values(b);
     sa == sb && va.len() == vb.len() && va.iter().zip(&vb).all(|(x, y)| (x - y).abs() <= 1e-5)
 }
+
+/// The report's examples also ship as presets (`presets/report/*.ron`), each
+/// property written as its `.tx` text: every one loads without a note, and
+/// each object's material and the polygon's frame are what lowering the
+/// `.tx` file onto their neutral base gives, so the preset shows what
+/// `marbre tx` renders.
+#[test]
+fn the_report_presets_are_their_tx_files() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/report");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let tx_path = entry.unwrap().path();
+        if tx_path.extension().is_none_or(|e| e != "tx") {
+            continue;
+        }
+        let ron_path = tx_path.with_extension("ron");
+        let loaded = marbre_core::preset::load(&ron_path)
+            .unwrap_or_else(|e| panic!("{}: {e}", ron_path.display()));
+        assert!(loaded.notes.is_empty(), "{:?}", loaded.notes);
+        let doc = tx::parse(&std::fs::read_to_string(&tx_path).unwrap()).unwrap();
+        // The presets' neutral base: the default material, a little rougher.
+        let base = Material {
+            roughness: Texture::scalar(0.45),
+            ..Material::default()
+        };
+        let lowered = tx::lower_document(&doc, &base, &dir).unwrap();
+        let scene = &loaded.preset.scene;
+        for material in [
+            &scene.spheres[0].material,
+            &scene.cylinders[0].material,
+            &scene.polygons[0].material,
+        ] {
+            for property in marbre_core::scene::Property::ALL {
+                let (mine, theirs) = (
+                    material.texture(property),
+                    lowered.material.texture(property),
+                );
+                assert!(
+                    approx_same(mine, theirs),
+                    "{}: {}\n{mine:?}\n{theirs:?}",
+                    ron_path.display(),
+                    property.name()
+                );
+            }
+            assert!(
+                approx_same(&material.bump, &lowered.material.bump),
+                "{}: bump",
+                ron_path.display()
+            );
+            assert_eq!(material.bump_height, lowered.material.bump_height);
+        }
+        assert_eq!(scene.polygons[0].uv_frame, lowered.polygon_frame);
+        count += 1;
+    }
+    assert_eq!(count, 20, "every example has its preset");
+}
