@@ -21,7 +21,7 @@ use std::path::PathBuf;
 pub fn material_ui(ui: &mut Ui, m: &mut Material) {
     for property in Property::ALL {
         let (kind, hint) = property_ui_info(property);
-        texture_ui(ui, property.name(), hint, m.texture_mut(property), kind, 1);
+        texture_ui(ui, property.label(), hint, m.texture_mut(property), kind, 1);
         if has_tx_section(property) {
             ui.indent(("tx", property.name()), |ui| tx_ui(ui, m, property));
         }
@@ -119,7 +119,7 @@ fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
                         let slot = layer.slot_mut(property);
                         let mut set = slot.is_some();
                         if ui
-                            .checkbox(&mut set, format!("sets {}", property.name()))
+                            .checkbox(&mut set, format!("sets {}", property.label()))
                             .on_hover_text("Ticked, the layer sets this property where its mask is")
                             .changed()
                         {
@@ -129,7 +129,7 @@ fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
                             });
                         }
                         if let Some(texture) = slot {
-                            texture_ui(ui, property.name(), hint, texture, kind, 1);
+                            texture_ui(ui, property.label(), hint, texture, kind, 1);
                         }
                     }
                 });

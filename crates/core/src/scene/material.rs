@@ -45,6 +45,14 @@ impl Property {
         }
     }
 
+    /// How the panel names it: its preset field name, in words.
+    pub fn label(self) -> &'static str {
+        match self {
+            Property::DiffuseTransmission => "diffuse transmission",
+            p => p.name(),
+        }
+    }
+
     /// Whether the property is a colour (else a scalar, the first channel).
     pub fn is_color(self) -> bool {
         matches!(
