@@ -5,6 +5,7 @@
 pub mod aa_scenes;
 pub mod accel;
 pub mod atomic_write;
+pub mod bake;
 pub mod bsdf;
 pub mod cubemap;
 pub mod env_sampling;
