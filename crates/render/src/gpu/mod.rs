@@ -6,6 +6,7 @@
 pub mod accumulation;
 pub mod async_readback;
 pub mod auto_exposure;
+pub mod bake;
 pub mod context;
 pub mod error_meter;
 pub mod features;

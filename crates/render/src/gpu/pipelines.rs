@@ -29,7 +29,20 @@ pub fn compute_pipeline(
     entries: &[wgpu::BindGroupLayoutEntry],
     entry_point: &str,
 ) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
-    let module = shader_module(device, program, features, "")?;
+    compute_pipeline_with(device, program, features, "", entries, entry_point)
+}
+
+/// [`compute_pipeline`] of a program that reads a scene's generated
+/// texture code (`generated_textures`).
+pub fn compute_pipeline_with(
+    device: &wgpu::Device,
+    program: Program,
+    features: &FeatureSet,
+    generated_textures: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+    entry_point: &str,
+) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
+    let module = shader_module(device, program, features, generated_textures)?;
     let label = format!("{program:?}");
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(&label),

@@ -74,6 +74,7 @@ const SOURCES: &[WgslFile] = &[
     texture::bump::WGSL,
     harness::geometry::WGSL,
     harness::sampling::WGSL,
+    super::bake::WGSL,
 ];
 
 /// The folder `marbre --dev` watches for edited WGSL: the repository's
@@ -105,10 +106,13 @@ pub enum Program {
     /// The compute pass that runs the BSDF, environment and MIS sampling
     /// functions on given inputs.
     SamplingHarness,
+    /// The compute pass that evaluates a scene's generated texture code at
+    /// given surface points (`marbre bake`).
+    Bake,
 }
 
 impl Program {
-    pub const ALL: [Program; 10] = [
+    pub const ALL: [Program; 11] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -119,6 +123,7 @@ impl Program {
         Program::AccumulationHarness,
         Program::GeometryHarness,
         Program::SamplingHarness,
+        Program::Bake,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -211,6 +216,19 @@ impl Program {
                 env_sampling::WGSL,
                 harness::sampling::WGSL,
             ]),
+            Program::Bake => {
+                noise(&mut out);
+                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
+                if features.contains(Feature::Image) {
+                    out.push(texture::image::WGSL);
+                }
+                out.push(r::TEXTURES);
+                if features.contains(Feature::Mesh) {
+                    out.push(accel::traverse::WGSL);
+                }
+                // `Hit`, which textures.wgsl's footprint reads.
+                out.extend([geometry::sphere::WGSL, r::INTERSECT, super::bake::WGSL]);
+            }
         }
         out
     }
@@ -277,8 +295,8 @@ pub fn sources_fingerprint() -> u64 {
     hasher.finish()
 }
 
-/// The WGSL text of `program` specialised for `features`. The trace program
-/// also takes the scene's generated texture code
+/// The WGSL text of `program` specialised for `features`. The trace and
+/// bake programs also take the scene's generated texture code
 /// ([`super::texture_codegen::generate`]); the others ignore it.
 pub fn assemble(
     program: Program,
@@ -291,7 +309,7 @@ pub fn assemble(
         module.push_str(&format!("{SECTION_HEADER}{}\n", file.name));
         module.push_str(&preprocess(&source_text(&file), file.name, &defines)?);
     }
-    if program == Program::Trace {
+    if matches!(program, Program::Trace | Program::Bake) {
         module.push_str(&format!("{SECTION_HEADER}generated textures\n"));
         module.push_str(generated_textures);
     }

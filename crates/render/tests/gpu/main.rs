@@ -9,6 +9,7 @@ const REPO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 mod accumulation;
 mod bad_input;
+mod bake;
 mod bvh;
 mod chi2;
 mod common;
