@@ -5,7 +5,7 @@
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
 use marbre_commands::{
-    accuracy_bench, bvh_bench, convergence_bench, noise, presets_bench, render, tx,
+    accuracy_bench, bake, bvh_bench, convergence_bench, noise, presets_bench, render, tx,
 };
 use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
@@ -69,6 +69,10 @@ enum Command {
     /// Render a TX text (the IFT528 report's texture language) on the
     /// report's preview scene, print it back, or render a gallery.
     Tx(tx::TxArgs),
+    /// Bake one material property of one object to an image in its (u, v)
+    /// square (sRGB PNG for colours, linear EXR for data), with the
+    /// mapping written beside it.
+    Bake(bake::BakeArgs),
     /// Accuracy against time: one knob at a time (samples, bounces, light
     /// selection, strategies, environment sampling, octaves, filtering,
     /// hash, shader), each variant's error against a cached high-spp
@@ -112,6 +116,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Noise(args)) => noise::run(&args),
         Some(Command::Tx(args)) => tx::run(&args),
+        Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::Bench(args)) => accuracy_bench::run(&args),
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),

@@ -1,6 +1,7 @@
 //! The headless commands: each is a thin layer over the library.
 
 pub mod accuracy_bench;
+pub mod bake;
 pub mod bvh_bench;
 pub mod convergence_bench;
 pub mod noise;

@@ -11,12 +11,16 @@
 //! world coordinates and the (u, v) it would compute there, so 2D and 3D
 //! patterns alike come out as the render shows them on the object.
 
+use crate::atomic_write::write_atomic;
+use crate::image_io::{ImageFormat, save_exr, save_png};
+use crate::scene::color_encoding::srgb_encode;
 use crate::scene::{Material, Property, Scene, SurfacePoint, UvFrame};
 use crate::texture::{cylinder_uv, plane_uv, sphere_uv};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
+use std::path::{Path, PathBuf};
 
 /// The largest image side `marbre bake` writes: 16M texels, whose points
 /// and values the GPU takes in chunks.
@@ -151,6 +155,26 @@ impl ObjectRef {
         }
     }
 
+    /// The index in [`Scene::materials`] of its material (a mesh's
+    /// first).
+    pub fn first_material(self, scene: &Scene) -> u32 {
+        let (s, c, p) = (
+            scene.spheres.len(),
+            scene.cylinders.len(),
+            scene.polygons.len(),
+        );
+        (match self {
+            ObjectRef::Sphere(i) => i,
+            ObjectRef::Cylinder(i) => s + i,
+            ObjectRef::Polygon(i) => s + c + i,
+            ObjectRef::Ground => s + c + p,
+            ObjectRef::Mesh(i) => scene
+                .mesh_material_bases()
+                .get(i)
+                .map_or(0, |&b| b as usize),
+        }) as u32
+    }
+
     /// Its name in the preset (`ground` for the ground); empty if the index
     /// is past the scene's objects.
     pub fn name(self, scene: &Scene) -> String {
@@ -236,12 +260,7 @@ impl UvSurface {
     /// bake (a mesh's triangles are rasterised in uv at that size).
     pub fn new(scene: &Scene, object: ObjectRef, size: u32) -> Result<Self> {
         check_size(size)?;
-        let base = |kind_offset: usize| kind_offset as u32;
-        let (s, c, p) = (
-            scene.spheres.len(),
-            scene.cylinders.len(),
-            scene.polygons.len(),
-        );
+        let material = object.first_material(scene);
         let missing = || anyhow::anyhow!("the scene has no {object:?}");
         Ok(match object {
             ObjectRef::Sphere(i) => {
@@ -250,7 +269,7 @@ impl UvSurface {
                     shape: Shape::Sphere {
                         center: sphere.center,
                         radius: sphere.radius,
-                        material: base(i),
+                        material,
                     },
                     description: "sphere: latitude-longitude about +y, u = (atan2(x, z) + π)/2π \
                                   around the axis, v from the south pole (0) to the north (1); \
@@ -265,7 +284,7 @@ impl UvSurface {
                         base: cylinder.base,
                         radius: cylinder.radius,
                         height: cylinder.height,
-                        material: base(s + i),
+                        material,
                     },
                     description: "cylinder side: u = (atan2(x, z) + π)/2π around +y, v = height \
                                   / cylinder height from the base (0) to the top (1); the caps \
@@ -288,7 +307,7 @@ impl UvSurface {
                         on_plane: polygon.vertices[0],
                         normal,
                         flat: false,
-                        material: base(s + c + i),
+                        material,
                     },
                     description: format!(
                         "polygon: the point origin + u·u_axis + v·v_axis of its frame (origin {}, \
@@ -315,7 +334,7 @@ impl UvSurface {
                         on_plane: Vec3::new(0.0, ground.height, 0.0),
                         normal: Vec3::Y,
                         flat: true,
-                        material: base(s + c + p),
+                        material,
                     },
                     description: match ground.uv_frame {
                         Some(f) => format!(
@@ -335,7 +354,7 @@ impl UvSurface {
             }
             ObjectRef::Mesh(i) => {
                 let mesh = scene.meshes.get(i).ok_or_else(missing)?;
-                let first = scene.mesh_material_bases()[i];
+                let first = material;
                 let geometry = &mesh.geometry.0;
                 let triangles: Vec<([Vec3; 3], [Vec2; 3], u32)> = mesh
                     .world_positions()
@@ -543,6 +562,78 @@ pub struct BakeMapping {
     /// of 1 stands for (the image holds the unscaled height).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bump_height: Option<f32>,
+}
+
+impl BakeMapping {
+    /// Where the sidecar of `image` goes: `<image>.mapping.ron`.
+    pub fn path_for(image: &Path) -> PathBuf {
+        let mut name = image.as_os_str().to_owned();
+        name.push(".mapping.ron");
+        PathBuf::from(name)
+    }
+
+    /// Writes it beside `image` (atomically), returning its path.
+    pub fn write_beside(&self, image: &Path) -> Result<PathBuf> {
+        let path = Self::path_for(image);
+        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())?;
+        write_atomic(&path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(path)
+    }
+}
+
+/// The format of a bake's output file, from its extension, once its
+/// folder is known to exist (a bake creates no folders).
+pub fn check_output(path: &Path) -> Result<ImageFormat> {
+    let format = ImageFormat::from_path(path)?;
+    let folder = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        bail!(
+            "cannot write {}: the folder {} does not exist",
+            path.display(),
+            folder.display()
+        );
+    }
+    Ok(format)
+}
+
+/// The colour space a bake of `property` is written in to `format`: a
+/// colour in a PNG is sRGB-encoded; data in a PNG, and anything in an
+/// EXR, is linear.
+pub fn color_space(property: BakeProperty, format: ImageFormat) -> &'static str {
+    match (format, property.is_color()) {
+        (ImageFormat::Png, true) => "srgb",
+        _ => "linear",
+    }
+}
+
+/// Writes baked texels (linear RGBA, row 0 at the top) to `path`: an EXR
+/// as they are (32-bit float), a PNG clamped to [0, 1] in 8 bits, colours
+/// sRGB-encoded (see [`color_space`]), alpha linear.
+pub fn write_image(
+    path: &Path,
+    property: BakeProperty,
+    size: u32,
+    texels: &[[f32; 4]],
+) -> Result<()> {
+    let format = check_output(path)?;
+    let written = match format {
+        ImageFormat::Exr => save_exr(size, size, texels, path),
+        ImageFormat::Png => {
+            let srgb = color_space(property, format) == "srgb";
+            let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            let image = image::RgbaImage::from_fn(size, size, |x, y| {
+                let t = texels[(y * size + x) as usize];
+                let c = |v: f32| byte(if srgb { srgb_encode(v.max(0.0)) } else { v });
+                image::Rgba([c(t[0]), c(t[1]), c(t[2]), byte(t[3])])
+            });
+            save_png(&image, path)
+        }
+    };
+    written.with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// How texels read (u, v), for the sidecar.

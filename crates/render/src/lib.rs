@@ -2,5 +2,6 @@
 //! the GPU passes (trace, accumulation, metering, display, readback) and the
 //! sessions that turn a preset into a ready renderer. No window, no UI.
 
+pub mod bake_file;
 pub mod gpu;
 pub mod session;
