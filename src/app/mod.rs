@@ -5,6 +5,7 @@
 //! → the renderer re-derives buffers (or the pipeline, when the feature set
 //! changes) → trace pass → display pass → egui pass → present.
 
+mod bake;
 mod camera_input;
 mod convergence;
 mod device_watch;
@@ -26,6 +27,7 @@ pub mod soak;
 mod ui_layer;
 mod viewer;
 
+pub use bake::BAKE_SIZE;
 pub use frame_budget::{DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS, parse_budget_ms};
 
 use anyhow::Result;

@@ -6,6 +6,7 @@ use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
+use marbre_core::bake::BakeProperty;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_core::scene::{
     Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
@@ -17,11 +18,17 @@ use marbre_core::texture::{
 use std::ops::RangeInclusive;
 use std::path::PathBuf;
 
-/// Every property's texture, the bump, the emission strength and layers.
-pub fn material_ui(ui: &mut Ui, m: &mut Material) {
+/// Every property's texture, the bump, the emission strength and layers;
+/// returns the property whose Bake… button was pressed.
+pub fn material_ui(ui: &mut Ui, m: &mut Material) -> Option<BakeProperty> {
+    let mut bake = None;
     for property in Property::ALL {
         let (kind, hint) = property_ui_info(property);
         texture_ui(ui, property.label(), hint, m.texture_mut(property), kind, 1);
+        let bakeable = BakeProperty::ALL
+            .into_iter()
+            .find(|b| b.material_property() == Some(property));
+        bake = bake.or(bakeable.filter(|&b| bake_button(ui, b)));
         if has_tx_section(property) {
             ui.indent(("tx", property.name()), |ui| tx_ui(ui, m, property));
         }
@@ -45,6 +52,7 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
         ValueKind::Scalar,
         1,
     );
+    bake = bake.or(Some(BakeProperty::Bump).filter(|&b| bake_button(ui, b)));
     ui.add(typed_beyond(slider(
         &mut m.bump_height,
         -Material::BUMP_HEIGHT_DRAG_RANGE..=Material::BUMP_HEIGHT_DRAG_RANGE,
@@ -55,6 +63,24 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) {
          or type any value: a steep bump bends shading normals away, and marbre falls back)",
     );
     layers_ui(ui, &mut m.layers);
+    bake
+}
+
+/// The Bake… button of a property: whether it was pressed.
+fn bake_button(ui: &mut Ui, property: BakeProperty) -> bool {
+    ui.small_button("Bake…")
+        .on_hover_text(format!(
+            "Write this {} to an image in the object's (u, v) square, {} texels a side, beside \
+             the preset (as `marbre bake` does: {}), with its mapping in a .mapping.ron beside it",
+            property.name(),
+            crate::app::BAKE_SIZE,
+            if property.is_color() {
+                "sRGB PNG"
+            } else {
+                "linear EXR"
+            }
+        ))
+        .clicked()
 }
 
 /// What a property's values are, and its tooltip.

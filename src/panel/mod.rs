@@ -187,6 +187,11 @@ pub enum PanelAction {
     BrowseEnvironment,
     /// Open a file from the recent list (a preset or an environment map).
     OpenRecent(PathBuf),
+    /// Bake an object's property to an image beside the preset.
+    Bake {
+        object: marbre_core::bake::ObjectRef,
+        property: marbre_core::bake::BakeProperty,
+    },
 }
 
 /// Draws the whole panel contents into `ui` and returns the buttons pressed.
@@ -203,7 +208,11 @@ pub fn draw(
             section(ui, "Preset", true, |ui| {
                 file_ui::preset_ui(ui, state, &mut actions);
             });
-            section(ui, "Materials", true, |ui| materials_ui(ui, scene));
+            section(ui, "Materials", true, |ui| {
+                if let Some((object, property)) = materials_ui(ui, scene) {
+                    actions.push(PanelAction::Bake { object, property });
+                }
+            });
             section(ui, "Environment", true, |ui| {
                 environment_ui(ui, &mut scene.environment, state, &mut actions);
             });

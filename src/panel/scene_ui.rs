@@ -5,13 +5,16 @@ use super::PanelAction;
 use super::material_editor::material_ui;
 use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_ui};
 use egui::{CollapsingHeader, Ui};
+use marbre_core::bake::{BakeProperty, ObjectRef};
 use marbre_core::scene::{Ground, OrbitCamera, PointLight, Scene};
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
 /// the ground. Only the first is open at start, so a scene with many
 /// objects still fits on screen.
-pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
+/// Returns the object and property of a Bake… button pressed.
+pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef, BakeProperty)> {
     let mut first = true;
+    let mut bake = None;
     let mut object =
         |ui: &mut Ui, key: (&str, usize), title: String, body: &mut dyn FnMut(&mut Ui)| {
             // Keyed by index: names come from the preset and need not be unique.
@@ -27,7 +30,10 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
             ui,
             ("sphere", i),
             format!("sphere “{}”", sphere.name),
-            &mut |ui| material_ui(ui, &mut sphere.material),
+            &mut |ui| {
+                let pressed = material_ui(ui, &mut sphere.material);
+                bake = bake.or(pressed.map(|p| (ObjectRef::Sphere(i), p)));
+            },
         );
     }
     for (i, cylinder) in scene.cylinders.iter_mut().enumerate() {
@@ -49,7 +55,8 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
                     .on_hover_text(
                         "Along +y; the side's v runs from 0 at the base to 1 at the top",
                     );
-                material_ui(ui, &mut cylinder.material);
+                let pressed = material_ui(ui, &mut cylinder.material);
+                bake = bake.or(pressed.map(|p| (ObjectRef::Cylinder(i), p)));
             },
         );
     }
@@ -58,7 +65,10 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
             ui,
             ("polygon", i),
             format!("polygon “{}”", polygon.name),
-            &mut |ui| material_ui(ui, &mut polygon.material),
+            &mut |ui| {
+                let pressed = material_ui(ui, &mut polygon.material);
+                bake = bake.or(pressed.map(|p| (ObjectRef::Polygon(i), p)));
+            },
         );
     }
     if let Some(ground) = &mut scene.ground {
@@ -72,7 +82,8 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
                  (oblique ones too) instead of world (x, z)",
                 default,
             );
-            material_ui(ui, &mut ground.material)
+            let pressed = material_ui(ui, &mut ground.material);
+            bake = bake.or(pressed.map(|p| (ObjectRef::Ground, p)));
         });
     }
     for (i, mesh) in scene.meshes.iter_mut().enumerate() {
@@ -80,14 +91,21 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) {
             ui,
             ("mesh", i),
             format!("mesh “{}”", mesh.name),
-            &mut |ui| mesh_ui(ui, mesh),
+            &mut |ui| {
+                let pressed = mesh_ui(ui, mesh);
+                bake = bake.or(pressed.map(|p| (ObjectRef::Mesh(i), p)));
+            },
         );
     }
+    bake
 }
 
 /// A mesh's placement and each of its MTL materials, editable like any
 /// other (a Cornell box wall can be marble); "reset" goes back to the file.
-pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) {
+/// Returns the property of a Bake… button pressed (a bake covers the whole
+/// mesh, each triangle in its own material).
+pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) -> Option<BakeProperty> {
+    let mut bake = None;
     ui.label(format!(
         "{} triangles from {}",
         mesh.geometry.0.len(),
@@ -113,10 +131,11 @@ pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) {
                     {
                         m.material = original.clone();
                     }
-                    material_ui(ui, &mut m.material);
+                    bake = bake.or(material_ui(ui, &mut m.material));
                 });
         });
     }
+    bake
 }
 
 pub(super) fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {

@@ -136,6 +136,7 @@ impl Viewer {
             self.renderer.forget_feature_override();
         }
         self.poll_kernel_timing();
+        self.poll_bakes();
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
         let edited = self.scene != *self.renderer.scene();

@@ -68,6 +68,8 @@ pub struct Viewer {
     device_watch: DeviceWatch,
     /// Which trace kernel runs, and `auto`'s timing of both.
     kernels: KernelChooser,
+    /// The Bake… buttons' bakes, running off the render thread.
+    bakes: super::bake::Bakes,
     /// How much tracing a frame asks for, learnt from the trace's times.
     budget: FrameBudget,
     /// What the Quality strip and the Stats panel report.
@@ -350,6 +352,7 @@ impl Viewer {
         let mut viewer = Self {
             device_watch,
             kernels,
+            bakes: Default::default(),
             budget: FrameBudget::new(options.frame_budget_ms),
             meters: Meters {
                 timer,
@@ -503,6 +506,16 @@ impl Viewer {
         }
     }
 
+    /// Reports the bakes that finished.
+    fn poll_bakes(&mut self) {
+        for result in self.bakes.finished() {
+            match result {
+                Ok(message) => self.panel.info(message),
+                Err(message) => self.panel.error(message),
+            }
+        }
+    }
+
     /// Installs the kernel `auto` found faster, once its timing is done.
     fn poll_kernel_timing(&mut self) {
         match self.kernels.poll(&mut self.settings) {
@@ -573,6 +586,13 @@ impl Viewer {
                 PanelAction::SetKernel(choice) => self.set_kernel(choice),
                 PanelAction::Undo => self.step_history(true),
                 PanelAction::Redo => self.step_history(false),
+                PanelAction::Bake { object, property } => self.bakes.start(
+                    &self.scene,
+                    self.renderer.images(),
+                    &self.edits.document.path,
+                    object,
+                    property,
+                ),
             }
         }
     }
