@@ -1,18 +1,17 @@
 //! `marbre render`: the viewer's renderer, offscreen.
+//!
+//! The render itself is `marbre_render::final_render::render_to_file`,
+//! which the viewer's Render dialog runs too; this file parses the flags
+//! into its job and shows its progress on the terminal.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
-use marbre_core::image_io;
 use marbre_core::scene::{LightPoints, Metering, Strategy, View};
-use marbre_render::gpu::auto_exposure;
-use marbre_render::gpu::error_meter::ErrorEstimate;
-use marbre_render::gpu::{GpuContext, KernelChoice, Renderer};
-use marbre_render::session::{
-    accumulate, describe_pick, load_scene, max_texture_side, pick_kernel, renderer_with,
-    trace_frame,
-};
+use marbre_render::final_render::{FinalRender, Progress, RenderObserver, Stop, render_to_file};
+use marbre_render::gpu::{GpuContext, KernelChoice};
+use marbre_render::session::load_scene;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -112,7 +111,6 @@ const DEFAULT_SPP: u32 = 64;
 const DEFAULT_MAX_SPP: u32 = 16384;
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let format = image_io::ImageFormat::from_path(&args.output)?;
     let spp = args.spp.unwrap_or(if args.target_error.is_some() {
         DEFAULT_MAX_SPP
     } else {
@@ -127,152 +125,61 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--target-error must be a positive number, like 0.01 for 1 %");
     }
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
-    if let Some(metering) = args.auto_exposure {
-        let display = &mut loaded.scene.render.display;
-        display.auto_exposure = true;
-        display.metering = match metering {
-            MeteringArg::Key => Metering::Key,
-            MeteringArg::Massal => Metering::MassalRms,
-        };
-    }
     let render = &mut loaded.scene.render;
     render.view = args.view.unwrap_or(render.view);
     render.transport.light_points = args.light_points.unwrap_or(render.transport.light_points);
     render.transport.strategy = args.strategy.unwrap_or(render.transport.strategy);
-    let ctx = GpuContext::headless()?;
-    let loaded = loaded.fit_environment(max_texture_side(&ctx));
-    for note in &loaded.notes {
-        eprintln!("note: {note}");
-    }
-    let (kernel, timings) = pick_kernel(&ctx, &loaded, args.size, args.kernel)?;
-    eprintln!("{}", describe_pick(kernel, timings.as_ref()));
-    let mut renderer = renderer_with(&ctx, &loaded, args.size, kernel)?;
-    let bar = indicatif::ProgressBar::new(u64::from(spp));
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})",
-        )
-        .expect("a valid template"),
-    );
-    bar.set_message(ctx.describe());
-    match args.target_error {
-        None => accumulate(&ctx, &mut renderer, spp, |n| bar.set_position(u64::from(n)))?,
-        Some(target) => {
-            let reached = accumulate_to_error(&ctx, &mut renderer, target, spp, &bar)?;
-            bar.finish();
-            report_error(&renderer, target, reached);
-        }
-    }
-    bar.finish();
-    // EXR output is the radiance, unscaled: only a PNG is exposed.
-    if loaded.scene.render.shown_display().auto_exposure
-        && matches!(format, image_io::ImageFormat::Png)
-    {
-        report_auto_exposure(&ctx, &mut renderer)?;
-    }
-    match format {
-        image_io::ImageFormat::Png => {
-            let image = renderer.read_display(&ctx)?;
-            image_io::save_png(&image, &args.output)
-        }
-        image_io::ImageFormat::Exr => {
-            let (w, h, pixels) = renderer.read_radiance(&ctx)?;
-            image_io::save_exr(w, h, &pixels, &args.output)
-        }
-    }
-    .with_context(|| format!("saving {}", args.output.display()))?;
-    eprintln!("wrote {}", args.output.display());
-    Ok(())
-}
-
-/// How often the error is measured while rendering to a target: each
-/// measurement waits for the GPU, so not after every frame of a fast one.
-const ERROR_CHECK_INTERVAL: Duration = Duration::from_millis(250);
-
-/// Traces until the estimated relative error is at most `target`, or
-/// `max_spp` samples per pixel; returns the last estimate.
-fn accumulate_to_error(
-    ctx: &GpuContext,
-    renderer: &mut Renderer,
-    target: f64,
-    max_spp: u32,
-    bar: &indicatif::ProgressBar,
-) -> Result<Option<ErrorEstimate>> {
-    let mut last_check: Option<Instant> = None;
-    while renderer.accumulated_samples() < max_spp {
-        // Waiting for each frame keeps the GPU no further ahead than the
-        // check: a target reached is not overshot by a queue of frames.
-        trace_frame(ctx, renderer)?;
-        bar.set_position(u64::from(renderer.accumulated_samples()));
-        if last_check.is_some_and(|t| t.elapsed() < ERROR_CHECK_INTERVAL) {
-            continue;
-        }
-        last_check = Some(Instant::now());
-        if let Some(e) = renderer.estimate_error(ctx)? {
-            bar.set_message(format!("error {:.2} %", 100.0 * e.relative));
-            if e.relative <= target {
-                return Ok(Some(e));
-            }
-        }
-    }
-    // The cap: measure the final image.
-    renderer.estimate_error(ctx)
-}
-
-/// Says where the error ended, against the target.
-fn report_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstimate>) {
-    let spp = renderer.accumulated_samples();
-    let seconds = renderer.accumulation_time().as_secs_f64();
-    match estimate {
-        Some(e) if e.relative <= target => eprintln!(
-            "target reached: estimated relative error {:.3} % (RMSE {:.5}) at {spp} spp in {seconds:.1} s",
-            100.0 * e.relative,
-            e.rmse
-        ),
-        Some(e) => eprintln!(
-            "target not reached: estimated relative error {:.3} % (RMSE {:.5}) at the cap of {spp} spp \
-             ({seconds:.1} s); raise --spp, about {:.0} s more would do",
-            100.0 * e.relative,
-            e.rmse,
-            e.seconds_to(target)
-        ),
-        None => eprintln!("no error estimate: it needs two frames (--spp {spp} is too few)"),
-    }
-}
-
-/// Prints the exposure the PNG gets: the GPU's metering (what the display
-/// pass applies) and the CPU twin's average over the whole image.
-fn report_auto_exposure(ctx: &GpuContext, renderer: &mut Renderer) -> Result<()> {
-    let metered = renderer.metering(ctx)?;
-    let (_, _, pixels) = renderer.read_radiance(ctx)?;
-    let display = renderer.scene().render.display;
-    let compensation = display.exposure;
-    let (what, metered_value, whole) = match display.metering {
-        Metering::Key => (
-            "log-average",
-            metered.log_average,
-            auto_exposure::log_average_luminance(&pixels),
-        ),
-        Metering::MassalRms => (
-            "Massal's RMS",
-            metered.rms,
-            auto_exposure::rms_luminance(&pixels),
-        ),
-    };
-    eprintln!(
-        "auto exposure: {:+.2} stops{} ({what} luminance {:.4} over {} metered texels; \
-         {:.4} over the whole image)",
-        metered.stops_for(display.metering),
-        if compensation == 0.0 {
-            String::new()
-        } else {
-            format!(", {compensation:+.2} stops of compensation on top")
+    let job = FinalRender {
+        size: args.size,
+        stop: match args.target_error {
+            None => Stop::Samples(spp),
+            Some(target) => Stop::TargetError {
+                target,
+                max_spp: spp,
+            },
         },
-        metered_value,
-        metered.count,
-        whole,
-    );
+        auto_exposure: args.auto_exposure.map(|m| match m {
+            MeteringArg::Key => Metering::Key,
+            MeteringArg::Massal => Metering::MassalRms,
+        }),
+        kernel: args.kernel,
+        output: args.output.clone(),
+    };
+    let ctx = GpuContext::headless()?;
+    let mut bar = Bar::new(spp, ctx.describe());
+    render_to_file(&ctx, loaded, &job, &mut bar)?;
     Ok(())
+}
+
+/// The terminal's progress bar, and the render's lines on stderr.
+struct Bar(indicatif::ProgressBar);
+
+impl Bar {
+    fn new(spp: u32, device: String) -> Self {
+        let bar = indicatif::ProgressBar::new(u64::from(spp));
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})",
+            )
+            .expect("a valid template"),
+        );
+        bar.set_message(device);
+        Self(bar)
+    }
+}
+
+impl RenderObserver for Bar {
+    fn note(&mut self, line: &str) {
+        self.0.suspend(|| eprintln!("{line}"));
+    }
+
+    fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {
+        self.0.set_position(u64::from(progress.samples));
+        if let Some(e) = progress.relative_error {
+            self.0.set_message(format!("error {:.2} %", 100.0 * e));
+        }
+        ControlFlow::Continue(())
+    }
 }
 
 #[cfg(test)]

@@ -3,5 +3,6 @@
 //! sessions that turn a preset into a ready renderer. No window, no UI.
 
 pub mod bake_file;
+pub mod final_render;
 pub mod gpu;
 pub mod session;

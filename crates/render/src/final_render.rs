@@ -1,0 +1,314 @@
+//! A final render to a file: a loaded scene traced to a number of samples
+//! or an error target, then written atomically as PNG or EXR. `marbre
+//! render` and the viewer's Render dialog both run [`render_to_file`], so
+//! that the dialog's image is the command's, byte for byte; each caller
+//! only says how progress is shown and whether to stop early.
+
+use crate::gpu::auto_exposure;
+use crate::gpu::error_meter::ErrorEstimate;
+use crate::gpu::{GpuContext, KernelChoice, Renderer};
+use crate::session::{
+    LoadedScene, describe_pick, load_environment, max_texture_side, pick_kernel, renderer_with,
+    trace_frame,
+};
+use anyhow::{Context, Result, bail};
+use marbre_core::image_io::{self, ImageFormat};
+use marbre_core::scene::{Metering, Scene};
+use marbre_core::texture::ImageSet;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// When a final render stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop {
+    /// After this many samples per pixel.
+    Samples(u32),
+    /// As soon as the estimated relative error (√relMSE, as the Quality
+    /// panel shows it) is at most `target`, or at `max_spp` samples.
+    TargetError { target: f64, max_spp: u32 },
+}
+
+impl Stop {
+    /// The most samples per pixel the render may take.
+    pub fn max_samples(self) -> u32 {
+        match self {
+            Stop::Samples(n) | Stop::TargetError { max_spp: n, .. } => n,
+        }
+    }
+}
+
+/// What to render from a loaded scene, and where to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinalRender {
+    pub size: (u32, u32),
+    pub stop: Stop,
+    /// Expose the PNG automatically with this metering, the scene's
+    /// exposure becoming a compensation; `None`: as the scene says.
+    pub auto_exposure: Option<Metering>,
+    pub kernel: KernelChoice,
+    /// `.png` (tone-mapped, sRGB) or `.exr` (linear radiance, float).
+    pub output: PathBuf,
+}
+
+/// How far a render has come, after each frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    pub samples: u32,
+    pub max_samples: u32,
+    /// The last estimated relative error, when rendering to a target.
+    pub relative_error: Option<f64>,
+}
+
+impl Progress {
+    /// The fraction done, 0 to 1: samples against the cap (a render to an
+    /// error target may end well before it).
+    pub fn fraction(&self) -> f32 {
+        (f64::from(self.samples) / f64::from(self.max_samples.max(1))).min(1.0) as f32
+    }
+}
+
+/// Where a render reports to: lines for the user (the kernel chosen, the
+/// error reached, the exposure, notes on the scene), and progress after
+/// each frame, whose answer can stop the render.
+pub trait RenderObserver {
+    fn note(&mut self, line: &str);
+    /// `Break` cancels the render: nothing is written.
+    fn progress(&mut self, progress: &Progress) -> ControlFlow<()>;
+}
+
+/// How a render ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    Written,
+    Cancelled,
+}
+
+/// A scene already in memory (the viewer's, as edited) with the images it
+/// has loaded, its environment read again from its files: what a render
+/// of it on another device needs (the window's renderer keeps its
+/// environment on its own device only).
+pub fn snapshot(scene: Scene, images: ImageSet) -> Result<LoadedScene> {
+    let mut notes = Vec::new();
+    let env = load_environment(
+        &scene.environment.source,
+        scene.environment.ldr_images,
+        u32::MAX,
+    )?
+    .map(|l| {
+        notes.extend(l.notes);
+        l.image
+    });
+    Ok(LoadedScene {
+        scene,
+        env,
+        images,
+        notes,
+    })
+}
+
+/// Renders `loaded` as `job` says on `ctx` and writes the image to
+/// `job.output` atomically (a sibling file renamed over it: a cancelled or
+/// failed render leaves no partial file). Errors name the output file.
+pub fn render_to_file(
+    ctx: &GpuContext,
+    mut loaded: LoadedScene,
+    job: &FinalRender,
+    observer: &mut dyn RenderObserver,
+) -> Result<Outcome> {
+    let format = ImageFormat::from_path(&job.output)?;
+    check_folder(&job.output)?;
+    if job.stop.max_samples() == 0 {
+        bail!("a render needs at least 1 sample per pixel");
+    }
+    if let Stop::TargetError { target, .. } = job.stop
+        && !(target.is_finite() && target > 0.0)
+    {
+        bail!("the target error must be a positive number, like 0.01 for 1 %");
+    }
+    if let Some(metering) = job.auto_exposure {
+        let display = &mut loaded.scene.render.display;
+        display.auto_exposure = true;
+        display.metering = metering;
+    }
+    let loaded = loaded.fit_environment(max_texture_side(ctx));
+    for note in &loaded.notes {
+        observer.note(&format!("note: {note}"));
+    }
+    let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
+    observer.note(&describe_pick(kernel, timings.as_ref()));
+    let mut renderer = renderer_with(ctx, &loaded, job.size, kernel)?;
+    let flow = match job.stop {
+        Stop::Samples(spp) => accumulate(ctx, &mut renderer, spp, observer)?,
+        Stop::TargetError { target, max_spp } => {
+            let (flow, reached) =
+                accumulate_to_error(ctx, &mut renderer, target, max_spp, observer)?;
+            if flow.is_continue() {
+                observer.note(&describe_error(&renderer, target, reached));
+            }
+            flow
+        }
+    };
+    if flow.is_break() {
+        return Ok(Outcome::Cancelled);
+    }
+    // EXR output is the radiance, unscaled: only a PNG is exposed.
+    if loaded.scene.render.shown_display().auto_exposure && format == ImageFormat::Png {
+        observer.note(&describe_auto_exposure(ctx, &mut renderer)?);
+    }
+    match format {
+        ImageFormat::Png => {
+            let image = renderer.read_display(ctx)?;
+            image_io::save_png(&image, &job.output)
+        }
+        ImageFormat::Exr => {
+            let (w, h, pixels) = renderer.read_radiance(ctx)?;
+            image_io::save_exr(w, h, &pixels, &job.output)
+        }
+    }
+    .with_context(|| format!("saving {}", job.output.display()))?;
+    observer.note(&format!("wrote {}", job.output.display()));
+    Ok(Outcome::Written)
+}
+
+/// Fails unless the folder `output` goes into exists: found before the
+/// render, not after it, and never created by surprise.
+fn check_folder(output: &Path) -> Result<()> {
+    let folder = output
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        let why = if folder.exists() {
+            "is not a folder"
+        } else {
+            "does not exist"
+        };
+        bail!(
+            "cannot write {}: {} {why}",
+            output.display(),
+            folder.display()
+        );
+    }
+    Ok(())
+}
+
+/// Traces `spp` samples per pixel, a frame at a time, each waited for;
+/// `Break` if the observer cancelled.
+fn accumulate(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    spp: u32,
+    observer: &mut dyn RenderObserver,
+) -> Result<ControlFlow<()>> {
+    while renderer.accumulated_samples() < spp {
+        trace_frame(ctx, renderer)?;
+        let progress = Progress {
+            samples: renderer.accumulated_samples(),
+            max_samples: spp,
+            relative_error: None,
+        };
+        if observer.progress(&progress).is_break() {
+            return Ok(ControlFlow::Break(()));
+        }
+    }
+    Ok(ControlFlow::Continue(()))
+}
+
+/// How often the error is measured while rendering to a target: each
+/// measurement waits for the GPU, so not after every frame of a fast one.
+const ERROR_CHECK_INTERVAL: Duration = Duration::from_millis(250);
+
+/// Traces until the estimated relative error is at most `target`, or
+/// `max_spp` samples per pixel, or the observer cancels; returns the last
+/// estimate.
+fn accumulate_to_error(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: f64,
+    max_spp: u32,
+    observer: &mut dyn RenderObserver,
+) -> Result<(ControlFlow<()>, Option<ErrorEstimate>)> {
+    let mut last_check: Option<Instant> = None;
+    let mut relative_error = None;
+    while renderer.accumulated_samples() < max_spp {
+        // Waiting for each frame keeps the GPU no further ahead than the
+        // check: a target reached is not overshot by a queue of frames.
+        trace_frame(ctx, renderer)?;
+        let due = last_check.is_none_or(|t| t.elapsed() >= ERROR_CHECK_INTERVAL);
+        if due {
+            last_check = Some(Instant::now());
+            if let Some(e) = renderer.estimate_error(ctx)? {
+                relative_error = Some(e.relative);
+                if e.relative <= target {
+                    return Ok((ControlFlow::Continue(()), Some(e)));
+                }
+            }
+        }
+        let progress = Progress {
+            samples: renderer.accumulated_samples(),
+            max_samples: max_spp,
+            relative_error,
+        };
+        if observer.progress(&progress).is_break() {
+            return Ok((ControlFlow::Break(()), None));
+        }
+    }
+    // The cap: measure the final image.
+    Ok((ControlFlow::Continue(()), renderer.estimate_error(ctx)?))
+}
+
+/// Where the error ended, against the target.
+fn describe_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstimate>) -> String {
+    let spp = renderer.accumulated_samples();
+    let seconds = renderer.accumulation_time().as_secs_f64();
+    match estimate {
+        Some(e) if e.relative <= target => format!(
+            "target reached: estimated relative error {:.3} % (RMSE {:.5}) at {spp} spp in {seconds:.1} s",
+            100.0 * e.relative,
+            e.rmse
+        ),
+        Some(e) => format!(
+            "target not reached: estimated relative error {:.3} % (RMSE {:.5}) at the cap of {spp} spp \
+             ({seconds:.1} s); raise the samples, about {:.0} s more would do",
+            100.0 * e.relative,
+            e.rmse,
+            e.seconds_to(target)
+        ),
+        None => format!("no error estimate: it needs two frames ({spp} spp is too few)"),
+    }
+}
+
+/// The exposure the PNG gets: the GPU's metering (what the display pass
+/// applies) and the CPU twin's average over the whole image.
+fn describe_auto_exposure(ctx: &GpuContext, renderer: &mut Renderer) -> Result<String> {
+    let metered = renderer.metering(ctx)?;
+    let (_, _, pixels) = renderer.read_radiance(ctx)?;
+    let display = renderer.scene().render.display;
+    let compensation = display.exposure;
+    let (what, metered_value, whole) = match display.metering {
+        Metering::Key => (
+            "log-average",
+            metered.log_average,
+            auto_exposure::log_average_luminance(&pixels),
+        ),
+        Metering::MassalRms => (
+            "Massal's RMS",
+            metered.rms,
+            auto_exposure::rms_luminance(&pixels),
+        ),
+    };
+    Ok(format!(
+        "auto exposure: {:+.2} stops{} ({what} luminance {:.4} over {} metered texels; \
+         {:.4} over the whole image)",
+        metered.stops_for(display.metering),
+        if compensation == 0.0 {
+            String::new()
+        } else {
+            format!(", {compensation:+.2} stops of compensation on top")
+        },
+        metered_value,
+        metered.count,
+        whole,
+    ))
+}
