@@ -19,6 +19,7 @@ mod history;
 mod kernel_choice;
 mod prompts;
 mod recovery;
+mod render_job;
 mod scene_loader;
 mod screenshots;
 mod settings;

@@ -19,6 +19,8 @@ pub enum Shortcut {
     Close,
     /// F12: save the image as PNG and EXR.
     Screenshot,
+    /// Ctrl+R: open or close the Render dialog.
+    RenderDialog,
 }
 
 /// The shortcuts pressed this frame, consumed so no widget sees them.
@@ -55,6 +57,7 @@ pub fn pressed(ctx: &egui::Context) -> Vec<Shortcut> {
         take(Modifiers::COMMAND, Key::Y, Shortcut::Redo);
         take(Modifiers::COMMAND, Key::Z, Shortcut::Undo);
         take(Modifiers::COMMAND, Key::O, Shortcut::Open);
+        take(Modifiers::COMMAND, Key::R, Shortcut::RenderDialog);
         take(Modifiers::NONE, Key::H, Shortcut::HideUi);
         pressed
     })
@@ -91,6 +94,7 @@ mod tests {
         assert_eq!(press(Modifiers::COMMAND, Key::S), [Shortcut::Save]);
         assert_eq!(press(shift_command, Key::S), [Shortcut::SaveAs]);
         assert_eq!(press(Modifiers::COMMAND, Key::O), [Shortcut::Open]);
+        assert_eq!(press(Modifiers::COMMAND, Key::R), [Shortcut::RenderDialog]);
         assert_eq!(press(Modifiers::NONE, Key::F1), [Shortcut::Help]);
         assert_eq!(press(Modifiers::NONE, Key::F11), [Shortcut::Fullscreen]);
         assert_eq!(press(Modifiers::NONE, Key::H), [Shortcut::HideUi]);

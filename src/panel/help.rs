@@ -35,6 +35,10 @@ pub const SHORTCUTS: &[Shortcut] = &[
         action: "Screenshot without the UI: PNG and EXR into screenshots/",
     },
     Shortcut {
+        keys: "Ctrl+R",
+        action: "Open the Render dialog: a final render to PNG or EXR, in the background",
+    },
+    Shortcut {
         keys: "Ctrl+Z",
         action: "Undo the last edit",
     },

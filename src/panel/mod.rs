@@ -12,6 +12,7 @@ mod file_ui;
 pub mod help;
 mod material_editor;
 mod quality;
+pub mod render_dialog;
 mod render_ui;
 mod scene_ui;
 mod stats;
@@ -83,6 +84,8 @@ pub struct PanelState {
     /// A preset loading in the background: what it is doing, and the
     /// fraction done.
     pub progress: Option<(String, f32)>,
+    /// The Render dialog's fields and the render under way.
+    pub render_dialog: render_dialog::RenderDialog,
 }
 
 impl PanelState {
@@ -104,6 +107,7 @@ impl PanelState {
             focus_preset_path: false,
             focus_env_path: false,
             progress: None,
+            render_dialog: Default::default(),
         }
     }
 
@@ -164,7 +168,7 @@ pub struct Stats {
 
 /// A button press the app must act on: these need files, the GPU or the
 /// window, which the panel has no access to.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum PanelAction {
     LoadPreset(PathBuf),
     /// Save to the preset file the scene came from.
@@ -192,6 +196,10 @@ pub enum PanelAction {
         object: marbre_core::bake::ObjectRef,
         property: marbre_core::bake::BakeProperty,
     },
+    /// Render the scene as it is now to a file, in the background (the
+    /// Render dialog's button; the app picks the kernel).
+    StartRender(marbre_render::final_render::FinalRender),
+    CancelRender,
 }
 
 /// Draws the whole panel contents into `ui` and returns the buttons pressed.
@@ -228,6 +236,7 @@ pub fn draw(
             section(ui, "Render", true, |ui| {
                 render_ui(ui, &mut scene.render, &mut actions);
                 kernel_ui(ui, stats, &mut actions);
+                render_dialog::button(ui, &mut state.render_dialog);
             });
 
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));

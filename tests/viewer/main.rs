@@ -8,6 +8,7 @@ const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
 mod e2e_window;
 mod obj_window;
+mod render_window;
 mod soak;
 mod window;
 mod xvfb;

@@ -7,6 +7,7 @@
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use marbre_core::scene::{LightPoints, Metering, Strategy, View};
+pub use marbre_render::final_render::parse_size;
 use marbre_render::final_render::{FinalRender, Progress, RenderObserver, Stop, render_to_file};
 use marbre_render::gpu::{GpuContext, KernelChoice};
 use marbre_render::session::load_scene;
@@ -90,20 +91,6 @@ fn parse_strategy(s: &str) -> Result<Strategy, String> {
 pub enum MeteringArg {
     Key,
     Massal,
-}
-
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&n| (1..=16384).contains(&n))
-            .ok_or_else(|| format!("`{v}` is not a size between 1 and 16384"))
-    };
-    Ok((parse(w)?, parse(h)?))
 }
 
 /// Samples per pixel without --target-error, and the cap with it.

@@ -38,6 +38,22 @@ impl Stop {
     }
 }
 
+/// A size written WIDTHxHEIGHT, each from 1 to 16384: `render --size`
+/// and the dialog's size field.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X', '×'])
+        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+            .ok_or_else(|| format!("`{v}` is not a size between 1 and 16384"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
 /// What to render from a loaded scene, and where to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FinalRender {

@@ -22,6 +22,7 @@ use super::history::History;
 use super::kernel_choice::KernelChooser;
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
+use super::render_job::{RenderJob, Update};
 use super::scene_loader::{FileKind, SceneKind, SceneLoad, load_reporting};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
@@ -98,6 +99,8 @@ pub struct Viewer {
     quitting: bool,
     clock: FrameClock,
     screenshot_requested: bool,
+    /// The Render dialog's render, running in the background.
+    render_job: Option<RenderJob>,
 }
 
 /// What the Quality strip and the Stats panel report, gathered frame by
@@ -397,6 +400,7 @@ impl Viewer {
                 ms_per_frame: 0.0,
             },
             screenshot_requested: false,
+            render_job: None,
         };
         if scripted {
             viewer.opened(&preset_path);
@@ -469,6 +473,9 @@ impl Viewer {
         if let Some(autosave) = &mut self.edits.autosave {
             autosave.finish();
         }
+        if let Some(job) = &self.render_job {
+            job.cancel();
+        }
         if self.window.fullscreen().is_none() {
             let size = self.window.inner_size();
             self.settings.window_size = Some((size.width, size.height));
@@ -514,6 +521,98 @@ impl Viewer {
                 Err(message) => self.panel.error(message),
             }
         }
+    }
+
+    /// The Render dialog's Render: the scene as it is now, rendered on a
+    /// thread of its own (`app/render_job.rs`) with the kernel the window
+    /// traces with.
+    fn start_render(&mut self, mut job: marbre_render::final_render::FinalRender) {
+        if self.render_job.is_some() {
+            return;
+        }
+        job.kernel = match self.renderer.kernel() {
+            marbre_render::gpu::Kernel::Fragment => marbre_render::gpu::KernelChoice::Fragment,
+            marbre_render::gpu::Kernel::Compute => marbre_render::gpu::KernelChoice::Compute,
+        };
+        let output = job.output.display().to_string();
+        let images = self.renderer.images().clone();
+        match RenderJob::start(&self.ctx, self.scene.clone(), images, job) {
+            Ok(started) => {
+                eprintln!("render: started {output}");
+                self.render_job = Some(started);
+                self.panel.render_dialog.last_result = None;
+                self.show_render_progress();
+            }
+            Err(e) => self.render_ended(format!("cannot render {output}: {e:#}"), true),
+        }
+    }
+
+    /// Shows the render's progress and lands what it reported.
+    fn poll_render(&mut self) {
+        let Some(job) = &mut self.render_job else {
+            return;
+        };
+        let output = job.job.output.display().to_string();
+        for update in job.poll() {
+            match update {
+                Update::Note(line) => {
+                    eprintln!("render: {line}");
+                    self.panel.info(line);
+                }
+                Update::Finished(result) => {
+                    self.render_job = None;
+                    self.panel.render_dialog.running = None;
+                    match result {
+                        Ok(marbre_render::final_render::Outcome::Written) => {
+                            self.render_ended(format!("rendered {output}"), false)
+                        }
+                        Ok(marbre_render::final_render::Outcome::Cancelled) => self.render_ended(
+                            format!("render of {output} cancelled: nothing written"),
+                            false,
+                        ),
+                        Err(e) => self.render_ended(format!("render failed: {e}"), true),
+                    }
+                    return;
+                }
+            }
+        }
+        self.show_render_progress();
+    }
+
+    /// The dialog's progress bar from the job's latest report.
+    fn show_render_progress(&mut self) {
+        let Some(job) = &self.render_job else {
+            return;
+        };
+        let progress = job.progress();
+        let line = match progress {
+            None => "preparing…".to_owned(),
+            Some(p) => match p.relative_error {
+                Some(e) => format!(
+                    "{} / {} spp, error {:.2} %",
+                    p.samples,
+                    p.max_samples,
+                    100.0 * e
+                ),
+                None => format!("{} / {} spp", p.samples, p.max_samples),
+            },
+        };
+        self.panel.render_dialog.running = Some(crate::panel::render_dialog::RunningView {
+            output: job.job.output.display().to_string(),
+            fraction: progress.map_or(0.0, |p| p.fraction()),
+            line,
+        });
+    }
+
+    /// How a render ended, in the dialog, the messages and the log.
+    fn render_ended(&mut self, text: String, is_error: bool) {
+        eprintln!("render: {text}");
+        if is_error {
+            self.panel.error(text.clone());
+        } else {
+            self.panel.info(text.clone());
+        }
+        self.panel.render_dialog.last_result = Some((text, is_error));
     }
 
     /// Installs the kernel `auto` found faster, once its timing is done.
@@ -593,6 +692,12 @@ impl Viewer {
                     object,
                     property,
                 ),
+                PanelAction::StartRender(job) => self.start_render(job),
+                PanelAction::CancelRender => {
+                    if let Some(job) = &self.render_job {
+                        job.cancel();
+                    }
+                }
             }
         }
     }
@@ -630,6 +735,7 @@ impl Viewer {
                 Shortcut::Close => self.show_help = false,
                 Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
                 Shortcut::Screenshot => self.screenshot_requested = true,
+                Shortcut::RenderDialog => self.panel.render_dialog.toggle(),
                 Shortcut::Fullscreen => {
                     let fullscreen = match self.window.fullscreen() {
                         Some(_) => None,
@@ -711,6 +817,9 @@ impl Viewer {
             let response = ui.allocate_rect(image_rect, egui::Sense::click_and_drag());
             dragging = camera_input::apply(ui, &response, &mut scene.camera);
             panel::help::draw_help_overlay(ui.ctx(), &mut show_help);
+            if !ui_hidden {
+                panel::render_dialog::show(ui.ctx(), &mut panel_state.render_dialog, &mut actions);
+            }
             if let Some(prompt) = prompt {
                 answer = prompts::show(ui.ctx(), prompt, &preset_name);
             }
@@ -732,6 +841,7 @@ impl Viewer {
             self.panel.error(format!("GPU error: {message}"));
         }
         self.poll_dialog();
+        self.poll_render();
         self.poll_file_watch();
         self.poll_loading()?;
         self.release_held_input()?;
