@@ -286,7 +286,7 @@ fn describe_error(renderer: &Renderer, target: f64, estimate: Option<ErrorEstima
         ),
         Some(e) => format!(
             "target not reached: estimated relative error {:.3} % (RMSE {:.5}) at the cap of {spp} spp \
-             ({seconds:.1} s); raise the samples, about {:.0} s more would do",
+             ({seconds:.1} s); raise the cap of samples per pixel (--spp), about {:.0} s more would do",
             100.0 * e.relative,
             e.rmse,
             e.seconds_to(target)
