@@ -1,0 +1,6 @@
+//! The command-line tools' integration tests, one binary: the accuracy
+//! bench end to end, and `marbre render` against the viewer's route to
+//! the same file.
+
+mod accuracy_bench;
+mod render;
