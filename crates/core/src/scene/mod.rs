@@ -8,18 +8,21 @@
 pub mod camera;
 pub mod color_encoding;
 pub mod environment;
+pub mod graph_layout;
 pub mod material;
 pub mod mesh;
 pub mod pattern;
 pub mod primitives;
 pub mod render_settings;
 pub mod render_view;
+pub mod texture_graph;
 pub mod texture_tree;
 pub mod transport;
 
 pub use camera::{OrbitCamera, SavedView};
 pub use color_encoding::ColorEncoding;
 pub use environment::{EnvSource, Environment, LdrImages};
+pub use graph_layout::{GraphLayout, MaterialKey, MaterialLayout};
 pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
@@ -144,6 +147,10 @@ pub struct Scene {
     pub point_light: Option<PointLight>,
     pub environment: Environment,
     pub render: RenderSettings,
+    /// Where the node editor draws each material's texture nodes: not
+    /// traced, but saved (see `graph_layout`).
+    #[serde(skip_serializing_if = "GraphLayout::is_empty")]
+    pub graph_layout: GraphLayout,
 }
 
 impl Scene {
@@ -163,6 +170,7 @@ impl Scene {
             point_light,
             environment,
             render,
+            graph_layout: _,
         } = self;
         *camera == other.camera
             && *views == other.views
