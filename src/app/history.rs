@@ -189,4 +189,75 @@ mod tests {
         assert_eq!(undone, MAX_STEPS);
         assert_eq!(current.render.display.exposure, 10.0);
     }
+
+    /// A node-graph edit (a parameter dragged in a node, then a link
+    /// dropped on another socket with the node's place) is what the graph
+    /// window does to the scene: each gesture is one step, and undo brings
+    /// back the tree the tree panel shows.
+    #[test]
+    fn node_graph_edits_are_steps() {
+        use glam::{Vec2, Vec3};
+        use marbre_core::scene::texture_graph::{NodePath, Socket, move_subtree, texture_at_mut};
+        use marbre_core::scene::{Child, MaterialKey, Pattern, Sphere, Texture};
+        let checker = |phase, a: Child, b: Child| {
+            Texture::blend(
+                Pattern::Checker2d {
+                    size: Vec2::splat(0.25),
+                    phase,
+                },
+                a,
+                b,
+            )
+        };
+        let mut sphere = Sphere::default();
+        sphere.material.diffuse = checker(
+            0.0,
+            checker(0.0, Vec3::X.into(), Vec3::Y.into()).into(),
+            Vec3::Z.into(),
+        );
+        let mut scene = Scene {
+            spheres: vec![sphere],
+            ..Scene::default()
+        };
+        let original = scene.clone();
+        let mut history = History::new(&scene);
+        let key = MaterialKey::Sphere(0);
+        let path: NodePath = "diffuse.a".parse().unwrap();
+
+        for k in 1..=5 {
+            let (m, _) = scene.material_and_layout_mut(key).unwrap();
+            texture_at_mut(m, &path).unwrap().pattern = Pattern::Checker2d {
+                size: Vec2::splat(0.25),
+                phase: 0.1 * k as f32,
+            };
+            history.observe(&scene, true);
+        }
+        history.observe(&scene, false);
+        let after_drag = scene.clone();
+
+        let (m, layout) = scene.material_and_layout_mut(key).unwrap();
+        let to = NodePath::root(path.root).child(Socket::B);
+        layout
+            .edit(key, |l| {
+                l.set(&path, Vec2::new(-600.0, 0.0));
+                move_subtree(m, l, &path, &to)
+            })
+            .unwrap();
+        history.observe(&scene, false);
+        let diffuse = &scene.spheres[0].material.diffuse;
+        assert_eq!(diffuse.a, Child::Color(Vec3::Z), "the tree shows the link");
+        assert!(
+            matches!(&diffuse.b, Child::Texture(t) if t.pattern == Pattern::Checker2d {
+                size: Vec2::splat(0.25),
+                phase: 0.5,
+            })
+        );
+        assert!(scene.graph_layout.get(key).is_some());
+
+        let undone = history.undo(&scene).unwrap();
+        assert_eq!(undone, after_drag);
+        let undone = history.undo(&undone).unwrap();
+        assert_eq!(undone, original);
+        assert!(!history.can_undo());
+    }
 }

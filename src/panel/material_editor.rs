@@ -280,7 +280,7 @@ fn texture_ui(
 /// The image file of an image node, and how its codes decode. The path is
 /// applied on Enter or when the field loses focus (the viewer then loads
 /// it), not at every keystroke.
-fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
+pub(super) fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
     let source = image.get_or_insert_with(|| ImageSource {
         path: PathBuf::new(),
         color_space: ColorSpace::Srgb,
@@ -312,7 +312,7 @@ fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
 /// The texture's own mapping: ticked, it and its subtree read the surface's
 /// coordinates (object or world for 3D patterns, the primitive's (u, v) for
 /// 2D ones) through a transform.
-fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
+pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
     let mut on = mapping.is_some();
     if ui
         .checkbox(&mut on, "mapping")
@@ -369,7 +369,7 @@ fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
 
 /// The math steps after a texture: each a dropdown, its parameters, and a
 /// remove button.
-fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
+pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
     let mut remove = None;
     for (i, op) in ops.iter_mut().enumerate() {
         ui.push_id(("op", i), |ui| {
@@ -435,7 +435,7 @@ fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
 
 /// The colour ramp: ticked, the pattern's blend factor picks a colour from
 /// the stops instead of blending `a` and `b` (which seed the first two).
-fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
+pub(super) fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
     let mut on = !texture.ramp.is_empty();
     if ui
         .checkbox(&mut on, "colour ramp")
@@ -562,7 +562,7 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
 }
 
 /// The pattern dropdown and the chosen pattern's parameters.
-fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
+pub(super) fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
     let mut index = pattern.index();
     ComboBox::new("pattern", "pattern")
         .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])

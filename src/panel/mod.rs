@@ -11,6 +11,7 @@ mod environment_ui;
 mod file_ui;
 pub mod help;
 mod material_editor;
+pub mod node_graph;
 mod quality;
 pub mod render_dialog;
 mod render_ui;
@@ -23,7 +24,7 @@ mod widgets;
 use egui::{ScrollArea, Ui};
 use environment_ui::environment_ui;
 use glam::Vec3;
-use marbre_core::scene::{EnvSource, Scene};
+use marbre_core::scene::{EnvSource, MaterialKey, Scene};
 use marbre_render::gpu::NonFiniteCounts;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
@@ -86,6 +87,8 @@ pub struct PanelState {
     pub progress: Option<(String, f32)>,
     /// The Render dialog's fields and the render under way.
     pub render_dialog: render_dialog::RenderDialog,
+    /// The material whose node-graph window is open.
+    pub node_graph: Option<MaterialKey>,
 }
 
 impl PanelState {
@@ -108,6 +111,7 @@ impl PanelState {
             focus_env_path: false,
             progress: None,
             render_dialog: Default::default(),
+            node_graph: None,
         }
     }
 
@@ -217,7 +221,7 @@ pub fn draw(
                 file_ui::preset_ui(ui, state, &mut actions);
             });
             section(ui, "Materials", true, |ui| {
-                if let Some((object, property)) = materials_ui(ui, scene) {
+                if let Some((object, property)) = materials_ui(ui, scene, &mut state.node_graph) {
                     actions.push(PanelAction::Bake { object, property });
                 }
             });
@@ -241,6 +245,7 @@ pub fn draw(
 
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));
         });
+    node_graph::window(ui.ctx(), scene, &mut state.node_graph, &|_, _| None);
     actions
 }
 

@@ -3,16 +3,22 @@
 
 use super::PanelAction;
 use super::material_editor::material_ui;
+use super::node_graph;
 use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_ui};
 use egui::{CollapsingHeader, Ui};
 use marbre_core::bake::{BakeProperty, ObjectRef};
-use marbre_core::scene::{Ground, OrbitCamera, PointLight, Scene};
+use marbre_core::scene::{Ground, MaterialKey, OrbitCamera, PointLight, Scene};
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
 /// the ground. Only the first is open at start, so a scene with many
-/// objects still fits on screen.
+/// objects still fits on screen. Each material has its node-graph toggle
+/// (`graph`: the material whose graph window is open).
 /// Returns the object and property of a Bake… button pressed.
-pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef, BakeProperty)> {
+pub(super) fn materials_ui(
+    ui: &mut Ui,
+    scene: &mut Scene,
+    graph: &mut Option<MaterialKey>,
+) -> Option<(ObjectRef, BakeProperty)> {
     let mut first = true;
     let mut bake = None;
     let mut object =
@@ -31,6 +37,7 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
             ("sphere", i),
             format!("sphere “{}”", sphere.name),
             &mut |ui| {
+                node_graph::toggle(ui, graph, MaterialKey::Sphere(i));
                 let pressed = material_ui(ui, &mut sphere.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Sphere(i), p)));
             },
@@ -55,6 +62,7 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
                     .on_hover_text(
                         "Along +y; the side's v runs from 0 at the base to 1 at the top",
                     );
+                node_graph::toggle(ui, graph, MaterialKey::Cylinder(i));
                 let pressed = material_ui(ui, &mut cylinder.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Cylinder(i), p)));
             },
@@ -66,6 +74,7 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
             ("polygon", i),
             format!("polygon “{}”", polygon.name),
             &mut |ui| {
+                node_graph::toggle(ui, graph, MaterialKey::Polygon(i));
                 let pressed = material_ui(ui, &mut polygon.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Polygon(i), p)));
             },
@@ -82,6 +91,7 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
                  (oblique ones too) instead of world (x, z)",
                 default,
             );
+            node_graph::toggle(ui, graph, MaterialKey::Ground);
             let pressed = material_ui(ui, &mut ground.material);
             bake = bake.or(pressed.map(|p| (ObjectRef::Ground, p)));
         });
@@ -92,7 +102,7 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
             ("mesh", i),
             format!("mesh “{}”", mesh.name),
             &mut |ui| {
-                let pressed = mesh_ui(ui, mesh);
+                let pressed = mesh_ui(ui, mesh, i, graph);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Mesh(i), p)));
             },
         );
@@ -103,8 +113,14 @@ pub(super) fn materials_ui(ui: &mut Ui, scene: &mut Scene) -> Option<(ObjectRef,
 /// A mesh's placement and each of its MTL materials, editable like any
 /// other (a Cornell box wall can be marble); "reset" goes back to the file.
 /// Returns the property of a Bake… button pressed (a bake covers the whole
-/// mesh, each triangle in its own material).
-pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) -> Option<BakeProperty> {
+/// mesh, each triangle in its own material). `index` is the mesh's in the
+/// scene, for the node-graph toggle.
+pub(super) fn mesh_ui(
+    ui: &mut Ui,
+    mesh: &mut marbre_core::scene::Mesh,
+    index: usize,
+    graph: &mut Option<MaterialKey>,
+) -> Option<BakeProperty> {
     let mut bake = None;
     ui.label(format!(
         "{} triangles from {}",
@@ -131,6 +147,11 @@ pub(super) fn mesh_ui(ui: &mut Ui, mesh: &mut marbre_core::scene::Mesh) -> Optio
                     {
                         m.material = original.clone();
                     }
+                    let key = MaterialKey::Mesh {
+                        mesh: index,
+                        material: k,
+                    };
+                    node_graph::toggle(ui, graph, key);
                     bake = bake.or(material_ui(ui, &mut m.material));
                 });
         });

@@ -1,0 +1,148 @@
+//! The node editor: a material's texture trees as a node graph in a
+//! window beside the panel (Blender's shader editor). Each texture is a
+//! node with its pattern and parameters, value children are inline inputs,
+//! and links run from a nested texture to its parent's socket and from each
+//! tree to the material's socket for its property. Dragging a link's end
+//! onto another input moves the subtree there (`texture_graph::move_subtree`),
+//! dropping it on nothing leaves a constant (`texture_graph::detach`);
+//! dragging a node's header moves the node (`Scene::graph_layout`).
+//!
+//! Every edit goes straight to the [`Scene`] the tree panel edits, so the
+//! two always agree and the app's history records graph edits like any
+//! other (one step per gesture).
+//!
+//! Written here rather than taken from a crate: none of the egui node-graph
+//! crates builds with egui 0.37 (checked 2026-12 with `cargo info -v`:
+//! egui-snarl 0.12.0 needs egui 0.36, egui-graph-edit 0.9.1 egui 0.35,
+//! egui_node_graph2 0.7.0 egui 0.29), and a tree needs little of them.
+
+mod canvas;
+mod layout;
+
+use egui::{Context, TextureId, Ui};
+use marbre_core::scene::texture_graph::NodePath;
+use marbre_core::scene::{MaterialKey, Scene};
+
+/// A preview image of the texture at a node, if one is at hand; the node
+/// draws it in its header. (The panel passes none until swatches exist.)
+pub type Swatches<'a> = &'a dyn Fn(MaterialKey, &NodePath) -> Option<TextureId>;
+
+/// A button that opens the node editor on `key`'s material (or closes it).
+pub fn toggle(ui: &mut Ui, open: &mut Option<MaterialKey>, key: MaterialKey) {
+    let mut shown = *open == Some(key);
+    if ui
+        .toggle_value(&mut shown, "node graph")
+        .on_hover_text(
+            "Show this material's texture trees as nodes and links in a window: \
+             drag a link's end to another input to move the subtree, onto nothing \
+             to leave a constant; drag a header to move a node",
+        )
+        .changed()
+    {
+        *open = shown.then_some(key);
+    }
+}
+
+/// The node editor's window for the material `open` names, if any; closing
+/// the window (or the material disappearing) clears `open`.
+pub fn window(
+    ctx: &Context,
+    scene: &mut Scene,
+    open: &mut Option<MaterialKey>,
+    swatches: Swatches,
+) {
+    let Some(key) = *open else { return };
+    let Some((material, layout)) = scene.material_and_layout_mut(key) else {
+        *open = None;
+        return;
+    };
+    let mut keep = true;
+    egui::Window::new(format!("node graph: {key}"))
+        .id(egui::Id::NULL.with("node graph window"))
+        .open(&mut keep)
+        .default_size([900.0, 560.0])
+        .resizable(true)
+        .show(ctx, |ui| {
+            canvas::canvas(ui, key, material, layout, swatches);
+        });
+    if !keep {
+        *open = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec2, Vec3};
+    use marbre_core::scene::{Child, Ground, Pattern, Sphere, Texture};
+
+    fn scene() -> Scene {
+        let checker = |a: Child, b: Child| {
+            Texture::blend(
+                Pattern::Checker2d {
+                    size: Vec2::splat(0.25),
+                    phase: 0.5,
+                },
+                a,
+                b,
+            )
+        };
+        let mut sphere = Sphere::default();
+        sphere.material.diffuse = checker(
+            checker(Vec3::X.into(), Vec3::Y.into()).into(),
+            Vec3::Z.into(),
+        );
+        sphere.material.roughness = Texture::mix(
+            Texture::blend(Pattern::Constant.with_index(2), 0.0, 1.0),
+            0.2,
+            0.8,
+        );
+        Scene {
+            spheres: vec![sphere],
+            ground: Some(Ground::default()),
+            ..Scene::default()
+        }
+    }
+
+    /// Drawing the window, several frames (egui sizes windows on the
+    /// first), edits nothing: no parameter, no position.
+    #[test]
+    fn drawing_the_graph_without_input_changes_nothing() {
+        let mut scene = scene();
+        let before = scene.clone();
+        let ctx = Context::default();
+        for key in [MaterialKey::Sphere(0), MaterialKey::Ground] {
+            let mut open = Some(key);
+            for _ in 0..3 {
+                ctx.run_ui(egui::RawInput::default(), |ui| {
+                    window(ui.ctx(), &mut scene, &mut open, &|_, _| None);
+                })
+                .drop_without_applying_deltas();
+            }
+            assert_eq!(open, Some(key));
+            assert_eq!(scene, before);
+            // The nodes were drawn: each measured its height.
+            let drawn: Option<f32> = ctx.data(|d| {
+                d.get_temp(
+                    egui::Id::NULL
+                        .with(("node canvas", key.to_string()))
+                        .with(("height", "diffuse".to_string())),
+                )
+            });
+            assert!(drawn.is_some_and(|h| h > 40.0), "{drawn:?}");
+        }
+    }
+
+    /// A material that is gone closes the window rather than panicking.
+    #[test]
+    fn a_missing_material_closes_the_window() {
+        let mut scene = scene();
+        let mut open = Some(MaterialKey::Cylinder(3));
+        let ctx = Context::default();
+        ctx.run_ui(egui::RawInput::default(), |ui| {
+            window(ui.ctx(), &mut scene, &mut open, &|_, _| None);
+        })
+        .drop_without_applying_deltas();
+        assert_eq!(open, None);
+    }
+}
