@@ -205,7 +205,7 @@ fn texture_ui(
             .id_salt("texture")
             .default_open(depth == 1)
             .show(ui, |ui| {
-                pattern_ui(ui, &mut texture.pattern);
+                pattern_ui(ui, texture);
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
                 }
@@ -516,14 +516,7 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
                     .changed()
             {
                 *child = if nested {
-                    Child::Texture(Box::new(Texture::blend(
-                        Pattern::Checker2d {
-                            size: glam::Vec2::splat(0.5),
-                            phase: 0.0,
-                        },
-                        child.clone(),
-                        child.clone(),
-                    )))
+                    Child::Texture(Box::new(Texture::nesting(child)))
                 } else {
                     let c = child.eval(Vec3::ZERO, glam::Vec2::ZERO);
                     match kind {
@@ -562,17 +555,18 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
 }
 
 /// The pattern dropdown and the chosen pattern's parameters.
-pub(super) fn pattern_ui(ui: &mut Ui, pattern: &mut Pattern) {
-    let mut index = pattern.index();
+pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
+    let mut index = texture.pattern.index();
     ComboBox::new("pattern", "pattern")
         .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])
         .on_hover_text("What blends between the two values across the surface");
-    if index != pattern.index() {
+    if index != texture.pattern.index() {
         // `with_index` carries the noise settings over, so tuning survives
-        // (Massal's marble takes his recipe instead).
-        *pattern = pattern.with_index(index);
+        // (Massal's marble takes his recipe instead); a constant's one value
+        // gets a contrasting second side, so the new pattern shows.
+        *texture = texture.with_pattern_contrasting(texture.pattern.with_index(index));
     }
-    match pattern {
+    match &mut texture.pattern {
         Pattern::Constant => {}
         Pattern::Checker { size } => {
             ui.add(slider(size, 0.01..=10.0, "cube size").logarithmic(true))

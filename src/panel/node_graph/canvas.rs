@@ -339,7 +339,7 @@ fn texture_node(
             .response
             .rect;
         ui.separator();
-        pattern_ui(ui, &mut texture.pattern);
+        pattern_ui(ui, texture);
         if texture.pattern == Pattern::Mix && texture.factor.is_none() {
             // A pattern just switched to mix: the tree panel's default.
             texture.factor = Some(Box::new(Texture::scalar(0.5)));

@@ -7,6 +7,7 @@
 
 pub mod camera;
 pub mod color_encoding;
+pub mod contrast;
 pub mod environment;
 pub mod graph_layout;
 pub mod material;

@@ -328,12 +328,24 @@ impl Pattern {
         }
     }
 
+    /// The first octave's frequency of a pattern's noise when it had none:
+    /// several features across a unit sphere.
+    pub const FRESH_NOISE_FREQUENCY: f32 = 3.0;
+
     /// The pattern with index `i`, keeping the noise settings of `self` where
     /// both have some, so switching the dropdown does not lose the tuning.
+    /// Fresh parameters show several features on a unit sphere (the 3D
+    /// checker 4 cubes across it, noise at [`Self::FRESH_NOISE_FREQUENCY`]).
     pub fn with_index(&self, i: usize) -> Pattern {
-        let noise = self.noise().copied().unwrap_or_default();
+        let noise = self.noise().copied().unwrap_or_else(|| NoiseSettings {
+            fractal: FractalParams {
+                frequency: Self::FRESH_NOISE_FREQUENCY,
+                ..FractalParams::default()
+            },
+            ..NoiseSettings::default()
+        });
         match i {
-            1 => Pattern::Checker { size: 1.0 },
+            1 => Pattern::Checker { size: 0.5 },
             2 => Pattern::Fbm { noise },
             3 => Pattern::Turbulence { noise },
             4 => Pattern::Marble {
