@@ -1,7 +1,7 @@
 //! Which shader features a scene needs: the key of shader specialisation.
 
 use marbre_core::noise::{HashKind, NoiseKind, NoiseSettings};
-use marbre_core::scene::{EnvSource, Material, Pattern, Scene};
+use marbre_core::scene::{EnvSource, Material, Pattern, Scene, Texture};
 use marbre_core::texture::ImageFilter;
 use std::collections::BTreeSet;
 
@@ -258,6 +258,18 @@ impl FeatureSet {
         let mut set = Self::for_noise(noise);
         set.0.insert(Feature::Footprint);
         set
+    }
+
+    /// For swatches: what evaluating `textures` alone needs (their
+    /// patterns and noise), point sampled (no footprint).
+    pub fn for_textures(textures: &[Texture]) -> Self {
+        Self(
+            textures
+                .iter()
+                .flat_map(Texture::patterns)
+                .flat_map(pattern_features)
+                .collect(),
+        )
     }
 
     /// For the texture harness: every pattern of the texture library, and

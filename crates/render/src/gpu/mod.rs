@@ -24,6 +24,7 @@ pub mod readback;
 pub mod renderer;
 pub mod scene_gpu;
 pub mod shader_source;
+pub mod swatch;
 pub mod testing;
 pub mod texture_codegen;
 pub mod trace_bands;

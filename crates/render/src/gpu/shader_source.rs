@@ -75,6 +75,7 @@ const SOURCES: &[WgslFile] = &[
     harness::geometry::WGSL,
     harness::sampling::WGSL,
     super::bake::WGSL,
+    super::swatch::WGSL,
 ];
 
 /// The folder `marbre --dev` watches for edited WGSL: the repository's
@@ -109,10 +110,13 @@ pub enum Program {
     /// The compute pass that evaluates a scene's generated texture code at
     /// given surface points (`marbre bake`).
     Bake,
+    /// The compute pass that evaluates texture nodes alone over a swatch
+    /// (the panel's previews), from generated texture code.
+    Swatch,
 }
 
 impl Program {
-    pub const ALL: [Program; 11] = [
+    pub const ALL: [Program; 12] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
@@ -124,6 +128,7 @@ impl Program {
         Program::GeometryHarness,
         Program::SamplingHarness,
         Program::Bake,
+        Program::Swatch,
     ];
 
     /// The files this program is made of, in order, for a feature set.
@@ -191,6 +196,19 @@ impl Program {
                     texture::mapping::WGSL,
                     texture::image::WGSL,
                     harness::texture::WGSL,
+                ]);
+            }
+            Program::Swatch => {
+                noise(&mut out);
+                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
+                if features.contains(Feature::Image) {
+                    out.push(texture::image::WGSL);
+                }
+                out.extend([
+                    r::TEXTURES,
+                    geometry::sphere::WGSL,
+                    r::INTERSECT,
+                    super::swatch::WGSL,
                 ]);
             }
             Program::BvhHarness => out.extend([accel::traverse::WGSL, harness::bvh::WGSL]),
@@ -296,7 +314,7 @@ pub fn sources_fingerprint() -> u64 {
 }
 
 /// The WGSL text of `program` specialised for `features`. The trace and
-/// bake programs also take the scene's generated texture code
+/// bake and swatch programs also take generated texture code
 /// ([`super::texture_codegen::generate`]); the others ignore it.
 pub fn assemble(
     program: Program,
@@ -309,7 +327,7 @@ pub fn assemble(
         module.push_str(&format!("{SECTION_HEADER}{}\n", file.name));
         module.push_str(&preprocess(&source_text(&file), file.name, &defines)?);
     }
-    if matches!(program, Program::Trace | Program::Bake) {
+    if matches!(program, Program::Trace | Program::Bake | Program::Swatch) {
         module.push_str(&format!("{SECTION_HEADER}generated textures\n"));
         module.push_str(generated_textures);
     }

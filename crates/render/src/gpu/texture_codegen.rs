@@ -142,6 +142,53 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
     Ok(GeneratedTextures { wgsl, params })
 }
 
+/// The code and parameters evaluating each of `textures` alone (the
+/// panel's preview swatches, `gpu::swatch`): `swatch_texture(index, …)`
+/// returns texture `index`'s colour, its noise signals read from
+/// `signals`, which `material_signals(index, …)` evaluates from the
+/// materials [`swatch_material`] makes. The same generator as
+/// [`generate`], so a swatch shows what the renderer would.
+pub fn generate_swatches(textures: &[Texture], images: &ImageSet) -> Result<GeneratedTextures> {
+    let mut generator = Generator {
+        images,
+        code: String::new(),
+        params: Vec::new(),
+        next: 0,
+    };
+    let mut dispatch = String::new();
+    for (index, texture) in textures.iter().enumerate() {
+        let name = format!("swatch_{index}");
+        generator.function(&name, texture, &material_signals(&swatch_material(texture)));
+        writeln!(
+            dispatch,
+            "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals);\n        }}"
+        )?;
+    }
+    ensure!(
+        generator.params.len() <= MAX_TEXTURE_PARAMS,
+        "the swatches' textures need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
+        generator.params.len()
+    );
+    let mut wgsl =
+        String::from("// Generated from texture trees for swatches (gpu::texture_codegen).\n\n");
+    wgsl.push_str(&generator.code);
+    write!(
+        wgsl,
+        "fn swatch_texture(index: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> vec3f {{\n    switch index {{\n{dispatch}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
+    )?;
+    let mut params = generator.params;
+    params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
+    Ok(GeneratedTextures { wgsl, params })
+}
+
+/// The material a swatch of `texture` reads its noise signals through: a
+/// default one whose diffuse colour is the texture.
+pub fn swatch_material(texture: &Texture) -> Material {
+    let mut material = Material::default();
+    *material.texture_mut(Property::Diffuse) = texture.clone();
+    material
+}
+
 /// A material's distinct fractal sums, gradient noise first (the order
 /// `material_signals` in textures.wgsl expects), at most [`MAX_SIGNALS`]
 /// (`Scene::sanitize` keeps materials within it).

@@ -31,6 +31,7 @@ mod presets;
 mod report_frames;
 mod sampling_stability;
 mod sampling_support;
+mod swatch;
 mod texture_graph;
 mod texture_parity;
 mod tx;
