@@ -25,6 +25,7 @@ mod screenshots;
 mod settings;
 mod shortcuts;
 pub mod soak;
+pub mod swatches;
 mod ui_layer;
 mod viewer;
 

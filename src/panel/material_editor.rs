@@ -1,6 +1,7 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
+use super::swatches;
 use super::tx_ui::{has_tx_section, tx_ui};
 use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
@@ -205,6 +206,7 @@ fn texture_ui(
             .id_salt("texture")
             .default_open(depth == 1)
             .show(ui, |ui| {
+                swatch_ui(ui, texture, kind);
                 pattern_ui(ui, texture);
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
@@ -275,6 +277,25 @@ fn texture_ui(
                 }
             });
     });
+}
+
+/// Side of a node's preview swatch in the panel, in points.
+const SWATCH_POINTS: f32 = 48.0;
+
+/// The node's preview swatch, its output on a unit sphere, once the viewer
+/// has rendered it; none for a constant, whose value shows as it is.
+fn swatch_ui(ui: &mut Ui, texture: &Texture, kind: ValueKind) {
+    if texture.as_constant().is_some() {
+        return;
+    }
+    let scalar = kind == ValueKind::Scalar;
+    if let Some(id) = swatches::swatch(ui.ctx(), ui.scope_id(), texture, scalar) {
+        ui.add(egui::Image::new((id, egui::Vec2::splat(SWATCH_POINTS))))
+            .on_hover_text(
+                "This node's output on the front of a unit sphere, point sampled (image nodes \
+                 show grey); refreshed after each edit",
+            );
+    }
 }
 
 /// The image file of an image node, and how its codes decode. The path is

@@ -17,6 +17,7 @@ pub mod render_dialog;
 mod render_ui;
 mod scene_ui;
 mod stats;
+pub mod swatches;
 mod transport;
 mod tx_ui;
 mod widgets;

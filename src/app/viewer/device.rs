@@ -4,6 +4,7 @@
 //! made is lost; the accumulated samples start over).
 
 use super::{Viewer, surface_config};
+use crate::app::swatches::Swatches;
 use anyhow::{Context as _, Result};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::pass_timer::PassTimer;
@@ -58,6 +59,9 @@ impl Viewer {
             None,
             Some(max_texture_side(&ctx) as usize),
         );
+        // The swatches' worker and images belong to the old device and
+        // context: a new book and worker render them again.
+        self.swatches = Swatches::new(&ctx, &egui_ctx);
         self.egui_ctx = egui_ctx;
         self.ctx = ctx;
         self.panel.error(format!(

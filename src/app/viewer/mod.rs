@@ -27,6 +27,7 @@ use super::scene_loader::{FileKind, SceneKind, SceneLoad, load_reporting};
 use super::settings::Settings;
 use super::shortcuts::{self, Shortcut};
 use super::soak::SoakDriver;
+use super::swatches::Swatches;
 use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::panel::{self, PanelAction, PanelState};
@@ -80,6 +81,8 @@ pub struct Viewer {
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
+    /// The texture nodes' preview swatches, rendered on a worker thread.
+    swatches: Swatches,
     scene: Scene,
     /// The preset being edited, its undo history and what guards it.
     edits: Editing,
@@ -317,6 +320,7 @@ impl Viewer {
         );
         let egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, config.format, Default::default());
+        let swatches = Swatches::new(&ctx, &egui_ctx);
         let env_path = match &loaded.scene.environment.source {
             EnvSource::LatLong { path } => path.display().to_string(),
             _ => String::new(),
@@ -375,6 +379,7 @@ impl Viewer {
             egui_ctx,
             egui_state,
             egui_renderer,
+            swatches,
             scene: loaded.scene,
             edits: Editing {
                 document,
@@ -825,6 +830,9 @@ impl Viewer {
             }
         });
         self.show_help = show_help;
+        if let Some(error) = self.swatches.after_ui(&self.egui_ctx) {
+            self.panel.error(error);
+        }
         self.handle_actions(actions);
         self.handle_shortcuts(pressed);
         if let Some(answer) = answer {

@@ -3,6 +3,9 @@
 use anyhow::{Context as _, Result};
 
 /// A device and what the stats panel and the benchmarks report about it.
+/// A clone shares the device (wgpu handles are reference counted): the
+/// viewer's swatch worker uses one.
+#[derive(Clone)]
 pub struct GpuContext {
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,

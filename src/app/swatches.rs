@@ -1,0 +1,135 @@
+//! The viewer's side of the preview swatches (`panel/swatches.rs` asks,
+//! `marbre_render::gpu::swatch` renders): a worker thread owns the swatch
+//! renderer and renders each batch of changed nodes there, waiting for the
+//! GPU off the UI thread; the UI thread only takes finished batches and
+//! uploads them as egui textures (`Context::load_texture`: 9 KiB per
+//! swatch, cheaper to keep than a native texture registered per swatch
+//! with its own bind group, and it never waits on the GPU).
+
+use crate::panel::swatches::{SharedSwatchBook, SwatchRequest, install};
+use anyhow::Result;
+use marbre_render::gpu::GpuContext;
+use marbre_render::gpu::swatch::{MAX_BATCH, SWATCH_SIZE, SwatchPixels, SwatchRenderer, to_srgba8};
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+use std::time::Instant;
+
+/// A batch the worker finished: what was asked, the swatches or why not,
+/// and the milliseconds it took (pipeline build included).
+struct Finished {
+    requests: Vec<SwatchRequest>,
+    swatches: Result<Vec<SwatchPixels>>,
+    ms: f32,
+}
+
+pub struct Swatches {
+    book: SharedSwatchBook,
+    /// `None` once the worker has gone (its thread could not start).
+    jobs: Option<Sender<Vec<SwatchRequest>>>,
+    finished: Receiver<Finished>,
+    in_flight: bool,
+    /// The last batch's time and size, for docs/PERFORMANCE.md's numbers
+    /// (printed with `MARBRE_SWATCH_TIMES=1`).
+    print_times: bool,
+}
+
+impl Swatches {
+    /// Starts the worker on a clone of `ctx`'s device and puts a new book
+    /// in `egui_ctx`, where the panels find it.
+    pub fn new(ctx: &GpuContext, egui_ctx: &egui::Context) -> Self {
+        let book = SharedSwatchBook::default();
+        install(egui_ctx, book.clone());
+        let (jobs, job_queue) = channel::<Vec<SwatchRequest>>();
+        let (done, finished) = channel();
+        let ctx = ctx.clone();
+        let started = std::thread::Builder::new()
+            .name("swatches".into())
+            .spawn(move || {
+                let mut renderer = SwatchRenderer::new(ctx);
+                for requests in job_queue {
+                    let start = Instant::now();
+                    let textures: Vec<_> = requests.iter().map(|r| r.texture.clone()).collect();
+                    let swatches = match &mut renderer {
+                        Ok(renderer) => renderer.render(&textures),
+                        Err(e) => Err(anyhow::anyhow!("{e:#}")),
+                    };
+                    let ms = start.elapsed().as_secs_f32() * 1000.0;
+                    if done
+                        .send(Finished {
+                            requests,
+                            swatches,
+                            ms,
+                        })
+                        .is_err()
+                    {
+                        break;
+                    }
+                }
+            });
+        Self {
+            book,
+            jobs: started.is_ok().then_some(jobs),
+            finished,
+            in_flight: false,
+            print_times: std::env::var_os("MARBRE_SWATCH_TIMES").is_some(),
+        }
+    }
+
+    /// After the panels ran: uploads a finished batch's swatches, sends the
+    /// next nodes that changed if no batch is rendering, and ends the
+    /// book's frame. Returns an error to show, if a batch failed.
+    pub fn after_ui(&mut self, egui_ctx: &egui::Context) -> Option<String> {
+        let mut error = None;
+        match self.finished.try_recv() {
+            Ok(done) => {
+                self.in_flight = false;
+                error = self.deliver(egui_ctx, done);
+            }
+            Err(TryRecvError::Disconnected) => self.jobs = None,
+            Err(TryRecvError::Empty) => {}
+        }
+        let Ok(mut book) = self.book.lock() else {
+            return error;
+        };
+        if !self.in_flight
+            && let Some(jobs) = &self.jobs
+        {
+            let requests = book.take_requests(MAX_BATCH);
+            if !requests.is_empty() {
+                self.in_flight = jobs.send(requests).is_ok();
+            }
+        }
+        book.end_frame();
+        error
+    }
+
+    fn deliver(&self, egui_ctx: &egui::Context, done: Finished) -> Option<String> {
+        if self.print_times {
+            eprintln!("swatches: {} in {:.1} ms", done.requests.len(), done.ms);
+        }
+        let swatches = match done.swatches {
+            Ok(swatches) => swatches,
+            Err(e) => return Some(format!("swatch previews: {e:#}")),
+        };
+        let Ok(mut book) = self.book.lock() else {
+            return None;
+        };
+        for (request, pixels) in done.requests.iter().zip(swatches) {
+            let rgba: Vec<u8> = pixels
+                .iter()
+                .flat_map(|&p| {
+                    let p = if request.scalar {
+                        [p[0], p[0], p[0], p[3]]
+                    } else {
+                        p
+                    };
+                    to_srgba8(p)
+                })
+                .collect();
+            let image = egui::ColorImage::from_rgba_unmultiplied([SWATCH_SIZE, SWATCH_SIZE], &rgba);
+            let handle = egui_ctx.load_texture("swatch", image, egui::TextureOptions::LINEAR);
+            book.deliver(request.id, handle);
+        }
+        egui_ctx.request_repaint();
+        None
+    }
+}
