@@ -27,9 +27,24 @@ pub struct Swatches {
     jobs: Option<Sender<Vec<SwatchRequest>>>,
     finished: Receiver<Finished>,
     in_flight: bool,
-    /// The last batch's time and size, for docs/PERFORMANCE.md's numbers
-    /// (printed with `MARBRE_SWATCH_TIMES=1`).
+    /// Set by `MARBRE_SWATCH_TIMES=1`: each batch's time is printed, and at
+    /// the end the UI thread's time in [`Swatches::after_ui`] per frame
+    /// (docs/PERFORMANCE.md's numbers).
     print_times: bool,
+    /// The UI thread's seconds in `after_ui`, and its calls.
+    ui_time: (f64, u64),
+}
+
+impl Drop for Swatches {
+    fn drop(&mut self) {
+        if self.print_times && self.ui_time.1 > 0 {
+            eprintln!(
+                "swatches: {:.3} ms per frame on the UI thread over {} frames",
+                self.ui_time.0 * 1000.0 / self.ui_time.1 as f64,
+                self.ui_time.1
+            );
+        }
+    }
 }
 
 impl Swatches {
@@ -71,6 +86,7 @@ impl Swatches {
             finished,
             in_flight: false,
             print_times: std::env::var_os("MARBRE_SWATCH_TIMES").is_some(),
+            ui_time: (0.0, 0),
         }
     }
 
@@ -78,6 +94,14 @@ impl Swatches {
     /// next nodes that changed if no batch is rendering, and ends the
     /// book's frame. Returns an error to show, if a batch failed.
     pub fn after_ui(&mut self, egui_ctx: &egui::Context) -> Option<String> {
+        let start = Instant::now();
+        let error = self.exchange(egui_ctx);
+        self.ui_time.0 += start.elapsed().as_secs_f64();
+        self.ui_time.1 += 1;
+        error
+    }
+
+    fn exchange(&mut self, egui_ctx: &egui::Context) -> Option<String> {
         let mut error = None;
         match self.finished.try_recv() {
             Ok(done) => {

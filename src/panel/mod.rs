@@ -307,6 +307,39 @@ mod tests {
         assert!(actions.is_empty(), "{actions:?}");
     }
 
+    /// With the viewer's swatch book in place and a swatch delivered for
+    /// every node that asked, drawing the material editor shows them and
+    /// still changes nothing.
+    #[test]
+    fn drawing_with_swatches_changes_nothing() {
+        let mut scene = marble_scene();
+        let before = scene.clone();
+        let ctx = egui::Context::default();
+        let book = swatches::SharedSwatchBook::default();
+        swatches::install(&ctx, book.clone());
+        let draw_once = |scene: &mut Scene| {
+            ctx.run_ui(egui::RawInput::default(), |ui| {
+                egui::CentralPanel::default()
+                    .show(ui, |ui| material_ui(ui, &mut scene.spheres[0].material));
+            })
+            .drop_without_applying_deltas();
+        };
+        draw_once(&mut scene);
+        let asked = book.lock().unwrap().take_requests(64);
+        assert!(
+            !asked.is_empty(),
+            "the open marble node asks for its swatch"
+        );
+        for request in &asked {
+            let image = ctx.load_texture("s", egui::ColorImage::example(), Default::default());
+            book.lock().unwrap().deliver(request.id, image);
+        }
+        draw_once(&mut scene);
+        assert_eq!(book.lock().unwrap().shown(), asked.len());
+        assert!(book.lock().unwrap().take_requests(64).is_empty());
+        assert_eq!(scene, before);
+    }
+
     /// `draw` leaves some sections closed; their bodies must not edit the
     /// scene either, whatever the source, pattern or light.
     #[test]
