@@ -1,7 +1,7 @@
 //! The Environment section: the source (none, constant, lat-long map, cube
 //! faces or cross), its fields and its rotation.
 
-use super::widgets::{labelled_color, slider};
+use super::widgets::{enter_pressed, labelled_color, slider};
 use super::{PanelAction, PanelState};
 use egui::{ComboBox, TextEdit, Ui};
 use marbre_core::scene::{EnvSource, Environment, LdrImages};
@@ -79,16 +79,19 @@ pub(super) fn source_fields_ui(
             ui.horizontal(|ui| {
                 let field = ui
                     .add(TextEdit::singleline(&mut state.env_path).hint_text("map.exr"))
-                    .on_hover_text("Latitude-longitude image: .exr, .hdr, .png or .jpg");
+                    .on_hover_text(
+                        "Latitude-longitude image: .exr, .hdr, .png or .jpg; Enter loads it",
+                    );
                 if std::mem::take(&mut state.focus_env_path) {
                     field.request_focus();
                 }
-                if ui
-                    .add_enabled(!state.env_path.trim().is_empty(), egui::Button::new("Load"))
+                let typed = !state.env_path.trim().is_empty();
+                let load = ui
+                    .add_enabled(typed, egui::Button::new("Load"))
                     .on_hover_text("Load the map at this path")
                     .on_disabled_hover_text("Type a path first")
-                    .clicked()
-                {
+                    .clicked();
+                if load || (typed && enter_pressed(ui, &field)) {
                     actions.push(PanelAction::LoadEnvironment(PathBuf::from(
                         state.env_path.trim(),
                     )));
@@ -112,6 +115,8 @@ pub(super) fn source_fields_ui(
 
 /// The path fields of a cube map (six faces, or a cross) and a Load button
 /// that puts them in the scene: typing alone does not load half a path.
+/// Enter in any of the fields loads too, once every path is typed; a
+/// request to focus the environment path puts the keyboard in the first.
 pub(super) fn cube_source_ui(
     ui: &mut Ui,
     source: &mut EnvSource,
@@ -138,28 +143,46 @@ pub(super) fn cube_source_ui(
                 .on_hover_text("A file the scene uses; relative to the preset file");
         }
     }
+    let focus = std::mem::take(&mut state.focus_env_path);
+    let mut entered = false;
     let ready = if is_faces {
         let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
         let hints = ["px.exr", "nx.exr", "py.exr", "ny.exr", "pz.exr", "nz.exr"];
-        for ((name, hint), path) in names.iter().zip(hints).zip(&mut state.cube_faces) {
+        for (i, ((name, hint), path)) in names
+            .iter()
+            .zip(hints)
+            .zip(&mut state.cube_faces)
+            .enumerate()
+        {
             ui.horizontal(|ui| {
                 ui.label(*name);
-                ui.add(TextEdit::singleline(path).hint_text(hint))
+                let field = ui
+                    .add(TextEdit::singleline(path).hint_text(hint))
                     .on_hover_text(
                         "A square face (.exr, .hdr, .png or .jpg), OpenGL orientation; \
-                         all six the same size",
+                         all six the same size; Enter loads them",
                     );
+                if focus && i == 0 {
+                    field.request_focus();
+                }
+                entered |= enter_pressed(ui, &field);
             });
         }
         state.cube_faces.iter().all(|p| !p.trim().is_empty())
     } else {
-        ui.add(TextEdit::singleline(&mut state.cube_cross).hint_text("cross.exr"))
+        let field = ui
+            .add(TextEdit::singleline(&mut state.cube_cross).hint_text("cross.exr"))
             .on_hover_text(
-                "One image of 4x3 square faces: +y above +z; -x, +z, +x, -z across; -y below",
+                "One image of 4x3 square faces: +y above +z; -x, +z, +x, -z across; -y below; \
+                 Enter loads it",
             );
+        if focus {
+            field.request_focus();
+        }
+        entered = enter_pressed(ui, &field);
         !state.cube_cross.trim().is_empty()
     };
-    if ui
+    let load = ui
         .add_enabled(ready, egui::Button::new("Load"))
         .on_hover_text("Load the cube map at these paths (resampled to lat-long)")
         .on_disabled_hover_text(if is_faces {
@@ -167,8 +190,8 @@ pub(super) fn cube_source_ui(
         } else {
             "Type the cross image's path first"
         })
-        .clicked()
-    {
+        .clicked();
+    if load || (ready && entered) {
         *source = cube_source_from(state, is_faces);
     }
 }

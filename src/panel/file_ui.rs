@@ -6,6 +6,7 @@
 //! portal, no zenity): Ctrl+O there focuses this field instead, and Enter
 //! in it loads the preset.
 
+use super::widgets::enter_pressed;
 use super::{PanelAction, PanelState, SHOWN_MESSAGES};
 use egui::{Button, TextEdit, Ui};
 use std::path::PathBuf;
@@ -23,7 +24,7 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         field.request_focus();
     }
     let path = PathBuf::from(state.preset_path.trim());
-    if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+    if enter_pressed(ui, &field) {
         actions.push(PanelAction::LoadPreset(path.clone()));
     }
     ui.horizontal(|ui| {

@@ -80,7 +80,8 @@ pub struct PanelState {
     /// Recently opened presets and environment maps, newest first.
     pub recent_files: Vec<PathBuf>,
     /// Set to put the keyboard in the preset or environment path field
-    /// (where no file dialog can open); cleared once done.
+    /// (the first cube path field for a cube source) where no file dialog
+    /// can open; cleared once done. Enter in any path field loads it.
     pub focus_preset_path: bool,
     pub focus_env_path: bool,
     /// A preset loading in the background: what it is doing, and the
@@ -293,6 +294,98 @@ mod tests {
             egui::CentralPanel::default().show(ui, &mut f);
         })
         .drop_without_applying_deltas();
+    }
+
+    /// Two headless frames on one context: in the first, `f` puts the
+    /// keyboard in a field (through the panel's focus request); in the
+    /// second, Enter is pressed there.
+    fn focus_then_press_enter(mut f: impl FnMut(&mut Ui)) {
+        let ctx = egui::Context::default();
+        let enter = egui::Event::Key {
+            key: egui::Key::Enter,
+            physical_key: None,
+            pressed: true,
+            repeat: false,
+            modifiers: egui::Modifiers::NONE,
+        };
+        for events in [vec![], vec![enter]] {
+            let input = egui::RawInput {
+                events,
+                ..Default::default()
+            };
+            ctx.run_ui(input, |ui| {
+                egui::CentralPanel::default().show(ui, &mut f);
+            })
+            .drop_without_applying_deltas();
+        }
+    }
+
+    #[test]
+    fn enter_in_the_environment_path_loads_the_map() {
+        let mut env = Environment {
+            source: EnvSource::LatLong {
+                path: "old.exr".into(),
+            },
+            ..Environment::default()
+        };
+        let mut state = PanelState::new(String::new(), "maps/sky.exr ".into());
+        state.focus_env_path = true;
+        let mut actions = Vec::new();
+        focus_then_press_enter(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+        assert_eq!(
+            actions,
+            [PanelAction::LoadEnvironment("maps/sky.exr".into())]
+        );
+    }
+
+    #[test]
+    fn enter_in_a_cube_path_field_loads_the_cube() {
+        let faces = ["px.exr", "nx.exr", "py.exr", "ny.exr", "pz.exr", "nz.exr"];
+        for is_faces in [true, false] {
+            let mut env = Environment::default();
+            let mut state = PanelState::new(String::new(), String::new());
+            state.cube_faces = faces.map(String::from);
+            state.cube_cross = "cross.exr".into();
+            // As after picking the cube entry in the source dropdown.
+            state.cube_pending = Some(is_faces);
+            state.focus_env_path = true;
+            let mut actions = Vec::new();
+            focus_then_press_enter(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+            let expected = if is_faces {
+                EnvSource::CubeFaces {
+                    faces: faces.map(PathBuf::from),
+                }
+            } else {
+                EnvSource::CubeCross {
+                    path: "cross.exr".into(),
+                }
+            };
+            assert_eq!(env.source, expected);
+        }
+    }
+
+    /// Enter with a face path missing loads nothing: half a cube is not a
+    /// source.
+    #[test]
+    fn enter_in_an_incomplete_cube_loads_nothing() {
+        let mut env = Environment::default();
+        let before = env.clone();
+        let mut state = PanelState::new(String::new(), String::new());
+        state.cube_faces = ["px.exr", "nx.exr", "py.exr", "", "pz.exr", "nz.exr"].map(String::from);
+        state.cube_pending = Some(true);
+        state.focus_env_path = true;
+        let mut actions = Vec::new();
+        focus_then_press_enter(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));
+        assert_eq!(env, before);
+    }
+
+    #[test]
+    fn enter_in_the_preset_path_loads_the_preset() {
+        let mut state = PanelState::new("presets/a.ron".into(), String::new());
+        state.focus_preset_path = true;
+        let mut actions = Vec::new();
+        focus_then_press_enter(|ui| file_ui::preset_ui(ui, &mut state, &mut actions));
+        assert_eq!(actions, [PanelAction::LoadPreset("presets/a.ron".into())]);
     }
 
     #[test]

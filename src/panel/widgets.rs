@@ -16,6 +16,13 @@ pub(super) fn section(ui: &mut Ui, title: &str, default_open: bool, body: impl F
         .show(ui, body);
 }
 
+/// Whether Enter was pressed in the single-line text field `field` this
+/// frame (egui takes the keyboard away from it then): every path field
+/// loads on Enter, as its Load button does.
+pub(super) fn enter_pressed(ui: &Ui, field: &Response) -> bool {
+    field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter))
+}
+
 /// A slider that clamps what the user enters but leaves a value already out
 /// of range (from a hand-written preset) alone: egui's default clamps and
 /// rounds the value every frame, which would edit the scene by itself.
