@@ -73,14 +73,33 @@ fn info_file_pid(name: &str) -> Option<u32> {
 
 /// Whether process `pid` is a marbre still running: on Linux, its /proc
 /// entry has the same command name as this process (after a reboot the pid
-/// may belong to another program, which does not count). Elsewhere every
-/// other writer counts as gone, so its file is offered.
+/// may belong to another program, which does not count) and it has not
+/// ended. A marbre killed a moment ago is a zombie until its parent (a
+/// shell) reaps it: its entry and name are still there, so its state
+/// decides. Elsewhere every other writer counts as gone, so its file is
+/// offered.
 fn process_alive(pid: u32) -> bool {
     if pid == std::process::id() {
         return true;
     }
     let command = |process: &str| std::fs::read_to_string(format!("/proc/{process}/comm")).ok();
-    matches!((command(&pid.to_string()), command("self")), (Some(a), Some(b)) if a == b)
+    let same_program =
+        matches!((command(&pid.to_string()), command("self")), (Some(a), Some(b)) if a == b);
+    same_program && !has_ended(pid)
+}
+
+/// Whether `/proc/<pid>/stat` says the process has ended: state `Z`
+/// (zombie, not yet reaped) or `X` (dead), or no entry at all.
+fn has_ended(pid: u32) -> bool {
+    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+        return true;
+    };
+    // "pid (comm) state ...": the name may hold spaces and parentheses, so
+    // the state is the first field after the last ')'.
+    let state = stat
+        .rfind(')')
+        .and_then(|end| stat[end + 1..].split_whitespace().next());
+    matches!(state, Some("Z" | "X") | None)
 }
 
 /// The newest recovery file in `dir` whose writer has ended, if any (the
@@ -194,6 +213,52 @@ mod tests {
 
     /// Pids beyond Linux's pid_max (2^22): no such process.
     const GONE: u32 = 1 << 23;
+
+    /// A marbre killed a moment ago whose parent has not reaped it yet: a
+    /// real zombie with this program's name (this test binary run again,
+    /// listing its tests and exiting), left unreaped while it is judged.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_zombie_writer_counts_as_gone() {
+        let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+            .args(["--list", "--exact", "no such test"])
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        let state = || {
+            let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+            let end = stat.rfind(')').unwrap();
+            stat[end + 1..]
+                .split_whitespace()
+                .next()
+                .unwrap()
+                .to_owned()
+        };
+        // Not reaped, the child stays a zombie once it exits.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while state() != "Z" {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "the child never exited"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        let name = |p: &str| std::fs::read_to_string(format!("/proc/{p}/comm")).unwrap();
+        assert_eq!(
+            name(&pid.to_string()),
+            name("self"),
+            "the zombie is named as a marbre"
+        );
+        assert!(!process_alive(pid), "a zombie is dead");
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-zombie")
+            .tempdir()
+            .unwrap();
+        left_by(dir.path(), pid, "2026-11-22 19:00:00", 2.0);
+        assert_eq!(pending_offer(dir.path()).map(|o| o.pid), Some(pid));
+        child.wait().unwrap();
+    }
 
     #[test]
     fn a_dead_writers_file_is_offered_and_a_live_ones_is_not() {
