@@ -5,6 +5,9 @@
 //!   window (UI included); its pixels must show a dark side panel with light
 //!   text in it (fonts render) and a rendered, non-flat image with the
 //!   preset's warm environment behind it.
+//! - `a_scripted_run_leaves_the_settings_alone`: `--exit-after-frames` with
+//!   `--window-screenshot` leaves settings.ron byte for byte and writes
+//!   nothing else into the configuration folder.
 //! - `number_keys_recall_saved_views`: the key 3, then F12: the screenshot
 //!   shows the preset's third saved view.
 //! - `f12_writes_png_and_exr`: a real F12 key press (sent with `xdotool`)
@@ -394,6 +397,55 @@ fn screenshot_pair(folder: &Path) -> Option<(PathBuf, PathBuf)> {
             (png, exr)
         })
         .find(|(_, exr)| exr.is_file())
+}
+
+/// A scripted run (`--exit-after-frames`, here with `--window-screenshot`)
+/// leaves the user's configuration folder as it found it: settings.ron
+/// byte for byte (not its last preset, window size or recent files), and
+/// no autosave or other file beside it.
+#[test]
+fn a_scripted_run_leaves_the_settings_alone() {
+    const TEST: &str = "a_scripted_run_leaves_the_settings_alone";
+    let _serial = serial();
+    let dir = TempDir::new("scripted-settings");
+    let Some(x) = display_or_skip(TEST, &dir, &[]) else {
+        return;
+    };
+    let config = dir.subdir("config");
+    let settings = config.join("settings.ron");
+    let before = format!(
+        "(window_size: Some((900, 600)), last_preset: Some({:?}), recent_files: [{:?}])\n",
+        Path::new(REPO).join("presets/marble.ron"),
+        Path::new(REPO).join("presets/marble.ron"),
+    );
+    std::fs::write(&settings, &before).unwrap();
+    let shot = dir.path().join("window.png");
+    let mut child = spawn_marbre(
+        &x,
+        &dir,
+        Path::new(REPO),
+        &[
+            "--preset".into(),
+            Path::new(REPO).join("presets/checkers.ron").into(),
+            "--exit-after-frames".into(),
+            "2".into(),
+            "--window-screenshot".into(),
+            shot.clone().into(),
+        ],
+    );
+    assert_success(wait_for_exit(&mut child, &dir, CHILD_TIMEOUT), &dir);
+    assert!(shot.is_file(), "the run did its work: {}", shot.display());
+    assert_eq!(
+        std::fs::read_to_string(&settings).unwrap(),
+        before,
+        "settings.ron changed; log:\n{}",
+        marbre_log(&dir)
+    );
+    let files: Vec<_> = std::fs::read_dir(&config)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(files, ["settings.ron"], "files in the configuration folder");
 }
 
 /// Keys 1–9 recall the preset's saved views: in the default preset, view 3

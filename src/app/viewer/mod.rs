@@ -90,7 +90,8 @@ pub struct Viewer {
     options: ViewerOptions,
     /// Window size, last preset, recent files; saved on exit.
     settings: Settings,
-    /// Where settings and the recovery file live (none: not persisted).
+    /// Where settings and the recovery file live (none: not persisted, as
+    /// in a scripted run).
     config_dir: Option<PathBuf>,
     /// Files on their way in: dialogs, loads, hot reload.
     incoming: Incoming,
@@ -342,13 +343,15 @@ impl Viewer {
         if !document.has_preset_file() {
             panel.preset_path = document.save_as_suggestion().display().to_string();
         }
-        // A soak's thousands of edits are not the user's work: nothing of
-        // it is autosaved or remembered.
-        let config_dir = config_dir.filter(|_| options.soak.is_none());
+        // A scripted run (--exit-after-frames, --window-screenshot, a soak)
+        // is not the user's work: nothing of it is autosaved or remembered,
+        // so the user's next start (window size, last preset, recent files)
+        // is the one their own last session left.
+        let persists = !scripted && options.window_screenshot.is_none();
+        let config_dir = config_dir.filter(|_| persists);
         // A run that crashed left its unsaved edits: offer them first.
         let prompt = config_dir
             .as_deref()
-            .filter(|_| !scripted)
             .and_then(recovery::pending_offer)
             .map(Prompt::Recover);
         let autosave = config_dir.clone().map(Autosave::new);
