@@ -1,11 +1,10 @@
 //! The Environment section: the source (none, constant, lat-long map, cube
 //! faces or cross), its fields and its rotation.
 
-use super::widgets::{enter_pressed, labelled_color, slider};
+use super::widgets::{enter_pressed, labelled_color, slider, typed_path};
 use super::{PanelAction, PanelState};
 use egui::{ComboBox, TextEdit, Ui};
 use marbre_core::scene::{EnvSource, Environment, LdrImages};
-use std::path::PathBuf;
 
 /// The environment sources in the order of the source dropdown.
 pub(super) const ENV_SOURCE_NAMES: [&str; 5] = [
@@ -92,9 +91,7 @@ pub(super) fn source_fields_ui(
                     .on_disabled_hover_text("Type a path first")
                     .clicked();
                 if load || (typed && enter_pressed(ui, &field)) {
-                    actions.push(PanelAction::LoadEnvironment(PathBuf::from(
-                        state.env_path.trim(),
-                    )));
+                    actions.push(PanelAction::LoadEnvironment(typed_path(&state.env_path)));
                 }
             });
             ui.horizontal(|ui| {
@@ -200,11 +197,11 @@ pub(super) fn cube_source_ui(
 pub(super) fn cube_source_from(state: &PanelState, faces: bool) -> EnvSource {
     if faces {
         EnvSource::CubeFaces {
-            faces: state.cube_faces.each_ref().map(|p| PathBuf::from(p.trim())),
+            faces: state.cube_faces.each_ref().map(|p| typed_path(p)),
         }
     } else {
         EnvSource::CubeCross {
-            path: PathBuf::from(state.cube_cross.trim()),
+            path: typed_path(&state.cube_cross),
         }
     }
 }
@@ -262,7 +259,7 @@ pub(super) fn env_source_ui(ui: &mut Ui, source: &mut EnvSource, state: &mut Pan
             radiance: state.last_radiance,
         },
         2 => EnvSource::LatLong {
-            path: PathBuf::from(state.env_path.trim()),
+            path: typed_path(&state.env_path),
         },
         3 => cube_source_from(state, true),
         4 => cube_source_from(state, false),

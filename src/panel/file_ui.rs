@@ -6,10 +6,9 @@
 //! portal, no zenity): Ctrl+O there focuses this field instead, and Enter
 //! in it loads the preset.
 
-use super::widgets::enter_pressed;
+use super::widgets::{enter_pressed, typed_path};
 use super::{PanelAction, PanelState, SHOWN_MESSAGES};
 use egui::{Button, TextEdit, Ui};
-use std::path::PathBuf;
 
 pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAction>) {
     let field = ui
@@ -23,7 +22,7 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
     if std::mem::take(&mut state.focus_preset_path) {
         field.request_focus();
     }
-    let path = PathBuf::from(state.preset_path.trim());
+    let path = typed_path(&state.preset_path);
     if enter_pressed(ui, &field) {
         actions.push(PanelAction::LoadPreset(path.clone()));
     }

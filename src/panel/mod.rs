@@ -328,7 +328,7 @@ mod tests {
             },
             ..Environment::default()
         };
-        let mut state = PanelState::new(String::new(), "maps/sky.exr ".into());
+        let mut state = PanelState::new(String::new(), "old/../maps/./sky.exr ".into());
         state.focus_env_path = true;
         let mut actions = Vec::new();
         focus_then_press_enter(|ui| environment_ui(ui, &mut env, &mut state, &mut actions));

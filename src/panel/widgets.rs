@@ -16,6 +16,17 @@ pub(super) fn section(ui: &mut Ui, title: &str, default_open: bool, body: impl F
         .show(ui, body);
 }
 
+/// The path typed in a field, tidied by its text (`bad/../envmaps/x.exr`
+/// is `envmaps/x.exr`) so that the scene and every message name it
+/// plainly; empty stays empty.
+pub(super) fn typed_path(text: &str) -> std::path::PathBuf {
+    let text = text.trim();
+    if text.is_empty() {
+        return std::path::PathBuf::new();
+    }
+    marbre_core::lexical_path::normalize(std::path::Path::new(text))
+}
+
 /// Whether Enter was pressed in the single-line text field `field` this
 /// frame (egui takes the keyboard away from it then): every path field
 /// loads on Enter, as its Load button does.

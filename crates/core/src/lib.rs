@@ -12,6 +12,7 @@ pub mod env_sampling;
 pub mod envmap;
 pub mod geometry;
 pub mod image_io;
+pub mod lexical_path;
 pub mod lights;
 pub mod mis;
 pub mod noise;

@@ -148,21 +148,20 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     }
     preset.format_version = FORMAT_VERSION;
     preset.colors.decode_scene(&mut preset.scene);
+    // Relative paths resolve against the preset's folder, tidied so that
+    // messages name `envmaps/x.exr`, not `bad/../envmaps/x.exr`.
     let folder = path.parent().unwrap_or(Path::new("."));
+    let resolve = |file: &mut PathBuf| {
+        if file.is_relative() {
+            *file = crate::lexical_path::normalize(&folder.join(&*file));
+        }
+    };
     for env in preset.scene.environment.source.paths_mut() {
-        if env.is_relative() {
-            *env = folder.join(&*env);
-        }
+        resolve(env);
     }
-    for_each_image_path(&mut preset.scene, &mut |image| {
-        if image.is_relative() {
-            *image = folder.join(&*image);
-        }
-    });
+    for_each_image_path(&mut preset.scene, &mut |image| resolve(image));
     for mesh in &mut preset.scene.meshes {
-        if mesh.obj.is_relative() {
-            mesh.obj = folder.join(&mesh.obj);
-        }
+        resolve(&mut mesh.obj);
     }
     let mut notes: Vec<String> = unknown
         .into_iter()
@@ -379,6 +378,18 @@ mod tests {
         };
         let text = to_text(&p, Path::new("/data/other/x.ron")).unwrap();
         assert!(text.contains("\"../envmaps/sky.exr\""), "{text}");
+    }
+
+    /// A preset in `bad/` naming `../envmaps/x.exr` points at
+    /// `envmaps/x.exr`, and every message about the file says so.
+    #[test]
+    fn loaded_paths_are_tidied_by_their_text() {
+        let text = "(scene: (environment: (source: LatLong(path: \"../envmaps/./x.exr\"))))";
+        let loaded = parse(text, Path::new("bad/x.ron")).unwrap();
+        assert_eq!(
+            loaded.preset.scene.environment.source.paths(),
+            [Path::new("envmaps/x.exr")]
+        );
     }
 
     #[test]
