@@ -101,21 +101,61 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         )
         .on_hover_text("The scene on screen stays until the new one has loaded");
     }
-    let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
-    for message in &state.messages[first..] {
-        // A message of several lines is a compiler's diagnostic or a
-        // report: monospace keeps its carets under the columns they point
-        // at, and egui's monospace font (Hack) has the box-drawing glyphs
-        // naga frames source lines with, which the proportional one lacks.
-        let mut text = egui::RichText::new(&message.text);
-        if message.text.contains('\n') {
-            text = text.monospace();
-        }
-        if message.is_error {
-            text = text.color(ui.visuals().error_fg_color);
-        }
-        ui.label(text);
+    messages_ui(ui, state);
+}
+
+/// The latest messages, each with its time; the older ones kept fold
+/// under them, and Clear empties the list.
+fn messages_ui(ui: &mut Ui, state: &mut PanelState) {
+    if state.messages.is_empty() {
+        return;
     }
+    let first = state.messages.len().saturating_sub(SHOWN_MESSAGES);
+    if first > 0 {
+        egui::CollapsingHeader::new(format!("{first} earlier messages"))
+            .id_salt("earlier messages")
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical()
+                    .id_salt("earlier messages scroll")
+                    .max_height(200.0)
+                    .show(ui, |ui| {
+                        for message in &state.messages[..first] {
+                            message_label(ui, message);
+                        }
+                    });
+            });
+    }
+    for message in &state.messages[first..] {
+        message_label(ui, message);
+    }
+    if ui
+        .small_button("Clear messages")
+        .on_hover_text("Empty the message list")
+        .clicked()
+    {
+        state.messages.clear();
+    }
+}
+
+fn message_label(ui: &mut Ui, message: &super::Message) {
+    // A message of several lines is a compiler's diagnostic or a report:
+    // monospace keeps its carets under the columns they point at, and
+    // egui's monospace font (Hack) has the box-drawing glyphs naga frames
+    // source lines with, which the proportional one lacks. The time goes
+    // on a line of its own there, so as not to shift the first line.
+    let separator = if message.text.contains('\n') {
+        '\n'
+    } else {
+        ' '
+    };
+    let mut text = egui::RichText::new(format!("{}{separator}{}", message.time, message.text));
+    if message.text.contains('\n') {
+        text = text.monospace();
+    }
+    if message.is_error {
+        text = text.color(ui.visuals().error_fg_color);
+    }
+    ui.label(text);
 }
 
 /// The recent presets and environment maps, newest first.

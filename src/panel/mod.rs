@@ -36,15 +36,18 @@ use widgets::{color_button, labelled_color, section, slider, vec3_ui};
 
 /// How many of the latest messages the Preset section shows.
 const SHOWN_MESSAGES: usize = 5;
-/// How many messages are kept, so that a long session does not grow the list
-/// without bound.
-const KEPT_MESSAGES: usize = 100;
+/// How many messages are kept (the older ones fold under the latest), so
+/// that a long session does not grow the list without bound.
+const KEPT_MESSAGES: usize = 50;
 
 /// A line of feedback for the user (a preset loaded, a file that failed).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Message {
     pub text: String,
     pub is_error: bool,
+    /// When it came, local time as `HH:MM:SS`: which of two similar
+    /// messages is the latest.
+    pub time: String,
 }
 
 /// What the panel keeps between frames that is not part of the scene.
@@ -127,8 +130,21 @@ impl PanelState {
         self.push(text.into(), true);
     }
 
+    /// A preset that failed to load: the error, and the path field back on
+    /// `document` (the preset still open, or where its Save as writes), so
+    /// that a later Save as does not write to the path that failed.
+    pub fn load_failed(&mut self, text: impl Into<String>, document: &std::path::Path) {
+        self.error(text);
+        self.preset_path = document.display().to_string();
+    }
+
     fn push(&mut self, text: String, is_error: bool) {
-        self.messages.push(Message { text, is_error });
+        let time = chrono::Local::now().format("%H:%M:%S").to_string();
+        self.messages.push(Message {
+            text,
+            is_error,
+            time,
+        });
         let excess = self.messages.len().saturating_sub(KEPT_MESSAGES);
         self.messages.drain(..excess);
     }
@@ -269,6 +285,7 @@ mod tests {
     use marbre_core::scene::{Ground, Sphere};
     use marbre_core::scene::{Pattern, Texture};
     use material_editor::material_ui;
+    use std::path::Path;
 
     fn marble_scene() -> Scene {
         let mut sphere = Sphere::default();
@@ -534,6 +551,33 @@ mod tests {
         frame(|ui| actions = draw_quality(ui, &mut state, &stats));
         assert_eq!(state.quality, before);
         assert!(actions.is_empty(), "{actions:?}");
+    }
+
+    #[test]
+    fn a_failed_load_puts_the_path_field_back_on_the_document() {
+        let mut state = PanelState::new("presets/a.ron".into(), String::new());
+        state.preset_path = "presets/typo.ron".into();
+        state.load_failed("presets/typo.ron: no such file", Path::new("presets/a.ron"));
+        assert_eq!(state.preset_path, "presets/a.ron");
+        let last = state.messages.last().unwrap();
+        assert!(last.is_error && last.text.contains("typo.ron"), "{last:?}");
+    }
+
+    /// Each message has its local time, `HH:MM:SS`.
+    #[test]
+    fn messages_are_time_stamped() {
+        let mut state = PanelState::new(String::new(), String::new());
+        let before = chrono::Local::now().time();
+        state.info("loaded");
+        let after = chrono::Local::now().time();
+        let time = &state.messages[0].time;
+        let parsed = chrono::NaiveTime::parse_from_str(time, "%H:%M:%S")
+            .unwrap_or_else(|e| panic!("{time}: {e}"));
+        let second = |t: chrono::NaiveTime| t.format("%H:%M:%S").to_string();
+        assert!(
+            second(before) <= second(parsed) && second(parsed) <= second(after),
+            "{time} between {before} and {after}"
+        );
     }
 
     #[test]

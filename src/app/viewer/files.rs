@@ -101,7 +101,8 @@ impl Viewer {
                 Ok(())
             }
             (Err(e), None) => {
-                self.panel.error(format!("{e:#}"));
+                let document = self.edits.document.save_as_suggestion();
+                self.panel.load_failed(format!("{e:#}"), &document);
                 Ok(())
             }
             // The last session's preset no longer loads: say why, and
