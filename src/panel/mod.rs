@@ -30,7 +30,7 @@ use marbre_render::gpu::NonFiniteCounts;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
 use scene_ui::{camera_ui, materials_ui, point_light_ui};
-use stats::stats_ui;
+use stats::{stats_ui, status_line};
 use std::path::PathBuf;
 use widgets::{color_button, labelled_color, section, slider, vec3_ui};
 
@@ -232,6 +232,8 @@ pub fn draw(
     stats: &Stats,
 ) -> Vec<PanelAction> {
     let mut actions = Vec::new();
+    status_line(ui, stats);
+    ui.separator();
     ScrollArea::vertical()
         .id_salt("panel scroll")
         .show(ui, |ui| {
@@ -578,6 +580,40 @@ mod tests {
             second(before) <= second(parsed) && second(parsed) <= second(after),
             "{time} between {before} and {after}"
         );
+    }
+
+    /// The frame rate is the panel's first line, above the Preset section,
+    /// not at the bottom of a long scroll.
+    #[test]
+    fn the_frame_rate_heads_the_panel() {
+        let mut scene = marble_scene();
+        let mut state = PanelState::new(String::new(), String::new());
+        let stats = Stats {
+            fps: 42.5,
+            ..Stats::default()
+        };
+        let ctx = egui::Context::default();
+        let output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            egui::CentralPanel::default().show(ui, |ui| {
+                draw(ui, &mut scene, &mut state, &stats);
+            });
+        });
+        let top_of = |needle: &str| {
+            output
+                .shapes
+                .iter()
+                .filter_map(|clipped| match &clipped.shape {
+                    egui::Shape::Text(text) if text.galley.text().starts_with(needle) => {
+                        Some(text.pos.y)
+                    }
+                    _ => None,
+                })
+                .reduce(f32::min)
+                .unwrap_or_else(|| panic!("no text starting {needle:?} drawn"))
+        };
+        let (fps, preset) = (top_of("42.5 fps"), top_of("Preset"));
+        output.drop_without_applying_deltas();
+        assert!(fps < preset, "fps at {fps}, Preset at {preset}");
     }
 
     #[test]

@@ -5,8 +5,24 @@ use super::Stats;
 use egui::{Color32, Ui};
 use marbre_render::gpu::NonFiniteCounts;
 
+/// The live figures in one line at the top of the panel, above what
+/// scrolls: frames per second, a round's cost and the samples so far.
+pub(super) fn status_line(ui: &mut Ui, stats: &Stats) {
+    let clock = if stats.ms_is_gpu { "GPU" } else { "CPU" };
+    let mut text = format!(
+        "{:.1} fps · {:.2} ms per round ({clock}) · {} spp",
+        stats.fps, stats.ms_per_frame, stats.samples
+    );
+    if stats.building {
+        text.push_str(" · building shader…");
+    }
+    ui.label(text).on_hover_text(
+        "Frames per second of the window; the trace's cost of one sample round; samples \
+         accumulated per pixel (details in Stats)",
+    );
+}
+
 pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {
-    ui.label(format!("{:.1} fps", stats.fps));
     ui.label(format!("{} lights", stats.lights)).on_hover_text(
         "Entries of the light table: the point light, emissive spheres and triangles",
     );
