@@ -298,6 +298,22 @@ fn swatch_ui(ui: &mut Ui, texture: &Texture, kind: ValueKind) {
     }
 }
 
+/// The octave count over the panel's width in quarter steps: egui's
+/// default 100-px rail put 16 octaves in 100 px, ten of them in a 60-px
+/// flick of the mouse.
+pub(super) fn octaves_slider(ui: &mut Ui, octaves: &mut f32) -> egui::Response {
+    ui.scope(|ui| {
+        // Room for the value box and the label beside the rail.
+        ui.spacing_mut().slider_width = (ui.available_width() - 130.0).max(160.0);
+        ui.add(slider(octaves, FractalParams::OCTAVES, "octaves").step_by(0.25))
+            .on_hover_text(
+                "More octaves: finer detail, one noise evaluation each; a fractional part fades \
+                 the last one in (in quarter steps)",
+            )
+    })
+    .inner
+}
+
 /// The image file of an image node, and how its codes decode. The path is
 /// applied on Enter or when the field loses focus (the viewer then loads
 /// it), not at every keystroke.
@@ -777,11 +793,7 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
             .on_disabled_hover_text("Unused: Perlin noise hashes with its permutation table");
     });
     let f = &mut noise.fractal;
-    ui.add(slider(&mut f.octaves, FractalParams::OCTAVES, "octaves"))
-        .on_hover_text(
-            "More octaves: finer detail, one noise evaluation each; a fractional part fades the \
-             last one in",
-        );
+    octaves_slider(ui, &mut f.octaves);
     ui.add(typed_beyond(
         slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true),
     ))

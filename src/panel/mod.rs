@@ -616,6 +616,58 @@ mod tests {
         assert!(fps < preset, "fps at {fps}, Preset at {preset}");
     }
 
+    /// On the octave slider, in a panel as wide as the viewer's, a press
+    /// sets the value under the pointer and a 20-px drag from there moves
+    /// it by less than two octaves, landing on quarters.
+    #[test]
+    fn the_octave_slider_moves_in_quarters_at_a_usable_rate() {
+        let ctx = egui::Context::default();
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(380.0, 300.0));
+        let run = |events: Vec<egui::Event>, octaves: &mut f32| {
+            let mut rail = egui::Rect::NOTHING;
+            let input = egui::RawInput {
+                screen_rect: Some(screen),
+                events,
+                ..Default::default()
+            };
+            ctx.run_ui(input, |ui| {
+                egui::CentralPanel::default().show(ui, |ui| {
+                    rail = material_editor::octaves_slider(ui, octaves).rect;
+                });
+            })
+            .drop_without_applying_deltas();
+            rail
+        };
+        let button = |pos, pressed| egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        };
+        let mut octaves = 4.0_f32;
+        let rail = run(vec![], &mut octaves);
+        let start = egui::pos2(rail.left() + 0.25 * rail.width(), rail.center().y);
+        let end = start + egui::vec2(20.0, 0.0);
+        run(
+            vec![egui::Event::PointerMoved(start), button(start, true)],
+            &mut octaves,
+        );
+        let pressed = octaves;
+        for events in [
+            vec![egui::Event::PointerMoved(start + egui::vec2(10.0, 0.0))],
+            vec![egui::Event::PointerMoved(end)],
+            vec![button(end, false)],
+        ] {
+            run(events, &mut octaves);
+        }
+        let quarter = |v: f32| v * 4.0 == (v * 4.0).round();
+        assert!(quarter(pressed) && quarter(octaves), "{pressed}, {octaves}");
+        assert!(
+            octaves > pressed && octaves - pressed < 2.0,
+            "20 px moved the octaves from {pressed} to {octaves}"
+        );
+    }
+
     #[test]
     fn messages_are_capped() {
         let mut state = PanelState::new(String::new(), String::new());
