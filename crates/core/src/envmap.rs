@@ -1651,43 +1651,28 @@ mod tests {
         assert_eq!((loaded.image.width, loaded.image.height), (512, 256));
         let max = loaded.image.max_value();
         assert!(max > 10000.0, "max {max}");
-        assert!(
-            loaded.notes.iter().any(|n| n.contains("negative")),
-            "{:?}",
-            loaded.notes
-        );
-        assert!(
-            loaded
-                .notes
-                .iter()
-                .all(|n| n.starts_with("esplanade.exr: "))
-        );
         let h = loaded.image.to_rgba16f();
         assert!(h.iter().all(|v| v.is_finite() && v.to_f32() >= 0.0));
     }
 
+    /// The maps marbre ships load clean, with no note: their negative
+    /// texels (left by the originals' lossy compression) were set to 0 in
+    /// the files once, so the loader's notes speak of the user's own files
+    /// only.
     #[test]
-    fn shipped_maps_load() {
+    fn shipped_maps_load_without_notes() {
+        let root = Path::new(crate::REPO).join("envmaps");
         for name in [
             "sky.exr",
             "esplanade.exr",
             "studio.exr",
             "sunset.exr",
             "forest.exr",
+            "cube/studio-cross.exr",
         ] {
-            let Some(path) = shipped_map(name) else {
-                eprintln!("{name} not found; skipping");
-                continue;
-            };
-            let loaded = load(&path).unwrap();
+            let loaded = load(&root.join(name)).unwrap();
             assert_clean(&loaded.image);
-            eprintln!(
-                "{name}: {}x{}, max {}, notes {:?}",
-                loaded.image.width,
-                loaded.image.height,
-                loaded.image.max_value(),
-                loaded.notes
-            );
+            assert_eq!(loaded.notes, Vec::<String>::new(), "{name}");
         }
     }
 
