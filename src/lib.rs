@@ -2,5 +2,6 @@
 //! over the renderer library (`marbre-render`).
 
 pub mod app;
+pub mod headless;
 pub mod heap;
 pub mod panel;

@@ -112,6 +112,14 @@ fn main() -> ExitCode {
     marbre::heap::limit_arenas();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    // Every command but the viewer and the soak (which open a window).
+    if cli
+        .command
+        .as_ref()
+        .is_some_and(|c| !matches!(c, Command::Soak(_)))
+    {
+        marbre::headless::quiet_device_select();
+    }
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Noise(args)) => noise::run(&args),

@@ -1,13 +1,15 @@
 //! The viewer's tests under Xvfb: the window (`window`), a user's session
 //! driven end to end (`e2e_window`), OBJ files opened as scenes
 //! (`obj_window`) and the soak (`soak`), each running the `marbre` binary
-//! on lavapipe. `xvfb` starts the display and drives it.
+//! on lavapipe. `xvfb` starts the display and drives it. `render_cli` runs
+//! `marbre render` (no window) for what it says on stderr.
 
 /// The repository's root: the presets and the test data.
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
 mod e2e_window;
 mod obj_window;
+mod render_cli;
 mod render_window;
 mod soak;
 mod window;

@@ -18,10 +18,32 @@ pub struct GpuContext {
 impl GpuContext {
     /// A device with no surface, for offscreen renders, the noise harness and
     /// tests. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select the adapter.
+    ///
+    /// The primary backends (Vulkan, Metal, DX12) are tried first, and
+    /// OpenGL only where none gives an adapter: creating the GL backend
+    /// probes for a Wayland display and an EGL driver, and libwayland and
+    /// EGL print their failures (`XDG_RUNTIME_DIR is invalid or not set`
+    /// where it is unset) on every command with no window. Where GL is the
+    /// only way, it is used and says what it says; `WGPU_BACKEND`, when
+    /// set, decides alone.
     pub fn headless() -> Result<Self> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
-        Self::from_instance(instance, None)
+        let descriptor = |backends| {
+            wgpu::InstanceDescriptor {
+                backends,
+                ..wgpu::InstanceDescriptor::new_without_display_handle()
+            }
+            .with_env()
+        };
+        let primary = Self::from_instance(
+            wgpu::Instance::new(descriptor(wgpu::Backends::PRIMARY)),
+            None,
+        );
+        match primary {
+            Err(_) if wgpu::Backends::from_env().is_none() => {
+                Self::from_instance(wgpu::Instance::new(descriptor(wgpu::Backends::all())), None)
+            }
+            result => result,
+        }
     }
 
     /// A device able to present to `surface`.

@@ -1,0 +1,73 @@
+//! `marbre render` as a user runs it, for what it says on stderr: no
+//! Wayland noise where `XDG_RUNTIME_DIR` is unset, the output folder it
+//! made, the EXR that auto exposure leaves unscaled, and a path through a
+//! file refused with the file named.
+
+use crate::REPO;
+use crate::xvfb::TempDir;
+use marbre_render::gpu::testing::gpu_or_skip;
+use std::path::Path;
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_marbre");
+
+/// `marbre render` of the default preset, tiny, to `output`, with no
+/// runtime folder and nothing steering Mesa's device selection.
+fn render(output: &Path, extra: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(["render", "--preset", "presets/default.ron", "--size", "8x8"])
+        .args(["--spp", "1", "--kernel", "fragment", "-o"])
+        .arg(output)
+        .args(extra)
+        .current_dir(REPO)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT")
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"))
+}
+
+#[test]
+fn render_says_what_it_did_and_nothing_else() {
+    const TEST: &str = "render_says_what_it_did_and_nothing_else";
+    let dir = TempDir::new("render-cli");
+    if gpu_or_skip(TEST).is_none() {
+        return;
+    }
+    let output = dir.path().join("renders/today/x.exr");
+    let run = render(&output, &["--auto-exposure"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{}: {stderr}", run.status);
+    assert!(output.is_file(), "no {}: {stderr}", output.display());
+    let folder = dir.path().join("renders");
+    assert!(
+        stderr.contains(&format!(
+            "note: created the folder {} for the output",
+            folder.display()
+        )),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("auto exposure does not scale") && stderr.contains("unscaled radiance"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}
+
+/// Refused before any GPU work: no adapter needed.
+#[test]
+fn render_through_a_file_names_the_file() {
+    let dir = TempDir::new("render-cli-file");
+    let file = dir.path().join("notes.txt");
+    std::fs::write(&file, "a file").unwrap();
+    let output = file.join("x.png");
+    let run = render(&output, &[]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{} is a file, not a folder", file.display())),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "a file");
+}
