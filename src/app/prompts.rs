@@ -35,6 +35,9 @@ pub enum Answer {
     Discard,
 }
 
+/// The dialog's width in points, its text wrapped to it.
+const PROMPT_WIDTH: f32 = 420.0;
+
 /// Draws `prompt` as a modal dialog; the answer once given.
 pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<Answer> {
     let (title, text, buttons): (&str, String, &[(&str, Answer)]) = match prompt {
@@ -88,7 +91,10 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
     };
     let mut answer = None;
     let response = egui::Modal::new(egui::Id::unique("marbre prompt")).show(ctx, |ui| {
-        ui.set_max_width(420.0);
+        // A fixed width: egui centres the dialog by the size it measured
+        // the frame before, and a width that followed the content moved
+        // it once measured (by about 35 px after the first frame).
+        ui.set_width(PROMPT_WIDTH);
         ui.heading(title);
         ui.label(text);
         ui.separator();
@@ -115,4 +121,53 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
         answer = Some(Answer::Cancel);
     }
     answer
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where the prompt's title is drawn in each of `frames` headless
+    /// frames on a 1280x720 screen (None where it is not drawn).
+    fn title_positions(prompt: &Prompt, frames: usize) -> Vec<Option<egui::Pos2>> {
+        let ctx = egui::Context::default();
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 720.0));
+        (0..frames)
+            .map(|_| {
+                let input = egui::RawInput {
+                    screen_rect: Some(screen),
+                    ..Default::default()
+                };
+                let output = ctx.run_ui(input, |ui| {
+                    show(ui.ctx(), prompt, "presets/default.ron");
+                });
+                let title = output
+                    .shapes
+                    .iter()
+                    .find_map(|clipped| match &clipped.shape {
+                        egui::Shape::Text(text) if text.galley.text() == "Unsaved changes" => {
+                            Some(text.pos)
+                        }
+                        _ => None,
+                    });
+                output.drop_without_applying_deltas();
+                title
+            })
+            .collect()
+    }
+
+    /// The prompt is drawn where it stays from its first frame on: it
+    /// used to jump by about 35 px once egui had measured it.
+    #[test]
+    fn the_prompt_does_not_move_after_its_first_frame() {
+        for prompt in [
+            Prompt::Quit,
+            Prompt::LoadPreset("presets/a/very/long/path/to/another/preset.ron".into()),
+        ] {
+            let positions = title_positions(&prompt, 4);
+            let drawn: Vec<_> = positions.iter().flatten().collect();
+            assert!(drawn.len() >= 3, "{positions:?}");
+            assert!(drawn.iter().all(|p| *p == drawn[0]), "{positions:?}");
+        }
+    }
 }
