@@ -30,9 +30,9 @@ use marbre_render::gpu::NonFiniteCounts;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
 use scene_ui::{camera_ui, materials_ui, point_light_ui};
-use stats::{stats_ui, status_line};
+use stats::{headline, stats_ui};
 use std::path::PathBuf;
-use widgets::{color_button, labelled_color, section, slider, vec3_ui};
+use widgets::{color_button, labelled_color, section, section_headed, slider, vec3_ui};
 
 /// How many of the latest messages the Preset section shows.
 const SHOWN_MESSAGES: usize = 5;
@@ -232,12 +232,12 @@ pub fn draw(
     stats: &Stats,
 ) -> Vec<PanelAction> {
     let mut actions = Vec::new();
-    status_line(ui, stats);
-    ui.separator();
     ScrollArea::vertical()
         .id_salt("panel scroll")
         .show(ui, |ui| {
-            section(ui, "Preset", true, |ui| {
+            // The frame rate heads the panel, not the bottom of Stats.
+            let header = format!("Preset      {}", headline(stats));
+            section_headed(ui, "Preset", header, true, |ui| {
                 file_ui::preset_ui(ui, state, &mut actions);
             });
             section(ui, "Materials", true, |ui| {
@@ -582,14 +582,15 @@ mod tests {
         );
     }
 
-    /// The frame rate is the panel's first line, above the Preset section,
-    /// not at the bottom of a long scroll.
+    /// The frame rate is on the panel's first line, the Preset section's
+    /// header, not at the bottom of a long scroll.
     #[test]
     fn the_frame_rate_heads_the_panel() {
         let mut scene = marble_scene();
         let mut state = PanelState::new(String::new(), String::new());
         let stats = Stats {
             fps: 42.5,
+            samples: 7,
             ..Stats::default()
         };
         let ctx = egui::Context::default();
@@ -598,22 +599,23 @@ mod tests {
                 draw(ui, &mut scene, &mut state, &stats);
             });
         });
-        let top_of = |needle: &str| {
-            output
-                .shapes
-                .iter()
-                .filter_map(|clipped| match &clipped.shape {
-                    egui::Shape::Text(text) if text.galley.text().starts_with(needle) => {
-                        Some(text.pos.y)
-                    }
-                    _ => None,
-                })
-                .reduce(f32::min)
-                .unwrap_or_else(|| panic!("no text starting {needle:?} drawn"))
-        };
-        let (fps, preset) = (top_of("42.5 fps"), top_of("Preset"));
+        let texts: Vec<(f32, String)> = output
+            .shapes
+            .iter()
+            .filter_map(|clipped| match &clipped.shape {
+                egui::Shape::Text(text) => Some((text.pos.y, text.galley.text().to_owned())),
+                _ => None,
+            })
+            .collect();
         output.drop_without_applying_deltas();
-        assert!(fps < preset, "fps at {fps}, Preset at {preset}");
+        let top = texts
+            .iter()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .expect("some text");
+        assert!(
+            top.1.starts_with("Preset") && top.1.contains("42.5 fps · 7 spp"),
+            "the first line is {top:?}"
+        );
     }
 
     /// On the octave slider, in a panel as wide as the viewer's, a press
@@ -666,6 +668,132 @@ mod tests {
             octaves > pressed && octaves - pressed < 2.0,
             "20 px moved the octaves from {pressed} to {octaves}"
         );
+    }
+
+    /// Stats with an estimate and a converging history to plot.
+    fn converging_stats() -> Stats {
+        Stats {
+            quality: QualityStats {
+                points: (1..40)
+                    .map(|i| [0.1 * f64::from(i), 0.2 / f64::from(i).sqrt()])
+                    .collect(),
+                latest: Some(marbre_render::gpu::error_meter::ErrorEstimate {
+                    rmse: 0.01,
+                    relative: 0.032,
+                    frames: 39,
+                    samples: 39,
+                    seconds: 3.9,
+                    generation: 0,
+                }),
+                ..QualityStats::default()
+            },
+            ..Stats::default()
+        }
+    }
+
+    /// The Quality strip's texts (top-left corner, text) and the points of
+    /// the plot's curves, over `frames` frames of `events` each.
+    fn quality_frame(
+        ctx: &egui::Context,
+        state: &mut PanelState,
+        stats: &Stats,
+        events: Vec<egui::Event>,
+    ) -> (Vec<(egui::Rect, String)>, Vec<egui::Pos2>) {
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(900.0, 200.0),
+            )),
+            events,
+            ..Default::default()
+        };
+        let output = ctx.run_ui(input, |ui| {
+            egui::CentralPanel::default().show(ui, |ui| {
+                draw_quality(ui, state, stats);
+            });
+        });
+        let mut texts = Vec::new();
+        let mut curve = Vec::new();
+        for clipped in &output.shapes {
+            match &clipped.shape {
+                egui::Shape::Text(text) => {
+                    texts.push((text.visual_bounding_rect(), text.galley.text().to_owned()));
+                }
+                // More than a fold arrow's three points: a plotted line.
+                egui::Shape::Path(path) if path.points.len() > 3 => {
+                    curve.extend(&path.points);
+                }
+                _ => {}
+            }
+        }
+        output.drop_without_applying_deltas();
+        (texts, curve)
+    }
+
+    /// The plot's key is drawn above the plot, off every curve.
+    #[test]
+    fn the_plot_key_sits_outside_the_plot() {
+        let ctx = egui::Context::default();
+        let mut state = PanelState::new(String::new(), String::new());
+        let stats = converging_stats();
+        quality_frame(&ctx, &mut state, &stats, vec![]);
+        let (texts, curve) = quality_frame(&ctx, &mut state, &stats, vec![]);
+        assert!(curve.len() > 10, "no curve drawn");
+        let highest = curve.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+        for name in ["estimate", "1/√t", "target"] {
+            let (rect, _) = texts
+                .iter()
+                .find(|(_, t)| t.ends_with(name))
+                .unwrap_or_else(|| panic!("no key for {name}: {texts:?}"));
+            assert!(
+                rect.bottom() <= highest,
+                "the key {name} at {rect:?} is over the curve (top {highest})"
+            );
+        }
+    }
+
+    /// A click on the strip's header folds it to that line (no plot, the
+    /// estimate still said); another unfolds it.
+    #[test]
+    fn the_quality_strip_folds_from_its_header() {
+        let ctx = egui::Context::default();
+        let mut state = PanelState::new(String::new(), String::new());
+        let stats = converging_stats();
+        let click = |ctx: &egui::Context, state: &mut PanelState| {
+            let (texts, _) = quality_frame(ctx, state, &stats, vec![]);
+            let (rect, _) = texts
+                .iter()
+                .find(|(_, t)| t.ends_with("Quality"))
+                .expect("a Quality header")
+                .clone();
+            let at = rect.center();
+            let button = |pressed| egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::NONE,
+            };
+            quality_frame(
+                ctx,
+                state,
+                &stats,
+                vec![egui::Event::PointerMoved(at), button(true)],
+            );
+            quality_frame(ctx, state, &stats, vec![button(false)]);
+        };
+        let has = |texts: &[(egui::Rect, String)], what: &str| {
+            texts.iter().any(|(_, t)| t.contains(what))
+        };
+        assert!(!state.quality.folded);
+        click(&ctx, &mut state);
+        assert!(state.quality.folded, "the click did not fold the strip");
+        let (texts, curve) = quality_frame(&ctx, &mut state, &stats, vec![]);
+        assert!(curve.is_empty() && !has(&texts, "GPU time"), "{texts:?}");
+        assert!(has(&texts, "estimated error 3.20 %"), "{texts:?}");
+        click(&ctx, &mut state);
+        assert!(!state.quality.folded);
+        let (texts, _) = quality_frame(&ctx, &mut state, &stats, vec![]);
+        assert!(has(&texts, "seconds (log)"), "{texts:?}");
     }
 
     #[test]

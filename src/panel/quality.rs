@@ -21,6 +21,9 @@ pub struct QualityControls {
     pub stop_at_target: bool,
     /// Save a screenshot (PNG and EXR) the moment the target is reached.
     pub screenshot_at_target: bool,
+    /// The strip folded to its header line (the estimate alone), leaving
+    /// the image its height.
+    pub folded: bool,
 }
 
 impl Default for QualityControls {
@@ -29,6 +32,7 @@ impl Default for QualityControls {
             target_error: 0.02,
             stop_at_target: false,
             screenshot_at_target: false,
+            folded: false,
         }
     }
 }
@@ -53,16 +57,42 @@ pub struct QualityStats {
     pub without_ms: Vec<Option<f32>>,
 }
 
-/// Three columns: convergence and its plot, the time of each pass, the
-/// cost of each feature.
+/// The header line, which folds the strip and holds convergence (the
+/// estimate, the target, the time left, what to do at the target), so
+/// that the folded strip keeps all but the figures; then three columns:
+/// the error plot, the time of each pass, the cost of each feature.
 pub fn quality_ui(
     ui: &mut Ui,
     controls: &mut QualityControls,
     stats: &QualityStats,
     actions: &mut Vec<PanelAction>,
 ) {
+    ui.horizontal_wrapped(|ui| {
+        // egui's own fold arrow (its fonts lack the arrow characters).
+        let size = egui::vec2(ui.spacing().icon_width, ui.spacing().interact_size.y);
+        let (_, arrow) = ui.allocate_exact_size(size, egui::Sense::click());
+        let openness = if controls.folded { 0.0 } else { 1.0 };
+        egui::collapsing_header::paint_default_icon(ui, openness, &arrow);
+        let title = ui.add(
+            egui::Label::new(egui::RichText::new("Quality").strong()).sense(egui::Sense::click()),
+        );
+        if (arrow | title)
+            .on_hover_text(if controls.folded {
+                "Show the convergence plot, the pass times and the feature costs"
+            } else {
+                "Fold the strip to this line, leaving the image its height"
+            })
+            .clicked()
+        {
+            controls.folded = !controls.folded;
+        }
+        convergence_ui(ui, controls, stats);
+    });
+    if controls.folded {
+        return;
+    }
     ui.columns(3, |columns| {
-        convergence_ui(&mut columns[0], controls, stats);
+        error_plot(&mut columns[0], controls.target_error, &stats.points);
         passes_ui(&mut columns[1], stats);
         egui::ScrollArea::vertical()
             .id_salt("feature costs")
@@ -70,6 +100,8 @@ pub fn quality_ui(
     });
 }
 
+/// The estimate, the target and the time left to it, and what to do on
+/// reaching it, along one wrapped line.
 fn convergence_ui(ui: &mut Ui, controls: &mut QualityControls, stats: &QualityStats) {
     match stats.latest {
         Some(e) => {
@@ -90,48 +122,49 @@ fn convergence_ui(ui: &mut Ui, controls: &mut QualityControls, stats: &QualitySt
             ui.label("estimated error: after two frames");
         }
     }
-    ui.horizontal(|ui| {
-        ui.label("target");
-        let mut percent = 100.0 * controls.target_error;
-        if ui
-            .add(
-                DragValue::new(&mut percent)
-                    .range(0.05..=50.0)
-                    .speed(0.05)
-                    .suffix(" %"),
-            )
-            .on_hover_text(
-                "The relative error to aim at, 0.05 to 50 %: half the error takes about four \
-                 times as long",
-            )
-            .changed()
-        {
-            controls.target_error = percent / 100.0;
+    ui.label("· target");
+    let mut percent = 100.0 * controls.target_error;
+    if ui
+        .add(
+            DragValue::new(&mut percent)
+                .range(0.05..=50.0)
+                .speed(0.05)
+                .suffix(" %"),
+        )
+        .on_hover_text(
+            "The relative error to aim at, 0.05 to 50 %: half the error takes about four \
+             times as long",
+        )
+        .changed()
+    {
+        controls.target_error = percent / 100.0;
+    }
+    if let Some(e) = stats.latest {
+        let left = e.seconds_to(controls.target_error);
+        if left == 0.0 {
+            ui.label("reached");
+        } else {
+            ui.label(format!("about {} left", human_seconds(left)))
+                .on_hover_text("Monte Carlo error falls as 1/√time.");
         }
-        if let Some(e) = stats.latest {
-            let left = e.seconds_to(controls.target_error);
-            if left == 0.0 {
-                ui.label("reached");
-            } else {
-                ui.label(format!("about {} left", human_seconds(left)))
-                    .on_hover_text("Monte Carlo error falls as 1/√time.");
-            }
-        }
-    });
-    ui.add(Checkbox::new(
-        &mut controls.stop_at_target,
-        "stop tracing at the target",
-    ))
-    .on_hover_text("At the target, the image stays and the GPU rests; any change starts again");
+    }
+    ui.label("· at the target:");
+    ui.add(Checkbox::new(&mut controls.stop_at_target, "stop"))
+        .on_hover_text(
+            "Stop tracing at the target: the image stays and the GPU rests; any change \
+             starts again",
+        );
     ui.add(Checkbox::new(
         &mut controls.screenshot_at_target,
-        "save a screenshot when the target is reached",
+        "screenshot",
     ))
-    .on_hover_text("Saves a PNG and an EXR into screenshots/, once each time the image restarts");
+    .on_hover_text(
+        "Save a PNG and an EXR into screenshots/ when the target is reached, once each \
+             time the image restarts",
+    );
     if stats.paused_at_target {
-        ui.label("paused: target reached (any change starts again)");
+        ui.label("· paused: target reached (any change starts again)");
     }
-    error_plot(ui, controls.target_error, &stats.points);
 }
 
 /// Log error against log time: a Monte Carlo estimate falls on a line of
@@ -145,23 +178,42 @@ fn error_plot(ui: &mut Ui, target: f64, points: &[[f64; 2]]) {
     let power_of_ten = |mark: egui_plot::GridMark, _: &std::ops::RangeInclusive<f64>| {
         axis_value(10f64.powf(mark.value))
     };
+    // The key sits above the plot, not in it: the curve runs corner to
+    // corner as the axes follow it, and a legend inside always hid part of it.
+    let [estimate, slope_color, target_color] = PLOT_COLORS;
+    ui.horizontal(|ui| {
+        for (color, name) in [
+            (estimate, "— estimate"),
+            (slope_color, "— 1/√t"),
+            (target_color, "— target"),
+        ] {
+            ui.colored_label(color, name);
+        }
+    });
     Plot::new("error against time")
-        .height(ui.available_height().max(80.0))
+        .height(ui.available_height().max(60.0))
         .x_axis_label("seconds (log)")
         .y_axis_label("relative error (log)")
         .x_axis_formatter(power_of_ten)
         .y_axis_formatter(power_of_ten)
         .allow_scroll(false)
-        .legend(egui_plot::Legend::default())
         .show(ui, |plot| {
             if let (Some(first), Some(last)) = (log.first(), log.last()) {
                 let slope = [first[0], last[0]].map(|x| [x, last[1] - 0.5 * (x - last[0])]);
-                plot.line(Line::new("1/√t", PlotPoints::from(slope.to_vec())));
+                plot.line(Line::new("1/√t", PlotPoints::from(slope.to_vec())).color(slope_color));
             }
-            plot.line(Line::new("estimate", PlotPoints::from(log)));
-            plot.hline(HLine::new("target", target.log10()));
+            plot.line(Line::new("estimate", PlotPoints::from(log)).color(estimate));
+            plot.hline(HLine::new("target", target.log10()).color(target_color));
         });
 }
+
+/// The colours of the estimate, the 1/√t line and the target, which the
+/// key above the plot names.
+const PLOT_COLORS: [egui::Color32; 3] = [
+    egui::Color32::from_rgb(100, 170, 255),
+    egui::Color32::from_rgb(160, 160, 160),
+    egui::Color32::from_rgb(230, 140, 60),
+];
 
 /// A tick label of a log axis: as few digits as its size needs.
 fn axis_value(v: f64) -> String {

@@ -5,21 +5,16 @@ use super::Stats;
 use egui::{Color32, Ui};
 use marbre_render::gpu::NonFiniteCounts;
 
-/// The live figures in one line at the top of the panel, above what
-/// scrolls: frames per second, a round's cost and the samples so far.
-pub(super) fn status_line(ui: &mut Ui, stats: &Stats) {
-    let clock = if stats.ms_is_gpu { "GPU" } else { "CPU" };
-    let mut text = format!(
-        "{:.1} fps · {:.2} ms per round ({clock}) · {} spp",
-        stats.fps, stats.ms_per_frame, stats.samples
-    );
-    if stats.building {
-        text.push_str(" · building shader…");
-    }
-    ui.label(text).on_hover_text(
-        "Frames per second of the window; the trace's cost of one sample round; samples \
-         accumulated per pixel (details in Stats)",
-    );
+/// The live figures for the first line of the panel (the Preset
+/// section's header, which stays where the panel starts): frames per
+/// second and samples per pixel so far.
+pub(super) fn headline(stats: &Stats) -> String {
+    let building = if stats.building {
+        " · building shader…"
+    } else {
+        ""
+    };
+    format!("{:.1} fps · {} spp{building}", stats.fps, stats.samples)
 }
 
 pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {

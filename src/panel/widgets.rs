@@ -10,8 +10,20 @@ use std::ops::RangeInclusive;
 
 /// A top-level collapsible section, its open state keyed by its title.
 pub(super) fn section(ui: &mut Ui, title: &str, default_open: bool, body: impl FnOnce(&mut Ui)) {
-    CollapsingHeader::new(title)
-        .id_salt(("section", title))
+    section_headed(ui, title, title, default_open, body);
+}
+
+/// A section whose header says more than its name (live figures): the
+/// open state stays keyed by `name` as the header changes.
+pub(super) fn section_headed(
+    ui: &mut Ui,
+    name: &str,
+    header: impl Into<egui::WidgetText>,
+    default_open: bool,
+    body: impl FnOnce(&mut Ui),
+) {
+    CollapsingHeader::new(header)
+        .id_salt(("section", name))
         .default_open(default_open)
         .show(ui, body);
 }

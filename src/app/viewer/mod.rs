@@ -48,8 +48,9 @@ use winit::window::{Fullscreen, Window};
 /// Width of the side panel, in points, when the window opens.
 const PANEL_WIDTH: f32 = 380.0;
 /// Height of the Quality strip under the image, in points, when the window
-/// opens.
-const QUALITY_HEIGHT: f32 = 190.0;
+/// opens: a fifth of a 720-pt window (it was a quarter); it can be dragged
+/// taller, or folded to its header line.
+const QUALITY_HEIGHT: f32 = 150.0;
 /// The smallest window, in points, that shows the panels; a smaller one
 /// (shrunk by hand, or by a window manager ignoring the minimum size)
 /// shows the image alone.
@@ -814,12 +815,19 @@ impl Viewer {
                                 actions = panel::draw(ui, scene, panel_state, &stats);
                             });
                     });
-                egui::Panel::bottom("marbre-quality")
-                    .resizable(true)
-                    .default_size(QUALITY_HEIGHT)
-                    .show(ui, |ui| {
-                        actions.extend(panel::draw_quality(ui, panel_state, &stats));
-                    });
+                // Folded, the strip is its header line: a panel of its
+                // own, so that the unfolded one keeps the height it was
+                // given.
+                let quality = if panel_state.quality.folded {
+                    egui::Panel::bottom("marbre-quality-folded").resizable(false)
+                } else {
+                    egui::Panel::bottom("marbre-quality")
+                        .resizable(true)
+                        .default_size(QUALITY_HEIGHT)
+                };
+                quality.show(ui, |ui| {
+                    actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                });
             }
             image_rect = ui.available_rect_before_wrap();
             let response = ui.allocate_rect(image_rect, egui::Sense::click_and_drag());
