@@ -1,7 +1,7 @@
 //! `marbre render` as a user runs it, for what it says on stderr: no
-//! Wayland noise where `XDG_RUNTIME_DIR` is unset, the output folder it
-//! made, the EXR that auto exposure leaves unscaled, and a path through a
-//! file refused with the file named.
+//! Wayland noise where `XDG_RUNTIME_DIR` is unset, the EXR that auto
+//! exposure leaves unscaled, and an output path through a missing folder
+//! or a file refused with the folder or the file named.
 
 use crate::REPO;
 use crate::xvfb::TempDir;
@@ -35,24 +35,36 @@ fn render_says_what_it_did_and_nothing_else() {
     if gpu_or_skip(TEST).is_none() {
         return;
     }
-    let output = dir.path().join("renders/today/x.exr");
+    let output = dir.path().join("x.exr");
     let run = render(&output, &["--auto-exposure"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{}: {stderr}", run.status);
     assert!(output.is_file(), "no {}: {stderr}", output.display());
-    let folder = dir.path().join("renders");
-    assert!(
-        stderr.contains(&format!(
-            "note: created the folder {} for the output",
-            folder.display()
-        )),
-        "{stderr}"
-    );
     assert!(
         stderr.contains("auto exposure does not scale") && stderr.contains("unscaled radiance"),
         "{stderr}"
     );
+    assert!(
+        stderr.contains("auto exposure: "),
+        "the exposure is reported: {stderr}"
+    );
     assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}
+
+/// Refused before any GPU work: no adapter needed.
+#[test]
+fn render_into_a_missing_folder_names_it_and_makes_nothing() {
+    let dir = TempDir::new("render-cli-missing");
+    let output = dir.path().join("renders/today/x.png");
+    let run = render(&output, &[]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{stderr}");
+    let folder = dir.path().join("renders");
+    assert!(
+        stderr.contains(&format!("the folder {} does not exist", folder.display())),
+        "{stderr}"
+    );
+    assert!(!folder.exists(), "a folder was made");
 }
 
 /// Refused before any GPU work: no adapter needed.

@@ -1,13 +1,13 @@
 //! Writing rendered images, atomically.
 //!
-//! An output's missing folders are created, as Blender does for a render's
-//! output path (`create_output_folder` says which, for the caller to
-//! report); a path through a file is refused with the file named.
+//! A render's output folder must exist (`check_output_folder`): a typo in
+//! a path is named before any rendering rather than made into folders,
+//! and a path through a file names the file.
 
 use crate::atomic_write::write_atomic;
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::io::ErrorKind;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFormat {
@@ -32,12 +32,11 @@ impl ImageFormat {
     }
 }
 
-/// Makes the folder `path` goes in. Returns the topmost folder created
-/// (None when it was there already); an error names the path component
-/// that is a file, or the folder that could not be made and why.
-pub fn create_output_folder(path: &Path) -> Result<Option<PathBuf>> {
+/// Fails unless the folder `path` goes in exists, naming the cause: the
+/// path component that is a file, or the topmost folder missing.
+pub fn check_output_folder(path: &Path) -> Result<()> {
     let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) else {
-        return Ok(None);
+        return Ok(());
     };
     let mut missing = None;
     for folder in dir.ancestors().take_while(|d| !d.as_os_str().is_empty()) {
@@ -55,15 +54,17 @@ pub fn create_output_folder(path: &Path) -> Result<Option<PathBuf>> {
             Err(e) => bail!("cannot write {}: {}: {e}", path.display(), folder.display()),
         }
     }
-    if missing.is_some() {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    match missing {
+        Some(folder) => bail!(
+            "cannot write {}: the folder {} does not exist",
+            path.display(),
+            folder.display()
+        ),
+        None => Ok(()),
     }
-    Ok(missing.map(Path::to_owned))
 }
 
 pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
-    create_output_folder(path)?;
     let mut bytes = Vec::new();
     image.write_to(
         &mut std::io::Cursor::new(&mut bytes),
@@ -75,7 +76,6 @@ pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
 
 pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Result<()> {
     use exr::prelude::*;
-    create_output_folder(path)?;
     let (w, h) = (width as usize, height as usize);
     let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let p = pixels[y * w + x];
@@ -92,23 +92,21 @@ pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Re
 mod tests {
     use super::*;
 
-    fn one_pixel() -> image::RgbaImage {
-        image::RgbaImage::from_pixel(1, 1, image::Rgba([10, 20, 30, 255]))
-    }
-
     #[test]
-    fn missing_folders_are_created_and_the_topmost_is_named() {
+    fn a_missing_folder_is_named_and_not_made() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("renders/today/x.png");
         assert_eq!(
-            create_output_folder(&out).unwrap(),
-            Some(dir.path().join("renders"))
+            check_output_folder(&out).unwrap_err().to_string(),
+            format!(
+                "cannot write {}: the folder {} does not exist",
+                out.display(),
+                dir.path().join("renders").display()
+            )
         );
-        assert!(dir.path().join("renders/today").is_dir());
-        assert_eq!(create_output_folder(&out).unwrap(), None, "there now");
-        save_png(&one_pixel(), &dir.path().join("more/y.png")).unwrap();
-        let saved = image::open(dir.path().join("more/y.png")).unwrap();
-        assert_eq!(saved.to_rgba8(), one_pixel());
+        assert!(!dir.path().join("renders").exists());
+        std::fs::create_dir_all(dir.path().join("renders/today")).unwrap();
+        check_output_folder(&out).unwrap();
     }
 
     #[test]
@@ -117,24 +115,19 @@ mod tests {
         let file = dir.path().join("notes.txt");
         std::fs::write(&file, "not a folder").unwrap();
         for out in [file.join("x.png"), file.join("a/b/x.exr")] {
-            let png = save_png(&one_pixel(), &out).unwrap_err().to_string();
-            let exr = save_exr(1, 1, &[[1.0; 4]], &out).unwrap_err().to_string();
-            for message in [png, exr] {
-                assert_eq!(
-                    message,
-                    format!(
-                        "cannot write {}: {} is a file, not a folder",
-                        out.display(),
-                        file.display()
-                    )
-                );
-            }
+            assert_eq!(
+                check_output_folder(&out).unwrap_err().to_string(),
+                format!(
+                    "cannot write {}: {} is a file, not a folder",
+                    out.display(),
+                    file.display()
+                )
+            );
         }
-        assert_eq!(std::fs::read_to_string(&file).unwrap(), "not a folder");
     }
 
     #[test]
-    fn a_bare_file_name_needs_no_folder() {
-        assert_eq!(create_output_folder(Path::new("x.png")).unwrap(), None);
+    fn a_bare_file_name_goes_in_the_current_folder() {
+        check_output_folder(Path::new("x.png")).unwrap();
     }
 }

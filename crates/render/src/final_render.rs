@@ -16,7 +16,7 @@ use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::scene::{Metering, Scene};
 use marbre_core::texture::ImageSet;
 use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// When a final render stops.
@@ -133,7 +133,9 @@ pub fn render_to_file(
     observer: &mut dyn RenderObserver,
 ) -> Result<Outcome> {
     let format = ImageFormat::from_path(&job.output)?;
-    check_folder(&job.output)?;
+    // Found before the render, not after it, and never created by
+    // surprise; a file in the way is named.
+    image_io::check_output_folder(&job.output)?;
     if job.stop.max_samples() == 0 {
         bail!("a render needs at least 1 sample per pixel");
     }
@@ -168,8 +170,17 @@ pub fn render_to_file(
     if flow.is_break() {
         return Ok(Outcome::Cancelled);
     }
-    // EXR output is the radiance, unscaled: only a PNG is exposed.
-    if loaded.scene.render.shown_display().auto_exposure && format == ImageFormat::Png {
+    // EXR output is the radiance, unscaled (as Blender and Mitsuba write
+    // it): only a PNG is exposed. The exposure is reported either way, and
+    // for an EXR the note says it was not applied.
+    if loaded.scene.render.shown_display().auto_exposure {
+        if format == ImageFormat::Exr {
+            observer.note(&format!(
+                "note: auto exposure does not scale {}: an EXR holds the unscaled radiance; \
+                 the exposure below is for a viewer or compositor to apply",
+                job.output.display()
+            ));
+        }
         observer.note(&describe_auto_exposure(ctx, &mut renderer)?);
     }
     match format {
@@ -185,28 +196,6 @@ pub fn render_to_file(
     .with_context(|| format!("saving {}", job.output.display()))?;
     observer.note(&format!("wrote {}", job.output.display()));
     Ok(Outcome::Written)
-}
-
-/// Fails unless the folder `output` goes into exists: found before the
-/// render, not after it, and never created by surprise.
-fn check_folder(output: &Path) -> Result<()> {
-    let folder = output
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !folder.is_dir() {
-        let why = if folder.exists() {
-            "is not a folder"
-        } else {
-            "does not exist"
-        };
-        bail!(
-            "cannot write {}: {} {why}",
-            output.display(),
-            folder.display()
-        );
-    }
-    Ok(())
 }
 
 /// Traces `spp` samples per pixel, a frame at a time, each waited for;
