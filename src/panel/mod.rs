@@ -25,7 +25,8 @@ mod widgets;
 use egui::{ScrollArea, Ui};
 use environment_ui::environment_ui;
 use glam::Vec3;
-use marbre_core::scene::{EnvSource, MaterialKey, Scene};
+use marbre_core::scene::texture_graph::NodePath;
+use marbre_core::scene::{EnvSource, MaterialKey, Scene, Texture};
 use marbre_render::gpu::NonFiniteCounts;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
@@ -265,7 +266,13 @@ pub fn draw(
 
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));
         });
-    node_graph::window(ui.ctx(), scene, &mut state.node_graph, &|_, _| None);
+    // The graph's nodes show the same preview swatches as the tree's.
+    let ctx = ui.ctx().clone();
+    let swatch = |key: MaterialKey, path: &NodePath, texture: &Texture| {
+        let id = egui::Id::new(("node graph swatch", key.to_string(), path.to_string()));
+        swatches::swatch(&ctx, id, texture, !path.is_color())
+    };
+    node_graph::window(ui.ctx(), scene, &mut state.node_graph, &swatch);
     actions
 }
 

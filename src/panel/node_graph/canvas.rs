@@ -125,13 +125,14 @@ pub(super) fn canvas(
             continue;
         };
         let top_left = origin + vec2(position.x, position.y);
+        let swatch = swatches(key, &node.path, texture);
         let drawn = texture_node(
             ui,
             rect,
             top_left,
             &node.path,
             texture,
-            swatches(key, &node.path),
+            swatch,
             &mut sockets,
         );
         if drawn.header.dragged() && drawn.header.drag_delta() != Vec2::ZERO {

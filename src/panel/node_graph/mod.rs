@@ -21,11 +21,11 @@ mod layout;
 
 use egui::{Context, TextureId, Ui};
 use marbre_core::scene::texture_graph::NodePath;
-use marbre_core::scene::{MaterialKey, Scene};
+use marbre_core::scene::{MaterialKey, Scene, Texture};
 
-/// A preview image of the texture at a node, if one is at hand; the node
-/// draws it in its header. (The panel passes none until swatches exist.)
-pub type Swatches<'a> = &'a dyn Fn(MaterialKey, &NodePath) -> Option<TextureId>;
+/// A preview image of the texture at a node (the node's path and its
+/// subtree), if one is at hand; the node draws it in its header.
+pub type Swatches<'a> = &'a dyn Fn(MaterialKey, &NodePath, &Texture) -> Option<TextureId>;
 
 /// A button that opens the node editor on `key`'s material (or closes it).
 pub fn toggle(ui: &mut Ui, open: &mut Option<MaterialKey>, key: MaterialKey) {
@@ -115,7 +115,7 @@ mod tests {
             let mut open = Some(key);
             for _ in 0..3 {
                 ctx.run_ui(egui::RawInput::default(), |ui| {
-                    window(ui.ctx(), &mut scene, &mut open, &|_, _| None);
+                    window(ui.ctx(), &mut scene, &mut open, &|_, _, _| None);
                 })
                 .drop_without_applying_deltas();
             }
@@ -140,7 +140,7 @@ mod tests {
         let mut open = Some(MaterialKey::Cylinder(3));
         let ctx = Context::default();
         ctx.run_ui(egui::RawInput::default(), |ui| {
-            window(ui.ctx(), &mut scene, &mut open, &|_, _| None);
+            window(ui.ctx(), &mut scene, &mut open, &|_, _, _| None);
         })
         .drop_without_applying_deltas();
         assert_eq!(open, None);
