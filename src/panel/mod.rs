@@ -269,7 +269,7 @@ pub fn draw(
     // The graph's nodes show the same preview swatches as the tree's.
     let ctx = ui.ctx().clone();
     let swatch = |key: MaterialKey, path: &NodePath, texture: &Texture| {
-        let id = egui::Id::new(("node graph swatch", key.to_string(), path.to_string()));
+        let id = egui::Id::NULL.with(("node graph swatch", key.to_string(), path.to_string()));
         swatches::swatch(&ctx, id, texture, !path.is_color())
     };
     node_graph::window(ui.ctx(), scene, &mut state.node_graph, &swatch);
