@@ -95,6 +95,8 @@ impl RenderDialog {
             auto_exposure: self.auto_exposure,
             kernel: KernelChoice::Auto,
             output,
+            // As `marbre render`: an EXR is the raw accumulation.
+            denoise_exr: false,
         })
     }
 

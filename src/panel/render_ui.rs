@@ -93,6 +93,16 @@ pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut 
         );
     ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
         .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
+    ui.add_enabled_ui(render.view == View::Lit, |ui| {
+        ui.checkbox(&mut render.display.denoise, "denoise")
+            .on_hover_text(
+                "Show the image through an edge-avoiding filter guided by the first surface's \
+                 albedo and normal (à-trous wavelets, SVGF's variance weight): a clean preview \
+                 from few samples, slightly blurred. PNG screenshots are filtered; EXRs stay \
+                 the raw accumulation. Turning it on restarts the accumulation",
+            )
+            .on_disabled_hover_text("Filters the lit image only");
+    });
     ui.checkbox(
         &mut render.display.show_non_finite,
         "show non-finite pixels",

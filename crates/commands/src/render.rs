@@ -64,6 +64,16 @@ pub struct RenderArgs {
     /// diffuse lobe uniform over the hemisphere).
     #[arg(long, value_parser = parse_strategy)]
     pub strategy: Option<Strategy>,
+    /// Filter the PNG with the denoiser (the viewer's "denoise"): an
+    /// edge-avoiding à-trous filter guided by the first hit's albedo and
+    /// normal, accumulated beside the radiance. An EXR stays the raw
+    /// accumulation unless --denoise-exr is given too.
+    #[arg(long)]
+    pub denoise: bool,
+    /// With --denoise, filter an EXR output as well (biased: it trades the
+    /// noise for some blur).
+    #[arg(long, requires = "denoise")]
+    pub denoise_exr: bool,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -114,6 +124,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
     let render = &mut loaded.scene.render;
     render.view = args.view.unwrap_or(render.view);
+    if args.denoise {
+        if render.view != View::Lit {
+            bail!(
+                "--denoise filters the lit image, not the {} view",
+                render.view.name()
+            );
+        }
+        render.display.denoise = true;
+    }
     render.transport.light_points = args.light_points.unwrap_or(render.transport.light_points);
     render.transport.strategy = args.strategy.unwrap_or(render.transport.strategy);
     let job = FinalRender {
@@ -131,6 +150,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }),
         kernel: args.kernel,
         output: args.output.clone(),
+        denoise_exr: args.denoise_exr,
     };
     let ctx = GpuContext::headless()?;
     let mut bar = Bar::new(spp, ctx.describe());

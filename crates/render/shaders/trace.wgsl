@@ -29,7 +29,22 @@ struct Accumulated {
     @location(0) mean: vec4f,
     @location(1) spread: vec4f,
     @location(2) compensation: vec4f,
+#if DENOISE_GUIDES
+    @location(3) albedo: vec4f,
+    @location(4) normal: vec4f,
+#endif
 }
+
+#if DENOISE_GUIDES
+// The denoiser's guides (gpu/denoise.rs): the first hit's albedo (plus its
+// emission) and shading normal, as the albedo and normal views record them
+// (view_at_hit), averaged over the pixel's samples like the radiance.
+@group(0) @binding(19) var previous_albedo: texture_2d<f32>;
+@group(0) @binding(20) var previous_normal: texture_2d<f32>;
+// What the current sample's camera ray met (0 where it escaped).
+var<private> sample_albedo: vec3f;
+var<private> sample_normal: vec3f;
+#endif
 
 fn camera_ray(pixel: vec2f) -> vec3f {
     let ndc = vec2f(pixel.x / frame.render_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.render_size.y * 2.0);
@@ -181,6 +196,10 @@ fn trace_path(pixel: vec2f) -> vec3f {
     // Where the path last scattered: light sampling's density for the
     // emitter a bounce reaches is measured from there.
     var scatter_point = frame.cam_pos;
+#if DENOISE_GUIDES
+    sample_albedo = vec3f(0.0);
+    sample_normal = vec3f(0.0);
+#endif
     if frame.view != VIEW_LIT && hit.t >= NO_HIT {
         return view_escaped();
     }
@@ -194,6 +213,14 @@ fn trace_path(pixel: vec2f) -> vec3f {
             if frame.view != VIEW_LIT {
                 return view_at_hit(hit, s);
             }
+#if DENOISE_GUIDES
+            if bounces == 0u && crossings == 0u {
+                // Emission joins the albedo: an emitter stands apart from
+                // a surface of its colour, and its edge is not blurred.
+                sample_albedo = s.diffuse + s.emission;
+                sample_normal = 0.5 + 0.5 * s.n;
+            }
+#endif
             let wo = -d;
 #if OPACITY
             // Draws only where the surface has holes, so an opaque scene
@@ -291,10 +318,18 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
     let spp = frame.samples_per_frame;
     var sum = vec3f(0.0);
     var dropped = 0u;
+#if DENOISE_GUIDES
+    var albedo_sum = vec3f(0.0);
+    var normal_sum = vec3f(0.0);
+#endif
     for (var k = 0u; k < spp; k++) {
         rng_seed(pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
         let jitter = vec2f(rand(), rand());
         var l = trace_path(vec2f(pixel) + jitter);
+#if DENOISE_GUIDES
+        albedo_sum += sample_albedo / f32(spp);
+        normal_sum += sample_normal / f32(spp);
+#endif
         // The optional firefly clamp (biased; off by default).
         let brightest = max(l.x, max(l.y, l.z));
         if frame.sample_clamp > 0.0 && brightest > frame.sample_clamp && frame.view == VIEW_LIT {
@@ -341,7 +376,18 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
     if dropped > 0u && prev_dropped == 0.0 {
         atomicAdd(&non_finite.pixels, 1u);
     }
-    return Accumulated(vec4f(mean, 1.0), vec4f(spread, prev_dropped + f32(dropped)), vec4f(updated.compensation, 0.0));
+    var out: Accumulated;
+    out.mean = vec4f(mean, 1.0);
+    out.spread = vec4f(spread, prev_dropped + f32(dropped));
+    out.compensation = vec4f(updated.compensation, 0.0);
+#if DENOISE_GUIDES
+    // Plain running means: a guide needs no more than a few bits.
+    let prev_albedo = select(textureLoad(previous_albedo, pixel, 0).xyz, vec3f(0.0), first);
+    let prev_normal = select(textureLoad(previous_normal, pixel, 0).xyz, vec3f(0.0), first);
+    out.albedo = vec4f(prev_albedo + (albedo_sum - prev_albedo) * w, 1.0);
+    out.normal = vec4f(prev_normal + (normal_sum - prev_normal) * w, 1.0);
+#endif
+    return out;
 }
 
 @fragment
@@ -350,11 +396,16 @@ fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {
     return trace_pixel(vec2u(position.xy));
 }
 
-// The compute kernel's outputs: the same three targets the fragment kernel
-// writes as colour attachments (locations 0, 1 and 2).
+// The compute kernel's outputs: the same targets the fragment kernel
+// writes as colour attachments (locations 0, 1 and 2, and the guides' 3 and
+// 4).
 @group(1) @binding(0) var out_mean: texture_storage_2d<rgba32float, write>;
 @group(1) @binding(1) var out_spread: texture_storage_2d<rgba32float, write>;
 @group(1) @binding(2) var out_compensation: texture_storage_2d<rgba32float, write>;
+#if DENOISE_GUIDES
+@group(1) @binding(3) var out_albedo: texture_storage_2d<rgba32float, write>;
+@group(1) @binding(4) var out_normal: texture_storage_2d<rgba32float, write>;
+#endif
 
 // The compute kernel's workgroup: 16 x 8 pixels (128 invocations, four
 // 32-wide SIMD groups on a GPU). On lavapipe it was 2-5 % faster than 8x8 on
@@ -375,4 +426,8 @@ fn cs_trace(@builtin(global_invocation_id) id: vec3u) {
     textureStore(out_mean, pixel, out.mean);
     textureStore(out_spread, pixel, out.spread);
     textureStore(out_compensation, pixel, out.compensation);
+#if DENOISE_GUIDES
+    textureStore(out_albedo, pixel, out.albedo);
+    textureStore(out_normal, pixel, out.normal);
+#endif
 }

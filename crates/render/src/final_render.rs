@@ -65,6 +65,10 @@ pub struct FinalRender {
     pub kernel: KernelChoice,
     /// `.png` (tone-mapped, sRGB) or `.exr` (linear radiance, float).
     pub output: PathBuf,
+    /// Write the EXR denoised (the scene's display must have `denoise`
+    /// on); otherwise an EXR is the raw accumulation. A PNG is what the
+    /// display shows, denoised when the scene's display says so.
+    pub denoise_exr: bool,
 }
 
 /// How far a render has come, after each frame.
@@ -189,7 +193,14 @@ pub fn render_to_file(
             image_io::save_png(&image, &job.output)
         }
         ImageFormat::Exr => {
-            let (w, h, pixels) = renderer.read_radiance(ctx)?;
+            let (w, h, pixels) = if job.denoise_exr {
+                renderer.read_denoised(ctx)?
+            } else {
+                if loaded.scene.render.display.denoise {
+                    observer.note("note: the EXR is the raw accumulation, not denoised");
+                }
+                renderer.read_radiance(ctx)?
+            };
             image_io::save_exr(w, h, &pixels, &job.output)
         }
     }

@@ -36,6 +36,7 @@ pub fn findings(knob: Knob, points: &[Point]) -> Vec<String> {
     match knob {
         Knob::Spp => curves.iter().filter_map(convergence_rate).collect(),
         Knob::Bounces | Knob::Octaves => ordered(&curves),
+        Knob::Denoise => denoised(&curves),
         _ => {
             let mut scenes: Vec<&str> = curves.iter().map(|c| c.scene).collect();
             scenes.dedup();
@@ -49,6 +50,36 @@ pub fn findings(knob: Knob, points: &[Point]) -> Vec<String> {
                 .collect()
         }
     }
+}
+
+/// For each scene and sample count, the denoised image's RMSE against the
+/// raw one's (the same accumulation, filtered), and what the filter cost.
+fn denoised(curves: &[Curve]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for raw in curves.iter().filter(|c| c.variant == "raw") {
+        let Some(filtered) = curves
+            .iter()
+            .find(|c| c.scene == raw.scene && c.variant == "denoised")
+        else {
+            continue;
+        };
+        for point in &raw.points {
+            let Some(f) = filtered.at_spp(point.spp) else {
+                continue;
+            };
+            let change = f.errors.rmse / point.errors.rmse - 1.0;
+            lines.push(format!(
+                "{} at {} spp: RMSE {:.4} raw, {:.4} denoised ({:+.0} %), the filter {:.1} ms.",
+                raw.scene,
+                point.spp,
+                point.errors.rmse,
+                f.errors.rmse,
+                100.0 * change,
+                f.filter_ms.unwrap_or(0.0),
+            ));
+        }
+    }
+    lines
 }
 
 /// The fitted exponents of RMSE against time and against samples.
@@ -248,7 +279,23 @@ mod tests {
                 mae: rmse,
             },
             timer: TimerKind::WallClock,
+            filter_ms: None,
         }
+    }
+
+    /// The denoise knob compares the two variants at each sample count.
+    #[test]
+    fn denoise_findings_compare_raw_and_filtered_at_equal_samples() {
+        let mut points = vec![
+            point(Knob::Denoise, "raw", 4, 1.0, 0.2),
+            point(Knob::Denoise, "denoised", 4, 1.1, 0.1),
+        ];
+        points[1].filter_ms = Some(12.0);
+        let lines = findings(Knob::Denoise, &points);
+        assert_eq!(
+            lines,
+            ["scene at 4 spp: RMSE 0.2000 raw, 0.1000 denoised (-50 %), the filter 12.0 ms."]
+        );
     }
 
     /// Error ∝ spp^-1/2 at 10 ms a sample: slope −0.5 against both, and

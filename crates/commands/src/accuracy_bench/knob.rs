@@ -16,10 +16,11 @@ pub enum Knob {
     Hash,
     Shader,
     FireflyClamp,
+    Denoise,
 }
 
 impl Knob {
-    pub const ALL: [Knob; 11] = [
+    pub const ALL: [Knob; 12] = [
         Knob::Spp,
         Knob::Bounces,
         Knob::LightSelection,
@@ -31,6 +32,7 @@ impl Knob {
         Knob::Hash,
         Knob::Shader,
         Knob::FireflyClamp,
+        Knob::Denoise,
     ];
 
     pub fn id(self) -> &'static str {
@@ -46,6 +48,7 @@ impl Knob {
             Knob::Hash => "hash",
             Knob::Shader => "shader",
             Knob::FireflyClamp => "firefly-clamp",
+            Knob::Denoise => "denoise",
         }
     }
 
@@ -62,6 +65,7 @@ impl Knob {
             Knob::Hash => "Noise hash",
             Knob::Shader => "Specialised or uber shader",
             Knob::FireflyClamp => "Firefly clamp (biased)",
+            Knob::Denoise => "Denoised preview (biased)",
         }
     }
 }

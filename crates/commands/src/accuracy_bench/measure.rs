@@ -12,6 +12,7 @@ use indicatif::ProgressBar;
 use marbre_core::scene::Scene;
 use marbre_render::gpu::{GpuContext, Kernel, KernelChoice, Renderer};
 use marbre_render::session::{LoadedScene, accumulate, pick_kernel, renderer_with};
+use std::time::Instant;
 
 /// Untimed frames before a variant's first timed one.
 const WARM_UP_FRAMES: u32 = 3;
@@ -29,6 +30,9 @@ pub struct Point {
     pub seconds: f64,
     pub errors: ErrorMetrics,
     pub timer: TimerKind,
+    /// For a denoised variant, the filter's wall-clock ms (its readback
+    /// included; also in `seconds`).
+    pub filter_ms: Option<f64>,
 }
 
 /// What a sweep measured.
@@ -82,16 +86,23 @@ impl Bench<'_> {
                 let times = self.timer.run(self.ctx, &mut renderer, spp, |done| {
                     self.progress.set_position(start + u64::from(done));
                 })?;
-                let (_, _, pixels) = renderer.read_radiance(self.ctx)?;
+                let (pixels, filter_ms) = if variant.denoise {
+                    let start = Instant::now();
+                    let (_, _, pixels) = renderer.read_denoised(self.ctx)?;
+                    (pixels, Some(start.elapsed().as_secs_f64() * 1000.0))
+                } else {
+                    (renderer.read_radiance(self.ctx)?.2, None)
+                };
                 points.push(Point {
                     knob: sweep.knob,
                     scene: sweep.scene_name.clone(),
                     variant: variant.name.clone(),
                     spp,
                     ms_per_frame: times.median_ms,
-                    seconds: times.seconds,
+                    seconds: times.seconds + filter_ms.unwrap_or(0.0) / 1000.0,
                     errors: ErrorMetrics::between(&pixels, reference),
                     timer: self.timer.kind(),
+                    filter_ms,
                 });
             }
         }

@@ -19,6 +19,9 @@ pub struct Scale {
     pub bounces: Vec<u32>,
     /// The octave counts swept (against 16).
     pub octaves: Vec<u32>,
+    /// The denoise knob's counts, raw and filtered, and its reference.
+    pub denoise_spp: Vec<u32>,
+    pub denoise_reference_spp: u32,
 }
 
 impl Scale {
@@ -32,6 +35,8 @@ impl Scale {
             reference_spp: 256,
             bounces: vec![1, 2, 4, 8],
             octaves: vec![1, 2, 4, 8, 12],
+            denoise_spp: vec![1, 4, 16],
+            denoise_reference_spp: 256,
         }
     }
 
@@ -45,6 +50,8 @@ impl Scale {
             reference_spp: 2048,
             bounces: (1..=8).collect(),
             octaves: (1..=12).collect(),
+            denoise_spp: vec![1, 4, 16, 64],
+            denoise_reference_spp: 4096,
         }
     }
 }

@@ -16,11 +16,14 @@ use marbre_render::session::{LoadedScene, prepare_scene};
 use std::path::Path;
 
 /// One value of the knob: the scene rendered, the shader's features if not
-/// the scene's own, and the scene whose reference it is measured against.
+/// the scene's own, whether the image measured is the denoised one (its
+/// scene's display has `denoise` on), and the scene whose reference it is
+/// measured against.
 pub struct Variant {
     pub name: String,
     pub scene: Scene,
     pub features: Option<FeatureSet>,
+    pub denoise: bool,
     pub reference: Scene,
 }
 
@@ -65,6 +68,7 @@ fn against(reference: &Scene, variants: Vec<(String, Scene)>) -> Vec<Variant> {
             name,
             scene,
             features: None,
+            denoise: false,
             reference: reference.clone(),
         })
         .collect()
@@ -294,6 +298,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                         name: hash.label().to_string(),
                         scene: scene.clone(),
                         features: None,
+                        denoise: false,
                         reference: scene,
                     }
                 })
@@ -313,6 +318,26 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
             variants[1].features = Some(FeatureSet::all());
             vec![Sweep::new(knob, "default", default, variants, scale)]
         }
+        Knob::Denoise => ["default", "cornell", "tiles"]
+            .into_iter()
+            .map(|name| {
+                let loaded = scenes::preset(root, name)?;
+                let scene = loaded.scene.clone();
+                let mut variants = against(
+                    &scene,
+                    vec![
+                        ("raw".into(), scene.clone()),
+                        ("denoised".into(), scene.clone()),
+                    ],
+                );
+                variants[1].denoise = true;
+                variants[1].scene.render.display.denoise = true;
+                let mut sweep = Sweep::new(knob, name, loaded, variants, scale);
+                sweep.spp = scale.denoise_spp.clone();
+                sweep.reference_spp = scale.denoise_reference_spp;
+                Ok(sweep)
+            })
+            .collect::<Result<_>>()?,
     })
 }
 

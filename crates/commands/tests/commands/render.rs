@@ -83,6 +83,8 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         view: None,
         light_points: None,
         strategy: None,
+        denoise: false,
+        denoise_exr: false,
     }
 }
 
@@ -93,6 +95,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         auto_exposure: auto_exposure.then_some(marbre_core::scene::Metering::Key),
         kernel: KernelChoice::Fragment,
         output,
+        denoise_exr: false,
     }
 }
 

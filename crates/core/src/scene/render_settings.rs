@@ -115,6 +115,12 @@ pub struct DisplaySettings {
     /// Debug view: pixels where a path gave a NaN or infinite sample (which
     /// the accumulation drops and counts) are painted magenta.
     pub show_non_finite: bool,
+    /// Show the accumulation through the denoiser (`gpu::denoise`): an
+    /// edge-avoiding filter guided by the first hit's albedo and normal,
+    /// which the trace pass then accumulates beside the radiance (a
+    /// specialised shader). Biased; off by default, and saved EXRs stay the
+    /// raw accumulation.
+    pub denoise: bool,
 }
 
 impl Default for DisplaySettings {
@@ -125,6 +131,7 @@ impl Default for DisplaySettings {
             metering: Metering::Key,
             tone_map: ToneMap::Aces,
             show_non_finite: false,
+            denoise: false,
         }
     }
 }
@@ -151,6 +158,7 @@ struct RenderSettingsFile {
     /// `DisplaySettings::metering`; presets written before it read Key.
     auto_exposure_metering: Metering,
     view: super::render_view::View,
+    denoise: bool,
 }
 
 impl From<RenderSettingsFile> for RenderSettings {
@@ -171,6 +179,7 @@ impl From<RenderSettingsFile> for RenderSettings {
                 metering: f.auto_exposure_metering,
                 tone_map: f.tone_map,
                 show_non_finite: f.show_non_finite,
+                denoise: f.denoise,
             },
         }
     }
@@ -193,6 +202,7 @@ impl From<RenderSettings> for RenderSettingsFile {
             show_non_finite: r.display.show_non_finite,
             auto_exposure_metering: r.display.metering,
             view: r.view,
+            denoise: r.display.denoise,
         }
     }
 }
@@ -260,6 +270,7 @@ impl RenderSettings {
                 tone_map: ToneMap::Clamp,
                 show_non_finite: self.display.show_non_finite,
                 metering: self.display.metering,
+                denoise: false,
             }
         } else {
             self.display
@@ -386,6 +397,9 @@ mod tests {
             metering: Metering::MassalRms,
             tone_map: ToneMap::Clamp,
             show_non_finite: true,
+            // Its guides come with a new pipeline, which restarts the
+            // accumulation by itself.
+            denoise: true,
         };
         assert!(base.traces_like(&shown));
         let mut traced = base;

@@ -69,10 +69,25 @@ impl PingPong {
     }
 }
 
+/// The denoiser's guides, accumulated beside the mean when the trace
+/// pipeline has `Feature::DenoiseGuides`: the first hit's albedo and
+/// normal.
+struct Guides {
+    albedo: PingPong,
+    normal: PingPong,
+}
+
 pub struct Accumulation {
     mean: PingPong,
     spread: PingPong,
     compensation: PingPong,
+    /// Allocated only while the pipeline writes them ([`Self::set_guides`]).
+    guides: Option<Guides>,
+    /// Bound in their place otherwise: a 1 × 1 texture the shader never
+    /// reads.
+    no_guide: wgpu::TextureView,
+    size: (u32, u32),
+    storage: bool,
     /// Index of the pair holding the latest frame.
     latest: usize,
     samples: u32,
@@ -102,6 +117,10 @@ impl Accumulation {
             mean: PingPong::new(device, "accumulated mean", size, storage),
             spread: PingPong::new(device, "accumulated spread", size, storage),
             compensation: PingPong::new(device, "mean compensation", size, storage),
+            guides: None,
+            no_guide: PingPong::new(device, "no guide", (1, 1), false).views[0].clone(),
+            size,
+            storage,
             latest: 0,
             samples: 0,
             frames: 0,
@@ -111,6 +130,46 @@ impl Accumulation {
             shown_count: 0,
             started: Instant::now(),
             generation: 0,
+        }
+    }
+
+    /// Allocates the guides' targets, or frees them: whether the trace
+    /// pipeline writes them. Call it before recording a band; a pipeline
+    /// change restarts the accumulation, so new targets start empty.
+    pub fn set_guides(&mut self, device: &wgpu::Device, on: bool) {
+        if on && self.guides.is_none() {
+            self.guides = Some(Guides {
+                albedo: PingPong::new(device, "albedo guide", self.size, self.storage),
+                normal: PingPong::new(device, "normal guide", self.size, self.storage),
+            });
+        } else if !on {
+            self.guides = None;
+        }
+    }
+
+    /// The latest albedo and normal guides, if accumulated.
+    pub fn latest_guides(&self) -> Option<(&wgpu::TextureView, &wgpu::TextureView)> {
+        self.guides
+            .as_ref()
+            .map(|g| (&g.albedo.views[self.latest], &g.normal.views[self.latest]))
+    }
+
+    /// The latest guides' textures (albedo, normal), if accumulated.
+    pub fn latest_guide_textures(&self) -> Option<[&wgpu::Texture; 2]> {
+        self.guides.as_ref().map(|g| {
+            [
+                &g.albedo.textures[self.latest],
+                &g.normal.textures[self.latest],
+            ]
+        })
+    }
+
+    /// The guides the next frame reads (bindings 19 and 20): the latest,
+    /// or the 1 × 1 stand-in.
+    pub fn previous_guide_views(&self) -> [&wgpu::TextureView; 2] {
+        match self.latest_guides() {
+            Some((albedo, normal)) => [albedo, normal],
+            None => [&self.no_guide, &self.no_guide],
         }
     }
 
@@ -213,32 +272,40 @@ impl Accumulation {
         &self.spread.textures[self.latest]
     }
 
-    /// The views a round writes: mean, spread, compensation (the compute
-    /// kernel's storage textures 0, 1 and 2).
-    pub fn write_views(&self) -> [&wgpu::TextureView; 3] {
+    /// The views a round writes: mean, spread, compensation, then the
+    /// albedo and normal guides if allocated (the compute kernel's storage
+    /// textures 0 to 4).
+    pub fn write_views(&self) -> Vec<&wgpu::TextureView> {
         let write = 1 - self.latest;
-        [
+        let mut views = vec![
             &self.mean.views[write],
             &self.spread.views[write],
             &self.compensation.views[write],
-        ]
+        ];
+        if let Some(g) = &self.guides {
+            views.extend([&g.albedo.views[write], &g.normal.views[write]]);
+        }
+        views
     }
 
     /// The colour attachments a round writes: mean, spread, compensation
-    /// (the trace shader's locations 0, 1 and 2). Loaded, not cleared: a
-    /// round is written a band at a time.
-    pub fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 3] {
-        self.write_views().map(|view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
+    /// and the guides (the trace shader's locations 0 to 4). Loaded, not
+    /// cleared: a round is written a band at a time.
+    pub fn attachments(&self) -> Vec<Option<wgpu::RenderPassColorAttachment<'_>>> {
+        self.write_views()
+            .into_iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
             })
-        })
+            .collect()
     }
 
     /// Records that a round of `samples` samples per pixel over a region

@@ -1,7 +1,7 @@
 //! Which shader features a scene needs: the key of shader specialisation.
 
 use marbre_core::noise::{HashKind, NoiseKind, NoiseSettings};
-use marbre_core::scene::{EnvSource, Material, Pattern, Scene, Texture};
+use marbre_core::scene::{EnvSource, Material, Pattern, Scene, Texture, View};
 use marbre_core::texture::ImageFilter;
 use std::collections::BTreeSet;
 
@@ -41,10 +41,11 @@ pub enum Feature {
     NoisePerlin,
     HashPcg,
     HashSin,
+    DenoiseGuides,
 }
 
 impl Feature {
-    pub const ALL: [Feature; 33] = [
+    pub const ALL: [Feature; 34] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -78,6 +79,7 @@ impl Feature {
         Feature::NoisePerlin,
         Feature::HashPcg,
         Feature::HashSin,
+        Feature::DenoiseGuides,
     ];
 
     /// Whether the feature's pattern is one of texture/patterns.wgsl's.
@@ -132,6 +134,7 @@ impl Feature {
             Feature::NoisePerlin => "NOISE_PERLIN",
             Feature::HashPcg => "HASH_PCG",
             Feature::HashSin => "HASH_SIN",
+            Feature::DenoiseGuides => "DENOISE_GUIDES",
         }
     }
 }
@@ -213,6 +216,11 @@ impl FeatureSet {
                     set.insert(Feature::EnvSampling);
                 }
             }
+        }
+        // The denoiser's guides: accumulated only while it is shown, on
+        // the lit image (a view is shown as it is).
+        if scene.render.display.denoise && scene.render.view == View::Lit {
+            set.insert(Feature::DenoiseGuides);
         }
         let patterns: Vec<&Pattern> = scene.materials().flat_map(|m| m.patterns()).collect();
         for pattern in &patterns {

@@ -8,6 +8,7 @@ pub mod async_readback;
 pub mod auto_exposure;
 pub mod bake;
 pub mod context;
+pub mod denoise;
 pub mod error_meter;
 pub mod features;
 pub mod geometry_buffers;

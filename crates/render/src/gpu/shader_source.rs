@@ -57,6 +57,7 @@ const SOURCES: &[WgslFile] = &[
     super::metering_grid::WGSL,
     super::auto_exposure::WGSL,
     super::error_meter::WGSL,
+    super::denoise::WGSL,
     harness::noise::WGSL,
     texture::PATTERNS_WGSL,
     r::BUMP,
@@ -92,6 +93,8 @@ pub enum Program {
     AutoExposure,
     /// The compute pass that estimates the image's error from its spread.
     ErrorMeter,
+    /// One iteration of the denoiser's edge-avoiding à-trous filter.
+    Denoise,
     /// The compute pass that evaluates noise at given points.
     NoiseHarness,
     /// The compute pass that evaluates the texture library's patterns.
@@ -121,6 +124,7 @@ impl Program {
         Program::Display,
         Program::AutoExposure,
         Program::ErrorMeter,
+        Program::Denoise,
         Program::NoiseHarness,
         Program::TextureHarness,
         Program::BvhHarness,
@@ -184,6 +188,7 @@ impl Program {
             Program::ErrorMeter => {
                 out.extend([super::metering_grid::WGSL, super::error_meter::WGSL])
             }
+            Program::Denoise => out.push(super::denoise::WGSL),
             Program::NoiseHarness => {
                 noise(&mut out);
                 out.push(harness::noise::WGSL);

@@ -33,6 +33,7 @@ impl TracePipeline {
         module: &wgpu::ShaderModule,
         kernel: Kernel,
         constants: &[(&str, f64)],
+        guides: bool,
     ) -> Result<Self> {
         match kernel {
             Kernel::Fragment => Ok(TracePipeline::Fragment(fullscreen_pipeline(
@@ -41,13 +42,20 @@ impl TracePipeline {
                 module,
                 &layouts.scene,
                 "fs_trace",
-                &[ACCUMULATION_FORMAT; 3],
+                &vec![ACCUMULATION_FORMAT; TraceLayouts::targets(guides)],
                 constants,
             )?)),
             Kernel::Compute => {
+                let needed = TraceLayouts::targets(guides) as u32;
+                let limit = device.limits().max_storage_textures_per_shader_stage;
+                anyhow::ensure!(
+                    limit >= needed,
+                    "the compute kernel cannot write the denoiser's guides on this adapter \
+                     ({limit} storage textures a stage, {needed} needed): use the fragment kernel"
+                );
                 let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                     label: Some("trace (compute)"),
-                    bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.outputs)],
+                    bind_group_layouts: &[Some(&layouts.scene), Some(layouts.outputs(guides))],
                     immediate_size: 0,
                 });
                 let pipeline = checked(device, "trace pipeline (compute)", || {
@@ -70,15 +78,32 @@ impl TracePipeline {
 }
 
 /// The bind group layouts of the trace pipelines: the scene (both kernels)
-/// and the compute kernel's storage-texture outputs.
+/// and the compute kernel's storage-texture outputs, without and with the
+/// denoiser's guides.
 #[derive(Clone)]
 pub struct TraceLayouts {
     pub scene: wgpu::BindGroupLayout,
-    pub outputs: wgpu::BindGroupLayout,
+    pub outputs: [wgpu::BindGroupLayout; 2],
 }
 
 impl TraceLayouts {
-    pub fn outputs(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    /// The targets a round writes: mean, spread and compensation, and the
+    /// albedo and normal guides with `guides`.
+    pub fn targets(guides: bool) -> usize {
+        if guides { 5 } else { 3 }
+    }
+
+    /// The compute kernel's output layout with or without guides.
+    pub fn outputs(&self, guides: bool) -> &wgpu::BindGroupLayout {
+        &self.outputs[usize::from(guides)]
+    }
+
+    /// Both output layouts: 3 and 5 storage textures.
+    pub fn output_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
+        [false, true].map(|guides| Self::output_layout(device, Self::targets(guides)))
+    }
+
+    fn output_layout(device: &wgpu::Device, count: usize) -> wgpu::BindGroupLayout {
         let output = |binding| {
             entry(
                 binding,
@@ -89,9 +114,10 @@ impl TraceLayouts {
                 },
             )
         };
+        let entries: Vec<_> = (0..count as u32).map(output).collect();
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace outputs"),
-            entries: &[output(0), output(1), output(2)],
+            entries: &entries,
         })
     }
 }

@@ -14,6 +14,7 @@ mod bvh;
 mod chi2;
 mod common;
 mod cubemap;
+mod denoise;
 mod diffuse_transmission;
 mod error_estimate;
 mod exposure;

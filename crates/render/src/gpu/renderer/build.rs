@@ -6,7 +6,7 @@
 
 use super::{Renderer, upload_env, upload_env_distribution};
 use crate::gpu::context::GpuContext;
-use crate::gpu::features::FeatureSet;
+use crate::gpu::features::{Feature, FeatureSet};
 use crate::gpu::kernel::Kernel;
 use crate::gpu::mesh_buffers::PreparedGeometry;
 use crate::gpu::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
@@ -38,6 +38,7 @@ impl Renderer {
             &module,
             key.kernel,
             &key.switches.constants(),
+            key.features.contains(Feature::DenoiseGuides),
         )?;
         Ok((pipeline, bytes))
     }

@@ -8,6 +8,7 @@ use super::{
 };
 use crate::gpu::accumulation::Accumulation;
 use crate::gpu::context::GpuContext;
+use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
 use crate::gpu::pipelines::fullscreen_pipeline;
 use crate::gpu::scene_gpu::FrameUniform;
@@ -179,6 +180,9 @@ impl Renderer {
             offset,
             bytemuck::cast_slice(&[uniform; 2]),
         );
+        let guides = self.key.features.contains(Feature::DenoiseGuides);
+        self.accumulation.set_guides(&ctx.device, guides);
+        let [previous_albedo, previous_normal] = self.accumulation.previous_guide_views();
         let (previous_mean, previous_spread) = self.accumulation.latest_views();
         let frame = wgpu::BufferBinding {
             buffer: &self.frame_buffer,
@@ -195,6 +199,8 @@ impl Renderer {
                 18,
                 wgpu::BindingResource::TextureView(self.accumulation.latest_compensation_view()),
             ),
+            bind(19, wgpu::BindingResource::TextureView(previous_albedo)),
+            bind(20, wgpu::BindingResource::TextureView(previous_normal)),
             bind(6, self.perm_buffer.as_entire_binding()),
             bind(7, self.texture_param_buffer.as_entire_binding()),
             bind(
@@ -215,15 +221,14 @@ impl Renderer {
             entries: &entries,
         });
         let outputs = matches!(self.trace_pipeline, TracePipeline::Compute(_)).then(|| {
-            let views = self.accumulation.write_views();
+            let entries: Vec<_> = (0u32..)
+                .zip(self.accumulation.write_views())
+                .map(|(i, view)| bind(i, wgpu::BindingResource::TextureView(view)))
+                .collect();
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("trace outputs"),
-                layout: &self.trace_layouts.outputs,
-                entries: &[
-                    bind(0, wgpu::BindingResource::TextureView(views[0])),
-                    bind(1, wgpu::BindingResource::TextureView(views[1])),
-                    bind(2, wgpu::BindingResource::TextureView(views[2])),
-                ],
+                layout: self.trace_layouts.outputs(guides),
+                entries: &entries,
             })
         });
         BandPass {
@@ -277,6 +282,21 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         target: &DisplayTarget<'_>,
         timer: Option<&PassTimer>,
+    ) -> Result<()> {
+        let denoised = self.record_denoise(ctx, encoder)?;
+        self.display_from(ctx, encoder, target, timer, denoised.as_ref())
+    }
+
+    /// [`Self::display`] of `source` instead of the latest mean: an image
+    /// of the shown size made from it (the denoised accumulation), exposed
+    /// and tone-mapped alike. Auto exposure still meters the mean.
+    fn display_from(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &DisplayTarget<'_>,
+        timer: Option<&PassTimer>,
+        source: Option<&wgpu::TextureView>,
     ) -> Result<()> {
         let DisplayTarget {
             view: target,
@@ -334,7 +354,9 @@ impl Renderer {
                 bind(0, self.display_buffer.as_entire_binding()),
                 bind(
                     1,
-                    wgpu::BindingResource::TextureView(self.accumulation.latest_views().0),
+                    wgpu::BindingResource::TextureView(
+                        source.unwrap_or(self.accumulation.latest_views().0),
+                    ),
                 ),
                 bind(2, self.auto_exposure.result().as_entire_binding()),
                 bind(

@@ -8,6 +8,7 @@
 //! share, its creation and what it reports.
 
 mod build;
+mod denoise;
 mod frame;
 mod readback;
 
@@ -16,6 +17,7 @@ use build::{PendingScene, PipelineKey, RenderSwitches};
 use super::accumulation::Accumulation;
 use super::auto_exposure::AutoExposure;
 use super::context::GpuContext;
+use super::denoise::Denoiser;
 use super::error_meter::ErrorMeter;
 use super::features::FeatureSet;
 use super::geometry_buffers::GeometryBuffers;
@@ -147,6 +149,10 @@ pub struct Renderer {
     error_meter: ErrorMeter,
     /// Counts the samples the trace pass dropped for being NaN or infinite.
     non_finite: NonFiniteCounter,
+    /// The denoiser, made the first time the display asks for it.
+    denoiser: Option<Denoiser>,
+    /// What the denoiser's output was filtered from.
+    denoised_from: Option<MeteredFrom>,
     size: (u32, u32),
     render_scale: f32,
     frame_index: u32,
@@ -225,6 +231,8 @@ impl Renderer {
                 entry(11, storage(true)),
                 entry(16, float_texture(false)),
                 entry(18, float_texture(false)),
+                entry(19, float_texture(false)),
+                entry(20, float_texture(false)),
                 entry(non_finite::BINDING, storage(false)),
                 entry(MeshBuffers::BINDINGS[0], storage(true)),
                 entry(MeshBuffers::BINDINGS[1], storage(true)),
@@ -252,7 +260,7 @@ impl Renderer {
         };
         let trace_layouts = TraceLayouts {
             scene: trace_layout,
-            outputs: TraceLayouts::outputs(device),
+            outputs: TraceLayouts::output_layouts(device),
         };
         let (trace_pipeline, trace_shader_bytes) =
             Self::build_trace_pipeline(&ctx.device, &trace_layouts, &key)?;
@@ -337,6 +345,8 @@ impl Renderer {
             accumulation,
             error_meter,
             non_finite,
+            denoiser: None,
+            denoised_from: None,
             size,
             render_scale: 1.0,
             frame_index: 0,

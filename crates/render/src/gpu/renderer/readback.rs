@@ -26,7 +26,7 @@ impl Renderer {
     }
 
     /// The traced region of one of the accumulation targets.
-    fn read_accumulated(
+    pub(super) fn read_accumulated(
         &self,
         ctx: &GpuContext,
         texture: &wgpu::Texture,
