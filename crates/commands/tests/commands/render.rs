@@ -192,3 +192,31 @@ fn a_missing_folder_is_named_before_rendering() {
     assert!(counter.reports.is_empty(), "nothing was traced");
     assert_eq!(dir.files(), Vec::<String>::new(), "no folder was made");
 }
+
+/// `--denoise` filters the PNG; the EXR stays the raw accumulation (the
+/// same bytes as without the flag) unless `--denoise-exr` asks for the
+/// filtered one, which then differs.
+#[test]
+fn denoise_filters_the_png_and_the_exr_only_when_asked() {
+    if gpu_or_skip("denoise_filters_the_png_and_the_exr_only_when_asked").is_none() {
+        return;
+    }
+    let dir = Scratch::new("render-denoise");
+    let run = |name: &str, denoise: bool, denoise_exr: bool| {
+        let output = dir.0.join(name);
+        render::run(&RenderArgs {
+            denoise,
+            denoise_exr,
+            ..cli_args(output.clone(), false)
+        })
+        .unwrap();
+        std::fs::read(output).unwrap()
+    };
+    assert_ne!(
+        run("raw.png", false, false),
+        run("denoised.png", true, false)
+    );
+    let raw_exr = run("raw.exr", false, false);
+    assert_eq!(raw_exr, run("asked-png-only.exr", true, false));
+    assert_ne!(raw_exr, run("denoised.exr", true, true));
+}
