@@ -163,6 +163,11 @@ impl Bench<'_> {
             renderer.set_feature_override(self.ctx, variant.features.clone())?;
         }
         accumulate(self.ctx, &mut renderer, WARM_UP_FRAMES, |_| {})?;
+        if variant.denoise {
+            // Builds the filter's pipelines, which its first timing would
+            // otherwise include.
+            renderer.read_denoised(self.ctx)?;
+        }
         Ok(renderer)
     }
 }
