@@ -89,9 +89,10 @@ fn the_quick_bench_covers_every_knob_and_finds_the_monte_carlo_rate() {
     };
     let results = accuracy_bench::run_on(&ctx, &args, false).unwrap();
     // An empty cache: every reference rendered, and kept for the next run;
-    // one is read back within the run, the esplanade's, which environment
-    // sampling and the firefly clamp both measure against.
-    assert_eq!(results.references_cached, 1);
+    // two are read back within the run: the esplanade's, which environment
+    // sampling and the firefly clamp both measure against, and the default
+    // preset's, which the shader and denoise knobs both measure against.
+    assert_eq!(results.references_cached, 2);
     let kept = std::fs::read_dir(&args.cache).unwrap().count();
     assert!(results.references_rendered >= Knob::ALL.len());
     assert_eq!(kept, results.references_rendered);

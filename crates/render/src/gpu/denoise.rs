@@ -287,6 +287,25 @@ struct Targets {
     views: [wgpu::TextureView; 2],
 }
 
+impl Targets {
+    fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let textures = [0, 1].map(|i| {
+            device.create_texture(&texture_descriptor(&format!("denoised {i}"), size, usage))
+        });
+        let views = textures
+            .each_ref()
+            .map(|t| t.create_view(&Default::default()));
+        Self {
+            size,
+            textures,
+            views,
+        }
+    }
+}
+
 /// The filter's compute pipelines (input, iteration), its targets and its
 /// parameter buffers, kept between frames.
 pub struct Denoiser {
@@ -357,26 +376,6 @@ impl Denoiser {
         settings: &DenoiseSettings,
     ) {
         let size = (sources.size.0.max(1), sources.size.1.max(1));
-        if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            let usage = wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC;
-            let textures = [0, 1].map(|i| {
-                ctx.device.create_texture(&texture_descriptor(
-                    &format!("denoised {i}"),
-                    size,
-                    usage,
-                ))
-            });
-            let views = textures
-                .each_ref()
-                .map(|t| t.create_view(&Default::default()));
-            self.targets = Some(Targets {
-                size,
-                textures,
-                views,
-            });
-        }
         let passes = settings.iterations as usize + 1;
         while self.params.len() < passes {
             self.params
@@ -387,7 +386,10 @@ impl Denoiser {
                     mapped_at_creation: false,
                 }));
         }
-        let targets = self.targets.as_ref().expect("made above");
+        let targets = match &mut self.targets {
+            Some(t) if t.size == size => t,
+            slot => slot.insert(Targets::new(&ctx.device, size)),
+        };
         for pass_index in 0..passes {
             // Pass 0 reads the mean and writes target 0; iteration i reads
             // target i % 2 and writes the other.
@@ -486,7 +488,9 @@ impl Denoiser {
         };
         self.record(ctx, &mut encoder, &sources, settings);
         ctx.queue.submit([encoder.finish()]);
-        let (texture, _) = self.output(settings).expect("recorded above");
+        let (texture, _) = self
+            .output(settings)
+            .ok_or_else(|| anyhow::anyhow!("denoise: no output was recorded"))?;
         let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
         Ok(opaque(bytemuck::cast_slice(&bytes).to_vec()))
     }

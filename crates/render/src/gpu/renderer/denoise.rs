@@ -77,16 +77,13 @@ impl Renderer {
     /// unless the scene's display has `denoise` on.
     pub fn read_denoised(&mut self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        if self.record_denoise(ctx, &mut encoder)?.is_none() {
-            bail!("no denoised image: the scene's display does not have denoise on");
-        }
-        ctx.queue.submit([encoder.finish()]);
+        let recorded = self.record_denoise(ctx, &mut encoder)?.is_some();
         let settings = DenoiseSettings::default();
-        let (texture, _) = self
-            .denoiser
-            .as_ref()
-            .and_then(|d| d.output(&settings))
-            .expect("recorded above");
+        let output = self.denoiser.as_ref().and_then(|d| d.output(&settings));
+        let (true, Some((texture, _))) = (recorded, output) else {
+            bail!("no denoised image: the scene's display does not have denoise on");
+        };
+        ctx.queue.submit([encoder.finish()]);
         let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
         let mut pixels: Vec<[f32; 4]> = bytemuck::cast_slice(&bytes).to_vec();
         for p in &mut pixels {
