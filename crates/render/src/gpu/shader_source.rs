@@ -119,7 +119,7 @@ pub enum Program {
 }
 
 impl Program {
-    pub const ALL: [Program; 12] = [
+    pub const ALL: [Program; 13] = [
         Program::Trace,
         Program::Display,
         Program::AutoExposure,
