@@ -773,7 +773,7 @@ fn preset_cube_paths_are_relative_to_the_preset() {
     assert_eq!(
         loaded.preset.scene.environment.source,
         EnvSource::CubeCross {
-            path: "/data/presets/../envmaps/c.exr".into()
+            path: "/data/envmaps/c.exr".into()
         }
     );
 }
