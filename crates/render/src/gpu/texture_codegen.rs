@@ -77,14 +77,10 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
             )?;
         }
     }
-    ensure!(
-        generator.params.len() <= MAX_TEXTURE_PARAMS,
-        "the scene's textures need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
-        generator.params.len()
-    );
-    let mut wgsl =
-        String::from("// Generated from the scene's texture trees (gpu::texture_codegen).\n\n");
-    wgsl.push_str(&generator.code);
+    let (mut wgsl, params) = generator.finish(
+        "// Generated from the scene's texture trees (gpu::texture_codegen).\n\n",
+        "the scene's textures",
+    )?;
     write!(
         wgsl,
         "fn surface_textures(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> SurfaceTextures {{\n    var out = SurfaceTextures(vec3f(0.0), vec3f(0.0), 0.0, 0.0, 1.0, vec3f(1.0), vec3f(0.0), vec3f(0.0));\n    switch material {{\n{dispatch}        default: {{}}\n    }}\n    return out;\n}}\n"
@@ -137,8 +133,6 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
         wgsl,
         "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
     )?;
-    let mut params = generator.params;
-    params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
     Ok(GeneratedTextures { wgsl, params })
 }
 
@@ -164,20 +158,14 @@ pub fn generate_swatches(textures: &[Texture], images: &ImageSet) -> Result<Gene
             "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals);\n        }}"
         )?;
     }
-    ensure!(
-        generator.params.len() <= MAX_TEXTURE_PARAMS,
-        "the swatches' textures need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
-        generator.params.len()
-    );
-    let mut wgsl =
-        String::from("// Generated from texture trees for swatches (gpu::texture_codegen).\n\n");
-    wgsl.push_str(&generator.code);
+    let (mut wgsl, params) = generator.finish(
+        "// Generated from texture trees for swatches (gpu::texture_codegen).\n\n",
+        "the swatches' textures",
+    )?;
     write!(
         wgsl,
         "fn swatch_texture(index: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> vec3f {{\n    switch index {{\n{dispatch}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
     )?;
-    let mut params = generator.params;
-    params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
     Ok(GeneratedTextures { wgsl, params })
 }
 
@@ -236,6 +224,20 @@ struct Generator<'a> {
 }
 
 impl Generator<'_> {
+    /// The generated functions after `header`, and the parameters padded to
+    /// the uniform array's size; refused when they do not fit (`what` names
+    /// whose they are).
+    fn finish(self, header: &str, what: &str) -> Result<(String, Vec<[f32; 4]>)> {
+        ensure!(
+            self.params.len() <= MAX_TEXTURE_PARAMS,
+            "{what} need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
+            self.params.len()
+        );
+        let mut params = self.params;
+        params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
+        Ok((format!("{header}{}", self.code), params))
+    }
+
     /// Generates the functions of material `index`'s textures and returns
     /// the statements of its case in `surface_textures` (each property's
     /// base texture, then each layer over it where its mask lies) and in
