@@ -2,7 +2,8 @@
 
 use glam::{Vec2, Vec3};
 use marbre_core::scene::{
-    EnvSource, Ground, Material, OrbitCamera, RenderSettings, Scene, Sphere, Texture,
+    EnvSource, Ground, Material, OrbitCamera, Property, RenderSettings, Scene, Sphere,
+    SurfacePoint, Texture,
 };
 use marbre_render::gpu::{GpuContext, Renderer};
 use marbre_render::session::accumulate;
@@ -281,4 +282,54 @@ pub fn mesh_of(triangles: Vec<[Vec3; 3]>, material: Material) -> marbre_core::sc
         )),
         ..Default::default()
     }
+}
+
+/// A unit sphere at (0.4, 0.1, 0) wearing `diffuse` over a Lambert 0.5, in
+/// white light, point sampled at 64 × 64 and 4 spp: every pixel the sphere
+/// covers shows the CPU reference's diffuse at the point its camera ray
+/// meets (`assert_pixels_match`'s tolerance for texel edges).
+pub fn assert_sphere_shows_its_diffuse(ctx: &GpuContext, diffuse: Texture) {
+    let center = Vec3::new(0.4, 0.1, 0.0);
+    let sphere = Sphere {
+        center,
+        radius: 1.0,
+        material: Material {
+            diffuse,
+            ..lambert(0.5)
+        },
+        ..Sphere::default()
+    };
+    let mut scene = Scene {
+        spheres: vec![sphere.clone()],
+        render: point_sampled(),
+        camera: OrbitCamera {
+            target: center,
+            distance: 3.5,
+            yaw_degrees: 30.0,
+            pitch_degrees: 20.0,
+            fov_degrees: 40.0,
+        },
+        ..Scene::default()
+    };
+    scene.environment.source = EnvSource::Constant {
+        radiance: Vec3::ONE,
+    };
+    let (w, h) = (64, 64);
+    let pixels = render(ctx, &scene, (w, h), 4);
+    assert_pixels_match(&pixels, (w, h), 0.15, |at| {
+        let (o, d) = camera_ray(&scene, (w, h), at);
+        let f = o - center;
+        let b = f.dot(d);
+        let disc = b * b - (f.length_squared() - 1.0);
+        (disc > 0.0).then(|| {
+            let p = o + (-b - disc.sqrt()) * d;
+            let offset = p - center;
+            let point = SurfacePoint {
+                object: offset,
+                world: p,
+                uv: marbre_core::texture::sphere_uv(offset),
+            };
+            sphere.material.value_at(Property::Diffuse, &point)
+        })
+    });
 }

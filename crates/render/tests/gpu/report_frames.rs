@@ -5,8 +5,7 @@
 use crate::common::*;
 use glam::{Vec2, Vec3};
 use marbre_core::scene::{
-    EnvSource, MappingSpace, Material, OrbitCamera, Pattern, Property, Scene, Sphere, SurfacePoint,
-    Texture, TextureMapping, UvFrame,
+    MappingSpace, OrbitCamera, Pattern, Property, Texture, TextureMapping, UvFrame,
 };
 use marbre_render::gpu::testing::gpu_or_skip;
 
@@ -95,47 +94,5 @@ fn a_framed_3d_mapping_renders_the_cpu_reference() {
             ..TextureTransform::default()
         },
     });
-    let center = Vec3::new(0.4, 0.1, 0.0);
-    let sphere = Sphere {
-        center,
-        radius: 1.0,
-        material: Material {
-            diffuse: cubes,
-            ..lambert(0.5)
-        },
-        ..Sphere::default()
-    };
-    let mut scene = Scene {
-        spheres: vec![sphere.clone()],
-        render: point_sampled(),
-        camera: OrbitCamera {
-            target: center,
-            distance: 3.5,
-            yaw_degrees: 30.0,
-            pitch_degrees: 20.0,
-            fov_degrees: 40.0,
-        },
-        ..Scene::default()
-    };
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::ONE,
-    };
-    let (w, h) = (64, 64);
-    let pixels = render(&ctx, &scene, (w, h), 4);
-    assert_pixels_match(&pixels, (w, h), 0.15, |at| {
-        let (o, d) = camera_ray(&scene, (w, h), at);
-        let f = o - center;
-        let b = f.dot(d);
-        let disc = b * b - (f.length_squared() - 1.0);
-        (disc > 0.0).then(|| {
-            let p = o + (-b - disc.sqrt()) * d;
-            let offset = p - center;
-            let point = SurfacePoint {
-                object: offset,
-                world: p,
-                uv: marbre_core::texture::sphere_uv(offset),
-            };
-            sphere.material.value_at(Property::Diffuse, &point)
-        })
-    });
+    assert_sphere_shows_its_diffuse(&ctx, cubes);
 }
