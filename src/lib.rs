@@ -2,6 +2,7 @@
 //! over the renderer library (`marbre-render`).
 
 pub mod app;
+pub mod exit_check;
 pub mod headless;
 pub mod heap;
 pub mod panel;

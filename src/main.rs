@@ -142,11 +142,16 @@ fn main() -> ExitCode {
             frame_budget_ms: cli.viewer.frame_budget_ms,
         }),
     };
-    match result {
+    let mut code = match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("marbre: error: {e:#}");
             ExitCode::FAILURE
         }
+    };
+    if let Err(why) = marbre::exit_check::check() {
+        eprintln!("marbre: error: {why}");
+        code = ExitCode::FAILURE;
     }
+    code
 }

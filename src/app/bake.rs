@@ -9,6 +9,7 @@ use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
 use marbre_render::bake_file::{BakeRequest, bake_to_file};
 use marbre_render::gpu::GpuContext;
+use marbre_render::worker::{Worker, names};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
 
@@ -41,13 +42,16 @@ pub fn output_beside(preset: &Path, object_name: &str, property: BakeProperty) -
 }
 
 /// Bakes running in the background; each reports one message when done.
+/// Dropping them waits for those still running: each has a device of its
+/// own, which must be gone before the process exits (`worker`'s doc).
 #[derive(Default)]
 pub struct Bakes {
-    running: Vec<Receiver<Result<String, String>>>,
+    running: Vec<(Receiver<Result<String, String>>, Worker)>,
 }
 
 impl Bakes {
-    /// Starts a bake of `object`'s `property` from a copy of `scene`.
+    /// Starts a bake of `object`'s `property` from a copy of `scene`; an
+    /// error if its thread cannot start.
     pub fn start(
         &mut self,
         scene: &Scene,
@@ -55,7 +59,7 @@ impl Bakes {
         preset: &Path,
         object: ObjectRef,
         property: BakeProperty,
-    ) {
+    ) -> Result<(), String> {
         let request = BakeRequest {
             object,
             property,
@@ -65,7 +69,8 @@ impl Bakes {
         };
         let (scene, images) = (scene.clone(), images.clone());
         let (send, receive) = channel();
-        std::thread::spawn(move || {
+        let output = request.output.clone();
+        let started = Worker::spawn(names::BAKE, move || {
             let result = GpuContext::headless()
                 .and_then(|ctx| bake_to_file(&ctx, &scene, &images, &request))
                 .map(|m| {
@@ -78,16 +83,18 @@ impl Bakes {
                     )
                 })
                 .map_err(|e| format!("bake: {e:#}"));
-            // The viewer may have closed meanwhile: nobody to tell.
             let _ = send.send(result);
         });
-        self.running.push(receive);
+        let worker = started
+            .map_err(|e| format!("bake of {}: cannot start its thread: {e}", output.display()))?;
+        self.running.push((receive, worker));
+        Ok(())
     }
 
     /// The messages of the bakes finished since the last call.
     pub fn finished(&mut self) -> Vec<Result<String, String>> {
         let mut done = Vec::new();
-        self.running.retain(|r| match r.try_recv() {
+        self.running.retain(|(r, _)| match r.try_recv() {
             Ok(result) => {
                 done.push(result);
                 false

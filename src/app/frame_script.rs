@@ -18,6 +18,13 @@ pub enum ScriptAction {
     LoadPreset(PathBuf),
     /// Destroy the device (`device.destroy()`) and recover from the loss.
     LoseDevice,
+    /// Start a render in the background, as the Render dialog's Render
+    /// does: `spp` samples per pixel at `size`, written to `output`.
+    StartRender {
+        size: (u32, u32),
+        spp: u32,
+        output: PathBuf,
+    },
 }
 
 /// What the viewer shows a script after presenting a frame.

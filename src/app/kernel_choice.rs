@@ -10,6 +10,9 @@ use anyhow::Result;
 use marbre_render::gpu::kernel::{self, compute_support};
 use marbre_render::gpu::{GpuContext, Kernel, KernelChoice};
 use marbre_render::session::{KernelTimings, LoadedScene, time_kernels};
+use marbre_render::worker::{Worker, names};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 
 /// The kernel stored for `adapter`: `Ok(None)` if none is, `Err` with a
@@ -41,7 +44,10 @@ pub struct KernelChooser {
     /// The adapter, as the settings file keys it.
     adapter: String,
     /// `auto` timing both kernels on a worker.
-    timing: Option<mpsc::Receiver<Result<KernelTimings>>>,
+    timing: Option<Timing>,
+    /// Timings a new choice cancelled, still finishing their current step:
+    /// joined once finished, or when the chooser goes.
+    cancelled: Vec<Timing>,
     /// Whether `auto` still has to time (no stored choice yet).
     needs_timing: bool,
     /// Why the kernel runs, for the Stats panel.
@@ -64,6 +70,7 @@ impl KernelChooser {
             choice,
             adapter,
             timing: None,
+            cancelled: Vec::new(),
             needs_timing: false,
             reason: String::new(),
         };
@@ -125,7 +132,11 @@ impl KernelChooser {
     ) -> Result<(Kernel, Vec<String>)> {
         let previous = self.choice;
         self.choice = choice;
-        self.timing = None;
+        self.cancelled.retain(|t| !t.worker.is_finished());
+        if let Some(timing) = self.timing.take() {
+            timing.cancel.store(true, Ordering::Relaxed);
+            self.cancelled.push(timing);
+        }
         let mut notes = Vec::new();
         match self.resolve(ctx, settings, &mut notes) {
             Ok(kernel) => Ok((kernel, notes)),
@@ -154,17 +165,27 @@ impl KernelChooser {
             }
         };
         let loaded = loaded.clone();
-        std::thread::spawn(move || {
-            let _ = sender.send(time_kernels(&sibling, &loaded, size));
-        });
-        self.timing = Some(receiver);
+        let cancel = Arc::new(AtomicBool::new(false));
+        let worker_cancel = cancel.clone();
+        match Worker::spawn(names::KERNEL_TIMING, move || {
+            let _ = sender.send(time_kernels(&sibling, &loaded, size, &worker_cancel));
+        }) {
+            Ok(worker) => {
+                self.timing = Some(Timing {
+                    result: receiver,
+                    cancel,
+                    worker,
+                })
+            }
+            Err(e) => self.reason = format!("auto: could not time the kernels ({e})"),
+        }
     }
 
     /// The kernel `auto` picked, once its timing is done (stored in
     /// `settings` for this adapter); a failed timing keeps the current
     /// kernel and says why.
     pub fn poll(&mut self, settings: &mut Settings) -> Option<Result<Kernel>> {
-        let result = self.timing.as_ref()?.try_recv().ok()?;
+        let result = self.timing.as_ref()?.result.try_recv().ok()?;
         self.timing = None;
         Some(match result {
             Ok(timings) => {
@@ -177,6 +198,22 @@ impl KernelChooser {
                 Err(e)
             }
         })
+    }
+}
+
+/// `auto`'s timing on its worker: the result to come, and the flag that
+/// stops it between steps.
+struct Timing {
+    result: mpsc::Receiver<Result<KernelTimings>>,
+    cancel: Arc<AtomicBool>,
+    /// Declared last: dropped (joined) after the flag is set.
+    worker: Worker,
+}
+
+impl Drop for Timing {
+    /// Stops the timing at its next step; the worker is joined next.
+    fn drop(&mut self) {
+        self.cancel.store(true, Ordering::Relaxed);
     }
 }
 

@@ -134,6 +134,14 @@ impl ApplicationHandler for App {
             v.request_redraw();
         }
     }
+
+    /// The viewer goes here, while the event loop (and its connection to
+    /// the display, which the surface presents through) still lives: its
+    /// workers are joined and its GPU objects dropped in order (`Viewer`'s
+    /// doc), so nothing that touches a driver outlives the loop.
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        self.viewer = None;
+    }
 }
 
 /// Opens the window and runs until it is closed (or the frame limit is hit).

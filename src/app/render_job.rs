@@ -18,6 +18,7 @@ use marbre_render::final_render::{
     FinalRender, Outcome, Progress, RenderObserver, render_to_file, snapshot,
 };
 use marbre_render::gpu::GpuContext;
+use marbre_render::worker::{Worker, names};
 use std::ops::ControlFlow;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -46,6 +47,19 @@ pub struct RenderJob {
     cancel: Arc<AtomicBool>,
     events: mpsc::Receiver<Event>,
     progress: Option<Progress>,
+    /// The render's thread, with its own device: joined on drop, after the
+    /// cancel flag is set (it then stops after its current frame). Held
+    /// only to be dropped.
+    _worker: Worker,
+}
+
+impl Drop for RenderJob {
+    /// A render still going when the window closes is cancelled (nothing
+    /// is written) and waited for, so that its device is dropped before
+    /// the process exits.
+    fn drop(&mut self) {
+        self.cancel();
+    }
 }
 
 impl RenderJob {
@@ -66,18 +80,17 @@ impl RenderJob {
             cancel: cancel.clone(),
         };
         let thread_job = job.clone();
-        std::thread::Builder::new()
-            .name("marbre render".to_owned())
-            .spawn(move || {
-                let result = snapshot(scene, images)
-                    .and_then(|loaded| render_to_file(&device, loaded, &thread_job, &mut observer));
-                let _ = sender.send(Event::Done(result));
-            })?;
+        let worker = Worker::spawn(names::RENDER_JOB, move || {
+            let result = snapshot(scene, images)
+                .and_then(|loaded| render_to_file(&device, loaded, &thread_job, &mut observer));
+            let _ = sender.send(Event::Done(result));
+        })?;
         Ok(Self {
             job,
             cancel,
             events,
             progress: None,
+            _worker: worker,
         })
     }
 

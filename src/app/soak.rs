@@ -94,6 +94,17 @@ const STRUCTURAL_CHANCE: f32 = 1.0 / 40.0;
 /// The chance that any other frame edits a parameter.
 const PARAMETER_CHANCE: f32 = 0.9;
 
+/// A soak ends with a Render dialog render still running, so that every
+/// soak exits the way a user closing the window mid-render does (the
+/// render is cancelled, its thread and device joined before the process
+/// ends; issue 26). It starts this many frames before the end, ...
+const END_RENDER_FRAMES: u64 = 3;
+/// ... at this size and this many samples per pixel, far more than those
+/// frames can trace, so that it is always under way at the exit and,
+/// cancelled, writes nothing.
+const END_RENDER_SIZE: (u32, u32) = (320, 180);
+const END_RENDER_SPP: u32 = 1 << 20;
+
 /// Drives a soak run: edits, loads and the device loss, then the verdict.
 pub struct SoakDriver {
     options: SoakOptions,
@@ -102,6 +113,10 @@ pub struct SoakDriver {
     load_interval: u64,
     /// The frame of the simulated device loss (mid-run, after the warm-up).
     loss_frame: u64,
+    /// The frame that starts a background render the run ends with still
+    /// under way ([`END_RENDER_FRAMES`] before the end; none in runs
+    /// shorter than ten frames).
+    render_frame: Option<u64>,
     loads: u64,
     losses: u64,
     parameter_edits: u64,
@@ -125,6 +140,7 @@ impl SoakDriver {
             rng: Pcg32::new(options.seed),
             load_interval,
             loss_frame: (frames / 2).max(options.warm_up_frames) + load_interval / 2,
+            render_frame: (frames >= 10).then(|| frames - END_RENDER_FRAMES),
             loads: 0,
             losses: 0,
             parameter_edits: 0,
@@ -149,6 +165,14 @@ impl SoakDriver {
         if frame == self.loss_frame {
             self.losses += 1;
             return ScriptAction::LoseDevice;
+        }
+        if Some(frame) == self.render_frame {
+            return ScriptAction::StartRender {
+                size: END_RENDER_SIZE,
+                spp: END_RENDER_SPP,
+                output: std::env::temp_dir()
+                    .join(format!("marbre-soak-{}.exr", std::process::id())),
+            };
         }
         if !self.options.presets.is_empty() && frame > 0 && frame.is_multiple_of(self.load_interval)
         {

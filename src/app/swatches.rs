@@ -10,6 +10,7 @@ use crate::panel::swatches::{SharedSwatchBook, SwatchRequest, install};
 use anyhow::Result;
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::swatch::{MAX_BATCH, SWATCH_SIZE, SwatchPixels, SwatchRenderer, to_srgba8};
+use marbre_render::worker::{Worker, names};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::time::Instant;
 
@@ -25,6 +26,9 @@ pub struct Swatches {
     book: SharedSwatchBook,
     /// `None` once the worker has gone (its thread could not start).
     jobs: Option<Sender<Vec<SwatchRequest>>>,
+    /// The thread that owns the swatch renderer (and a clone of the
+    /// device); joined on drop, after `jobs` is closed.
+    worker: Option<Worker>,
     finished: Receiver<Finished>,
     in_flight: bool,
     /// Set by `MARBRE_SWATCH_TIMES=1`: each batch's time is printed, and at
@@ -36,7 +40,13 @@ pub struct Swatches {
 }
 
 impl Drop for Swatches {
+    /// Closes the job channel, so that the worker ends after the batch it
+    /// is rendering, and joins it: the renderer, its device clone and maybe
+    /// the last reference to the wgpu instance are dropped on that thread,
+    /// which must be done before the process exits (`worker`'s doc).
     fn drop(&mut self) {
+        self.jobs = None;
+        self.worker = None;
         if self.print_times && self.ui_time.1 > 0 {
             eprintln!(
                 "swatches: {:.3} ms per frame on the UI thread over {} frames",
@@ -56,33 +66,35 @@ impl Swatches {
         let (jobs, job_queue) = channel::<Vec<SwatchRequest>>();
         let (done, finished) = channel();
         let ctx = ctx.clone();
-        let started = std::thread::Builder::new()
-            .name("swatches".into())
-            .spawn(move || {
-                let mut renderer = SwatchRenderer::new(ctx);
-                for requests in job_queue {
-                    let start = Instant::now();
-                    let textures: Vec<_> = requests.iter().map(|r| r.texture.clone()).collect();
-                    let swatches = match &mut renderer {
-                        Ok(renderer) => renderer.render(&textures),
-                        Err(e) => Err(anyhow::anyhow!("{e:#}")),
-                    };
-                    let ms = start.elapsed().as_secs_f32() * 1000.0;
-                    if done
-                        .send(Finished {
-                            requests,
-                            swatches,
-                            ms,
-                        })
-                        .is_err()
-                    {
-                        break;
-                    }
+        let started = Worker::spawn(names::SWATCHES, move || {
+            let mut renderer = SwatchRenderer::new(ctx);
+            for requests in job_queue {
+                let start = Instant::now();
+                let textures: Vec<_> = requests.iter().map(|r| r.texture.clone()).collect();
+                let swatches = match &mut renderer {
+                    Ok(renderer) => renderer.render(&textures),
+                    Err(e) => Err(anyhow::anyhow!("{e:#}")),
+                };
+                let ms = start.elapsed().as_secs_f32() * 1000.0;
+                if done
+                    .send(Finished {
+                        requests,
+                        swatches,
+                        ms,
+                    })
+                    .is_err()
+                {
+                    break;
                 }
-            });
+            }
+        });
+        let worker = started
+            .inspect_err(|e| log::warn!("swatch previews: cannot start the worker: {e}"))
+            .ok();
         Self {
             book,
-            jobs: started.is_ok().then_some(jobs),
+            jobs: worker.is_some().then_some(jobs),
+            worker,
             finished,
             in_flight: false,
             print_times: std::env::var_os("MARBRE_SWATCH_TIMES").is_some(),

@@ -6,3 +6,4 @@ pub mod bake_file;
 pub mod final_render;
 pub mod gpu;
 pub mod session;
+pub mod worker;

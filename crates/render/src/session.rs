@@ -10,6 +10,7 @@ use marbre_core::preset;
 use marbre_core::scene::{EnvSource, LdrImages, Scene};
 use marbre_core::texture::ImageSet;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The preset the viewer opens when none is named.
 pub const DEFAULT_PRESET: &str = "presets/default.ron";
@@ -274,22 +275,42 @@ impl std::fmt::Display for KernelTimings {
 }
 
 /// Times both kernels on `loaded` at `size` (at most
-/// [`KERNEL_TIMING_SIZE`]): see [`KernelTimings`].
+/// [`KERNEL_TIMING_SIZE`]): see [`KernelTimings`]. `cancel` is looked at
+/// between the steps that take long on a CPU adapter (each kernel's
+/// pipeline build and first draw): once it is set, the timing stops there
+/// with an error, so that a viewer closing meanwhile waits for one step
+/// at most.
 pub fn time_kernels(
     ctx: &GpuContext,
     loaded: &LoadedScene,
     size: (u32, u32),
+    cancel: &AtomicBool,
 ) -> Result<KernelTimings> {
     let size = (
         size.0.clamp(1, KERNEL_TIMING_SIZE.0),
         size.1.clamp(1, KERNEL_TIMING_SIZE.1),
     );
+    let go_on = || {
+        anyhow::ensure!(
+            !cancel.load(Ordering::Relaxed),
+            "the kernel timing was cancelled"
+        );
+        Ok(())
+    };
     let mut fragment = renderer_with(ctx, loaded, size, Kernel::Fragment)?;
+    go_on()?;
+    trace_frame(ctx, &mut fragment)?;
+    go_on()?;
     let mut compute = renderer_with(ctx, loaded, size, Kernel::Compute)?;
+    go_on()?;
+    trace_frame(ctx, &mut compute)?;
+    go_on()?;
+    // Each kernel drew its first frame above (the shader compile, on a CPU
+    // adapter): one more untimed frame each makes the two of warm-up.
     let ms = time_interleaved(
         ctx,
         &mut [&mut fragment, &mut compute],
-        2,
+        1,
         KERNEL_TIMING_FRAMES,
     )?;
     Ok(KernelTimings {
@@ -352,7 +373,7 @@ pub fn pick_kernel(
     if choice != KernelChoice::Auto || kernel == Kernel::Fragment {
         return Ok((kernel, None));
     }
-    let timings = time_kernels(ctx, loaded, size)?;
+    let timings = time_kernels(ctx, loaded, size, &AtomicBool::new(false))?;
     Ok((timings.faster(), Some(timings)))
 }
 

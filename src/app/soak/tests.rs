@@ -237,7 +237,7 @@ fn ten_thousand_steps_make_every_edit_and_keep_the_scene_valid() {
     let mut driver = SoakDriver::new(&options);
     let mut scene = load(&presets[0]);
     assert!(is_sanitized(&scene), "the starting preset is not sanitised");
-    let (mut loads, mut losses, mut nothing) = (Vec::new(), 0, 0);
+    let (mut loads, mut losses, mut renders, mut nothing) = (Vec::new(), 0, 0, 0);
     for frame in 0..options.frames {
         match driver.step(frame, &mut scene) {
             ScriptAction::Nothing => nothing += 1,
@@ -246,6 +246,7 @@ fn ten_thousand_steps_make_every_edit_and_keep_the_scene_valid() {
                 loads.push(path);
             }
             ScriptAction::LoseDevice => losses += 1,
+            ScriptAction::StartRender { .. } => renders += 1,
         }
         assert!(
             is_sanitized(&scene),
@@ -254,6 +255,7 @@ fn ten_thousand_steps_make_every_edit_and_keep_the_scene_valid() {
     }
     eprintln!("{}", driver.summary(0));
     assert_eq!(losses, 1);
+    assert_eq!(renders, 1);
     assert!(loads.len() >= presets.len(), "{loads:?}");
     for preset in &presets {
         assert!(loads.contains(preset), "{} never loaded", preset.display());
@@ -302,6 +304,15 @@ fn a_repeated_frame_gets_no_second_action() {
             (150, ScriptAction::LoadPreset(root.join(DEFAULT_PRESETS[1]))),
             (187, ScriptAction::LoseDevice),
             (225, ScriptAction::LoadPreset(root.join(DEFAULT_PRESETS[2]))),
+            (
+                297,
+                ScriptAction::StartRender {
+                    size: END_RENDER_SIZE,
+                    spp: END_RENDER_SPP,
+                    output: std::env::temp_dir()
+                        .join(format!("marbre-soak-{}.exr", std::process::id())),
+                }
+            ),
         ]
     );
 }

@@ -31,7 +31,7 @@ use super::swatches::Swatches;
 use super::ui_layer::{STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::panel::{self, PanelAction, PanelState};
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
 use marbre_render::gpu::pass_timer::PassTimer;
 use marbre_render::gpu::{GpuContext, NonFiniteCounts, Renderer};
@@ -61,29 +61,37 @@ const MIN_UI_SIZE: egui::Vec2 = egui::vec2(PANEL_WIDTH + 240.0, QUALITY_HEIGHT +
 /// milliseconds.
 const HEAP_TRIM_INTERVAL: std::time::Duration = std::time::Duration::from_secs(5);
 
+/// The fields are declared in the order they must be dropped in (Rust
+/// drops a struct's fields in declaration order), which is the shutdown
+/// order (issue 26): first the workers that hold a device (each joined by
+/// its own drop: the Render dialog's render, bakes, `auto`'s kernel
+/// timing, the swatches) and the file watchers, then the GPU objects made
+/// on the window's device, then the surface, the device and instance,
+/// and last the window the surface draws on. `App` drops the viewer in
+/// `exiting`, while the event loop and its display connection still live.
 pub struct Viewer {
-    window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
-    ctx: GpuContext,
-    renderer: Renderer,
-    /// Lost devices and uncaptured GPU errors.
-    device_watch: DeviceWatch,
-    /// Which trace kernel runs, and `auto`'s timing of both.
-    kernels: KernelChooser,
+    /// The Render dialog's render, running in the background.
+    render_job: Option<RenderJob>,
     /// The Bake… buttons' bakes, running off the render thread.
     bakes: super::bake::Bakes,
-    /// How much tracing a frame asks for, learnt from the trace's times.
-    budget: FrameBudget,
+    /// Which trace kernel runs, and `auto`'s timing of both.
+    kernels: KernelChooser,
+    /// The texture nodes' preview swatches, rendered on a worker thread.
+    swatches: Swatches,
+    /// Files on their way in: dialogs, loads, hot reload.
+    incoming: Incoming,
+    renderer: Renderer,
     /// What the Quality strip and the Stats panel report.
     meters: Meters,
     /// The panel's pixels kept between frames (`app/ui_layer.rs`).
     ui_layer: Option<UiLayer>,
-    egui_ctx: egui::Context,
-    egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
-    /// The texture nodes' preview swatches, rendered on a worker thread.
-    swatches: Swatches,
+    egui_state: egui_winit::State,
+    egui_ctx: egui::Context,
+    /// Lost devices and uncaptured GPU errors.
+    device_watch: DeviceWatch,
+    /// How much tracing a frame asks for, learnt from the trace's times.
+    budget: FrameBudget,
     scene: Scene,
     /// The preset being edited, its undo history and what guards it.
     edits: Editing,
@@ -94,8 +102,6 @@ pub struct Viewer {
     /// Where settings and the recovery file live (none: not persisted, as
     /// in a scripted run).
     config_dir: Option<PathBuf>,
-    /// Files on their way in: dialogs, loads, hot reload.
-    incoming: Incoming,
     /// A script driving the frames (`marbre soak`), through its one hook.
     script: Option<Box<dyn FrameScript>>,
     show_help: bool,
@@ -104,8 +110,10 @@ pub struct Viewer {
     quitting: bool,
     clock: FrameClock,
     screenshot_requested: bool,
-    /// The Render dialog's render, running in the background.
-    render_job: Option<RenderJob>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    ctx: GpuContext,
+    window: Arc<Window>,
 }
 
 /// What the Quality strip and the Stats panel report, gathered frame by
@@ -293,12 +301,7 @@ impl Viewer {
         } else {
             (LoadedScene::placeholder(), Default::default())
         };
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
-        let surface = instance
-            .create_surface(window.clone())
-            .context("creating the window surface")?;
-        let ctx = GpuContext::for_surface(instance, &surface)?;
+        let (ctx, surface) = GpuContext::for_window(window.clone())?;
         let device_watch = DeviceWatch::default();
         device_watch.attach(&ctx.device);
         let size = window.inner_size();
@@ -694,13 +697,17 @@ impl Viewer {
                 PanelAction::SetKernel(choice) => self.set_kernel(choice),
                 PanelAction::Undo => self.step_history(true),
                 PanelAction::Redo => self.step_history(false),
-                PanelAction::Bake { object, property } => self.bakes.start(
-                    &self.scene,
-                    self.renderer.images(),
-                    &self.edits.document.path,
-                    object,
-                    property,
-                ),
+                PanelAction::Bake { object, property } => {
+                    if let Err(e) = self.bakes.start(
+                        &self.scene,
+                        self.renderer.images(),
+                        &self.edits.document.path,
+                        object,
+                        property,
+                    ) {
+                        self.panel.error(e);
+                    }
+                }
                 PanelAction::StartRender(job) => self.start_render(job),
                 PanelAction::CancelRender => {
                     if let Some(job) = &self.render_job {
@@ -922,6 +929,16 @@ impl Viewer {
                     .take_lost()
                     .unwrap_or_else(|| "destroyed by the soak".to_owned());
                 self.recover_device(&reason)?;
+            }
+            ScriptAction::StartRender { size, spp, output } => {
+                self.start_render(marbre_render::final_render::FinalRender {
+                    size,
+                    stop: marbre_render::final_render::Stop::Samples(spp),
+                    auto_exposure: None,
+                    kernel: marbre_render::gpu::KernelChoice::Auto,
+                    output,
+                    denoise_exr: false,
+                })
             }
         }
         Ok(())

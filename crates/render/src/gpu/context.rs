@@ -27,21 +27,35 @@ impl GpuContext {
     /// only way, it is used and says what it says; `WGPU_BACKEND`, when
     /// set, decides alone.
     pub fn headless() -> Result<Self> {
-        let descriptor = |backends| {
-            wgpu::InstanceDescriptor {
-                backends,
-                ..wgpu::InstanceDescriptor::new_without_display_handle()
-            }
-            .with_env()
-        };
-        let primary = Self::from_instance(
-            wgpu::Instance::new(descriptor(wgpu::Backends::PRIMARY)),
-            None,
-        );
+        let primary = Self::from_instance(instance_of(wgpu::Backends::PRIMARY), None);
         match primary {
             Err(_) if wgpu::Backends::from_env().is_none() => {
-                Self::from_instance(wgpu::Instance::new(descriptor(wgpu::Backends::all())), None)
+                Self::from_instance(instance_of(wgpu::Backends::all()), None)
             }
+            result => result,
+        }
+    }
+
+    /// A device able to present to `window`, and the window's surface; the
+    /// backends tried as [`GpuContext::headless`] tries them. Where Vulkan
+    /// works, the GL backend is never started: EGL and Mesa's GL driver
+    /// would otherwise be loaded beside it, with threads and exit handlers
+    /// of their own (issue 26 saw a process exit tear EGL down under a
+    /// worker still using it).
+    pub fn for_window<W>(window: W) -> Result<(Self, wgpu::Surface<'static>)>
+    where
+        W: Into<wgpu::SurfaceTarget<'static>> + Clone,
+    {
+        let on = |backends| -> Result<(Self, wgpu::Surface<'static>)> {
+            let instance = instance_of(backends);
+            let surface = instance
+                .create_surface(window.clone())
+                .context("creating the window surface")?;
+            let ctx = Self::from_instance(instance, Some(&surface))?;
+            Ok((ctx, surface))
+        };
+        match on(wgpu::Backends::PRIMARY) {
+            Err(_) if wgpu::Backends::from_env().is_none() => on(wgpu::Backends::all()),
             result => result,
         }
     }
@@ -119,4 +133,15 @@ impl GpuContext {
         let info = self.adapter.get_info();
         format!("{} ({:?})", info.name, info.backend)
     }
+}
+
+/// An instance on `backends`, unless `WGPU_BACKEND` names others.
+fn instance_of(backends: wgpu::Backends) -> wgpu::Instance {
+    wgpu::Instance::new(
+        wgpu::InstanceDescriptor {
+            backends,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        }
+        .with_env(),
+    )
 }

@@ -13,6 +13,7 @@
 //! first draw then finds it there.
 
 use super::trace_pass::TracePipeline;
+use crate::worker::{Worker, names};
 use anyhow::{Result, anyhow};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
 use std::time::{Duration, Instant};
@@ -76,7 +77,7 @@ struct Queue {
 pub struct PipelineBuilder {
     queue: Arc<(Mutex<Queue>, Condvar)>,
     /// The worker, once the first build starts; joined on drop.
-    worker: Option<std::thread::JoinHandle<()>>,
+    worker: Option<Worker>,
 }
 
 impl Default for PipelineBuilder {
@@ -109,7 +110,15 @@ impl PipelineBuilder {
         ready.notify_one();
         if self.worker.is_none() {
             let queue = self.queue.clone();
-            self.worker = Some(std::thread::spawn(move || work(&queue)));
+            // A thread that cannot start drops the job, whose build then
+            // reports "dropped before it ran"; the next request tries again.
+            match Worker::spawn(names::PIPELINE_BUILD, move || work(&queue)) {
+                Ok(worker) => self.worker = Some(worker),
+                Err(e) => {
+                    log::warn!("cannot start the pipeline builder's thread: {e}");
+                    lock.lock().unwrap_or_else(|e| e.into_inner()).next = None;
+                }
+            }
         }
         PipelineBuild { receiver }
     }
@@ -129,9 +138,7 @@ impl Drop for PipelineBuilder {
             queue.next = None;
         }
         ready.notify_one();
-        if let Some(worker) = self.worker.take() {
-            let _ = worker.join();
-        }
+        self.worker = None;
     }
 }
 

@@ -19,6 +19,7 @@ use marbre_render::session::{
     LoadedScene, load_scene, pick_kernel, renderer_with, time_kernels, trace_frame,
 };
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 /// The size every test traces at: small, and neither side a multiple of
 /// the compute kernel's 16×8 workgroup (the invocations past the edge must
@@ -617,7 +618,7 @@ fn pick_kernel_honours_the_choice_and_auto_keeps_the_faster() {
     );
     assert_eq!(resolve(&ctx, KernelChoice::Auto).unwrap(), Kernel::Compute);
 
-    let t = time_kernels(&ctx, &loaded, size).unwrap();
+    let t = time_kernels(&ctx, &loaded, size, &AtomicBool::new(false)).unwrap();
     assert_eq!(t.size, size);
     for ms in [t.fragment_ms, t.compute_ms] {
         assert!(ms.is_finite() && ms > 0.0, "{t}");
@@ -638,7 +639,18 @@ fn pick_kernel_honours_the_choice_and_auto_keeps_the_faster() {
 
     // A size beyond the timing size is clamped to it (and a zero side to
     // one): a slow adapter is never timed at a window's full size.
-    let t = time_kernels(&ctx, &loaded, (0, 100_000)).unwrap();
+    let t = time_kernels(&ctx, &loaded, (0, 100_000), &AtomicBool::new(false)).unwrap();
     assert_eq!(t.size.0, 1, "{t}");
     assert!(t.size.1 < 100_000 && t.size.1 > 1, "{t}");
+
+    // A cancelled timing (the viewer closing) stops after its first step
+    // with an error, never with a verdict.
+    let cancelled = time_kernels(&ctx, &loaded, size, &AtomicBool::new(true));
+    assert!(
+        cancelled
+            .as_ref()
+            .is_err_and(|e| e.to_string().contains("cancelled")),
+        "{:?}",
+        cancelled.map(|t| t.to_string())
+    );
 }
