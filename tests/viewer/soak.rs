@@ -103,6 +103,21 @@ fn a_short_soak_passes_and_writes_its_report() {
         log.contains("3 preset loads; 1 device loss(es); 0 validation error(s)"),
         "the loads, the loss or the validation count differ:\n{log}"
     );
+    // It exits with a Render dialog render under way (started 3 frames
+    // before the end, far from done): cancelled, nothing written, its
+    // thread and device joined before main returns. The debug binary
+    // checks that last point itself (src/exit_check.rs): a GPU thread alive
+    // at exit would have failed the exit status above.
+    let render = std::env::temp_dir().join(format!("marbre-soak-{}.exr", child.0.id()));
+    assert!(
+        log.contains(&format!("render: started {}", render.display())),
+        "the end-of-run render did not start:\n{log}"
+    );
+    assert!(
+        !render.exists(),
+        "the cancelled render wrote {}",
+        render.display()
+    );
 
     let text = std::fs::read_to_string(&csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
     let rows = parse_rows(&text);
