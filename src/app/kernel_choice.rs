@@ -206,7 +206,7 @@ impl KernelChooser {
 struct Timing {
     result: mpsc::Receiver<Result<KernelTimings>>,
     cancel: Arc<AtomicBool>,
-    /// Declared last: dropped (joined) after the flag is set.
+    /// Joined as the timing drops, after its `Drop` has set the flag.
     worker: Worker,
 }
 

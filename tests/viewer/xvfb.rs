@@ -108,10 +108,17 @@ impl Xvfb {
         // `-displayfd 1`: the server picks the first free display number and
         // writes it to its stdout once it accepts connections, so there is
         // neither a race for a number nor a socket to poll for.
+        // `-noreset`: by default the server resets whenever its last client
+        // disconnects, and a client connecting meanwhile is refused. The
+        // tests poll with xdotool (a client that connects and leaves) while
+        // the viewer opens its first connection: `f12_writes_png_and_exr`
+        // once failed so, with winit's "Failed to open connection to X
+        // server" (2026-11-27).
         let mut child = Command::new("Xvfb")
             .args([
                 "-displayfd",
                 "1",
+                "-noreset",
                 "-screen",
                 "0",
                 "1280x800x24",
