@@ -5,7 +5,8 @@
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
 use marbre_commands::{
-    accuracy_bench, bake, bvh_bench, convergence_bench, noise, presets_bench, render, tx,
+    accuracy_bench, bake, bvh_bench, convergence_bench, edit_bench, noise, presets_bench, render,
+    tx,
 };
 use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
@@ -85,6 +86,9 @@ enum Command {
     /// Time and error at increasing samples per pixel against a cached
     /// high-spp reference (default: the Cornell box at 512x512).
     BenchConvergence(convergence_bench::ConvergenceBenchArgs),
+    /// The CPU cost of one frame of a slider drag: an edited scene handed
+    /// to the renderer (parameter, camera and display edits).
+    BenchEdit(edit_bench::EditBenchArgs),
     /// Run the viewer for many frames under seeded random edits, preset
     /// loads and a simulated device loss; fail if memory (RSS, GPU bytes,
     /// GPU objects) grows beyond a bound after the warm-up or wgpu reports
@@ -129,6 +133,7 @@ fn main() -> ExitCode {
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),
         Some(Command::BenchConvergence(args)) => convergence_bench::run(&args),
+        Some(Command::BenchEdit(args)) => edit_bench::run(&args),
         Some(Command::Soak(args)) => soak::run(&args),
         None => marbre::app::run(marbre::app::ViewerOptions {
             preset: cli.viewer.preset,
