@@ -14,7 +14,7 @@
 //! over an OBJ or MTL file whatever the route.
 
 use marbre_core::preset::{self, Header, Preset, PresetError};
-use marbre_core::scene::Scene;
+use marbre_core::scene::{Change, Scene};
 use std::path::{Path, PathBuf};
 
 pub struct Document {
@@ -30,6 +30,10 @@ pub struct Document {
     /// watcher reports with this content is our own save, not an outside
     /// edit.
     saved_text: Option<String>,
+    /// Whether the scene had edits the file lacks, as of the last
+    /// [`Document::observe`]: read every frame (the panel's mark, the
+    /// autosave) without comparing scenes.
+    unsaved: bool,
 }
 
 impl Document {
@@ -39,11 +43,27 @@ impl Document {
             header,
             saved: scene.clone(),
             saved_text: std::fs::read_to_string(path).ok(),
+            unsaved: false,
         }
     }
 
-    /// Whether `scene` has edits the file does not have (camera aside).
-    /// Called every frame: nothing is cloned.
+    /// Follows the frame's `change` (from the scene of the frame before):
+    /// only an edit can make the scene differ from the file, or, undone,
+    /// the same again.
+    pub fn observe(&mut self, scene: &Scene, change: Change) {
+        if change.edits_document() {
+            self.unsaved = self.is_dirty(scene);
+        }
+    }
+
+    /// Whether the scene has edits the file lacks, as of the last
+    /// [`Document::observe`] or save.
+    pub fn unsaved(&self) -> bool {
+        self.unsaved
+    }
+
+    /// Whether `scene` has edits the file does not have (camera aside), as
+    /// of now: for the actions that may lose them (open, quit).
     pub fn is_dirty(&mut self, scene: &Scene) -> bool {
         self.saved.camera = scene.camera;
         *scene != self.saved
@@ -84,6 +104,7 @@ impl Document {
         self.path = path.to_owned();
         self.saved = scene.clone();
         self.saved_text = Some(text);
+        self.unsaved = false;
         Ok(())
     }
 

@@ -1,8 +1,9 @@
 //! Undo and redo of scene edits (issue 7).
 //!
-//! The viewer shows the history every frame's scene after the UI ran; a
-//! scene that differs from the last one seen is an edit, recorded as the
-//! scene before it. Edits made while one gesture goes on (a slider dragged,
+//! The viewer shows the history every frame's scene after the UI ran,
+//! with what changed since the frame before (worked out once, in
+//! `Scene::changes_from`); a change other than the camera's is an edit,
+//! recorded as the scene before it. Nothing is compared here. Edits made while one gesture goes on (a slider dragged,
 //! a number typed: the pointer held or a text field focused) coalesce into
 //! one step, so one Ctrl+Z undoes a whole drag, as in Blender.
 //!
@@ -10,7 +11,7 @@
 //! Blender keeps view navigation out of its undo), so undo keeps the view
 //! the user has now.
 
-use marbre_core::scene::Scene;
+use marbre_core::scene::{Change, Scene};
 
 /// Steps kept; the oldest are forgotten first.
 const MAX_STEPS: usize = 200;
@@ -20,8 +21,8 @@ pub struct History {
     undo: Vec<Scene>,
     /// The scenes undone, most recent last.
     redo: Vec<Scene>,
-    /// The scene as last seen; its camera is set to the one compared with
-    /// it, so that only the rest counts.
+    /// The scene as of the last edit seen (its camera aside): the step
+    /// the next edit records.
     last: Scene,
     /// A gesture is under way and its edits join the latest step.
     step_open: bool,
@@ -37,13 +38,13 @@ impl History {
         }
     }
 
-    /// Records `scene` if it differs from the last one seen; `gesture` says
-    /// whether the user is still dragging or typing.
+    /// Records `scene` if `change` (from the scene seen the frame before)
+    /// edits it; `gesture` says whether the user is still dragging or
+    /// typing.
     ///
     /// Called every frame: the scene is cloned only when it changed.
-    pub fn observe(&mut self, scene: &Scene, gesture: bool) {
-        self.last.camera = scene.camera;
-        if *scene != self.last {
+    pub fn observe(&mut self, scene: &Scene, change: Change, gesture: bool) {
+        if change.edits_document() {
             let before = std::mem::replace(&mut self.last, scene.clone());
             if !self.step_open {
                 self.undo.push(before);
@@ -97,6 +98,49 @@ impl History {
 mod tests {
     use super::*;
 
+    /// The history as the viewer drives it: each frame's scene with its
+    /// change from the frame before; an undone or redone scene becomes the
+    /// next frame's baseline (the viewer hands it to the renderer at once).
+    struct Frames {
+        history: History,
+        frame: Scene,
+    }
+
+    impl Frames {
+        fn new(scene: &Scene) -> Self {
+            Self {
+                history: History::new(scene),
+                frame: scene.clone(),
+            }
+        }
+
+        fn observe(&mut self, scene: &Scene, gesture: bool) {
+            let change = scene.changes_from(&self.frame);
+            self.history.observe(scene, change, gesture);
+            self.frame = scene.clone();
+        }
+
+        fn undo(&mut self, current: &Scene) -> Option<Scene> {
+            let scene = self.history.undo(current)?;
+            self.frame = scene.clone();
+            Some(scene)
+        }
+
+        fn redo(&mut self, current: &Scene) -> Option<Scene> {
+            let scene = self.history.redo(current)?;
+            self.frame = scene.clone();
+            Some(scene)
+        }
+
+        fn can_undo(&self) -> bool {
+            self.history.can_undo()
+        }
+
+        fn can_redo(&self) -> bool {
+            self.history.can_redo()
+        }
+    }
+
     fn with_exposure(exposure: f32) -> Scene {
         let mut scene = Scene::default();
         scene.render.display.exposure = exposure;
@@ -105,7 +149,7 @@ mod tests {
 
     #[test]
     fn each_edit_is_a_step_undone_and_redone_in_order() {
-        let mut h = History::new(&with_exposure(0.0));
+        let mut h = Frames::new(&with_exposure(0.0));
         h.observe(&with_exposure(1.0), false);
         h.observe(&with_exposure(2.0), false);
         let one = h.undo(&with_exposure(2.0)).unwrap();
@@ -122,7 +166,7 @@ mod tests {
     /// A slider dragged through many values is one step.
     #[test]
     fn a_drag_coalesces_into_one_step() {
-        let mut h = History::new(&with_exposure(0.0));
+        let mut h = Frames::new(&with_exposure(0.0));
         for k in 1..=30 {
             h.observe(&with_exposure(k as f32 * 0.1), true);
         }
@@ -138,7 +182,7 @@ mod tests {
     /// both ends the focus and edits (one frame): that edit is a step.
     #[test]
     fn a_gesture_without_an_edit_does_not_swallow_the_next_edit() {
-        let mut history = History::new(&with_exposure(0.0));
+        let mut history = Frames::new(&with_exposure(0.0));
         history.observe(&with_exposure(0.0), true);
         history.observe(&with_exposure(0.0), true);
         history.observe(&with_exposure(1.0), false);
@@ -148,7 +192,7 @@ mod tests {
 
     #[test]
     fn an_edit_after_undo_clears_redo() {
-        let mut h = History::new(&with_exposure(0.0));
+        let mut h = Frames::new(&with_exposure(0.0));
         h.observe(&with_exposure(1.0), false);
         let zero = h.undo(&with_exposure(1.0)).unwrap();
         h.observe(&zero, false);
@@ -160,7 +204,7 @@ mod tests {
     /// Orbiting is not a step, and undo keeps the current view.
     #[test]
     fn camera_moves_are_not_steps_and_undo_keeps_the_view() {
-        let mut h = History::new(&with_exposure(0.0));
+        let mut h = Frames::new(&with_exposure(0.0));
         let mut moved = with_exposure(0.0);
         moved.camera.yaw_degrees = 40.0;
         h.observe(&moved, true);
@@ -176,7 +220,7 @@ mod tests {
 
     #[test]
     fn the_oldest_steps_are_forgotten_past_the_limit() {
-        let mut h = History::new(&with_exposure(0.0));
+        let mut h = Frames::new(&with_exposure(0.0));
         for k in 1..=(MAX_STEPS + 10) {
             h.observe(&with_exposure(k as f32), false);
         }
@@ -220,7 +264,7 @@ mod tests {
             ..Scene::default()
         };
         let original = scene.clone();
-        let mut history = History::new(&scene);
+        let mut history = Frames::new(&scene);
         let key = MaterialKey::Sphere(0);
         let path: NodePath = "diffuse.a".parse().unwrap();
 

@@ -102,6 +102,7 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
     println!("adapter: {}", ctx.describe());
     println!("preset: {}", args.preset.display());
     let mut scene = loaded.scene.clone();
+    let mut previous = scene.clone();
     let drags: Vec<Drag> = Drag::ALL
         .into_iter()
         .filter(|d| d.apply(&mut scene.clone(), 0))
@@ -111,7 +112,7 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
         for (k, drag) in drags.iter().enumerate() {
             drag.apply(&mut scene, i + 1);
             let start = Instant::now();
-            hand_over(&ctx, &mut renderer, &scene)?;
+            hand_over(&ctx, &mut renderer, &scene, &mut previous)?;
             times[k].push(start.elapsed().as_secs_f64() * 1e6);
         }
     }
@@ -129,10 +130,18 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// What the viewer does with an edited scene each frame.
-fn hand_over(ctx: &GpuContext, renderer: &mut Renderer, scene: &Scene) -> Result<()> {
-    if scene != renderer.scene() {
-        renderer.request_scene(ctx, scene)?;
+/// What the viewer does with an edited scene each frame: works out what
+/// changed since the frame before, once, and hands it on.
+fn hand_over(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    scene: &Scene,
+    previous: &mut Scene,
+) -> Result<()> {
+    let change = scene.changes_from(previous);
+    if !change.is_empty() {
+        renderer.request_scene(ctx, scene, change)?;
+        previous.clone_from(scene);
     }
     if let Some(result) = renderer.poll_build(ctx) {
         result?;

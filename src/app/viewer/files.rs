@@ -509,7 +509,7 @@ impl Viewer {
                     "shaders reloaded from {} (#{generation})",
                     dir.display()
                 ));
-                if let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
+                if let Err(e) = self.renderer.rebuild(&self.ctx) {
                     self.panel.error(format!("{e:#}"));
                 }
             }

@@ -7,6 +7,7 @@ use crate::app::screenshots;
 use crate::app::ui_layer::{self, UiLayer};
 use crate::panel::{QualityStats, Stats};
 use anyhow::{Context as _, Result};
+use marbre_core::scene::Change;
 use marbre_render::gpu::pass_timer::Pass;
 use marbre_render::gpu::readback::read_texture;
 use marbre_render::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
@@ -126,6 +127,9 @@ impl Viewer {
             let ldr = std::mem::replace(&mut env.ldr_images, drawn_ldr);
             self.load_environment_source(source, ldr);
         }
+        // What this frame's edits changed, worked out once against the
+        // scene the renderer was last asked to draw, and handed on.
+        let mut change = self.scene.changes_from(self.renderer.requested_scene());
         // A structural edit that changes the scene's features ends any
         // feature-cost experiment: the new shader is specialised again.
         if self
@@ -139,25 +143,27 @@ impl Viewer {
         self.poll_bakes();
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
-        let edited = self.scene != *self.renderer.scene();
-        if edited && let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene) {
+        if let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene, change) {
             // Keep what is on screen; show why the edit was refused.
             self.panel.error(format!("{e:#}"));
-            self.scene = self.renderer.scene().clone();
+            self.scene = self.renderer.requested_scene().clone();
+            change = Change::empty();
         }
         if let Some(Err(e)) = self.renderer.poll_build(&self.ctx) {
             // The shader failed to build: the old one stays, and so does
-            // the scene it renders.
+            // the scene it renders (for the history, an edit back to it).
             self.panel.error(format!("{e:#}"));
-            self.scene = self.renderer.scene().clone();
+            let failed = std::mem::replace(&mut self.scene, self.renderer.scene().clone());
+            change |= self.scene.changes_from(&failed);
         }
         // What the scene now is, after any refused edit was put back: one
         // step of the undo history unless a drag or typing goes on.
         let gesture = self.egui_ctx.input(|i| i.pointer.any_down())
             || self.egui_ctx.egui_wants_keyboard_input();
-        self.edits.history.observe(&self.scene, gesture);
+        self.edits.history.observe(&self.scene, change, gesture);
+        self.edits.document.observe(&self.scene, change);
         // Only an edit can add an image or change a path.
-        if edited {
+        if change.edits_document() {
             self.reload_images_if_needed();
         }
         // Minimised: nothing to draw into (the surface keeps its last

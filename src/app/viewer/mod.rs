@@ -661,7 +661,15 @@ impl Viewer {
             self.edits.history.redo(&self.scene)
         };
         match restored {
-            Some(scene) => self.scene = scene,
+            Some(scene) => {
+                // A restored scene is handed on at once, so that the next
+                // frame's change is the edits made after it, not the undo.
+                let change = scene.changes_from(self.renderer.requested_scene());
+                match self.renderer.request_scene(&self.ctx, &scene, change) {
+                    Ok(()) => self.scene = scene,
+                    Err(e) => self.panel.error(format!("{e:#}")),
+                }
+            }
             None => self.panel.info(if undo {
                 "nothing to undo"
             } else {
@@ -794,7 +802,7 @@ impl Viewer {
         let mut dragging = false;
         self.panel.can_undo = self.edits.history.can_undo();
         self.panel.can_redo = self.edits.history.can_redo();
-        self.panel.unsaved = self.edits.document.is_dirty(&self.scene);
+        self.panel.unsaved = self.edits.document.unsaved();
         self.panel
             .recent_files
             .clone_from(&self.settings.recent_files);
@@ -959,7 +967,7 @@ impl Viewer {
 
     /// Copies unsaved edits to the recovery file when it is time.
     fn autosave(&mut self) {
-        let dirty = self.edits.document.is_dirty(&self.scene);
+        let dirty = self.edits.document.unsaved();
         let Some(autosave) = &mut self.edits.autosave else {
             return;
         };

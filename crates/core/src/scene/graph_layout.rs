@@ -3,7 +3,7 @@
 //! left.
 //!
 //! It belongs to the scene, not to the materials: it is not traced
-//! (`Scene::traces_like` passes over it, so moving a node keeps the
+//! (`Scene::changes_from` calls it an annotation, so moving a node keeps the
 //! accumulation and the shader), but it is part of the document (a moved
 //! node is an undoable edit and unsaved work). Keys are text, a material's
 //! place in the scene and then a node's [`NodePath`], so the file reads

@@ -1,6 +1,6 @@
 //! Materials: which texture drives which surface property.
 
-use super::pattern::{Pattern, SurfacePoint};
+use super::pattern::{MAX_SIGNALS, Pattern, Signal, SurfacePoint};
 use super::texture_tree::Texture;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -364,6 +364,34 @@ impl Material {
                 texture.visit_mut(f);
             }
         }
+    }
+
+    /// The material's distinct fractal sums, gradient noise first (the
+    /// order `material_signals` in textures.wgsl expects), at most
+    /// [`MAX_SIGNALS`] (`Scene::sanitize` keeps materials within it).
+    pub fn signals(&self) -> Vec<Signal> {
+        let mut signals = Vec::new();
+        for signal in self.all_textures().iter().flat_map(|t| t.signals(None)) {
+            if !signals.contains(&signal) {
+                signals.push(signal);
+            }
+        }
+        signals.truncate(MAX_SIGNALS);
+        signals.sort_by_key(|s| s.noise.kind as u8);
+        signals
+    }
+
+    /// For each fractal sum the textures read, in tree order, its slot in
+    /// [`Material::signals`] (None past [`MAX_SIGNALS`]): the indices the
+    /// generated code reads them at. Two materials whose sums are shared
+    /// alike have equal slots.
+    pub fn signal_slots(&self) -> Vec<Option<usize>> {
+        let signals = self.signals();
+        self.all_textures()
+            .iter()
+            .flat_map(|t| t.signals(None))
+            .map(|s| signals.iter().position(|x| *x == s))
+            .collect()
     }
 
     /// Every pattern of every texture, nested ones included.

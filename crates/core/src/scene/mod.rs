@@ -6,6 +6,7 @@
 //! re-derivation.
 
 pub mod camera;
+pub mod change;
 pub mod color_encoding;
 pub mod contrast;
 pub mod environment;
@@ -21,6 +22,7 @@ pub mod texture_tree;
 pub mod transport;
 
 pub use camera::{OrbitCamera, SavedView};
+pub use change::Change;
 pub use color_encoding::ColorEncoding;
 pub use environment::{EnvSource, Environment, LdrImages};
 pub use graph_layout::{GraphLayout, MaterialKey, MaterialLayout};
@@ -155,36 +157,6 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Whether the two scenes trace the same samples: equal but for their
-    /// display settings (exposure, tone map, the debug view), whose edits
-    /// keep the accumulation. Destructured in full, so that a new field has
-    /// to be sorted into traced or displayed.
-    pub fn traces_like(&self, other: &Scene) -> bool {
-        let Scene {
-            camera,
-            views,
-            spheres,
-            cylinders,
-            polygons,
-            ground,
-            meshes,
-            point_light,
-            environment,
-            render,
-            graph_layout: _,
-        } = self;
-        *camera == other.camera
-            && *views == other.views
-            && *spheres == other.spheres
-            && *cylinders == other.cylinders
-            && *polygons == other.polygons
-            && *ground == other.ground
-            && *meshes == other.meshes
-            && *point_light == other.point_light
-            && *environment == other.environment
-            && render.traces_like(&other.render)
-    }
-
     /// Every material in GPU order: the spheres', the cylinders', the
     /// polygons', the ground's, then each mesh's.
     pub fn materials(&self) -> impl Iterator<Item = &Material> {

@@ -328,6 +328,18 @@ impl Pattern {
         }
     }
 
+    /// Whether the two patterns compile to the same code: one kind, and
+    /// the same choices the code holds (an image's filter and wrap, the
+    /// noise kind and hash, which pick functions); their numbers may
+    /// differ.
+    pub fn same_kind(&self, other: &Pattern) -> bool {
+        let choices = |p: &Pattern| match p {
+            Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8)),
+            _ => p.noise().map(|n| (n.kind as u8, n.hash as u8)),
+        };
+        self.index() == other.index() && choices(self) == choices(other)
+    }
+
     /// The first octave's frequency of a pattern's noise when it had none:
     /// several features across a unit sphere.
     pub const FRESH_NOISE_FREQUENCY: f32 = 3.0;

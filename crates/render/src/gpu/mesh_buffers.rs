@@ -11,7 +11,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use marbre_core::accel::{Bvh, TriangleVerts};
 use marbre_core::lights::{EmitterTriangle, LightGpu, LightTable};
-use marbre_core::scene::{MeshPlacement, Scene};
+use marbre_core::scene::{Change, MeshPlacement, Scene};
 use std::time::Duration;
 use wgpu::util::DeviceExt;
 
@@ -69,31 +69,9 @@ pub struct MeshBuffers {
     /// The triangles in BVH order, as the light table reads them.
     emitters: Vec<EmitterTriangle>,
     table: LightTable,
-    /// What the light table was built from (with the geometry): a camera
-    /// move or a texture edit away from emitters leaves it as it is,
-    /// without walking a million triangles again.
-    light_key: Option<LightKey>,
     stats: MeshStats,
     /// Geometry a loader thread prepared for the next scene.
     provided: Option<PreparedGeometry>,
-}
-
-/// Everything besides the triangles that the light table reads.
-#[derive(Debug, Clone, PartialEq)]
-struct LightKey {
-    point_light: Option<marbre_core::scene::PointLight>,
-    sphere_radii: Vec<f32>,
-    materials: Vec<marbre_core::scene::Material>,
-}
-
-impl LightKey {
-    fn of(scene: &Scene) -> Self {
-        Self {
-            point_light: scene.point_light.clone(),
-            sphere_radii: scene.spheres.iter().map(|s| s.radius).collect(),
-            materials: scene.materials().cloned().collect(),
-        }
-    }
 }
 
 fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
@@ -173,7 +151,6 @@ impl MeshBuffers {
             lights: storage_buffer(device, "lights", &[]),
             emitters: Vec::new(),
             table: LightTable::default(),
-            light_key: None,
             stats: MeshStats::default(),
             provided: None,
         };
@@ -182,14 +159,21 @@ impl MeshBuffers {
         out
     }
 
-    /// Brings the buffers up to `scene`: the BVH if its geometry moved, the
-    /// light table if the geometry or anything else it reads changed.
-    pub fn update(&mut self, device: &wgpu::Device, scene: &Scene) {
-        if GeometryKey::of(scene) != self.key {
+    /// Brings the buffers up to `scene` after `change`: the BVH if its
+    /// geometry moved, the light table if anything it reads may have (the
+    /// geometry, the materials' emission, the point light).
+    pub fn update(&mut self, device: &wgpu::Device, scene: &Scene, change: Change) {
+        if change.contains(Change::GEOMETRY) && GeometryKey::of(scene) != self.key {
             self.rebuild_geometry(device, scene);
-            self.light_key = None;
         }
-        self.rebuild_lights(device, scene);
+        if change.intersects(
+            Change::GEOMETRY
+                | Change::LIGHTS
+                | Change::MATERIAL_PARAMETERS
+                | Change::MATERIAL_STRUCTURE,
+        ) {
+            self.rebuild_lights(device, scene);
+        }
     }
 
     fn rebuild_geometry(&mut self, device: &wgpu::Device, scene: &Scene) {
@@ -228,11 +212,6 @@ impl MeshBuffers {
     }
 
     fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {
-        let key = LightKey::of(scene);
-        if self.light_key.as_ref() == Some(&key) {
-            return;
-        }
-        self.light_key = Some(key);
         let table = LightTable::build(scene, &self.emitters);
         if table != self.table {
             let entries: Vec<LightGpu> = table.lights.clone();

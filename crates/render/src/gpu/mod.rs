@@ -28,6 +28,7 @@ pub mod shader_source;
 pub mod swatch;
 pub mod testing;
 pub mod texture_codegen;
+pub mod texture_params;
 pub mod trace_bands;
 pub mod trace_pass;
 

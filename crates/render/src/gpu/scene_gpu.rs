@@ -1,6 +1,5 @@
 //! The scene flattened into the std140/std430 structs of `crates/render/shaders/scene.wgsl`.
 
-use super::texture_codegen;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use marbre_core::lights::LightSelection;
@@ -196,7 +195,7 @@ pub fn hash_id(h: HashKind) -> u32 {
 /// evaluation per hit, gradient noise first) and its bump height. The
 /// textures themselves are generated code (`texture_codegen`).
 pub fn material(m: &Material) -> MaterialGpu {
-    let signals = texture_codegen::material_signals(m);
+    let signals = m.signals();
     let mut out = MaterialGpu {
         signal_count: signals.len() as u32,
         first_perlin: signals
@@ -400,9 +399,11 @@ mod tests {
 
     /// The element count of a uniform array global in the trace shader.
     fn wgsl_array_len(name: &str) -> u32 {
-        let generated =
-            texture_codegen::generate(&Scene::default(), &marbre_core::texture::ImageSet::empty())
-                .unwrap();
+        let generated = crate::gpu::texture_codegen::generate(
+            &Scene::default(),
+            &marbre_core::texture::ImageSet::empty(),
+        )
+        .unwrap();
         let source = crate::gpu::shader_source::assemble(
             crate::gpu::shader_source::Program::Trace,
             &crate::gpu::features::FeatureSet::all(),
@@ -440,7 +441,7 @@ mod tests {
         assert_eq!(wgsl_array_len("polygons") as usize, polygons(&scene).len());
         assert_eq!(
             wgsl_array_len("texture_params") as usize,
-            texture_codegen::generate(&scene, &marbre_core::texture::ImageSet::empty())
+            crate::gpu::texture_codegen::generate(&scene, &marbre_core::texture::ImageSet::empty())
                 .unwrap()
                 .params
                 .len()

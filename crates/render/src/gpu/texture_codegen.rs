@@ -15,8 +15,6 @@
 //! generated code reads them from `signals`.
 
 use anyhow::{Result, ensure};
-use marbre_core::scene::pattern::MAX_SIGNALS;
-use marbre_core::scene::texture_tree::IMAGE_UNAVAILABLE;
 use marbre_core::scene::{
     Child, MappingSpace, Material, MathOp, Pattern, Property, Scene, Signal, Texture,
     TextureMapping,
@@ -24,9 +22,8 @@ use marbre_core::scene::{
 use marbre_core::texture::{ImageFilter, ImageSet, ImageWrap};
 use std::fmt::Write;
 
-/// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
-/// crates/render/shaders/scene.wgsl): 16 KiB.
-pub const MAX_TEXTURE_PARAMS: usize = 1024;
+use super::texture_params::{Field, Slot, Step, Tree, pattern_params};
+pub use super::texture_params::{MAX_TEXTURE_PARAMS, ParamPlan};
 
 /// The generated code and the parameters it reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,17 +33,15 @@ pub struct GeneratedTextures {
     pub wgsl: String,
     /// The `texture_params` values, padded to [`MAX_TEXTURE_PARAMS`].
     pub params: Vec<[f32; 4]>,
+    /// Where each of `params` comes from: fills them for another scene of
+    /// the same structure without generating the code.
+    pub plan: ParamPlan,
 }
 
 /// The code and parameters for every material of `scene`, in GPU order:
 /// `surface_textures`, and `surface_height` for the bump textures.
 pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
-    let mut generator = Generator {
-        images,
-        code: String::new(),
-        params: Vec::new(),
-        next: 0,
-    };
+    let mut generator = Generator::new(images);
     let mut dispatch = String::new();
     let mut transmittances = String::new();
     let mut emissions = String::new();
@@ -70,14 +65,19 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
         )?;
         if material.has_bump() {
             let name = format!("texture_{index}_bump");
-            generator.function(&name, &material.bump, &material_signals(material));
+            generator.function(
+                &name,
+                (index, Tree::Bump),
+                &material.bump,
+                &material.signals(),
+            );
             writeln!(
                 heights,
                 "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals).x;\n        }}"
             )?;
         }
     }
-    let (mut wgsl, params) = generator.finish(
+    let (mut wgsl, params, plan) = generator.finish(
         "// Generated from the scene's texture trees (gpu::texture_codegen).\n\n",
         "the scene's textures",
     )?;
@@ -133,7 +133,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
         wgsl,
         "\n// The bump height of a material (0 for those without bump).\nfn surface_height(material: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> f32 {{\n    switch material {{\n{heights}        default: {{}}\n    }}\n    return 0.0;\n}}\n"
     )?;
-    Ok(GeneratedTextures { wgsl, params })
+    Ok(GeneratedTextures { wgsl, params, plan })
 }
 
 /// The code and parameters evaluating each of `textures` alone (the
@@ -143,22 +143,22 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
 /// materials [`swatch_material`] makes. The same generator as
 /// [`generate`], so a swatch shows what the renderer would.
 pub fn generate_swatches(textures: &[Texture], images: &ImageSet) -> Result<GeneratedTextures> {
-    let mut generator = Generator {
-        images,
-        code: String::new(),
-        params: Vec::new(),
-        next: 0,
-    };
+    let mut generator = Generator::new(images);
     let mut dispatch = String::new();
     for (index, texture) in textures.iter().enumerate() {
         let name = format!("swatch_{index}");
-        generator.function(&name, texture, &material_signals(&swatch_material(texture)));
+        generator.function(
+            &name,
+            (index, Tree::Swatch),
+            texture,
+            &swatch_material(texture).signals(),
+        );
         writeln!(
             dispatch,
             "        case {index}u: {{\n            return {name}(p, pw, uv, fp, signals);\n        }}"
         )?;
     }
-    let (mut wgsl, params) = generator.finish(
+    let (mut wgsl, params, plan) = generator.finish(
         "// Generated from texture trees for swatches (gpu::texture_codegen).\n\n",
         "the swatches' textures",
     )?;
@@ -166,7 +166,7 @@ pub fn generate_swatches(textures: &[Texture], images: &ImageSet) -> Result<Gene
         wgsl,
         "fn swatch_texture(index: u32, p: vec3f, pw: vec3f, uv: vec2f, fp: Footprint, signals: vec4f) -> vec3f {{\n    switch index {{\n{dispatch}        default: {{}}\n    }}\n    return vec3f(0.0);\n}}\n"
     )?;
-    Ok(GeneratedTextures { wgsl, params })
+    Ok(GeneratedTextures { wgsl, params, plan })
 }
 
 /// The material a swatch of `texture` reads its noise signals through: a
@@ -175,21 +175,6 @@ pub fn swatch_material(texture: &Texture) -> Material {
     let mut material = Material::default();
     *material.texture_mut(Property::Diffuse) = texture.clone();
     material
-}
-
-/// A material's distinct fractal sums, gradient noise first (the order
-/// `material_signals` in textures.wgsl expects), at most [`MAX_SIGNALS`]
-/// (`Scene::sanitize` keeps materials within it).
-pub fn material_signals(material: &Material) -> Vec<Signal> {
-    let mut signals = Vec::new();
-    for signal in material.all_textures().iter().flat_map(|t| t.signals(None)) {
-        if !signals.contains(&signal) {
-            signals.push(signal);
-        }
-    }
-    signals.truncate(MAX_SIGNALS);
-    signals.sort_by_key(|s| s.noise.kind as u8);
-    signals
 }
 
 /// Where a texture node is evaluated: the WGSL expressions of its 3D point
@@ -219,15 +204,35 @@ struct Generator<'a> {
     images: &'a ImageSet,
     code: String,
     params: Vec<[f32; 4]>,
+    /// Where each of `params` comes from.
+    slots: Vec<Slot>,
+    /// The material and tree of the function being generated, and the
+    /// steps from its root to the node being generated.
+    owner: usize,
+    tree: Tree,
+    path: Vec<Step>,
     /// Numbers the local variables of the function being generated.
     next: usize,
 }
 
-impl Generator<'_> {
-    /// The generated functions after `header`, and the parameters padded to
-    /// the uniform array's size; refused when they do not fit (`what` names
-    /// whose they are).
-    fn finish(self, header: &str, what: &str) -> Result<(String, Vec<[f32; 4]>)> {
+impl<'a> Generator<'a> {
+    fn new(images: &'a ImageSet) -> Self {
+        Self {
+            images,
+            code: String::new(),
+            params: Vec::new(),
+            slots: Vec::new(),
+            owner: 0,
+            tree: Tree::Material,
+            path: Vec::new(),
+            next: 0,
+        }
+    }
+
+    /// The generated functions after `header`, the parameters padded to
+    /// the uniform array's size, and their plan; refused when they do not
+    /// fit (`what` names whose they are).
+    fn finish(self, header: &str, what: &str) -> Result<(String, Vec<[f32; 4]>, ParamPlan)> {
         ensure!(
             self.params.len() <= MAX_TEXTURE_PARAMS,
             "{what} need {} parameter slots; the renderer holds {MAX_TEXTURE_PARAMS}",
@@ -235,7 +240,8 @@ impl Generator<'_> {
         );
         let mut params = self.params;
         params.resize(MAX_TEXTURE_PARAMS, [0.0; 4]);
-        Ok((format!("{header}{}", self.code), params))
+        let plan = ParamPlan { slots: self.slots };
+        Ok((format!("{header}{}", self.code), params, plan))
     }
 
     /// Generates the functions of material `index`'s textures and returns
@@ -243,11 +249,11 @@ impl Generator<'_> {
     /// base texture, then each layer over it where its mask lies) and in
     /// `surface_opacity` (the same for opacity alone).
     fn material(&mut self, index: usize, material: &Material) -> MaterialCases {
-        let signals = material_signals(material);
+        let signals = material.signals();
         let mut masks = Vec::new();
         for (l, layer) in material.layers.iter().enumerate() {
             let name = format!("texture_{index}_layer{l}_mask");
-            self.function(&name, &layer.mask, &signals);
+            self.function(&name, (index, Tree::LayerMask(l)), &layer.mask, &signals);
             masks.push(format!(
                 "            let mask{l} = clamp({name}(p, pw, uv, fp, signals).x, 0.0, 1.0);\n"
             ));
@@ -257,21 +263,23 @@ impl Generator<'_> {
             transmittance: String::new(),
             emission: String::new(),
         };
-        let strength = self.param([material.emission_strength, 0.0, 0.0, 0.0]);
+        let strength = self.emission_strength_slot(index, material);
         // The layer masks the transmittance reads (each declared once).
         let mut transmittance_masks = std::collections::BTreeSet::new();
         let mut transmittance = String::new();
         for property in Property::ALL {
             let value = property.name();
             let name = format!("texture_{index}_{value}");
-            self.function(&name, material.texture(property), &signals);
+            let tree = (index, Tree::Property(property));
+            self.function(&name, tree, material.texture(property), &signals);
             let mut statements =
                 format!("            var {value} = {name}(p, pw, uv, fp, signals);\n");
             let mut masks_read = Vec::new();
             for (l, layer) in material.layers.iter().enumerate() {
                 if let Some(texture) = layer.texture(property) {
                     let name = format!("texture_{index}_layer{l}_{value}");
-                    self.function(&name, texture, &signals);
+                    let tree = (index, Tree::LayerProperty(l, property));
+                    self.function(&name, tree, texture, &signals);
                     let _ = writeln!(
                         statements,
                         "            {value} = mix({value}, {name}(p, pw, uv, fp, signals), mask{l});"
@@ -308,7 +316,17 @@ impl Generator<'_> {
         cases
     }
 
-    fn function(&mut self, name: &str, texture: &Texture, signals: &[Signal]) {
+    /// Generates function `name` evaluating `texture`, tree `tree` of
+    /// material (or swatch) `owner`.
+    fn function(
+        &mut self,
+        name: &str,
+        (owner, tree): (usize, Tree),
+        texture: &Texture,
+        signals: &[Signal],
+    ) {
+        (self.owner, self.tree) = (owner, tree);
+        self.path.clear();
         self.next = 0;
         let mut body = String::new();
         let site = Site {
@@ -324,38 +342,75 @@ impl Generator<'_> {
         );
     }
 
-    /// Reserves a parameter slot and returns the WGSL that reads it.
-    fn param(&mut self, value: [f32; 4]) -> String {
+    /// Reserves a parameter slot for `field` of `node` (the node at the
+    /// current path) and returns the WGSL that reads it.
+    fn slot(&mut self, node: &Texture, field: Field) -> String {
+        let value = field
+            .value(node, self.images)
+            .expect("the generator reads only the numbers a node has");
+        self.push(value, field)
+    }
+
+    /// The slot of material `owner`'s emission strength.
+    fn emission_strength_slot(&mut self, owner: usize, material: &Material) -> String {
+        (self.owner, self.tree) = (owner, Tree::Material);
+        self.path.clear();
+        self.push(
+            [material.emission_strength, 0.0, 0.0, 0.0],
+            Field::EmissionStrength,
+        )
+    }
+
+    fn push(&mut self, value: [f32; 4], field: Field) -> String {
         self.params.push(value);
+        self.slots.push(Slot {
+            owner: self.owner,
+            tree: self.tree,
+            path: self.path.as_slice().into(),
+            field,
+        });
         format!("texture_params[{}]", self.params.len() - 1)
     }
 
+    /// `node`'s child `child`, reached by `step` (`a` or `b`): a
+    /// constant's slot, or the nested texture's statements.
     fn child(
         &mut self,
-        child: &Child,
+        node: &Texture,
+        (step, child): (Step, &Child),
         site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
         match child {
-            Child::Scalar(v) => format!("{}.xyz", self.param([*v, *v, *v, 0.0])),
-            Child::Color(c) => format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0])),
-            Child::Texture(t) => self.texture(t, site, signals, body),
+            Child::Scalar(_) | Child::Color(_) => {
+                format!("{}.xyz", self.slot(node, Field::Constant(step)))
+            }
+            Child::Texture(t) => self.nested(t, step, site, signals, body),
         }
+    }
+
+    /// [`Generator::texture`] of a node one `step` below the current one.
+    fn nested(
+        &mut self,
+        texture: &Texture,
+        step: Step,
+        site: &Site,
+        signals: &[Signal],
+        body: &mut String,
+    ) -> String {
+        self.path.push(step);
+        let value = self.texture(texture, site, signals, body);
+        self.path.pop();
+        value
     }
 
     /// The ramp of texture `k` at its blend factor `t{k}`, unrolled stop by
     /// stop (twin of `texture::ramp`): before the first stop its colour, then
     /// each pair of neighbours takes over past its first position.
-    fn ramp(
-        &mut self,
-        stops: &[marbre_core::texture::RampStop],
-        k: usize,
-        body: &mut String,
-    ) -> String {
-        let slots: Vec<String> = stops
-            .iter()
-            .map(|s| self.param([s.color.x, s.color.y, s.color.z, s.position]))
+    fn ramp(&mut self, texture: &Texture, k: usize, body: &mut String) -> String {
+        let slots: Vec<String> = (0..texture.ramp.len())
+            .map(|i| self.slot(texture, Field::RampStop(i)))
             .collect();
         let _ = writeln!(body, "    var ramp{k} = {}.xyz;", slots[0]);
         for pair in slots.windows(2) {
@@ -382,8 +437,8 @@ impl Generator<'_> {
     ) -> String {
         let rect = texture.image.as_ref().and_then(|s| self.images.rect(s));
         let color = match rect {
-            Some(rect) => {
-                let rect = self.param(rect);
+            Some(_) => {
+                let rect = self.slot(texture, Field::ImageRect);
                 let (uv, wrap) = (&site.uv, wrap.id());
                 match filter {
                     ImageFilter::Nearest => format!("image_nearest({rect}, {uv}, {wrap}u).xyz"),
@@ -399,17 +454,14 @@ impl Generator<'_> {
                     }
                 }
             }
-            None => {
-                let c = IMAGE_UNAVAILABLE;
-                format!("{}.xyz", self.param([c.x, c.y, c.z, 0.0]))
-            }
+            None => format!("{}.xyz", self.slot(texture, Field::ImageUnavailable)),
         };
         let _ = writeln!(body, "    let c{k} = {color};");
         if texture.ramp.is_empty() {
             return format!("c{k}");
         }
         let _ = writeln!(body, "    let t{k} = luminance(c{k});");
-        self.ramp(&texture.ramp, k, body)
+        self.ramp(texture, k, body)
     }
 
     /// Appends the statements evaluating `texture` at `site` to `body` and
@@ -428,11 +480,11 @@ impl Generator<'_> {
         let mapped;
         let site = match &texture.mapping {
             Some(mapping) => {
-                let [r0, r1, r2] = mapping.rows().map(|row| self.param(row));
+                let [r0, r1, r2] = [0, 1, 2].map(|i| self.slot(texture, Field::MappingRow(i)));
                 // A frame moves the 3D point alone: (u, v) then read the
                 // transform's own rows.
                 let [u0, u1, u2] = if mapping.frame.is_some() {
-                    mapping.uv_rows().map(|row| self.param(row))
+                    [0, 1, 2].map(|i| self.slot(texture, Field::UvRow(i)))
                 } else {
                     [r0.clone(), r1.clone(), r2.clone()]
                 };
@@ -440,8 +492,7 @@ impl Generator<'_> {
                     MappingSpace::Object => "p",
                     MappingSpace::World => "pw",
                 };
-                let [su, sv, s3] = mapping.footprint_scale();
-                let scale = self.param([su, sv, s3, 0.0]);
+                let scale = self.slot(texture, Field::FootprintScale);
                 let _ = writeln!(
                     body,
                     "    let p{k} = affine_rows({point}, {r0}, {r1}, {r2});\n    let uv{k} = affine_rows(vec3f(uv, 0.0), {u0}, {u1}, {u2}).xy;\n    let fp{k} = Footprint(fp.uv * {scale}.xy, fp.p * {scale}.z, fp.axes * {scale}.z);"
@@ -461,19 +512,19 @@ impl Generator<'_> {
             return value;
         }
         let _ = writeln!(body, "    var r{k} = {value};");
-        for op in &texture.ops {
+        for (i, op) in texture.ops.iter().enumerate() {
             let r = format!("r{k}");
             let expression = match op {
                 MathOp::Abs => format!("abs({r})"),
                 MathOp::Invert => format!("1.0 - {r}"),
-                MathOp::Scale(_) => format!("{r} * {}.x", self.param(op.params())),
-                MathOp::Bias(_) => format!("{r} + {}.x", self.param(op.params())),
+                MathOp::Scale(_) => format!("{r} * {}.x", self.slot(texture, Field::Op(i))),
+                MathOp::Bias(_) => format!("{r} + {}.x", self.slot(texture, Field::Op(i))),
                 MathOp::Clamp { .. } => {
-                    let q = self.param(op.params());
+                    let q = self.slot(texture, Field::Op(i));
                     format!("min(max({r}, vec3f({q}.x)), vec3f({q}.y))")
                 }
                 MathOp::Power(_) => {
-                    let q = self.param(op.params());
+                    let q = self.slot(texture, Field::Op(i));
                     format!("pow(max({r}, vec3f(0.0)), vec3f({q}.x))")
                 }
             };
@@ -493,7 +544,7 @@ impl Generator<'_> {
         body: &mut String,
     ) -> String {
         if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
-            return self.child(&texture.a, site, signals, body);
+            return self.child(texture, (Step::A, &texture.a), site, signals, body);
         }
         if let Pattern::Image { filter, wrap } = texture.pattern {
             return self.image(texture, k, filter, wrap, site, body);
@@ -510,10 +561,14 @@ impl Generator<'_> {
             .map_or_else(|| "0.0".to_string(), |i| format!("signals[{i}]"));
         let mut child_uv = uv.to_string();
         let mut child_footprint = fp.to_string();
+        // The pattern's own numbers, one slot (those that have any).
+        let q = match pattern_params(&texture.pattern) {
+            Some(_) => self.slot(texture, Field::Pattern),
+            None => String::new(),
+        };
         let t = match texture.pattern {
             Pattern::Constant => "0.0".to_string(),
-            Pattern::Checker { size } => {
-                let q = self.param([size, size, size, 0.0]);
+            Pattern::Checker { .. } => {
                 format!(
                     "select(checker_3d({p}, {q}.xyz), filtered_checker_3d({p}, {q}.xyz, 0.5 * {fp}.axes), filter_checkers)"
                 )
@@ -525,19 +580,15 @@ impl Generator<'_> {
             Pattern::Image { .. } => unreachable!("image nodes are generated by `image`"),
             Pattern::Mix => match &texture.factor {
                 Some(factor) => {
-                    let f = self.texture(factor, site, signals, body);
+                    let f = self.nested(factor, Step::Factor, site, signals, body);
                     format!("clamp({f}.x, 0.0, 1.0)")
                 }
                 None => "0.0".to_string(),
             },
-            Pattern::Marble {
-                stripe_frequency, ..
-            } => {
-                let q = self.param([stripe_frequency, 0.0, 0.0, 0.0]);
+            Pattern::Marble { .. } => {
                 format!("0.5 + 0.5 * marble_stripes({p}.x, {signal}, {q}.x)")
             }
-            Pattern::Checker2d { size, phase } => {
-                let q = self.param([size.x, size.y, phase, 0.0]);
+            Pattern::Checker2d { .. } => {
                 let _ = writeln!(body, "    let cell{k} = checker_2d({uv}, {q}.xy, {q}.z);");
                 child_uv = format!("cell{k}.local");
                 child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
@@ -545,69 +596,42 @@ impl Generator<'_> {
                     "select(cell{k}.select, filtered_checker_2d({uv}, {q}.xy, {q}.z, 0.5 * {fp}.uv), filter_checkers)"
                 )
             }
-            Pattern::Brick {
-                size,
-                mortar,
-                row_offset,
-            } => {
-                let q = self.param([size.x, size.y, mortar, row_offset]);
+            Pattern::Brick { .. } => {
                 let _ = writeln!(body, "    let cell{k} = brick({uv}, {q}.xy, {q}.z, {q}.w);");
                 child_uv = format!("cell{k}.local");
                 child_footprint = format!("Footprint({fp}.uv / {q}.xy, {fp}.p, {fp}.axes)");
                 format!("cell{k}.select")
             }
-            Pattern::Tile {
-                mortar_half_width,
-                bevel,
-            } => {
-                let q = self.param([mortar_half_width, bevel, 0.0, 0.0]);
+            Pattern::Tile { .. } => {
                 format!("tile_height({uv}, {q}.x, {q}.y)")
             }
-            Pattern::Waves {
-                frequency,
-                direction,
-            } => {
-                let q = self.param([frequency, direction.x, direction.y, 0.0]);
+            Pattern::Waves { .. } => {
                 format!("waves({uv}, {q}.x, {q}.yz)")
             }
-            Pattern::Cutout { sides, radius } => {
-                let q = self.param([radius, sides as f32, 0.0, 0.0]);
+            Pattern::Cutout { .. } => {
                 format!("cutout({uv}, u32({q}.y), {q}.x)")
             }
-            Pattern::Wood {
-                ring_width,
-                turbulence_amount,
-                ..
-            } => {
-                let q = self.param([ring_width, turbulence_amount, 0.0, 0.0]);
+            Pattern::Wood { .. } => {
                 format!("wood_rings({p}, WOOD_AXIS, {q}.x, {q}.y * {signal})")
             }
-            Pattern::Veins {
-                frequency,
-                turbulence_amount,
-                ..
-            } => {
-                let q = self.param([frequency, turbulence_amount, 0.0, 0.0]);
+            Pattern::Veins { .. } => {
                 format!("max(sin({q}.x * {p}.x + {q}.y * {signal}), 0.0)")
             }
-            Pattern::MassalMarble {
-                stripe_frequency, ..
-            } => {
-                let q = self.param([stripe_frequency, 0.0, 0.0, 0.0]);
+            Pattern::MassalMarble { .. } => {
                 format!("massal_marble({p}, {q}.x, {signal})")
             }
         };
         let _ = writeln!(body, "    let t{k} = {t};");
         if !texture.ramp.is_empty() {
-            return self.ramp(&texture.ramp, k, body);
+            return self.ramp(texture, k, body);
         }
         let child_site = Site {
             uv: child_uv,
             footprint: child_footprint,
             ..site.clone()
         };
-        let a = self.child(&texture.a, &child_site, signals, body);
-        let b = self.child(&texture.b, &child_site, signals, body);
+        let a = self.child(texture, (Step::A, &texture.a), &child_site, signals, body);
+        let b = self.child(texture, (Step::B, &texture.b), &child_site, signals, body);
         let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
         format!("v{k}")
     }

@@ -16,6 +16,7 @@ mod common;
 mod cubemap;
 mod denoise;
 mod diffuse_transmission;
+mod edit_path;
 mod error_estimate;
 mod exposure;
 mod extreme_radiance;

@@ -676,7 +676,13 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
         Vec3::new(0.1, 0.8, 0.1),
         Vec3::new(0.1, 0.1, 0.8),
     );
-    renderer.request_scene(&ctx, &edited).unwrap();
+    renderer
+        .request_scene(
+            &ctx,
+            &edited,
+            edited.changes_from(renderer.requested_scene()),
+        )
+        .unwrap();
     assert!(renderer.is_building());
     // Meanwhile: the old pipeline, the old scene.
     assert_eq!(renderer.features(), &before);
@@ -735,7 +741,9 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
         });
     }
     huge.ground.as_mut().unwrap().material.layers = layers;
-    let error = renderer.request_scene(&ctx, &huge).unwrap_err();
+    let error = renderer
+        .request_scene(&ctx, &huge, huge.changes_from(renderer.requested_scene()))
+        .unwrap_err();
     assert!(
         format!("{error:#}").contains("parameter slots"),
         "{error:#}"

@@ -276,10 +276,15 @@ fn the_layout_round_trips_through_a_preset_and_is_not_traced() {
     let back = preset::parse(&text, Path::new("g.ron")).unwrap();
     assert_eq!(back.preset.scene, scene);
     assert!(back.notes.is_empty(), "{:?}", back.notes);
-    assert!(scene.traces_like(&Scene {
+    let unlaid = Scene {
         graph_layout: Default::default(),
         ..scene.clone()
-    }));
+    };
+    assert_eq!(
+        scene.changes_from(&unlaid),
+        crate::scene::Change::ANNOTATIONS,
+        "the layout is saved but not traced"
+    );
     assert_ne!(
         scene,
         Scene {

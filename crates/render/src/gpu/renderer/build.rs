@@ -1,23 +1,26 @@
 //! Deciding what to build for a scene and installing it: the pipeline key
 //! (features, generated texture code, override constants, shader sources,
 //! kernel), builds on the worker thread, and writing an installed scene
-//! into the buffers (restarting the accumulation only when what is traced
-//! changed).
+//! into the buffers. What to do is read from the edit's [`Change`],
+//! worked out once by the caller: a parameter edit fills the texture
+//! numbers from the code's [`ParamPlan`] and never generates code; only a
+//! structural one generates it, and only a new key builds a pipeline.
 
 use super::{Renderer, upload_env, upload_env_distribution};
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::{Feature, FeatureSet};
+use crate::gpu::kernel;
 use crate::gpu::kernel::Kernel;
 use crate::gpu::mesh_buffers::PreparedGeometry;
 use crate::gpu::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use crate::gpu::pipelines::{compile_wgsl, upload_atlas, validate};
 use crate::gpu::shader_source::{Program, assemble, sources_generation};
+use crate::gpu::texture_codegen::{self, ParamPlan};
 use crate::gpu::trace_pass::{TraceLayouts, TracePipeline};
-use crate::gpu::{kernel, texture_codegen};
 use anyhow::Result;
 use marbre_core::envmap;
 use marbre_core::envmap::EnvImage;
-use marbre_core::scene::Scene;
+use marbre_core::scene::{Change, Scene};
 use marbre_core::texture::ImageSet;
 use std::sync::Arc;
 use std::time::Duration;
@@ -56,16 +59,23 @@ impl Renderer {
     /// (the viewer's Kernel switch): the current one draws until then.
     pub fn request_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
         self.choose_kernel(ctx, kernel)?;
-        let scene = self.latest_requested_scene();
-        self.start_scene(ctx, &scene, true)
+        self.rebuild(ctx)
     }
 
-    /// The scene of the build under way, else the one drawing.
-    fn latest_requested_scene(&self) -> Scene {
+    /// The scene last requested: the build's under way, else the one
+    /// drawing. The viewer works out each frame's [`Change`] against it.
+    pub fn requested_scene(&self) -> &Scene {
         self.pending
             .as_ref()
             .map_or(&self.scene, |p| &p.target.scene)
-            .clone()
+    }
+
+    /// Builds the pipeline again, without waiting, if what its key reads
+    /// besides the scene changed (the shader files `marbre --dev`
+    /// reloads).
+    pub fn rebuild(&mut self, ctx: &GpuContext) -> Result<()> {
+        let scene = self.requested_scene().clone();
+        self.start_scene(ctx, &scene, Change::empty(), true)
     }
 
     fn choose_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
@@ -86,9 +96,10 @@ impl Renderer {
     /// headless renders and tests. If the build fails, the previous pipeline
     /// and scene stay and the error is returned.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
+        let change = scene.changes_from(self.requested_scene());
         // Waiting here, the first draw may as well compile on this device:
         // no warm-up.
-        self.start_scene(ctx, scene, false)?;
+        self.start_scene(ctx, scene, change, false)?;
         match self.pending.take() {
             Some(mut pending) => {
                 let built = pending.build.wait()?;
@@ -99,63 +110,89 @@ impl Renderer {
         }
     }
 
-    /// Applies an edited scene without waiting: for the viewer. Parameter
-    /// edits only rewrite buffers and show at the next frame. An edit that
-    /// changes the feature set or the texture trees' structure starts a
-    /// pipeline build on a worker thread; until [`Renderer::poll_build`]
-    /// reports it done, the old pipeline keeps rendering the old scene (with
-    /// the new camera). A later edit of the same structure joins that build.
-    pub fn request_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<()> {
-        self.start_scene(ctx, scene, true)
+    /// Applies an edited scene without waiting: for the viewer, which
+    /// says what changed since the scene it last requested (`change`, from
+    /// [`Scene::changes_from`]). Parameter edits only rewrite buffers and
+    /// show at the next frame. An edit that changes the feature set or the
+    /// texture trees' structure starts a pipeline build on a worker thread;
+    /// until [`Renderer::poll_build`] reports it done, the old pipeline
+    /// keeps rendering the old scene (with the new camera). A later edit of
+    /// the same structure joins that build.
+    pub fn request_scene(&mut self, ctx: &GpuContext, scene: &Scene, change: Change) -> Result<()> {
+        if change.is_empty() {
+            return Ok(());
+        }
+        self.start_scene(ctx, scene, change, true)
     }
 
     /// [`Renderer::request_scene`], warming the driver's shader cache on a
     /// second device first if `warm_up` (and the adapter compiles at draw).
-    fn start_scene(&mut self, ctx: &GpuContext, scene: &Scene, warm_up: bool) -> Result<()> {
+    fn start_scene(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        change: Change,
+        warm_up: bool,
+    ) -> Result<()> {
         let features = self
             .feature_override
             .clone()
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
-        let target_scene = self
-            .pending
+        let switches = RenderSwitches::of(scene);
+        let (textures, params) = self.texture_numbers(scene, change)?;
+        let latest = self.pending.as_ref().map_or(&self.key, |p| &p.key);
+        let same_pipeline = textures
             .as_ref()
-            .map_or(&self.scene, |p| &p.target.scene);
-        // Camera and light edits (every frame of a drag) leave the textures
-        // alone: regenerate them only when a material changed.
-        let textures = if target_scene.materials().eq(scene.materials()) {
-            None
-        } else {
-            Some(texture_codegen::generate(scene, &self.images)?)
-        };
+            .is_none_or(|(wgsl, _)| *wgsl == latest.code)
+            && features == latest.features
+            && switches == latest.switches
+            && self.kernel == latest.kernel
+            && sources_generation() == latest.sources;
         let target = Target {
             scene: scene.clone(),
-            params: textures.as_ref().map(|t| t.params.clone()),
+            params,
+            change,
         };
-        let code = match (&textures, &self.pending) {
-            (Some(t), _) => t.wgsl.clone(),
-            (None, Some(p)) => p.key.code.clone(),
-            (None, None) => self.key.code.clone(),
+        if same_pipeline {
+            match &mut self.pending {
+                Some(pending) => {
+                    pending.target.join(target);
+                    self.follow_camera(scene, change);
+                }
+                None => self.apply(ctx, target),
+            }
+            return Ok(());
+        }
+        let (code, plan) = match textures {
+            Some(textures) => textures,
+            None => (latest.code.clone(), self.latest_plan().clone()),
         };
         let key = PipelineKey {
             features,
             code,
-            switches: RenderSwitches::of(scene),
+            switches,
             sources: sources_generation(),
             kernel: self.kernel,
         };
         if key == self.key {
+            // Back to the pipeline in place (an edit undone while its build
+            // ran): the scene differs from the installed one by more than
+            // this edit, so everything is written.
             self.pending = None;
-            self.apply(ctx, target);
+            self.apply(
+                ctx,
+                Target {
+                    change: Change::all(),
+                    ..target
+                },
+            );
             return Ok(());
         }
         if let Some(pending) = &mut self.pending
             && pending.key == key
         {
-            // Keep the parameters of a regenerated tree, or those already
-            // waiting.
-            let params = target.params.or(pending.target.params.take());
-            pending.target = Target { params, ..target };
-            self.follow_camera(scene);
+            pending.target.join(target);
+            self.follow_camera(scene, change);
             return Ok(());
         }
         let warm_context = if warm_up {
@@ -178,9 +215,42 @@ impl Renderer {
         let build = self.builder.start(warm_up, move || {
             Self::build_trace_pipeline(&device, &layouts, &build_key)
         });
-        self.pending = Some(PendingScene { build, key, target });
-        self.follow_camera(scene);
+        self.pending = Some(PendingScene {
+            build,
+            key,
+            plan,
+            target,
+        });
+        self.follow_camera(scene, change);
         Ok(())
+    }
+
+    /// The plan of the latest requested texture code: the build's under
+    /// way, else the one drawing.
+    fn latest_plan(&self) -> &ParamPlan {
+        self.pending
+            .as_ref()
+            .map_or(&self.texture_plan, |p| &p.plan)
+    }
+
+    /// The texture code (with its plan) and numbers `scene` needs after
+    /// `change`: all generated for a structural edit; for a parameter edit
+    /// only the numbers, filled by the plan of the code in place; neither
+    /// for an edit away from the materials.
+    fn texture_numbers(&mut self, scene: &Scene, change: Change) -> Result<TextureNumbers> {
+        if !change.regenerates_code() && change.contains(Change::MATERIAL_PARAMETERS) {
+            if let Some(params) = self.latest_plan().evaluate(scene, &self.images) {
+                return Ok((None, Some(params)));
+            }
+            // The change was worked out against another scene than the
+            // plan's (a caller's slip): generating is always right.
+            log::warn!("a parameter edit did not fit the texture code in place; generating it");
+        } else if !change.regenerates_code() {
+            return Ok((None, None));
+        }
+        let textures = texture_codegen::generate(scene, &self.images)?;
+        self.code_generations += 1;
+        Ok((Some((textures.wgsl, textures.plan)), Some(textures.params)))
     }
 
     /// Whether a pipeline build is under way.
@@ -212,28 +282,37 @@ impl Renderer {
         self.trace_shader_bytes = built.shader_bytes;
         self.last_build = Some(built.took);
         self.key = std::mem::take(&mut pending.key);
+        self.texture_plan = std::mem::take(&mut pending.plan);
+        // The installed scene may be several edits behind: everything is
+        // written. A new pipeline draws a new image even for the same scene
+        // (a feature compiled out): the samples of the old one must go.
         let target = Target {
             scene: std::mem::take(&mut pending.target.scene),
             params: pending.target.params.take(),
+            change: Change::all(),
         };
-        // A new pipeline draws a new image even for the same scene (a
-        // feature compiled out): the samples of the old one must go.
         self.reset_accumulation();
         self.apply(ctx, target);
     }
 
-    /// Writes a scene whose pipeline is in place into the buffers.
+    /// Writes a scene whose pipeline is in place into the buffers its
+    /// change touches. (The frame uniform, which holds the camera, the
+    /// lights and the render settings, is written at each trace.)
     fn apply(&mut self, ctx: &GpuContext, target: Target) {
         if let Some(params) = &target.params {
             ctx.queue
                 .write_buffer(&self.texture_param_buffer, 0, bytemuck::cast_slice(params));
         }
-        let scene = &target.scene;
-        self.geometry.write(&ctx.queue, scene);
-        self.meshes.update(&ctx.device, scene);
+        let (scene, change) = (&target.scene, target.change);
+        if change
+            .intersects(Change::GEOMETRY | Change::MATERIAL_PARAMETERS | Change::MATERIAL_STRUCTURE)
+        {
+            self.geometry.write(&ctx.queue, scene);
+        }
+        self.meshes.update(&ctx.device, scene, change);
         // Display-only edits (exposure, auto exposure, tone map, the debug
         // view) keep the samples.
-        if !self.scene.traces_like(scene) {
+        if change.resets_accumulation() {
             self.reset_accumulation();
         }
         self.scene = target.scene;
@@ -241,8 +320,8 @@ impl Renderer {
 
     /// While a build is pending the old scene is drawn, but seen from the
     /// new camera: orbiting stays live.
-    fn follow_camera(&mut self, scene: &Scene) {
-        if self.scene.camera != scene.camera {
+    fn follow_camera(&mut self, scene: &Scene, change: Change) {
+        if change.contains(Change::CAMERA) {
             self.scene.camera = scene.camera;
             self.reset_accumulation();
         }
@@ -292,8 +371,7 @@ impl Renderer {
             })?;
         }
         self.feature_override = features;
-        let scene = self.latest_requested_scene();
-        self.start_scene(ctx, &scene, true)
+        self.rebuild(ctx)
     }
 
     /// Goes back to specialising per scene at the next scene request,
@@ -313,6 +391,8 @@ impl Renderer {
             self.install(ctx, built, &mut pending);
         }
         let textures = texture_codegen::generate(&self.scene, &images)?;
+        self.code_generations += 1;
+        self.texture_plan = textures.plan;
         if textures.wgsl != self.key.code {
             let key = PipelineKey {
                 code: textures.wgsl,
@@ -344,11 +424,27 @@ impl Renderer {
     }
 }
 
-/// A scene waiting for its pipeline: what to write into the buffers once
-/// the pipeline is in place (the texture parameters if they changed).
+/// What an edit needs of the texture code: the code generated anew with
+/// its plan (structural edits), and the numbers to write (parameter edits
+/// too); None where it needs nothing new.
+type TextureNumbers = (Option<(String, ParamPlan)>, Option<Vec<[f32; 4]>>);
+
+/// A scene to write into the buffers once its pipeline is in place: the
+/// texture parameters if they changed, and what changed.
 pub(super) struct Target {
     pub(super) scene: Scene,
     pub(super) params: Option<Vec<[f32; 4]>>,
+    pub(super) change: Change,
+}
+
+impl Target {
+    /// A later edit waiting for the same pipeline: its scene, its numbers
+    /// (or those already waiting), both changes.
+    fn join(&mut self, later: Target) {
+        self.params = later.params.or(self.params.take());
+        self.change |= later.change;
+        self.scene = later.scene;
+    }
 }
 
 /// What a trace pipeline is built from: two scenes with equal keys share
@@ -392,6 +488,8 @@ impl RenderSwitches {
 pub(super) struct PendingScene {
     pub(super) build: PipelineBuild,
     pub(super) key: PipelineKey,
+    /// Where the numbers of the key's texture code come from.
+    pub(super) plan: ParamPlan,
     pub(super) target: Target,
 }
 

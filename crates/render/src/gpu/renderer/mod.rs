@@ -102,6 +102,11 @@ pub struct Renderer {
     /// What the trace pipeline was built from: a scene whose key differs
     /// needs a new pipeline.
     key: PipelineKey,
+    /// Where each number of the key's texture code comes from.
+    texture_plan: texture_codegen::ParamPlan,
+    /// How many times texture code was generated since creation (a
+    /// parameter edit must not add one).
+    code_generations: u64,
     /// When set, the shader is built with these features whatever the scene
     /// uses: `FeatureSet::all()` is the uber shader the benchmarks compare.
     feature_override: Option<FeatureSet>,
@@ -251,6 +256,7 @@ impl Renderer {
         });
         let images = ImageSet::empty();
         let textures = texture_codegen::generate(scene, &images)?;
+        let texture_plan = textures.plan;
         let key = PipelineKey {
             features,
             code: textures.wgsl,
@@ -319,6 +325,8 @@ impl Renderer {
             warm_up: None,
             last_build: None,
             key,
+            texture_plan,
+            code_generations: 1,
             feature_override: None,
             kernel,
             compute_supported,
@@ -379,6 +387,13 @@ impl Renderer {
 
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// How many times this renderer generated texture code, its first
+    /// scene's included: structural edits and new images add one each,
+    /// parameter edits none.
+    pub fn code_generations(&self) -> u64 {
+        self.code_generations
     }
 
     /// Samples per pixel averaged so far.
