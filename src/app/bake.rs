@@ -4,6 +4,7 @@
 //! on a worker thread with its own headless device (through the same
 //! `bake_file` as `marbre bake`), so the frame never waits for it.
 
+use crate::panel::BAKE_SIZE;
 use marbre_core::bake::{BakeProperty, ObjectRef};
 use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
@@ -12,9 +13,6 @@ use marbre_render::gpu::GpuContext;
 use marbre_render::worker::{Worker, names};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
-
-/// Texels a side of a bake from the viewer (`marbre bake`'s default).
-pub const BAKE_SIZE: u32 = 1024;
 
 /// Where a bake of `object`'s `property` goes, beside `preset`: named
 /// after the preset, the object and the property, `.png` for colours and

@@ -29,7 +29,6 @@ pub mod swatches;
 mod ui_layer;
 mod viewer;
 
-pub use bake::BAKE_SIZE;
 pub use frame_budget::{DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS, parse_budget_ms};
 
 use anyhow::Result;

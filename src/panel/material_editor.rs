@@ -67,6 +67,10 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) -> Option<BakeProperty> {
     bake
 }
 
+/// Texels a side of a bake from the viewer (`marbre bake`'s default): the
+/// Bake… button says it, `app::bake` writes it.
+pub const BAKE_SIZE: u32 = 1024;
+
 /// The Bake… button of a property: whether it was pressed.
 fn bake_button(ui: &mut Ui, property: BakeProperty) -> bool {
     ui.small_button("Bake…")
@@ -74,7 +78,7 @@ fn bake_button(ui: &mut Ui, property: BakeProperty) -> bool {
             "Write this {} to an image in the object's (u, v) square, {} texels a side, beside \
              the preset (as `marbre bake` does: {}), with its mapping in a .mapping.ron beside it",
             property.name(),
-            crate::app::BAKE_SIZE,
+            BAKE_SIZE,
             if property.is_color() {
                 "sRGB PNG"
             } else {

@@ -28,6 +28,7 @@ use glam::Vec3;
 use marbre_core::scene::texture_graph::NodePath;
 use marbre_core::scene::{EnvSource, MaterialKey, Scene, Texture};
 use marbre_render::gpu::NonFiniteCounts;
+pub use material_editor::BAKE_SIZE;
 pub use quality::{QualityControls, QualityStats};
 use render_ui::{kernel_ui, render_ui};
 use scene_ui::{camera_ui, materials_ui, point_light_ui};
