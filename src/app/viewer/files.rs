@@ -237,19 +237,24 @@ impl Viewer {
     }
 
     /// Installs a whole new scene and environment, and its images if given;
-    /// on failure nothing changes.
+    /// on failure nothing changes. The scene reaches the renderer here, not
+    /// through the frame's change, so the history and the document are
+    /// told here: a preset or a map loaded is one undoable edit.
     pub(super) fn apply_scene(
         &mut self,
         scene: Scene,
         env: Option<&envmap::EnvImage>,
         images: Option<ImageSet>,
     ) -> Result<()> {
+        let change = scene.changes_from(&self.scene);
         self.renderer.set_scene(&self.ctx, &scene)?;
         if let Some(images) = images {
             self.renderer.set_images(&self.ctx, images)?;
         }
         self.renderer.set_environment(&self.ctx, env);
         self.scene = scene;
+        self.edits.history.observe(&self.scene, change, false);
+        self.edits.document.observe(&self.scene, change);
         Ok(())
     }
 
