@@ -14,7 +14,7 @@
 
 use super::Scene;
 use super::material::Material;
-use super::texture_graph::NodePath;
+use super::node_path::NodePath;
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

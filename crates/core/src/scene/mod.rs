@@ -13,6 +13,7 @@ pub mod environment;
 pub mod graph_layout;
 pub mod material;
 pub mod mesh;
+pub mod node_path;
 pub mod pattern;
 pub mod primitives;
 pub mod render_settings;

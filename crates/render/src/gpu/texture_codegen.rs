@@ -22,8 +22,9 @@ use marbre_core::scene::{
 use marbre_core::texture::{ImageFilter, ImageSet, ImageWrap};
 use std::fmt::Write;
 
-use super::texture_params::{Field, Slot, Step, Tree, pattern_params};
+use super::texture_params::{Field, Place, Slot, pattern_params};
 pub use super::texture_params::{MAX_TEXTURE_PARAMS, ParamPlan};
+use marbre_core::scene::node_path::{NodePath, Root, Socket};
 
 /// The generated code and the parameters it reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,7 +68,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
             let name = format!("texture_{index}_bump");
             generator.function(
                 &name,
-                (index, Tree::Bump),
+                (index, Root::Bump),
                 &material.bump,
                 &material.signals(),
             );
@@ -149,7 +150,8 @@ pub fn generate_swatches(textures: &[Texture], images: &ImageSet) -> Result<Gene
         let name = format!("swatch_{index}");
         generator.function(
             &name,
-            (index, Tree::Swatch),
+            // A swatch's texture is its material's diffuse (`swatch_material`).
+            (index, Root::Property(Property::Diffuse)),
             texture,
             &swatch_material(texture).signals(),
         );
@@ -206,11 +208,10 @@ struct Generator<'a> {
     params: Vec<[f32; 4]>,
     /// Where each of `params` comes from.
     slots: Vec<Slot>,
-    /// The material and tree of the function being generated, and the
-    /// steps from its root to the node being generated.
+    /// The material of the function being generated, and the path of the
+    /// node being generated.
     owner: usize,
-    tree: Tree,
-    path: Vec<Step>,
+    path: NodePath,
     /// Numbers the local variables of the function being generated.
     next: usize,
 }
@@ -223,8 +224,7 @@ impl<'a> Generator<'a> {
             params: Vec::new(),
             slots: Vec::new(),
             owner: 0,
-            tree: Tree::Material,
-            path: Vec::new(),
+            path: NodePath::root(Root::Bump),
             next: 0,
         }
     }
@@ -253,7 +253,7 @@ impl<'a> Generator<'a> {
         let mut masks = Vec::new();
         for (l, layer) in material.layers.iter().enumerate() {
             let name = format!("texture_{index}_layer{l}_mask");
-            self.function(&name, (index, Tree::LayerMask(l)), &layer.mask, &signals);
+            self.function(&name, (index, Root::Mask(l)), &layer.mask, &signals);
             masks.push(format!(
                 "            let mask{l} = clamp({name}(p, pw, uv, fp, signals).x, 0.0, 1.0);\n"
             ));
@@ -270,7 +270,7 @@ impl<'a> Generator<'a> {
         for property in Property::ALL {
             let value = property.name();
             let name = format!("texture_{index}_{value}");
-            let tree = (index, Tree::Property(property));
+            let tree = (index, Root::Property(property));
             self.function(&name, tree, material.texture(property), &signals);
             let mut statements =
                 format!("            var {value} = {name}(p, pw, uv, fp, signals);\n");
@@ -278,7 +278,7 @@ impl<'a> Generator<'a> {
             for (l, layer) in material.layers.iter().enumerate() {
                 if let Some(texture) = layer.texture(property) {
                     let name = format!("texture_{index}_layer{l}_{value}");
-                    let tree = (index, Tree::LayerProperty(l, property));
+                    let tree = (index, Root::Layer(l, property));
                     self.function(&name, tree, texture, &signals);
                     let _ = writeln!(
                         statements,
@@ -316,17 +316,17 @@ impl<'a> Generator<'a> {
         cases
     }
 
-    /// Generates function `name` evaluating `texture`, tree `tree` of
-    /// material (or swatch) `owner`.
+    /// Generates function `name` evaluating `texture`, the tree at `root`
+    /// of material (or swatch) `owner`.
     fn function(
         &mut self,
         name: &str,
-        (owner, tree): (usize, Tree),
+        (owner, root): (usize, Root),
         texture: &Texture,
         signals: &[Signal],
     ) {
-        (self.owner, self.tree) = (owner, tree);
-        self.path.clear();
+        self.owner = owner;
+        self.path = NodePath::root(root);
         self.next = 0;
         let mut body = String::new();
         let site = Site {
@@ -348,60 +348,57 @@ impl<'a> Generator<'a> {
         let value = field
             .value(node, self.images)
             .expect("the generator reads only the numbers a node has");
-        self.push(value, field)
+        self.push(value, Place::Node(self.path.clone(), field))
     }
 
     /// The slot of material `owner`'s emission strength.
     fn emission_strength_slot(&mut self, owner: usize, material: &Material) -> String {
-        (self.owner, self.tree) = (owner, Tree::Material);
-        self.path.clear();
+        self.owner = owner;
         self.push(
             [material.emission_strength, 0.0, 0.0, 0.0],
-            Field::EmissionStrength,
+            Place::EmissionStrength,
         )
     }
 
-    fn push(&mut self, value: [f32; 4], field: Field) -> String {
+    fn push(&mut self, value: [f32; 4], place: Place) -> String {
         self.params.push(value);
         self.slots.push(Slot {
             owner: self.owner,
-            tree: self.tree,
-            path: self.path.as_slice().into(),
-            field,
+            place,
         });
         format!("texture_params[{}]", self.params.len() - 1)
     }
 
-    /// `node`'s child `child`, reached by `step` (`a` or `b`): a
-    /// constant's slot, or the nested texture's statements.
+    /// `node`'s child `child`, in its socket `a` or `b`: a constant's
+    /// slot, or the nested texture's statements.
     fn child(
         &mut self,
         node: &Texture,
-        (step, child): (Step, &Child),
+        (socket, child): (Socket, &Child),
         site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
         match child {
             Child::Scalar(_) | Child::Color(_) => {
-                format!("{}.xyz", self.slot(node, Field::Constant(step)))
+                format!("{}.xyz", self.slot(node, Field::Constant(socket)))
             }
-            Child::Texture(t) => self.nested(t, step, site, signals, body),
+            Child::Texture(t) => self.nested(t, socket, site, signals, body),
         }
     }
 
-    /// [`Generator::texture`] of a node one `step` below the current one.
+    /// [`Generator::texture`] of the node in the current one's `socket`.
     fn nested(
         &mut self,
         texture: &Texture,
-        step: Step,
+        socket: Socket,
         site: &Site,
         signals: &[Signal],
         body: &mut String,
     ) -> String {
-        self.path.push(step);
+        self.path.steps.push(socket);
         let value = self.texture(texture, site, signals, body);
-        self.path.pop();
+        self.path.steps.pop();
         value
     }
 
@@ -544,7 +541,7 @@ impl<'a> Generator<'a> {
         body: &mut String,
     ) -> String {
         if texture.pattern == Pattern::Constant && texture.ramp.is_empty() {
-            return self.child(texture, (Step::A, &texture.a), site, signals, body);
+            return self.child(texture, (Socket::A, &texture.a), site, signals, body);
         }
         if let Pattern::Image { filter, wrap } = texture.pattern {
             return self.image(texture, k, filter, wrap, site, body);
@@ -580,7 +577,7 @@ impl<'a> Generator<'a> {
             Pattern::Image { .. } => unreachable!("image nodes are generated by `image`"),
             Pattern::Mix => match &texture.factor {
                 Some(factor) => {
-                    let f = self.nested(factor, Step::Factor, site, signals, body);
+                    let f = self.nested(factor, Socket::Factor, site, signals, body);
                     format!("clamp({f}.x, 0.0, 1.0)")
                 }
                 None => "0.0".to_string(),
@@ -630,8 +627,8 @@ impl<'a> Generator<'a> {
             footprint: child_footprint,
             ..site.clone()
         };
-        let a = self.child(texture, (Step::A, &texture.a), &child_site, signals, body);
-        let b = self.child(texture, (Step::B, &texture.b), &child_site, signals, body);
+        let a = self.child(texture, (Socket::A, &texture.a), &child_site, signals, body);
+        let b = self.child(texture, (Socket::B, &texture.b), &child_site, signals, body);
         let _ = writeln!(body, "    let v{k} = mix({a}, {b}, t{k});");
         format!("v{k}")
     }

@@ -2,8 +2,9 @@
 //!
 //! `texture_codegen` fixes a scene's texture structure in WGSL and reads
 //! every number from the `texture_params` uniform at a constant index. As
-//! it generates, it records for each slot the node it reads and which of
-//! its numbers ([`Slot`]): a [`ParamPlan`]. A parameter edit (an octave
+//! it generates, it records for each slot the node it reads (by its
+//! `NodePath`, the name the node editor uses too) and which of its numbers
+//! ([`Slot`]): a [`ParamPlan`]. A parameter edit (an octave
 //! count, a colour; `Change::MATERIAL_PARAMETERS`) keeps the structure, so
 //! the plan of the code in place fills the buffer from the edited scene
 //! ([`ParamPlan::evaluate`]) and no code is generated, hashed or compared.
@@ -12,57 +13,15 @@
 //! the plan alike: the two cannot disagree on a value, and the order is the
 //! generator's own.
 
+use marbre_core::scene::node_path::{NodePath, Socket};
+use marbre_core::scene::texture_graph::texture_at;
 use marbre_core::scene::texture_tree::IMAGE_UNAVAILABLE;
-use marbre_core::scene::{Child, Material, Pattern, Property, Scene, Texture};
+use marbre_core::scene::{Child, Material, Pattern, Scene, Texture};
 use marbre_core::texture::ImageSet;
 
 /// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
 /// crates/render/shaders/scene.wgsl): 16 KiB.
 pub const MAX_TEXTURE_PARAMS: usize = 1024;
-
-/// Which tree of a material a slot's node lies in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Tree {
-    Property(Property),
-    LayerMask(usize),
-    LayerProperty(usize, Property),
-    Bump,
-    /// A swatch's texture (`generate_swatches`): not a scene's, so a plan
-    /// holding one is not evaluated against a scene.
-    Swatch,
-    /// The material itself (its emission strength).
-    Material,
-}
-
-impl Tree {
-    fn root(self, material: &Material) -> Option<&Texture> {
-        match self {
-            Tree::Property(p) => Some(material.texture(p)),
-            Tree::LayerMask(l) => material.layers.get(l).map(|l| &l.mask),
-            Tree::LayerProperty(l, p) => material.layers.get(l)?.texture(p),
-            Tree::Bump => Some(&material.bump),
-            Tree::Swatch | Tree::Material => None,
-        }
-    }
-}
-
-/// A step from a texture node to a nested one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Step {
-    A,
-    B,
-    Factor,
-}
-
-impl Step {
-    fn subtree(self, node: &Texture) -> Option<&Texture> {
-        match self {
-            Step::A => node.a.texture(),
-            Step::B => node.b.texture(),
-            Step::Factor => node.factor.as_deref(),
-        }
-    }
-}
 
 /// Which number of a node a slot holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -76,7 +35,7 @@ pub(crate) enum Field {
     /// The pattern's own numbers ([`pattern_params`]).
     Pattern,
     /// The constant child `a` or `b`.
-    Constant(Step),
+    Constant(Socket),
     /// Ramp stop `i`: its colour and position.
     RampStop(usize),
     /// Where its image lies in the atlas.
@@ -85,8 +44,6 @@ pub(crate) enum Field {
     ImageUnavailable,
     /// Math step `i`'s numbers.
     Op(usize),
-    /// The material's emission strength.
-    EmissionStrength,
 }
 
 impl Field {
@@ -102,10 +59,10 @@ impl Field {
                 Some([u, v, w, 0.0])
             }
             Field::Pattern => pattern_params(&node.pattern),
-            Field::Constant(step) => match step {
-                Step::A => constant(&node.a),
-                Step::B => constant(&node.b),
-                Step::Factor => None,
+            Field::Constant(socket) => match socket {
+                Socket::A => constant(&node.a),
+                Socket::B => constant(&node.b),
+                Socket::Factor => None,
             },
             Field::RampStop(i) => node
                 .ramp
@@ -117,7 +74,6 @@ impl Field {
                 Some([c.x, c.y, c.z, 0.0])
             }
             Field::Op(i) => node.ops.get(i).map(|op| op.params()),
-            Field::EmissionStrength => None,
         }
     }
 }
@@ -176,14 +132,22 @@ pub(crate) fn pattern_params(pattern: &Pattern) -> Option<[f32; 4]> {
     })
 }
 
-/// One slot of `texture_params`: the node of material `owner`'s `tree`
-/// reached by `path`, and which of its numbers.
+/// Where in a material a slot's number lies.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Place {
+    /// A number of the texture node at the path.
+    Node(NodePath, Field),
+    /// The material's emission strength.
+    EmissionStrength,
+}
+
+/// One slot of `texture_params`: a number of material `owner` (in
+/// `Scene::materials` order; a swatch's index for swatches, whose texture
+/// is their material's diffuse).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Slot {
     pub(crate) owner: usize,
-    pub(crate) tree: Tree,
-    pub(crate) path: Box<[Step]>,
-    pub(crate) field: Field,
+    pub(crate) place: Place,
 }
 
 /// The slots of generated texture code, in order.
@@ -202,15 +166,9 @@ impl ParamPlan {
         let mut params = Vec::with_capacity(MAX_TEXTURE_PARAMS);
         for slot in &self.slots {
             let material = materials.get(slot.owner)?;
-            let value = match slot.tree {
-                Tree::Material => [material.emission_strength, 0.0, 0.0, 0.0],
-                tree => {
-                    let mut node = tree.root(material)?;
-                    for step in &slot.path {
-                        node = step.subtree(node)?;
-                    }
-                    slot.field.value(node, images)?
-                }
+            let value = match &slot.place {
+                Place::EmissionStrength => [material.emission_strength, 0.0, 0.0, 0.0],
+                Place::Node(path, field) => field.value(texture_at(material, path)?, images)?,
             };
             params.push(value);
         }
