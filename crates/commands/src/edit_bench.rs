@@ -102,7 +102,6 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
     println!("adapter: {}", ctx.describe());
     println!("preset: {}", args.preset.display());
     let mut scene = loaded.scene.clone();
-    let mut previous = scene.clone();
     let drags: Vec<Drag> = Drag::ALL
         .into_iter()
         .filter(|d| d.apply(&mut scene.clone(), 0))
@@ -112,7 +111,7 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
         for (k, drag) in drags.iter().enumerate() {
             drag.apply(&mut scene, i + 1);
             let start = Instant::now();
-            hand_over(&ctx, &mut renderer, &scene, &mut previous)?;
+            hand_over(&ctx, &mut renderer, &scene)?;
             times[k].push(start.elapsed().as_secs_f64() * 1e6);
         }
     }
@@ -130,19 +129,12 @@ pub fn run(args: &EditBenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// What the viewer does with an edited scene each frame: works out what
-/// changed since the frame before, once, and hands it on.
-fn hand_over(
-    ctx: &GpuContext,
-    renderer: &mut Renderer,
-    scene: &Scene,
-    previous: &mut Scene,
-) -> Result<()> {
-    let change = scene.changes_from(previous);
-    if !change.is_empty() {
-        renderer.request_scene(ctx, scene, change)?;
-        previous.clone_from(scene);
-    }
+/// What the viewer does with an edited scene each frame
+/// (`app/viewer/frame.rs`): works out what changed since the scene the
+/// renderer was last asked to draw, once, and hands it on.
+fn hand_over(ctx: &GpuContext, renderer: &mut Renderer, scene: &Scene) -> Result<()> {
+    let change = scene.changes_from(renderer.requested_scene());
+    renderer.request_scene(ctx, scene, change)?;
     if let Some(result) = renderer.poll_build(ctx) {
         result?;
     }
