@@ -31,6 +31,8 @@ pub mod texture_codegen;
 pub mod texture_params;
 pub mod trace_bands;
 pub mod trace_pass;
+#[cfg(test)]
+pub(crate) mod twin_layout;
 
 pub use context::GpuContext;
 pub use features::{Feature, FeatureSet};

@@ -386,19 +386,8 @@ mod tests {
     use glam::Vec3;
     use marbre_core::scene::{Pattern, Texture};
 
-    #[test]
-    fn struct_sizes_match_the_wgsl_layout() {
-        // Sizes computed by hand from crates/render/shaders/scene.wgsl's alignment rules.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 272);
-        assert_eq!(std::mem::size_of::<CylinderGpu>(), 32);
-        assert_eq!(std::mem::size_of::<PolygonGpu>(), 192);
-        assert_eq!(std::mem::size_of::<NoiseParamsGpu>(), 48);
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 400);
-        assert_eq!(std::mem::size_of::<SphereGpu>(), 16);
-    }
-
-    /// The element count of a uniform array global in the trace shader.
-    fn wgsl_array_len(name: &str) -> u32 {
+    /// The uber trace shader, parsed: every struct and global it may hold.
+    fn trace_module() -> naga::Module {
         let generated = crate::gpu::texture_codegen::generate(
             &Scene::default(),
             &marbre_core::texture::ImageSet::empty(),
@@ -410,7 +399,42 @@ mod tests {
             &generated.wgsl,
         )
         .unwrap();
-        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        naga::front::wgsl::parse_str(&source).unwrap()
+    }
+
+    /// Each struct uploaded to the trace shader has its WGSL twin's layout,
+    /// as naga lays the WGSL out (no size computed by hand).
+    #[test]
+    fn structs_have_their_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::twin_layout;
+        let module = &trace_module();
+        twin_layout!(module, FrameUniform => "Frame", [
+            cam_pos, tan_half_fov, cam_right, aspect, cam_up, frame_index, cam_forward,
+            accumulated, light_pos, env_intensity, light_power, env_rotation, env_constant,
+            background_visible, ground_height, sphere_count, samples_per_frame, max_bounces,
+            render_size, env_kind, has_ground, cylinder_count, polygon_count, pixel_spread,
+            env_sampling, env_distribution_size, light_count, light_selection,
+            light_total_power, light_samples, strategy, russian_roulette_from, triangle_count,
+            opaque_one, sample_clamp, band_start, band_end, view, light_points, depth_scale,
+            ground_uv_origin, ground_uv_u, ground_uv_v,
+        ]);
+        twin_layout!(module, NoiseParamsGpu => "NoiseParams", [
+            kind, hash, octaves, frequency, amplitude, persistence, lacunarity, shape,
+            distortion, world, footprint_scale, progression,
+        ]);
+        twin_layout!(module, MaterialGpu => "Material", [
+            signals, signal_rows, signal_count, first_perlin, bump_height, emitted_luminance,
+        ]);
+        twin_layout!(module, CylinderGpu => "Cylinder", [base, radius, height]);
+        twin_layout!(module, PolygonGpu => "Polygon", [
+            vertices, normal, vertex_count, uv_origin, uv_u, uv_v,
+        ]);
+        twin_layout!(module, SphereGpu => "Sphere", [center, radius]);
+    }
+
+    /// The element count of a uniform array global in the trace shader.
+    fn wgsl_array_len(name: &str) -> u32 {
+        let module = trace_module();
         let (_, global) = module
             .global_variables
             .iter()

@@ -269,29 +269,17 @@ mod tests {
     use crate::gpu::shader_source::assemble;
 
     /// naga accepts the harness (no GPU needed), and the WGSL structs have
-    /// the sizes of their Rust twins.
+    /// the layouts of their Rust twins.
     #[test]
     fn the_harness_wgsl_validates() {
+        use crate::gpu::twin_layout::twin_layout;
         let source = assemble(Program::BvhHarness, &FeatureSet::default(), "").unwrap();
         validate(&source).unwrap();
-        let module = naga::front::wgsl::parse_str(&source).unwrap();
-        let size = |name: &str| {
-            let layouter = {
-                let mut l = naga::proc::Layouter::default();
-                l.update(module.to_ctx()).unwrap();
-                l
-            };
-            let (handle, _) = module
-                .types
-                .iter()
-                .find(|(_, t)| t.name.as_deref() == Some(name))
-                .unwrap();
-            layouter[handle].size as usize
-        };
-        assert_eq!(size("BvhNode"), std::mem::size_of::<BvhNode>());
-        assert_eq!(size("TriangleVerts"), std::mem::size_of::<TriangleVerts>());
-        assert_eq!(size("HarnessRay"), std::mem::size_of::<GpuRay>());
-        assert_eq!(size("BvhHarness"), std::mem::size_of::<HarnessUniform>());
+        let module = &naga::front::wgsl::parse_str(&source).unwrap();
+        twin_layout!(module, BvhNode => "BvhNode", [min, a, max, count]);
+        twin_layout!(module, TriangleVerts => "TriangleVerts", [v0, v1, v2]);
+        twin_layout!(module, GpuRay => "HarnessRay", [origin, direction]);
+        twin_layout!(module, HarnessUniform => "BvhHarness", [count, row_pitch]);
     }
 
     /// The shader's constants are the CPU traversal's.

@@ -1,0 +1,51 @@
+//! Checks a `Pod` struct against its WGSL twin from naga's own layout,
+//! for the tests: the same size, and every WGSL member at the offset of
+//! the Rust field of its name (fields named `_…` are padding, on either
+//! side; the size covers them). Nothing is computed by hand, so a field added on
+//! one side only, or moved, fails the test that names both structs.
+
+/// Asserts the twin layout: `twin_layout!(module, RustType => "WgslName",
+/// [field, …])`, listing every Rust field but the padding.
+macro_rules! twin_layout {
+    ($module:expr, $rust:ty => $wgsl:expr, [$($field:ident),* $(,)?]) => {
+        $crate::gpu::twin_layout::check(
+            $module,
+            $wgsl,
+            stringify!($rust),
+            std::mem::size_of::<$rust>(),
+            &[$((stringify!($field), std::mem::offset_of!($rust, $field))),*],
+        )
+    };
+}
+pub(crate) use twin_layout;
+
+/// The body of [`twin_layout!`].
+pub(crate) fn check(
+    module: &naga::Module,
+    wgsl: &str,
+    rust: &str,
+    rust_size: usize,
+    fields: &[(&str, usize)],
+) {
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(wgsl))
+        .unwrap_or_else(|| panic!("no WGSL struct {wgsl} (twin of {rust})"));
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        panic!("WGSL {wgsl} is not a struct");
+    };
+    assert_eq!(
+        *span as usize, rust_size,
+        "size of WGSL {wgsl} and Rust {rust}"
+    );
+    let wgsl_fields: Vec<(&str, usize)> = members
+        .iter()
+        .map(|m| (m.name.as_deref().unwrap_or("?"), m.offset as usize))
+        .filter(|(name, _)| !name.starts_with('_'))
+        .collect();
+    assert_eq!(
+        wgsl_fields, fields,
+        "fields and offsets of WGSL {wgsl} against Rust {rust}"
+    );
+}
