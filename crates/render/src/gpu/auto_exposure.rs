@@ -300,6 +300,24 @@ mod tests {
         (a - b).abs() / b.abs()
     }
 
+    /// The metered result and the metering grid have their WGSL twins'
+    /// layouts, as naga lays them out.
+    #[test]
+    fn structs_have_their_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::twin_layout;
+        let source = crate::gpu::shader_source::assemble(
+            crate::gpu::shader_source::Program::AutoExposure,
+            &crate::gpu::FeatureSet::default(),
+            "",
+        )
+        .unwrap();
+        let module = &naga::front::wgsl::parse_str(&source).unwrap();
+        twin_layout!(module, Metered => "Metered", [
+            log_average, stops, scale, count, rms, rms_stops, rms_scale, padding,
+        ]);
+        twin_layout!(module, MeteringGrid => "MeteringGrid", [region, grid]);
+    }
+
     #[test]
     fn log_average_of_a_constant_image_is_its_luminance() {
         for l in [0.0, 0.05, 0.18, 1.0, 50.0, 1e4] {

@@ -314,6 +314,26 @@ impl ErrorMeter {
 mod tests {
     use super::*;
 
+    /// The parameters and sums have their WGSL twins' layouts, as naga
+    /// lays them out.
+    #[test]
+    fn structs_have_their_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::twin_layout;
+        let source = crate::gpu::shader_source::assemble(
+            crate::gpu::shader_source::Program::ErrorMeter,
+            &crate::gpu::FeatureSet::default(),
+            "",
+        )
+        .unwrap();
+        let module = &naga::front::wgsl::parse_str(&source).unwrap();
+        twin_layout!(module, ErrorParams => "ErrorParams", [
+            grid, frames, samples, seconds, generation,
+        ]);
+        twin_layout!(module, ErrorSums => "ErrorSums", [
+            spread, relative_spread, channels, frames, samples, seconds, generation,
+        ]);
+    }
+
     #[test]
     fn one_frame_has_no_estimate_and_two_do() {
         let mean = vec![[0.5_f32; 4]; 4];

@@ -402,8 +402,9 @@ mod tests {
         naga::front::wgsl::parse_str(&source).unwrap()
     }
 
-    /// Each struct uploaded to the trace shader has its WGSL twin's layout,
-    /// as naga lays the WGSL out (no size computed by hand).
+    /// Each struct uploaded to the trace shader (the scene's, the light
+    /// table's, the meshes') has its WGSL twin's layout, as naga lays the
+    /// WGSL out (no size computed by hand).
     #[test]
     fn structs_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::twin_layout;
@@ -430,6 +431,15 @@ mod tests {
             vertices, normal, vertex_count, uv_origin, uv_u, uv_v,
         ]);
         twin_layout!(module, SphereGpu => "Sphere", [center, radius]);
+        use crate::gpu::mesh_buffers::TriangleAttributesGpu;
+        use marbre_core::accel::{BvhNode, TriangleVerts};
+        use marbre_core::lights::LightGpu;
+        twin_layout!(module, LightGpu => "Light", [kind, primitive, cdf, power]);
+        twin_layout!(module, TriangleAttributesGpu => "TriangleAttributes", [
+            uv01, uv2, material,
+        ]);
+        twin_layout!(module, BvhNode => "BvhNode", [min, a, max, count]);
+        twin_layout!(module, TriangleVerts => "TriangleVerts", [v0, v1, v2]);
     }
 
     /// The element count of a uniform array global in the trace shader.

@@ -144,6 +144,9 @@ mod tests {
         let source = assemble(Program::GeometryHarness, &FeatureSet::default(), "").unwrap();
         validate(&source).unwrap();
         let module = naga::front::wgsl::parse_str(&source).unwrap();
+        crate::gpu::twin_layout::twin_layout!(&module, HarnessUniform => "GeometryHarness", [
+            mode, count,
+        ]);
         let constant = |name: &str| {
             let (_, c) = module
                 .constants
