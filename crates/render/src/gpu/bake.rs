@@ -175,3 +175,23 @@ pub fn bake(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bake's settings and texels have its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_settings_and_texels_have_their_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(
+            Program::Bake,
+            &FeatureSet::default(),
+            &texture_codegen::generate(&Scene::default(), &ImageSet::empty())
+                .unwrap()
+                .wgsl,
+        );
+        twin_layout!(module, BakeSettings => "BakeSettings", [count, property]);
+        twin_layout!(module, TexelGpu => "BakeTexel", [p, material, pw, uv]);
+    }
+}

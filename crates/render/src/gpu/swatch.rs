@@ -240,3 +240,26 @@ pub fn to_srgba8(pixel: [f32; 4]) -> [u8; 4] {
         byte(clean(pixel[3])),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A swatch batch and its points have its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_batch_has_its_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(
+            Program::Swatch,
+            &FeatureSet::default(),
+            &crate::gpu::texture_codegen::generate_swatches(
+                &[],
+                &marbre_core::texture::ImageSet::empty(),
+            )
+            .unwrap()
+            .wgsl,
+        );
+        twin_layout!(module, SwatchPointGpu => "SwatchPoint", [p, uv]);
+        twin_layout!(module, SwatchBatchGpu => "SwatchBatch", [points, swatches]);
+    }
+}

@@ -13,6 +13,10 @@ struct SwatchPoint {
 struct SwatchBatch {
     points: u32,
     swatches: u32,
+    // A uniform's size rounds up to 16 bytes: the padding is spelled out,
+    // as in its Rust twin.
+    _pad0: u32,
+    _pad1: u32,
 }
 
 @group(0) @binding(16) var<uniform> swatch_batch: SwatchBatch;

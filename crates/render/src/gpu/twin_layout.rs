@@ -49,3 +49,13 @@ pub(crate) fn check(
         "fields and offsets of WGSL {wgsl} against Rust {rust}"
     );
 }
+
+/// `program` assembled with `features` and generated `code`, parsed.
+pub(crate) fn module_of(
+    program: crate::gpu::shader_source::Program,
+    features: &crate::gpu::FeatureSet,
+    code: &str,
+) -> naga::Module {
+    let source = crate::gpu::shader_source::assemble(program, features, code).unwrap();
+    naga::front::wgsl::parse_str(&source).unwrap()
+}

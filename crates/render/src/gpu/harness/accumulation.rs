@@ -150,3 +150,17 @@ pub fn run(
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harness uniform and a stream have its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_uniform_and_stream_have_their_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(Program::AccumulationHarness, &FeatureSet::default(), "");
+        twin_layout!(module, HarnessUniform => "AccumulationHarness", [first_frame, frames, spp, one]);
+        twin_layout!(module, StreamState => "Stream", [seed, values]);
+    }
+}

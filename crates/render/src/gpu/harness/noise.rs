@@ -111,3 +111,20 @@ pub fn env_uv(ctx: &GpuContext, directions: &[Vec3]) -> Result<Vec<Vec2>> {
             .collect(),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harness uniform has its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_uniform_has_its_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(
+            Program::NoiseHarness,
+            &FeatureSet::for_noise_harness(&Default::default()),
+            "",
+        );
+        twin_layout!(module, HarnessUniform => "Harness", [noise, mode, count, param]);
+    }
+}

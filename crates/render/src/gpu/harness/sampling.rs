@@ -340,3 +340,20 @@ impl SamplingHarness {
 fn points(directions: &[Vec3]) -> Vec<[f32; 4]> {
     directions.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harness frame has its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_frame_has_its_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(
+            Program::SamplingHarness,
+            &FeatureSet([Feature::EnvMap].into_iter().collect()),
+            "",
+        );
+        twin_layout!(module, SamplingFrame => "SamplingFrame", [env_constant, env_intensity, env_distribution_size, env_rotation, env_kind, strategy, mode, count, alpha, diffuse, mirror, specular, uniform_diffuse, normal, wo, diffuse_transmission]);
+    }
+}

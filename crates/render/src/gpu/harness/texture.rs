@@ -320,3 +320,20 @@ pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Resu
         points,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harness uniform has its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_uniform_has_its_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(
+            Program::TextureHarness,
+            &FeatureSet::for_texture_library(&Default::default()),
+            "",
+        );
+        twin_layout!(module, HarnessUniform => "TextureHarness", [noise, mode, count, sides, a, b, c, stops]);
+    }
+}

@@ -489,3 +489,16 @@ fn upload_env(ctx: &GpuContext, env: Option<&EnvImage>) -> wgpu::TextureView {
         bytemuck::cast_slice(&image.to_rgba16f()),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The display uniform has its WGSL twin's layout, as naga lays it out.
+    #[test]
+    fn the_display_uniform_has_its_wgsl_twins_layout() {
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(Program::Display, &FeatureSet::default(), "");
+        twin_layout!(module, DisplayUniform => "Display", [exposure_scale, tone_map, encode_srgb, auto_exposure, origin, scale, show_non_finite, padding]);
+    }
+}
