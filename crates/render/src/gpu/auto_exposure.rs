@@ -304,14 +304,8 @@ mod tests {
     /// layouts, as naga lays them out.
     #[test]
     fn structs_have_their_wgsl_twins_layout() {
-        use crate::gpu::twin_layout::twin_layout;
-        let source = crate::gpu::shader_source::assemble(
-            crate::gpu::shader_source::Program::AutoExposure,
-            &crate::gpu::FeatureSet::default(),
-            "",
-        )
-        .unwrap();
-        let module = &naga::front::wgsl::parse_str(&source).unwrap();
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(Program::AutoExposure, &FeatureSet::default(), "");
         twin_layout!(module, Metered => "Metered", [
             log_average, stops, scale, count, rms, rms_stops, rms_scale, padding,
         ]);

@@ -318,14 +318,8 @@ mod tests {
     /// lays them out.
     #[test]
     fn structs_have_their_wgsl_twins_layout() {
-        use crate::gpu::twin_layout::twin_layout;
-        let source = crate::gpu::shader_source::assemble(
-            crate::gpu::shader_source::Program::ErrorMeter,
-            &crate::gpu::FeatureSet::default(),
-            "",
-        )
-        .unwrap();
-        let module = &naga::front::wgsl::parse_str(&source).unwrap();
+        use crate::gpu::twin_layout::{module_of, twin_layout};
+        let module = &module_of(Program::ErrorMeter, &FeatureSet::default(), "");
         twin_layout!(module, ErrorParams => "ErrorParams", [
             grid, frames, samples, seconds, generation,
         ]);
