@@ -10,8 +10,8 @@ use glam::Vec3;
 use marbre_core::bake::BakeProperty;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_core::scene::{
-    Child, Layer, MappingSpace, Material, MathOp, Pattern, Property, Texture, TextureMapping,
-    UvFrame,
+    Child, Layer, MappingSpace, Material, MathOp, PATTERNS, Pattern, PatternKind, Property,
+    Texture, TextureMapping, UvFrame,
 };
 use marbre_core::texture::{
     ColorSpace, ImageFilter, ImageSource, ImageWrap, MAX_RAMP_STOPS, RampStop,
@@ -597,18 +597,26 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
 
 /// The pattern dropdown and the chosen pattern's parameters.
 pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
-    let mut index = texture.pattern.index();
+    let kind = texture.pattern.kind();
+    let mut index = kind as usize;
     ComboBox::new("pattern", "pattern")
-        .show_index(ui, &mut index, Pattern::NAMES.len(), |i| Pattern::NAMES[i])
-        .on_hover_text("What blends between the two values across the surface");
-    if index != texture.pattern.index() {
-        // `with_index` carries the noise settings over, so tuning survives
+        .show_index(ui, &mut index, PATTERNS.len(), |i| PATTERNS[i].name)
+        .on_hover_text(match kind.info().tx_keyword {
+            Some(keyword) => {
+                format!("What blends between the two values across the surface (TX: {keyword})")
+            }
+            None => "What blends between the two values across the surface".to_string(),
+        });
+    if let Some(chosen) = PatternKind::from_index(index)
+        && chosen != kind
+    {
+        // `with_kind` carries the noise settings over, so tuning survives
         // (Massal's marble takes his recipe instead); a constant's one value
         // gets a contrasting second side, so the new pattern shows.
-        *texture = texture.with_pattern_contrasting(texture.pattern.with_index(index));
+        *texture = texture.with_pattern_contrasting(texture.pattern.with_kind(chosen));
     }
     match &mut texture.pattern {
-        Pattern::Constant => {}
+        Pattern::Constant | Pattern::Diagonal => {}
         Pattern::Checker { size } => {
             ui.add(slider(size, 0.01..=10.0, "cube size").logarithmic(true))
                 .on_hover_text("Side of the checkerboard's cubes, in scene units");

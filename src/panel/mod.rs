@@ -550,7 +550,9 @@ mod tests {
                     generation: 0,
                 }),
                 passes: vec![("trace", Some(3.5)), ("display", None)],
-                scene_features: vec![marbre_render::gpu::Feature::PatternCutout],
+                scene_features: vec![marbre_render::gpu::Feature::Pattern(
+                    marbre_core::scene::PatternKind::Cutout,
+                )],
                 with_all_ms: Some(3.5),
                 without_ms: vec![Some(3.1)],
                 ..QualityStats::default()

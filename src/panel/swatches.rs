@@ -132,8 +132,10 @@ mod tests {
         let book = SharedSwatchBook::default();
         install(&ctx, book.clone());
         let id = Id::NULL.with("node");
-        let mut t = Texture::color(Vec3::splat(0.5))
-            .with_pattern_contrasting(Pattern::Constant.with_index(1));
+        let mut t = Texture::color(Vec3::splat(0.5)).with_pattern_contrasting(Pattern::fresh(
+            marbre_core::scene::PatternKind::Checker,
+            None,
+        ));
         assert_eq!(swatch(&ctx, id, &t, false), None);
         let sent = book.lock().unwrap().take_requests(8);
         assert_eq!(sent.len(), 1);

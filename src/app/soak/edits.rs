@@ -14,8 +14,8 @@ use super::rng::Pcg32;
 use glam::{Vec2, Vec3};
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, Progression};
 use marbre_core::scene::{
-    Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Metering, Pattern, RenderSettings,
-    Scene, Sphere, Texture, ToneMap,
+    Child, EnvSource, MAX_MATERIALS, MAX_SPHERES, Material, Metering, Pattern, PatternKind,
+    RenderSettings, Scene, Sphere, Texture, ToneMap,
 };
 
 /// The structural edits: each changes what the shader is built from.
@@ -55,10 +55,6 @@ impl Structural {
 
 /// The name of the sphere the soak adds, so that it removes only its own.
 const SOAK_SPHERE: &str = "soak sphere";
-
-/// The panel's pattern dropdown, without the image pattern (index 14,
-/// which needs a file).
-const PATTERNS: usize = 15;
 
 /// Changes one value somewhere in the scene, as a slider drag would; false
 /// when the drawn edit would not have survived sanitising (nothing changed).
@@ -118,7 +114,9 @@ pub fn structural_edit(
             m.visit_textures_mut(&mut |t| noisy += usize::from(t.pattern.noise().is_some()));
             if noisy == 0 {
                 // Nothing to switch yet: bring a noise in.
-                edit_random_texture(rng, m, |_, t| t.pattern = t.pattern.with_index(2));
+                edit_random_texture(rng, m, |_, t| {
+                    t.pattern = t.pattern.with_kind(PatternKind::Fbm)
+                });
                 return;
             }
             let mut k = rng.below(noisy);
@@ -289,7 +287,7 @@ fn edit_pattern_parameter(rng: &mut Pcg32, pattern: &mut Pattern) {
         Pattern::Fbm { noise } | Pattern::Turbulence { noise } | Pattern::Ridged { noise } => {
             edit_fractal(rng, &mut noise.fractal)
         }
-        Pattern::Constant | Pattern::Mix | Pattern::Image { .. } => {}
+        Pattern::Constant | Pattern::Mix | Pattern::Image { .. } | Pattern::Diagonal => {}
     }
 }
 
@@ -335,11 +333,11 @@ fn edit_render_settings(rng: &mut Pcg32, render: &mut RenderSettings) {
 /// the noise settings as the panel does; a mix gets the factor it needs,
 /// and any other pattern loses it.
 fn switch_pattern(rng: &mut Pcg32, texture: &mut Texture) {
-    let index = match rng.below(PATTERNS) {
-        14 => 15,
-        i => i,
-    };
-    texture.pattern = texture.pattern.with_index(index);
+    // The panel's list without the image pattern, which needs a file.
+    let kinds: Vec<PatternKind> = PatternKind::all()
+        .filter(|&k| k != PatternKind::Image)
+        .collect();
+    texture.pattern = texture.pattern.with_kind(kinds[rng.below(kinds.len())]);
     texture.factor = match texture.pattern {
         Pattern::Mix => Some(Box::new(Texture::scalar(rng.unit()))),
         _ => None,

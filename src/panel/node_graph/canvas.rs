@@ -330,10 +330,8 @@ fn texture_node(
                     ui.image((swatch, Vec2::splat(32.0)));
                 }
                 ui.add(
-                    Label::new(
-                        egui::RichText::new(Pattern::NAMES[texture.pattern.index()]).strong(),
-                    )
-                    .selectable(false),
+                    Label::new(egui::RichText::new(texture.pattern.info().name).strong())
+                        .selectable(false),
                 )
                 .on_hover_text(path.to_string());
             })

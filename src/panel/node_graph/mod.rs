@@ -93,7 +93,11 @@ mod tests {
             Vec3::Z.into(),
         );
         sphere.material.roughness = Texture::mix(
-            Texture::blend(Pattern::Constant.with_index(2), 0.0, 1.0),
+            Texture::blend(
+                Pattern::fresh(marbre_core::scene::PatternKind::Fbm, None),
+                0.0,
+                1.0,
+            ),
             0.2,
             0.8,
         );

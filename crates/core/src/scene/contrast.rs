@@ -4,6 +4,7 @@
 //! both sides took the old value and the switch looked broken (issue 21).
 
 use super::pattern::Pattern;
+use super::pattern_table::PatternKind;
 use super::texture_tree::{Child, Texture};
 use crate::texture::luminance;
 use glam::{Vec2, Vec3};
@@ -56,7 +57,7 @@ impl Texture {
         }
         if pattern == Pattern::Mix && t.factor.is_none() {
             t.factor = Some(Box::new(Texture::blend(
-                Pattern::Constant.with_index(2),
+                Pattern::fresh(PatternKind::Fbm, None),
                 0.0,
                 1.0,
             )));
@@ -117,15 +118,15 @@ mod tests {
             Texture::color(Vec3::splat(0.5)),
             Texture::scalar(0.1),
         ] {
-            for i in 1..Pattern::NAMES.len() {
-                let t = old.with_pattern_contrasting(old.pattern.with_index(i));
-                assert_eq!(t.pattern.index(), i);
-                assert_eq!(t.a, old.a, "{}: a keeps the old value", Pattern::NAMES[i]);
+            for kind in PatternKind::all().skip(1) {
+                let t = old.with_pattern_contrasting(old.pattern.with_kind(kind));
+                assert_eq!(t.pattern.kind(), kind);
+                assert_eq!(t.a, old.a, "{}: a keeps the old value", kind.info().name);
                 let difference = (side_luminance(&t.a) - side_luminance(&t.b)).abs();
                 assert!(
                     difference >= MIN_CONTRAST,
                     "{}: {difference}",
-                    Pattern::NAMES[i]
+                    kind.info().name
                 );
                 assert_eq!(
                     matches!(t.b, Child::Scalar(_)),
@@ -139,8 +140,7 @@ mod tests {
     /// flat), so the mix shows both sides.
     #[test]
     fn a_new_mix_gets_a_varying_factor() {
-        let t = Texture::color(Vec3::splat(0.3))
-            .with_pattern_contrasting(Pattern::Constant.with_index(13));
+        let t = Texture::color(Vec3::splat(0.3)).with_pattern_contrasting(Pattern::Mix);
         let factor = t.factor.expect("a factor");
         let values: Vec<f32> = (0..64)
             .map(|i| {
@@ -159,7 +159,7 @@ mod tests {
     #[test]
     fn differing_sides_are_kept() {
         let old = Texture::blend(Pattern::Checker { size: 1.0 }, 0.2, 0.9);
-        let t = old.with_pattern_contrasting(old.pattern.with_index(4));
+        let t = old.with_pattern_contrasting(old.pattern.with_kind(PatternKind::Marble));
         assert_eq!((t.a, t.b), (old.a, old.b));
     }
 

@@ -5,6 +5,7 @@
 //! The functions themselves live in the texture library (`crate::texture`);
 //! this is the scene's record of which one and with what parameters.
 
+use super::pattern_table::{PatternInfo, PatternKind};
 use super::primitives::UvFrame;
 use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum, rebase::rebase};
 use crate::texture;
@@ -98,6 +99,9 @@ pub enum Pattern {
         noise: NoiseSettings,
         stripe_frequency: f32,
     },
+    /// The texture report's example of a new texture (§2.1, `MaTexture`):
+    /// `a` where u < v, `b` elsewhere.
+    Diagonal,
 }
 
 /// A fractal sum a pattern reads: the noise, what each octave adds, and
@@ -282,50 +286,38 @@ fn affine_rows(m: &Affine3A) -> [[f32; 4]; 3] {
 }
 
 impl Pattern {
-    pub const NAMES: [&'static str; 16] = [
-        "constant",
-        "checker 3D",
-        "fBm",
-        "turbulence",
-        "marble",
-        "checker (uv)",
-        "brick",
-        "tile",
-        "cutout",
-        "wood",
-        "veins",
-        "waves",
-        "ridged",
-        "mix",
-        "image",
-        "marble (Massal)",
-    ];
-
     /// The frequency of Massal's marble when chosen in the panel: his 0.05
     /// was for spheres about 100 pixels in radius; scaled to marbre's unit
     /// spheres, a stripe about a radius wide.
     pub const MASSAL_MARBLE_FREQUENCY: f32 = 5.0;
 
-    /// Index into [`Pattern::NAMES`]; also the pattern id in the shader.
-    pub fn index(&self) -> usize {
+    /// Which pattern this is, without its numbers: its row of
+    /// [`PATTERNS`](super::pattern_table::PATTERNS).
+    pub fn kind(&self) -> PatternKind {
         match self {
-            Pattern::Constant => 0,
-            Pattern::Checker { .. } => 1,
-            Pattern::Fbm { .. } => 2,
-            Pattern::Turbulence { .. } => 3,
-            Pattern::Marble { .. } => 4,
-            Pattern::Checker2d { .. } => 5,
-            Pattern::Brick { .. } => 6,
-            Pattern::Tile { .. } => 7,
-            Pattern::Cutout { .. } => 8,
-            Pattern::Wood { .. } => 9,
-            Pattern::Veins { .. } => 10,
-            Pattern::Waves { .. } => 11,
-            Pattern::Ridged { .. } => 12,
-            Pattern::Mix => 13,
-            Pattern::Image { .. } => 14,
-            Pattern::MassalMarble { .. } => 15,
+            Pattern::Constant => PatternKind::Constant,
+            Pattern::Checker { .. } => PatternKind::Checker,
+            Pattern::Fbm { .. } => PatternKind::Fbm,
+            Pattern::Turbulence { .. } => PatternKind::Turbulence,
+            Pattern::Marble { .. } => PatternKind::Marble,
+            Pattern::Checker2d { .. } => PatternKind::Checker2d,
+            Pattern::Brick { .. } => PatternKind::Brick,
+            Pattern::Tile { .. } => PatternKind::Tile,
+            Pattern::Cutout { .. } => PatternKind::Cutout,
+            Pattern::Wood { .. } => PatternKind::Wood,
+            Pattern::Veins { .. } => PatternKind::Veins,
+            Pattern::Waves { .. } => PatternKind::Waves,
+            Pattern::Ridged { .. } => PatternKind::Ridged,
+            Pattern::Mix => PatternKind::Mix,
+            Pattern::Image { .. } => PatternKind::Image,
+            Pattern::MassalMarble { .. } => PatternKind::MassalMarble,
+            Pattern::Diagonal => PatternKind::Diagonal,
         }
+    }
+
+    /// Its row of the pattern table.
+    pub fn info(&self) -> &'static PatternInfo {
+        self.kind().info()
     }
 
     /// Whether the two patterns compile to the same code: one kind, and
@@ -337,78 +329,132 @@ impl Pattern {
             Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8)),
             _ => p.noise().map(|n| (n.kind as u8, n.hash as u8)),
         };
-        self.index() == other.index() && choices(self) == choices(other)
+        self.kind() == other.kind() && choices(self) == choices(other)
     }
 
     /// The first octave's frequency of a pattern's noise when it had none:
     /// several features across a unit sphere.
     pub const FRESH_NOISE_FREQUENCY: f32 = 3.0;
 
-    /// The pattern with index `i`, keeping the noise settings of `self` where
-    /// both have some, so switching the dropdown does not lose the tuning.
-    /// Fresh parameters show several features on a unit sphere (the 3D
-    /// checker 4 cubes across it, noise at [`Self::FRESH_NOISE_FREQUENCY`]).
-    pub fn with_index(&self, i: usize) -> Pattern {
-        let noise = self.noise().copied().unwrap_or_else(|| NoiseSettings {
+    /// A fresh pattern of `kind`, reading `noise` where it has noise (so
+    /// switching the panel's list keeps the tuning), else noise at
+    /// [`Self::FRESH_NOISE_FREQUENCY`]. Fresh numbers show several features
+    /// on a unit sphere (the 3D checker 4 cubes across it).
+    pub fn fresh(kind: PatternKind, noise: Option<NoiseSettings>) -> Pattern {
+        let noise = noise.unwrap_or_else(|| NoiseSettings {
             fractal: FractalParams {
                 frequency: Self::FRESH_NOISE_FREQUENCY,
                 ..FractalParams::default()
             },
             ..NoiseSettings::default()
         });
-        match i {
-            1 => Pattern::Checker { size: 0.5 },
-            2 => Pattern::Fbm { noise },
-            3 => Pattern::Turbulence { noise },
-            4 => Pattern::Marble {
+        match kind {
+            PatternKind::Constant => Pattern::Constant,
+            PatternKind::Checker => Pattern::Checker { size: 0.5 },
+            PatternKind::Fbm => Pattern::Fbm { noise },
+            PatternKind::Turbulence => Pattern::Turbulence { noise },
+            PatternKind::Marble => Pattern::Marble {
                 noise,
                 stripe_frequency: 4.0,
             },
-            5 => Pattern::Checker2d {
+            PatternKind::Checker2d => Pattern::Checker2d {
                 size: Vec2::splat(0.125),
                 phase: 0.0,
             },
-            6 => Pattern::Brick {
+            PatternKind::Brick => Pattern::Brick {
                 size: Vec2::new(0.25, 0.1),
                 mortar: 0.01,
                 row_offset: 0.5,
             },
-            7 => Pattern::Tile {
+            PatternKind::Tile => Pattern::Tile {
                 mortar_half_width: 0.02,
                 bevel: 0.02,
             },
-            8 => Pattern::Cutout {
+            PatternKind::Cutout => Pattern::Cutout {
                 sides: 0,
                 radius: 0.4,
             },
-            9 => Pattern::Wood {
+            PatternKind::Wood => Pattern::Wood {
                 noise,
                 ring_width: 0.12,
                 turbulence_amount: 0.3,
             },
-            10 => Pattern::Veins {
+            PatternKind::Veins => Pattern::Veins {
                 noise,
                 frequency: 10.0,
                 turbulence_amount: 5.0,
             },
-            11 => Pattern::Waves {
+            PatternKind::Waves => Pattern::Waves {
                 frequency: 4.0,
                 direction: Vec2::X,
             },
-            12 => Pattern::Ridged { noise },
-            13 => Pattern::Mix,
-            14 => Pattern::Image {
+            PatternKind::Ridged => Pattern::Ridged { noise },
+            PatternKind::Mix => Pattern::Mix,
+            PatternKind::Image => Pattern::Image {
                 filter: Default::default(),
                 wrap: Default::default(),
             },
             // His recipe, not the previous pattern's noise: the marble is
             // his only with his turbulence.
-            15 => Pattern::MassalMarble {
+            PatternKind::MassalMarble => Pattern::MassalMarble {
                 noise: NoiseSettings::massal(Self::MASSAL_MARBLE_FREQUENCY),
                 stripe_frequency: Self::MASSAL_MARBLE_FREQUENCY,
             },
-            _ => Pattern::Constant,
+            PatternKind::Diagonal => Pattern::Diagonal,
         }
+    }
+
+    /// A fresh pattern of `kind` keeping this one's noise settings.
+    pub fn with_kind(&self, kind: PatternKind) -> Pattern {
+        Self::fresh(kind, self.noise().copied())
+    }
+
+    /// The numbers the generated code reads as one `vec4f` (`{q}` in the
+    /// table's [`PatternCode`](super::pattern_table::PatternCode)); None
+    /// for the patterns that read none (constant, noise sums, mix, image,
+    /// diagonal).
+    pub fn numbers(&self) -> Option<[f32; 4]> {
+        Some(match *self {
+            Pattern::Checker { size } => [size, size, size, 0.0],
+            Pattern::Marble {
+                stripe_frequency, ..
+            }
+            | Pattern::MassalMarble {
+                stripe_frequency, ..
+            } => [stripe_frequency, 0.0, 0.0, 0.0],
+            Pattern::Checker2d { size, phase } => [size.x, size.y, phase, 0.0],
+            Pattern::Brick {
+                size,
+                mortar,
+                row_offset,
+            } => [size.x, size.y, mortar, row_offset],
+            Pattern::Tile {
+                mortar_half_width,
+                bevel,
+            } => [mortar_half_width, bevel, 0.0, 0.0],
+            Pattern::Waves {
+                frequency,
+                direction,
+            } => [frequency, direction.x, direction.y, 0.0],
+            Pattern::Cutout { sides, radius } => [radius, sides as f32, 0.0, 0.0],
+            Pattern::Wood {
+                ring_width,
+                turbulence_amount,
+                ..
+            } => [ring_width, turbulence_amount, 0.0, 0.0],
+            Pattern::Veins {
+                frequency,
+                turbulence_amount,
+                ..
+            } => [frequency, turbulence_amount, 0.0, 0.0],
+            Pattern::Constant
+            | Pattern::Fbm { .. }
+            | Pattern::Turbulence { .. }
+            | Pattern::Ridged { .. }
+            | Pattern::Mix
+            | Pattern::Image { .. }
+            | Pattern::Diagonal => return None,
+        })
     }
 
     pub fn noise(&self) -> Option<&NoiseSettings> {
@@ -491,6 +537,7 @@ impl Pattern {
                 direction,
             } => (texture::waves(uv, frequency, direction), uv),
             Pattern::Cutout { sides, radius } => (texture::cutout(uv, sides, radius), uv),
+            Pattern::Diagonal => (texture::diagonal(uv), uv),
             Pattern::Wood {
                 ring_width,
                 turbulence_amount,

@@ -615,7 +615,7 @@ impl Texture {
             } else {
                 notes.push(format!(
                     "{what}: a material reads at most {MAX_SIGNALS} distinct noises; a {} pattern became constant",
-                    Pattern::NAMES[self.pattern.index()]
+                    self.pattern.info().name
                 ));
                 self.pattern = Pattern::Constant;
             }

@@ -1,4 +1,5 @@
-// The texture library's patterns; twin of  (the CPU reference).
+// The texture library's patterns; twin of crates/core/src/texture/*.rs
+// (the CPU reference).
 // Each is a pure function of a point and its parameters: where the point
 // falls (which child, which cell-local point). Each pattern is compiled in
 // only when the scene uses it (its PATTERN_* feature).
@@ -154,5 +155,12 @@ fn marble_veins(p: vec3f, axis: vec3f, frequency: f32, turbulence_amount: f32, n
 // (marble.rs's massal_marble_stripes).
 fn massal_marble(p: vec3f, stripe_frequency: f32, turbulence_value: f32) -> f32 {
     return 0.5 * sin((p.x + p.y) * stripe_frequency + turbulence_value) + 0.5;
+}
+#endif
+
+#if PATTERN_DIAGONAL
+// Twin of diagonal.rs: the report's `u < v` example, 0 above the diagonal.
+fn diagonal(uv: vec2f) -> f32 {
+    return select(1.0, 0.0, uv.x < uv.y);
 }
 #endif

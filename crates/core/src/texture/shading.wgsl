@@ -1,5 +1,5 @@
 // The texture library's shading helpers: normal perturbation by a height
-// gradient, and colour ramps; twin of  (waves, bump, ramp).
+// gradient, and colour ramps; twin of crates/core/src/texture/{waves,bump,ramp}.rs.
 
 fn waves_gradient(uv: vec2f, frequency: f32, amplitude: f32, direction: vec2f) -> vec2f {
     let phase = TWO_PI * frequency * dot(direction, uv);

@@ -168,7 +168,7 @@ impl Raiser {
                 "a math step (scale, bias, abs, invert, clamp, power)",
             ));
         }
-        let name = Pattern::NAMES[t.pattern.index()];
+        let name = t.pattern.info().name;
         let same = |a: &crate::noise::NoiseSettings, b: crate::noise::NoiseSettings, what: &str| {
             if *a == b {
                 Ok(())
@@ -317,7 +317,8 @@ impl Raiser {
             | Pattern::Marble { .. }
             | Pattern::MassalMarble { .. }
             | Pattern::Waves { .. }
-            | Pattern::Mix => {
+            | Pattern::Mix
+            | Pattern::Diagonal => {
                 return Err(no_form(&format!(
                     "the {name} pattern (on {}; VAGUE waves only bump)",
                     self.channel.name()

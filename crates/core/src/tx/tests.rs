@@ -711,3 +711,19 @@ fn a_tx_error_in_a_preset_names_the_file_and_the_place_in_the_text() {
         .to_string();
     assert!(e.contains("roughness has no TX coefficient"), "{e}");
 }
+
+/// The pattern table's TX keywords are the parser's: each one opens a
+/// texture (a text of it alone fails past the keyword, not at it), and the
+/// parser's list of textures names each.
+#[test]
+fn the_pattern_tables_keywords_open_textures() {
+    for row in crate::scene::PATTERNS.iter() {
+        let Some(keyword) = row.tx_keyword else {
+            continue;
+        };
+        let e = parse(&format!("TX {keyword}")).unwrap_err().to_string();
+        assert!(!e.contains("column 4"), "{keyword}: {e}");
+        let e = parse("TX").unwrap_err().to_string();
+        assert!(e.contains(keyword), "{keyword} missing from {e}");
+    }
+}

@@ -1,7 +1,9 @@
 //! Which shader features a scene needs: the key of shader specialisation.
 
 use marbre_core::noise::{HashKind, NoiseKind, NoiseSettings};
-use marbre_core::scene::{EnvSource, Material, Pattern, Scene, Texture, View};
+use marbre_core::scene::{
+    EnvSource, Material, PATTERNS, Pattern, PatternKind, Scene, Texture, View,
+};
 use marbre_core::texture::ImageFilter;
 use std::collections::BTreeSet;
 
@@ -17,21 +19,9 @@ pub enum Feature {
     EnvMap,
     EnvSampling,
     EnvConstant,
-    PatternChecker,
-    PatternFbm,
-    PatternTurbulence,
-    PatternMarble,
-    PatternChecker2d,
-    PatternBrick,
-    PatternTile,
-    PatternCutout,
-    PatternWood,
-    PatternVeins,
-    PatternMassalMarble,
-    PatternWaves,
-    PatternRidged,
-    PatternMix,
-    Image,
+    /// A pattern's code: its row of the pattern table (`PATTERNS`) says
+    /// its define, whether it reads (u, v) and the texture library.
+    Pattern(PatternKind),
     Bump,
     Footprint,
     Opacity,
@@ -45,7 +35,8 @@ pub enum Feature {
 }
 
 impl Feature {
-    pub const ALL: [Feature; 34] = [
+    /// The features that are not patterns.
+    const OTHERS: [Feature; 19] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -55,21 +46,6 @@ impl Feature {
         Feature::EnvMap,
         Feature::EnvSampling,
         Feature::EnvConstant,
-        Feature::PatternChecker,
-        Feature::PatternFbm,
-        Feature::PatternTurbulence,
-        Feature::PatternMarble,
-        Feature::PatternChecker2d,
-        Feature::PatternBrick,
-        Feature::PatternTile,
-        Feature::PatternCutout,
-        Feature::PatternWood,
-        Feature::PatternVeins,
-        Feature::PatternMassalMarble,
-        Feature::PatternWaves,
-        Feature::PatternRidged,
-        Feature::PatternMix,
-        Feature::Image,
         Feature::Bump,
         Feature::Footprint,
         Feature::Opacity,
@@ -82,20 +58,13 @@ impl Feature {
         Feature::DenoiseGuides,
     ];
 
-    /// Whether the feature's pattern is one of texture/patterns.wgsl's.
-    fn reads_library(self) -> bool {
-        matches!(
-            self,
-            Feature::PatternChecker2d
-                | Feature::Image
-                | Feature::PatternBrick
-                | Feature::PatternTile
-                | Feature::PatternCutout
-                | Feature::PatternWood
-                | Feature::PatternVeins
-                | Feature::PatternMassalMarble
-                | Feature::PatternWaves
-        )
+    /// Every feature: each pattern with code, and the others.
+    pub fn all() -> impl Iterator<Item = Feature> {
+        let patterns = PATTERNS
+            .iter()
+            .filter(|row| row.define.is_some())
+            .map(|row| Feature::Pattern(row.kind));
+        Self::OTHERS.into_iter().chain(patterns)
     }
 
     /// The name used by `#if` in the WGSL sources.
@@ -110,21 +79,10 @@ impl Feature {
             Feature::EnvMap => "ENV_MAP",
             Feature::EnvSampling => "ENV_SAMPLING",
             Feature::EnvConstant => "ENV_CONSTANT",
-            Feature::PatternChecker => "PATTERN_CHECKER",
-            Feature::PatternFbm => "PATTERN_FBM",
-            Feature::PatternTurbulence => "PATTERN_TURBULENCE",
-            Feature::PatternMarble => "PATTERN_MARBLE",
-            Feature::PatternChecker2d => "PATTERN_CHECKER_2D",
-            Feature::PatternBrick => "PATTERN_BRICK",
-            Feature::PatternTile => "PATTERN_TILE",
-            Feature::PatternCutout => "PATTERN_CUTOUT",
-            Feature::PatternWood => "PATTERN_WOOD",
-            Feature::PatternVeins => "PATTERN_VEINS",
-            Feature::PatternMassalMarble => "PATTERN_MASSAL_MARBLE",
-            Feature::PatternWaves => "PATTERN_WAVES",
-            Feature::PatternRidged => "PATTERN_RIDGED",
-            Feature::PatternMix => "PATTERN_MIX",
-            Feature::Image => "IMAGE",
+            Feature::Pattern(kind) => kind
+                .info()
+                .define
+                .expect("a pattern feature is one with code"),
             Feature::Bump => "BUMP",
             Feature::Footprint => "FOOTPRINT",
             Feature::Opacity => "OPACITY",
@@ -137,6 +95,9 @@ impl Feature {
             Feature::DenoiseGuides => "DENOISE_GUIDES",
         }
     }
+
+    /// The image pattern's feature: it also binds the image atlas.
+    pub const IMAGE: Feature = Feature::Pattern(PatternKind::Image);
 }
 
 /// The set of features a shader is built with. Two scenes with equal sets
@@ -147,7 +108,7 @@ pub struct FeatureSet(pub BTreeSet<Feature>);
 impl FeatureSet {
     /// Everything: the "uber shader" that renders any scene.
     pub fn all() -> Self {
-        Self(Feature::ALL.into_iter().collect())
+        Self(Feature::all().collect())
     }
 
     pub fn contains(&self, f: Feature) -> bool {
@@ -162,16 +123,11 @@ impl FeatureSet {
         if self.contains(Feature::NoiseGradient) || self.contains(Feature::NoisePerlin) {
             names.insert("NOISE");
         }
-        let uv_patterns = [
-            Feature::PatternChecker2d,
-            Feature::PatternBrick,
-            Feature::PatternTile,
-            Feature::PatternCutout,
-            Feature::PatternWaves,
-            Feature::Image,
-            Feature::Bump,
-        ];
-        if uv_patterns.iter().any(|&f| self.contains(f)) {
+        let reads_uv = |f: &Feature| match f {
+            Feature::Pattern(kind) => kind.info().reads_uv,
+            f => *f == Feature::Bump,
+        };
+        if self.0.iter().any(reads_uv) {
             names.insert("TEXTURE_UV");
         }
         // ∂p/∂u and ∂p/∂v: bump tilts the normal along them, footprints
@@ -226,19 +182,20 @@ impl FeatureSet {
         for pattern in &patterns {
             set.extend(pattern_features(pattern));
         }
-        // The footprint serves checkers, noise and mipmapped images. Whether
-        // checkers are filtered and octaves clamped are override constants
-        // of the same module (`RenderSwitches`), so toggling them keeps it.
+        // The footprint serves filtered patterns, noise and mipmapped
+        // images. Whether checkers are filtered and octaves clamped are
+        // override constants of the same module (`RenderSwitches`), so
+        // toggling them keeps it.
         let footprint_users = patterns.iter().any(|p| {
-            matches!(
-                p,
-                Pattern::Checker { .. }
-                    | Pattern::Checker2d { .. }
-                    | Pattern::Image {
+            p.info().filtered
+                || p.noise().is_some()
+                || matches!(
+                    p,
+                    Pattern::Image {
                         filter: ImageFilter::Trilinear,
                         ..
                     }
-            ) || p.noise().is_some()
+                )
         });
         if footprint_users {
             set.insert(Feature::Footprint);
@@ -280,13 +237,17 @@ impl FeatureSet {
         )
     }
 
-    /// For the texture harness: every pattern of the texture library, and
-    /// what the `noise` their turbulence uses needs.
+    /// For the texture harness: every pattern of the texture library (and
+    /// the 3D checker), and what the `noise` their turbulence uses needs.
     pub fn for_texture_library(noise: &NoiseSettings) -> Self {
         let mut set = Self::for_noise(noise);
-        set.0.insert(Feature::PatternChecker);
-        set.0
-            .extend(Feature::ALL.into_iter().filter(|f| f.reads_library()));
+        set.0.insert(Feature::Pattern(PatternKind::Checker));
+        set.0.extend(
+            PATTERNS
+                .iter()
+                .filter(|row| row.uses_library)
+                .map(|row| Feature::Pattern(row.kind)),
+        );
         set
     }
 }
@@ -321,23 +282,9 @@ fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {
 }
 
 fn pattern_features(p: &Pattern) -> Vec<Feature> {
-    let mut out = match p {
-        Pattern::Constant => vec![],
-        Pattern::Checker { .. } => vec![Feature::PatternChecker],
-        Pattern::Fbm { .. } => vec![Feature::PatternFbm],
-        Pattern::Turbulence { .. } => vec![Feature::PatternTurbulence],
-        Pattern::Marble { .. } => vec![Feature::PatternMarble],
-        Pattern::Checker2d { .. } => vec![Feature::PatternChecker2d],
-        Pattern::Brick { .. } => vec![Feature::PatternBrick],
-        Pattern::Tile { .. } => vec![Feature::PatternTile],
-        Pattern::Cutout { .. } => vec![Feature::PatternCutout],
-        Pattern::Wood { .. } => vec![Feature::PatternWood],
-        Pattern::Veins { .. } => vec![Feature::PatternVeins],
-        Pattern::MassalMarble { .. } => vec![Feature::PatternMassalMarble],
-        Pattern::Waves { .. } => vec![Feature::PatternWaves],
-        Pattern::Ridged { .. } => vec![Feature::PatternRidged],
-        Pattern::Mix => vec![Feature::PatternMix],
-        Pattern::Image { .. } => vec![Feature::Image],
+    let mut out = match p.info().define {
+        Some(_) => vec![Feature::Pattern(p.kind())],
+        None => vec![],
     };
     if let Some(n) = p.noise() {
         out.extend(noise_features(n));
@@ -381,7 +328,7 @@ mod tests {
         for f in [
             Feature::Opacity,
             Feature::Emission,
-            Feature::PatternRidged,
+            Feature::Pattern(PatternKind::Ridged),
             Feature::NoiseWarp,
         ] {
             assert!(set.contains(f), "{f:?} missing from {set:?}");
@@ -410,7 +357,7 @@ mod tests {
         assert_eq!(
             set.0,
             [
-                Feature::PatternMarble,
+                Feature::Pattern(PatternKind::Marble),
                 Feature::NoisePerlin,
                 Feature::Footprint
             ]

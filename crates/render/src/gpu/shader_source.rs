@@ -153,7 +153,7 @@ impl Program {
             Program::Trace => {
                 noise(&mut out);
                 out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::Image) {
+                if features.contains(Feature::IMAGE) {
                     out.push(texture::image::WGSL);
                 }
                 out.push(r::TEXTURES);
@@ -206,7 +206,7 @@ impl Program {
             Program::Swatch => {
                 noise(&mut out);
                 out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::Image) {
+                if features.contains(Feature::IMAGE) {
                     out.push(texture::image::WGSL);
                 }
                 out.extend([
@@ -242,7 +242,7 @@ impl Program {
             Program::Bake => {
                 noise(&mut out);
                 out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::Image) {
+                if features.contains(Feature::IMAGE) {
                     out.push(texture::image::WGSL);
                 }
                 out.push(r::TEXTURES);

@@ -16,7 +16,7 @@
 use marbre_core::scene::node_path::{NodePath, Socket};
 use marbre_core::scene::texture_graph::texture_at;
 use marbre_core::scene::texture_tree::IMAGE_UNAVAILABLE;
-use marbre_core::scene::{Child, Material, Pattern, Scene, Texture};
+use marbre_core::scene::{Child, Material, Scene, Texture};
 use marbre_core::texture::ImageSet;
 
 /// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
@@ -32,7 +32,7 @@ pub(crate) enum Field {
     UvRow(usize),
     /// How its mapping scales the footprint.
     FootprintScale,
-    /// The pattern's own numbers ([`pattern_params`]).
+    /// The pattern's own numbers ([`Pattern::numbers`]).
     Pattern,
     /// The constant child `a` or `b`.
     Constant(Socket),
@@ -58,7 +58,7 @@ impl Field {
                 let [u, v, w] = mapping()?.footprint_scale();
                 Some([u, v, w, 0.0])
             }
-            Field::Pattern => pattern_params(&node.pattern),
+            Field::Pattern => node.pattern.numbers(),
             Field::Constant(socket) => match socket {
                 Socket::A => constant(&node.a),
                 Socket::B => constant(&node.b),
@@ -84,52 +84,6 @@ fn constant(child: &Child) -> Option<[f32; 4]> {
         Child::Color(c) => Some([c.x, c.y, c.z, 0.0]),
         Child::Texture(_) => None,
     }
-}
-
-/// The numbers of a pattern the generated code reads as one `vec4f`
-/// (None for the patterns that read none: constant, noise sums, mix,
-/// image).
-pub(crate) fn pattern_params(pattern: &Pattern) -> Option<[f32; 4]> {
-    Some(match *pattern {
-        Pattern::Checker { size } => [size, size, size, 0.0],
-        Pattern::Marble {
-            stripe_frequency, ..
-        }
-        | Pattern::MassalMarble {
-            stripe_frequency, ..
-        } => [stripe_frequency, 0.0, 0.0, 0.0],
-        Pattern::Checker2d { size, phase } => [size.x, size.y, phase, 0.0],
-        Pattern::Brick {
-            size,
-            mortar,
-            row_offset,
-        } => [size.x, size.y, mortar, row_offset],
-        Pattern::Tile {
-            mortar_half_width,
-            bevel,
-        } => [mortar_half_width, bevel, 0.0, 0.0],
-        Pattern::Waves {
-            frequency,
-            direction,
-        } => [frequency, direction.x, direction.y, 0.0],
-        Pattern::Cutout { sides, radius } => [radius, sides as f32, 0.0, 0.0],
-        Pattern::Wood {
-            ring_width,
-            turbulence_amount,
-            ..
-        } => [ring_width, turbulence_amount, 0.0, 0.0],
-        Pattern::Veins {
-            frequency,
-            turbulence_amount,
-            ..
-        } => [frequency, turbulence_amount, 0.0, 0.0],
-        Pattern::Constant
-        | Pattern::Fbm { .. }
-        | Pattern::Turbulence { .. }
-        | Pattern::Ridged { .. }
-        | Pattern::Mix
-        | Pattern::Image { .. } => return None,
-    })
 }
 
 /// Where in a material a slot's number lies.

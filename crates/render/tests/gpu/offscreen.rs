@@ -490,7 +490,12 @@ fn a_feature_can_be_compiled_out_unless_the_texture_code_needs_it() {
         set
     };
     let refused = renderer
-        .request_feature_override(&ctx, Some(without(Feature::PatternChecker)))
+        .request_feature_override(
+            &ctx,
+            Some(without(Feature::Pattern(
+                marbre_core::scene::PatternKind::Checker,
+            ))),
+        )
         .expect_err("the ground's checker is called by the texture code");
     assert!(
         format!("{refused:#}").contains("cannot be built with those features"),

@@ -328,7 +328,7 @@ fn the_empty_feature_set_validates() {
 
 #[test]
 fn every_single_feature_set_validates() {
-    for f in Feature::ALL {
+    for f in Feature::all() {
         let set = FeatureSet([f].into_iter().collect());
         assert_validates(&set, &Scene::default(), &format!("{{{f:?}}}"));
     }

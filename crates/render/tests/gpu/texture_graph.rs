@@ -4,8 +4,8 @@
 use crate::common::*;
 use glam::{Vec2, Vec3};
 use marbre_core::scene::{
-    Cylinder, EnvSource, Ground, Layer, Material, MathOp, OrbitCamera, Pattern, PointLight,
-    Polygon, Property, Scene, Sphere, Texture, UvFrame,
+    Cylinder, EnvSource, Ground, Layer, Material, MathOp, OrbitCamera, Pattern, PatternKind,
+    PointLight, Polygon, Property, Scene, Sphere, Texture, UvFrame,
 };
 use marbre_render::gpu::testing::gpu_or_skip;
 
@@ -121,6 +121,78 @@ fn massal_marble_renders_the_cpu_reference() {
     let lo = values.iter().copied().fold(f32::MAX, f32::min);
     let hi = values.iter().copied().fold(f32::MIN, f32::max);
     assert!(hi > 2.0 * lo, "one tone only: {lo}..{hi}");
+}
+
+/// Every pattern of the table (the image apart: `image_texture_renders_the_
+/// cpu_reference`) with its fresh numbers, through the generated WGSL, on
+/// a ground in white light (their noise in two octaves): its blend factor
+/// thresholded halfway across its range in the image by math steps (t −
+/// threshold, × 100, clamped to [0.2, 0.8]) so that each pixel away
+/// from an edge has one value, which must be the CPU reference's. A pattern
+/// added to the table is tested here without a line more.
+#[test]
+fn every_pattern_of_the_table_renders_its_cpu_reference() {
+    let Some(ctx) = gpu_or_skip("every_pattern_of_the_table_renders_its_cpu_reference") else {
+        return;
+    };
+    for kind in PatternKind::all().filter(|&k| k != PatternKind::Image) {
+        let name = kind.info().name;
+        let mut pattern = Pattern::fresh(kind, None);
+        // Two octaves: finer islands of the thresholded sum would slip
+        // between the reference's samples of a pixel.
+        if let Some(noise) = pattern.noise_mut() {
+            noise.fractal.octaves = 2.0;
+        }
+        let mut diffuse = Texture::blend(pattern, 0.0, 1.0);
+        if kind == PatternKind::Mix {
+            diffuse.factor = Some(Box::new(Texture::blend(
+                Pattern::Checker { size: 0.7 },
+                0.0,
+                1.0,
+            )));
+        }
+        println!("pattern: {name}");
+        let mut scene = textured_ground_in_white_light(diffuse.clone());
+        scene.camera = OrbitCamera {
+            target: Vec3::new(0.3, 0.0, 0.3),
+            distance: 1.5,
+            yaw_degrees: 10.0,
+            pitch_degrees: 75.0,
+            fov_degrees: 50.0,
+        };
+        let (w, h) = (64, 48);
+        // The threshold: halfway between the least and the greatest t at
+        // the pixels' centres.
+        let t: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let at = Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+                let p = ground_point(&scene, (w, h), at);
+                diffuse.eval(p, Vec2::new(p.x, p.z)).x
+            })
+            .collect();
+        let lo = t.iter().copied().fold(f32::MAX, f32::min);
+        let hi = t.iter().copied().fold(f32::MIN, f32::max);
+        diffuse.ops = vec![
+            MathOp::Bias(-0.5 * (lo + hi)),
+            MathOp::Scale(100.0),
+            MathOp::Clamp { min: 0.2, max: 0.8 },
+        ];
+        scene.ground.as_mut().unwrap().material.diffuse = diffuse;
+        let material = scene.ground.as_ref().unwrap().material.clone();
+        let pixels = render(&ctx, &scene, (w, h), 4);
+        assert_ground_matches(&scene, &pixels, (w, h), 0.3, |p, uv| {
+            material.value(Property::Diffuse, p, uv)
+        });
+        // Both sides of the threshold are on screen, but for the constant.
+        let values: Vec<f32> = pixels.iter().map(|p| p[0]).collect();
+        let lo = values.iter().copied().fold(f32::MAX, f32::min);
+        let hi = values.iter().copied().fold(f32::MIN, f32::max);
+        assert_eq!(
+            hi > 2.0 * lo,
+            kind != PatternKind::Constant,
+            "{name}: {lo}..{hi}"
+        );
+    }
 }
 
 /// A sphere that is black but emits E, with opacity α, in a constant
@@ -704,7 +776,9 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
     assert!(
         renderer
             .features()
-            .contains(marbre_render::gpu::Feature::PatternChecker2d)
+            .contains(marbre_render::gpu::Feature::Pattern(
+                marbre_core::scene::PatternKind::Checker2d
+            ))
     );
     assert_eq!(renderer.scene(), &edited);
     let first_frame = std::time::Instant::now();

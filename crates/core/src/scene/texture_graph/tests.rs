@@ -1,6 +1,6 @@
 use super::*;
 use crate::preset::{self, Preset};
-use crate::scene::{Layer, MaterialKey, MathOp, Pattern, Scene, Sphere};
+use crate::scene::{Layer, MaterialKey, MathOp, PATTERNS, Pattern, PatternKind, Scene, Sphere};
 use glam::Vec2;
 use proptest::prelude::*;
 use std::path::Path;
@@ -24,11 +24,11 @@ fn checker(a: impl Into<Child>, b: impl Into<Child>) -> Texture {
 /// fbm, 0.2, 0.8), a layer with a mask.
 fn material() -> Material {
     let marble = Texture::blend(
-        Pattern::Constant.with_index(Pattern::NAMES.iter().position(|n| *n == "marble").unwrap()),
+        Pattern::fresh(PatternKind::Marble, None),
         Vec3::X,
         Vec3::ONE,
     );
-    let fbm = Texture::blend(Pattern::Constant.with_index(2), 0.0, 1.0);
+    let fbm = Texture::blend(Pattern::fresh(PatternKind::Fbm, None), 0.0, 1.0);
     Material {
         diffuse: checker(marble, Vec3::Z),
         roughness: Texture::mix(fbm, 0.2, 0.8),
@@ -318,8 +318,8 @@ fn value() -> impl Strategy<Value = Child> {
 /// A random tree: any pattern with its default parameters, value or
 /// texture children, a factor under a mix, math steps.
 fn tree() -> impl Strategy<Value = Texture> {
-    let leaf = (0..Pattern::NAMES.len(), value(), value()).prop_map(|(i, a, b)| {
-        let pattern = Pattern::Constant.with_index(i);
+    let leaf = (0..PATTERNS.len(), value(), value()).prop_map(|(i, a, b)| {
+        let pattern = Pattern::fresh(PATTERNS[i].kind, None);
         let factor = (pattern == Pattern::Mix).then(|| Box::new(Texture::scalar(0.5)));
         Texture {
             factor,
@@ -329,14 +329,14 @@ fn tree() -> impl Strategy<Value = Texture> {
     leaf.prop_recursive(4, 24, 3, |inner| {
         let child = prop_oneof![value(), inner.clone().prop_map(Child::from)];
         (
-            0..Pattern::NAMES.len(),
+            0..PATTERNS.len(),
             child.clone(),
             child,
             inner,
             proptest::collection::vec(0..MathOp::NAMES.len(), 0..3),
         )
             .prop_map(|(i, a, b, factor, ops)| {
-                let pattern = Pattern::Constant.with_index(i);
+                let pattern = Pattern::fresh(PATTERNS[i].kind, None);
                 Texture {
                     factor: (pattern == Pattern::Mix).then(|| Box::new(factor)),
                     ops: ops.into_iter().map(MathOp::with_index).collect(),

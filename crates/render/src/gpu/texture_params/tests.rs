@@ -5,7 +5,7 @@
 use super::*;
 use crate::gpu::texture_codegen::generate;
 use crate::session::load_scene;
-use marbre_core::scene::Change;
+use marbre_core::scene::{Change, Pattern};
 use std::path::Path;
 
 /// Every shipped preset, with its images loaded.
