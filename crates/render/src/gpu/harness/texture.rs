@@ -120,6 +120,60 @@ pub enum PatternQuery {
     },
 }
 
+/// Which function of the texture library the harness runs: its
+/// `harness.mode`. Each has a named constant in texture.wgsl (`MODE_` and
+/// the name in upper snake case), checked by a test, so that the shader's
+/// `switch` reads names, not numbers.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Checker2d = 0,
+    Checker3d = 1,
+    FilteredChecker2d = 2,
+    Brick = 3,
+    Tile = 4,
+    Cutout = 5,
+    Wood = 6,
+    MarbleVeins = 7,
+    WavesGradient = 8,
+    Bump = 9,
+    Ramp = 10,
+    SphereUv = 11,
+    CylinderUv = 12,
+    PlaneUv = 13,
+    TriangleUv = 14,
+    Transform = 15,
+    Image = 16,
+    FilteredChecker3d = 17,
+    MassalMarble = 18,
+}
+
+#[cfg(test)]
+impl Mode {
+    /// Every mode, for the test that finds their WGSL constants.
+    const ALL: [Mode; 19] = [
+        Mode::Checker2d,
+        Mode::Checker3d,
+        Mode::FilteredChecker2d,
+        Mode::Brick,
+        Mode::Tile,
+        Mode::Cutout,
+        Mode::Wood,
+        Mode::MarbleVeins,
+        Mode::WavesGradient,
+        Mode::Bump,
+        Mode::Ramp,
+        Mode::SphereUv,
+        Mode::CylinderUv,
+        Mode::PlaneUv,
+        Mode::TriangleUv,
+        Mode::Transform,
+        Mode::Image,
+        Mode::FilteredChecker3d,
+        Mode::MassalMarble,
+    ];
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct HarnessUniform {
@@ -142,11 +196,11 @@ impl PatternQuery {
         let v3 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
         match self {
             PatternQuery::Checker2d { size, phase } => {
-                u.mode = 0;
+                u.mode = Mode::Checker2d as u32;
                 u.a = v2(*size, *phase, 0.0);
             }
             PatternQuery::Checker3d { size } => {
-                u.mode = 1;
+                u.mode = Mode::Checker3d as u32;
                 u.a = v3(*size, 0.0);
             }
             PatternQuery::FilteredChecker2d {
@@ -154,12 +208,12 @@ impl PatternQuery {
                 phase,
                 half_width,
             } => {
-                u.mode = 2;
+                u.mode = Mode::FilteredChecker2d as u32;
                 u.a = v2(*size, *phase, 0.0);
                 u.b = v2(*half_width, 0.0, 0.0);
             }
             PatternQuery::FilteredChecker3d { size, half_width } => {
-                u.mode = 17;
+                u.mode = Mode::FilteredChecker3d as u32;
                 u.a = v3(*size, 0.0);
                 u.b = v3(*half_width, 0.0);
             }
@@ -168,7 +222,7 @@ impl PatternQuery {
                 mortar,
                 row_offset,
             } => {
-                u.mode = 3;
+                u.mode = Mode::Brick as u32;
                 u.a = v2(*size, *mortar, *row_offset);
             }
             PatternQuery::Tile {
@@ -176,11 +230,11 @@ impl PatternQuery {
                 bevel_width,
                 bevel_height,
             } => {
-                u.mode = 4;
+                u.mode = Mode::Tile as u32;
                 u.a = [*mortar_half_width, *bevel_width, *bevel_height, 0.0];
             }
             PatternQuery::Cutout { sides, radius } => {
-                u.mode = 5;
+                u.mode = Mode::Cutout as u32;
                 u.sides = *sides;
                 u.a[0] = *radius;
             }
@@ -190,7 +244,7 @@ impl PatternQuery {
                 turbulence_amount,
                 noise,
             } => {
-                u.mode = 6;
+                u.mode = Mode::Wood as u32;
                 u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *ring_width);
                 u.b[0] = *turbulence_amount;
@@ -201,7 +255,7 @@ impl PatternQuery {
                 turbulence_amount,
                 noise,
             } => {
-                u.mode = 7;
+                u.mode = Mode::MarbleVeins as u32;
                 u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *frequency);
                 u.b[0] = *turbulence_amount;
@@ -210,7 +264,7 @@ impl PatternQuery {
                 stripe_frequency,
                 noise,
             } => {
-                u.mode = 18;
+                u.mode = Mode::MassalMarble as u32;
                 u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
                 u.a[0] = *stripe_frequency;
             }
@@ -219,7 +273,7 @@ impl PatternQuery {
                 amplitude,
                 direction,
             } => {
-                u.mode = 8;
+                u.mode = Mode::WavesGradient as u32;
                 u.a = [*frequency, *amplitude, 0.0, 0.0];
                 u.b = v2(*direction, 0.0, 0.0);
             }
@@ -229,7 +283,7 @@ impl PatternQuery {
                 dh_du,
                 dh_dv,
             } => {
-                u.mode = 9;
+                u.mode = Mode::Bump as u32;
                 u.a = v3(*dp_du, 0.0);
                 u.b = v3(*dp_dv, 0.0);
                 u.c = [*dh_du, *dh_dv, 0.0, 0.0];
@@ -240,15 +294,15 @@ impl PatternQuery {
                     "a ramp holds at most {MAX_RAMP_STOPS} stops on the GPU, not {}",
                     stops.len()
                 );
-                u.mode = 10;
+                u.mode = Mode::Ramp as u32;
                 u.sides = stops.len() as u32;
                 for (slot, s) in u.stops.iter_mut().zip(stops) {
                     *slot = v3(s.color, s.position);
                 }
             }
-            PatternQuery::SphereUv => u.mode = 11,
+            PatternQuery::SphereUv => u.mode = Mode::SphereUv as u32,
             PatternQuery::CylinderUv { height } => {
-                u.mode = 12;
+                u.mode = Mode::CylinderUv as u32;
                 u.a[0] = *height;
             }
             PatternQuery::PlaneUv {
@@ -256,13 +310,13 @@ impl PatternQuery {
                 u_axis,
                 v_axis,
             } => {
-                u.mode = 13;
+                u.mode = Mode::PlaneUv as u32;
                 u.a = v3(*origin, 0.0);
                 u.b = v3(*u_axis, 0.0);
                 u.c = v3(*v_axis, 0.0);
             }
             PatternQuery::TriangleUv { vertices, uvs } => {
-                u.mode = 14;
+                u.mode = Mode::TriangleUv as u32;
                 for (slot, v) in u.stops.iter_mut().zip(vertices) {
                     *slot = v3(*v, 0.0);
                 }
@@ -271,7 +325,7 @@ impl PatternQuery {
                 }
             }
             PatternQuery::Transform { to_texture } => {
-                u.mode = 15;
+                u.mode = Mode::Transform as u32;
                 let (m, t) = (to_texture.matrix3, to_texture.translation);
                 u.a = v3(m.x_axis.into(), t.x);
                 u.b = v3(m.y_axis.into(), t.y);
@@ -283,7 +337,7 @@ impl PatternQuery {
                 filter,
                 wrap,
             } => {
-                u.mode = 16;
+                u.mode = Mode::Image as u32;
                 u.a = atlas.entries[*entry].params();
                 u.b = [filter.id() as f32, wrap.id() as f32, 0.0, 0.0];
             }
@@ -335,5 +389,39 @@ mod tests {
             "",
         );
         twin_layout!(module, HarnessUniform => "TextureHarness", [noise, mode, count, sides, a, b, c, stops]);
+    }
+
+    /// Every mode has its named constant in texture.wgsl, of its value:
+    /// the shader's `switch` and [`Mode`] are one list.
+    #[test]
+    fn every_mode_has_its_wgsl_constant() {
+        use crate::gpu::twin_layout::module_of;
+        let module = module_of(
+            Program::TextureHarness,
+            &FeatureSet::for_texture_library(&Default::default()),
+            "",
+        );
+        let value = |name: &str| {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))?;
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => Some(v),
+                _ => None,
+            }
+        };
+        for mode in Mode::ALL {
+            let name = format!("{mode:?}");
+            let mut wgsl = String::from("MODE");
+            for (i, ch) in name.char_indices() {
+                let after_lower = i > 0 && name[..i].ends_with(|c: char| c.is_ascii_lowercase());
+                if (ch.is_ascii_uppercase() || ch.is_ascii_digit()) && (i == 0 || after_lower) {
+                    wgsl.push('_');
+                }
+                wgsl.push(ch.to_ascii_uppercase());
+            }
+            assert_eq!(value(&wgsl), Some(mode as u32), "{wgsl} in texture.wgsl");
+        }
     }
 }
