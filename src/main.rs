@@ -52,7 +52,7 @@ struct ViewerArgs {
     dev: bool,
     /// The trace kernel: fragment, compute, or auto (the faster on this
     /// adapter, timed on the first scene and remembered).
-    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    #[arg(long, default_value_t = KernelChoice::Auto, value_parser = marbre_commands::kernel_choice_parser())]
     kernel: KernelChoice,
     /// Trace time per frame in ms: the panel stays live while a slow
     /// adapter refines the image a band at a time; 0 traces a whole round

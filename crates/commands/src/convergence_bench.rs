@@ -44,7 +44,7 @@ pub struct ConvergenceBenchArgs {
     /// auto (the faster of the two on this preset, timed first). The
     /// reference is rendered with the fragment kernel: both give the same
     /// image, so one cached reference serves both.
-    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }
 

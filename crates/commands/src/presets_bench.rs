@@ -30,7 +30,7 @@ pub struct PresetsBenchArgs {
     /// and of the anti-aliasing tables: fragment, compute, or auto (the
     /// one `auto` picks for each preset). Both kernels' frame times are
     /// measured whatever this is.
-    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }
 

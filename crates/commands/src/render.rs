@@ -46,7 +46,7 @@ pub struct RenderArgs {
     pub auto_exposure: Option<MeteringArg>,
     /// The trace kernel: fragment, compute, or auto (the faster of the
     /// two on this scene, timed first).
-    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
     /// What each sample records instead of the preset's view: lit (the
     /// radiance), hit-mask, primitive, normal, albedo or depth. A view's

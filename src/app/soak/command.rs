@@ -30,7 +30,11 @@ pub struct SoakArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// The trace kernel, as the viewer's `--kernel`.
-    #[arg(long, value_enum, default_value_t = marbre_render::gpu::KernelChoice::Auto)]
+    #[arg(
+        long,
+        default_value_t = marbre_render::gpu::KernelChoice::Auto,
+        value_parser = marbre_commands::kernel_choice_parser()
+    )]
     pub kernel: marbre_render::gpu::KernelChoice,
     /// Trace time per frame in ms, as the viewer's `--frame-budget-ms`.
     #[arg(long, default_value_t = crate::app::DEFAULT_FRAME_BUDGET_MS, value_parser = crate::app::parse_budget_ms)]

@@ -61,7 +61,7 @@ pub struct AccuracyBenchArgs {
     /// on each sweep's scene, timed first; all the sweep's variants then
     /// use it). References are rendered with the fragment kernel: both
     /// kernels give the same image.
-    #[arg(long, value_enum, default_value_t = KernelChoice::Auto)]
+    #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }
 

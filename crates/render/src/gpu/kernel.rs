@@ -1,6 +1,6 @@
 //! Which kernel runs the trace: the fragment shader over a full-screen
 //! triangle, or a compute dispatch. Both call the same WGSL body
-//! (`trace_pixel` in crates/render/shaders/trace.wgsl) and give the same image; which is
+//! (`trace_pixel` in shaders/trace.wgsl) and give the same image; which is
 //! faster depends on the adapter. An NVIDIA H100 runs pixel shaders on few
 //! of its units (the prototype traced the default preset at 1080p in 0.7 ms
 //! in compute against 19.5 ms in fragment), while on lavapipe neither wins
@@ -46,8 +46,10 @@ impl fmt::Display for Kernel {
     }
 }
 
-/// What the user asked for: a kernel, or the faster of the two.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+/// What the user asked for: a kernel, or the faster of the two. Its names
+/// parse and print (`--kernel`'s values: the command-line crates hand
+/// [`KernelChoice::NAMES`] to clap; this crate has no clap).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KernelChoice {
     Fragment,
     Compute,
@@ -58,6 +60,18 @@ pub enum KernelChoice {
 }
 
 impl KernelChoice {
+    pub const ALL: [KernelChoice; 3] = [
+        KernelChoice::Fragment,
+        KernelChoice::Compute,
+        KernelChoice::Auto,
+    ];
+    /// The names [`KernelChoice::name`] gives, in [`KernelChoice::ALL`]'s order.
+    pub const NAMES: [&'static str; 3] = ["fragment", "compute", "auto"];
+
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
     /// The kernel this choice names, `None` for `auto`.
     pub fn fixed(self) -> Option<Kernel> {
         match self {
@@ -68,7 +82,29 @@ impl KernelChoice {
     }
 }
 
-/// The compute kernel's workgroup, in pixels (crates/render/shaders/trace.wgsl's
+impl fmt::Display for KernelChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for KernelChoice {
+    type Err = String;
+
+    fn from_str(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "`{name}` is not a kernel (one of {})",
+                    Self::NAMES.join(", ")
+                )
+            })
+    }
+}
+
+/// The compute kernel's workgroup, in pixels (shaders/trace.wgsl's
 /// `@workgroup_size`, where the measurement that chose it is).
 pub const WORKGROUP: (u32, u32) = (16, 8);
 
