@@ -1,7 +1,7 @@
 // The per-frame trace pass: `samples_per_frame` jittered paths per pixel,
 // folded into the running mean held in the accumulation target, and the
 // spread of the frames' means folded into the second-moment target (what
-// the error meter, crates/render/src/gpu/error_meter.wgsl, estimates the image's error
+// the error meter, shaders/error_meter.wgsl, estimates the image's error
 // from). One body, `trace_pixel`, and two kernels that call it: `fs_trace`
 // (a full-screen triangle, the targets as colour attachments) and
 // `cs_trace` (a compute dispatch over a band of rows, the targets as

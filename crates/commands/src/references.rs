@@ -115,7 +115,7 @@ fn hash_scene(scene: &Scene, hasher: &mut impl Hasher) -> Result<()> {
 /// Renders the reference on a fresh renderer, from its frame 0.
 ///
 /// The trace shader seeds sample `j` of a frame `f` from `j · φ + f`
-/// (`crates/render/shaders/trace.wgsl`). Here sample `j` lies in frame
+/// (`shaders/trace.wgsl`). Here sample `j` lies in frame
 /// `j / REFERENCE_SAMPLES_PER_FRAME`; a measured render, one sample per
 /// frame after at least one warm-up frame, traces its sample `j` in a frame
 /// past `j`. So no measured sample repeats a reference sample, and the

@@ -22,7 +22,7 @@ pub use crate::scene::transport::LightSelection;
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/lights.wgsl");
 
-/// `Light` of `crates/render/shaders/scene.wgsl`.
+/// `Light` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
 pub struct LightGpu {

@@ -1,6 +1,7 @@
 //! Preset files: a [`Scene`] in RON, versioned, with precise errors.
 
 use crate::atomic_write::write_atomic;
+use crate::scene::text_property::with_text_reader;
 use crate::scene::{ColorEncoding, Scene};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -122,8 +123,9 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         ColorEncoding::Linear => crate::tx::Colors::Linear,
         ColorEncoding::Srgb => crate::tx::Colors::AsTyped,
     };
-    let parsed: Result<Preset, _> =
-        crate::tx::with_preset_colors(tx_colors, || serde_path_to_error::deserialize(tracked));
+    let parsed: Result<Preset, _> = with_text_reader(crate::tx::read_preset_property, || {
+        crate::tx::with_preset_colors(tx_colors, || serde_path_to_error::deserialize(tracked))
+    });
     let mut preset = match parsed {
         Ok(p) => p,
         Err(e) => {

@@ -448,7 +448,9 @@ impl Viewer {
         if self.options.dev && self.incoming.shader_watch.is_none() {
             let shaders = dev_shader_dir();
             let watch = FileWatch::new().and_then(|mut w| {
-                w.watch_tree(&shaders)?;
+                for folder in shader_source::DEV_SOURCE_FOLDERS {
+                    w.watch_tree(&shaders.join(folder))?;
+                }
                 Ok(w)
             });
             match watch {
@@ -550,8 +552,8 @@ pub(super) fn scene_header(path: &Path) -> Header {
     }
 }
 
-/// The folder holding every WGSL file `--dev` reads: the source tree's
-/// `crates/` (resolved, so that messages name it plainly).
+/// The source tree whose `shaders/` and `crates/` hold every WGSL file
+/// `--dev` reads (resolved, so that messages name it plainly).
 fn dev_shader_dir() -> PathBuf {
     let dir = PathBuf::from(shader_source::DEV_SOURCE_ROOT);
     dir.canonicalize().unwrap_or(dir)

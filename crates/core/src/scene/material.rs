@@ -466,8 +466,6 @@ impl Material {
 /// like the rest of the file. It is saved as a tree.
 mod property_serde {
     use super::super::texture_tree::{Child, ChildVisitor, Texture};
-    use super::Material;
-    use crate::tx::{self, Channel};
     use serde::{Deserializer, Serialize, Serializer};
 
     pub fn serialize<S: Serializer>(texture: &Texture, s: S) -> Result<S::Ok, S::Error> {
@@ -477,23 +475,11 @@ mod property_serde {
         }
     }
 
-    /// A property's value, or TX text lowered onto `channel` (none: the
-    /// property has no TX coefficient, and text is refused naming it).
-    fn deserialize_as<'de, D: Deserializer<'de>>(
-        d: D,
-        channel: Option<Channel>,
-        name: &str,
-    ) -> Result<Texture, D::Error> {
-        let read = |text: &str| match channel {
-            Some(channel) => {
-                let base = Material::default();
-                tx::lower_preset_property(text, channel, channel.texture(&base))
-                    .map(|t| Child::Texture(Box::new(t)))
-                    .map_err(|e| e.to_string())
-            }
-            None => Err(format!(
-                "{name} has no TX coefficient; write it as a value or a texture"
-            )),
+    /// A property's value, or its text read by the preset's reader
+    /// (`scene::text_property`: TX lowered onto the field's coefficient).
+    fn deserialize_as<'de, D: Deserializer<'de>>(d: D, name: &str) -> Result<Texture, D::Error> {
+        let read = |text: &str| {
+            super::super::text_property::read(name, text).map(|t| Child::Texture(Box::new(t)))
         };
         Ok(Texture::from(
             d.deserialize_any(ChildVisitor { text: Some(&read) })?,
@@ -501,29 +487,29 @@ mod property_serde {
     }
 
     macro_rules! fields {
-        ($($field:ident => $channel:expr),* $(,)?) => {$(
+        ($($field:ident),* $(,)?) => {$(
             pub mod $field {
                 pub use super::serialize;
                 pub fn deserialize<'de, D: serde::Deserializer<'de>>(
                     d: D,
                 ) -> Result<super::Texture, D::Error> {
-                    super::deserialize_as(d, $channel, stringify!($field))
+                    super::deserialize_as(d, stringify!($field))
                 }
             }
         )*};
     }
 
     fields! {
-        diffuse => Some(super::Channel::Diffuse),
-        specular => Some(super::Channel::Specular),
-        roughness => None,
-        mirror => Some(super::Channel::Mirror),
-        opacity => Some(super::Channel::Opacity),
-        transmission => Some(super::Channel::Transmission),
-        emission => None,
-        diffuse_transmission => Some(super::Channel::DiffuseTransmission),
-        bump => Some(super::Channel::Bump),
-        mask => None,
+        diffuse,
+        specular,
+        roughness,
+        mirror,
+        opacity,
+        transmission,
+        emission,
+        diffuse_transmission,
+        bump,
+        mask,
     }
 }
 

@@ -19,9 +19,11 @@ pub mod pattern_table;
 pub mod primitives;
 pub mod render_settings;
 pub mod render_view;
+pub mod text_property;
 pub mod texture_graph;
 pub mod texture_tree;
 pub mod transport;
+pub mod uv_frame;
 
 pub use camera::{OrbitCamera, SavedView};
 pub use change::Change;
@@ -32,7 +34,8 @@ pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use pattern_table::{PATTERNS, PatternCode, PatternInfo, PatternKind};
-pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon, UvFrame};
+pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon};
+pub use uv_frame::UvFrame;
 pub use render_settings::{DisplaySettings, Metering, RenderSettings, ToneMap};
 pub use render_view::View;
 pub use texture_tree::{Child, MathOp, Texture};
@@ -125,12 +128,12 @@ impl Default for PointLight {
 
 /// The most spheres a scene holds: the renderer keeps spheres and their
 /// materials (one more, the ground's) in fixed-size uniform arrays
-/// (`crates/render/shaders/scene.wgsl`), whose divergent reads cost far less than
+/// (`shaders/scene.wgsl`), whose divergent reads cost far less than
 /// storage-buffer reads on lavapipe.
 pub const MAX_SPHERES: usize = 63;
 
 /// The most materials a scene holds: every primitive's, the ground's and the
-/// meshes' (a uniform array in `crates/render/shaders/scene.wgsl`, within the 64 KiB a
+/// meshes' (a uniform array in `shaders/scene.wgsl`, within the 64 KiB a
 /// uniform binding may hold).
 pub const MAX_MATERIALS: usize = 160;
 

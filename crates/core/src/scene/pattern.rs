@@ -6,7 +6,7 @@
 //! this is the scene's record of which one and with what parameters.
 
 use super::pattern_table::{PatternInfo, PatternKind};
-use super::primitives::UvFrame;
+use super::uv_frame::UvFrame;
 use crate::noise::{FractalParams, FractalShape, NoiseSettings, fractal_sum, rebase::rebase};
 use crate::texture;
 use glam::{Affine3A, Vec2, Vec3};
@@ -15,7 +15,7 @@ use std::ops::RangeInclusive;
 
 /// The most distinct fractal sums (noise signals) one material's textures
 /// may read: the shader evaluates each once per hit (`MAX_SIGNALS` in
-/// crates/render/shaders/scene.wgsl).
+/// shaders/scene.wgsl).
 pub const MAX_SIGNALS: usize = 4;
 
 /// What drives a property across a surface. Each pattern yields a blend

@@ -65,7 +65,7 @@ impl View {
         }
     }
 
-    /// The number `crates/render/shaders/view.wgsl` reads.
+    /// The number `shaders/view.wgsl` reads.
     pub fn id(self) -> u32 {
         self as u32
     }

@@ -14,7 +14,7 @@ pub struct RampStop {
 }
 
 /// Rec. 709 luminance, the weight a ramp gives an image's colour (twin of
-/// `luminance` in crates/render/shaders/common.wgsl).
+/// `luminance` in shaders/common.wgsl).
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }

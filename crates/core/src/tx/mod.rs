@@ -134,6 +134,21 @@ pub fn with_preset_colors<R>(colors: Colors, f: impl FnOnce() -> R) -> R {
     out
 }
 
+/// The reader of a preset's properties written as text
+/// (`scene::text_property`, installed by `preset::parse`): the TX text of
+/// field `field` lowered onto the default material's value of its
+/// coefficient (CD for diffuse, CT's opacity or transmission, TUILE and
+/// VAGUE for the bump).
+pub fn read_preset_property(field: &str, text: &str) -> Result<crate::scene::Texture, String> {
+    let Some(channel) = Channel::ALL.into_iter().find(|c| c.name() == field) else {
+        return Err(format!(
+            "{field} has no TX coefficient; write it as a value or a texture"
+        ));
+    };
+    let base = Material::default();
+    lower_preset_property(text, channel, channel.texture(&base)).map_err(|e| e.to_string())
+}
+
 /// One property's tree from the TX text a preset holds in its place:
 /// colours decoded from display values once (see [`with_preset_colors`]),
 /// image paths as written (the preset resolves them against its folder).

@@ -19,10 +19,6 @@
 
 use std::time::{Duration, Instant};
 
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/accumulation.wgsl");
-
 /// The format of both targets: linear radiance needs floats, and the
 /// running mean needs more than half precision to keep averaging.
 pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;

@@ -8,7 +8,7 @@
 //! ([`marbre_core::scene::Metering`]).
 //!
 //! [`AutoExposure`] meters the accumulation target on the GPU
-//! (`crates/render/src/gpu/auto_exposure.wgsl`): one workgroup reads a grid of texels
+//! (`shaders/auto_exposure.wgsl`): one workgroup reads a grid of texels
 //! spread over the traced region ([`super::metering_grid`]) and reduces it,
 //! and the result stays in a buffer that the display pass binds, so the
 //! frame never waits for a readback. The free functions are its CPU twin.
@@ -24,10 +24,6 @@ use bytemuck::{Pod, Zeroable};
 use marbre_core::scene::Metering;
 use wgpu::util::DeviceExt;
 
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/auto_exposure.wgsl");
-
 /// Reinhard's key: the scene's log-average maps to this middle grey.
 pub const KEY: f32 = 0.18;
 /// Added to every luminance before the log, so black does not give -∞.
@@ -42,8 +38,8 @@ pub const MASSAL_TARGET: f32 = 0.6;
 /// Below this RMS luminance Massal keeps his default exposure (scale 1).
 pub const MASSAL_MIN_RMS: f32 = 0.001;
 
-/// What the metering pass writes (`Metered` in crates/render/src/gpu/auto_exposure.wgsl
-/// and crates/render/shaders/tonemap.wgsl).
+/// What the metering pass writes (`Metered` in shaders/auto_exposure.wgsl
+/// and shaders/tonemap.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Metered {
@@ -291,6 +287,7 @@ impl AutoExposure {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::shader_source::renderer_files;
 
     fn grey(l: f32) -> [f32; 4] {
         [l, l, l, 1.0]
@@ -472,15 +469,15 @@ mod tests {
                 .filter(|l| !l.is_empty())
                 .collect::<Vec<_>>()
         };
-        let metering = declaration(WGSL.text);
-        let display = declaration(include_str!("../../shaders/tonemap.wgsl"));
+        let metering = declaration(renderer_files::AUTO_EXPOSURE.text);
+        let display = declaration(renderer_files::TONEMAP.text);
         assert_eq!(metering, display);
         assert_eq!(metering.len() - 1, std::mem::size_of::<Metered>() / 4);
     }
 
     #[test]
     fn the_shader_constants_are_the_cpu_twins() {
-        let source = WGSL.text;
+        let source = renderer_files::AUTO_EXPOSURE.text;
         for line in [
             format!("const DELTA: f32 = {DELTA:e};"),
             format!("const KEY: f32 = {KEY};"),

@@ -21,10 +21,6 @@ use marbre_core::bake::{BakeProperty, BakeTexel, UvSurface};
 use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
 
-/// The shader code this module runs.
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/bake.wgsl");
-
 /// Texels evaluated per dispatch: 48 MiB of points, within every
 /// adapter's storage-binding limit (128 MiB) and 16,384 workgroups.
 const CHUNK: usize = 1 << 20;

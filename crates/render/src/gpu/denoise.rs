@@ -26,10 +26,6 @@ use super::shader_source::Program;
 use anyhow::{Result, ensure};
 use wgpu::util::DeviceExt;
 
-/// The shader code this module is the CPU twin of.
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/denoise.wgsl");
-
 /// The shader's workgroup (8 × 8 pixels).
 const WORKGROUP: u32 = 8;
 

@@ -3,7 +3,7 @@
 //! `marbre render --target-error` stops at.
 //!
 //! The trace pass keeps, per pixel and channel, the running mean and the
-//! spread of its frames' means about it (`crates/render/shaders/trace.wgsl`, weighted
+//! spread of its frames' means about it (`shaders/trace.wgsl`, weighted
 //! Welford). After F frames of equal samples per frame, spread / (F − 1) is
 //! an unbiased estimate of the variance of the pixel's mean, which is its
 //! expected squared error. Averaged over the pixels it estimates the MSE
@@ -13,7 +13,7 @@
 //! misses the fireflies no frame has met yet.
 //!
 //! [`ErrorMeter`] sums a grid of texels on the GPU
-//! (`crates/render/src/gpu/error_meter.wgsl`) and reads the sums back without stalling;
+//! (`shaders/error_meter.wgsl`) and reads the sums back without stalling;
 //! [`estimate`] is its CPU twin.
 
 use super::async_readback::AsyncReadback;
@@ -26,10 +26,6 @@ use super::readback::read_buffer;
 use super::shader_source::Program;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
-
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/error_meter.wgsl");
 
 /// Added to mean² in the relative error, so that black pixels are judged
 /// absolutely (the relMSE of Rousselle et al., as the benchmarks use).

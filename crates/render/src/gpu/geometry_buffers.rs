@@ -1,5 +1,5 @@
 //! The uniform buffers holding a scene's primitives and their materials.
-//! They are fixed-size arrays (see `crates/render/shaders/scene.wgsl`), so an edit only
+//! They are fixed-size arrays (see `shaders/scene.wgsl`), so an edit only
 //! rewrites them; they never grow.
 
 use super::scene_gpu;
@@ -60,7 +60,7 @@ impl GeometryBuffers {
     }
 
     /// The trace bind group's entries for these buffers (bindings 1, 2, 9
-    /// and 10 of `crates/render/shaders/scene.wgsl`).
+    /// and 10 of `shaders/scene.wgsl`).
     pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
         use super::pipelines::buffer_entry as entry;
         [

@@ -1,6 +1,6 @@
 //! The storage buffers of the scene's triangles and lights: the BVH nodes,
 //! the triangles' vertices and attributes in BVH order (bindings 12–14 of
-//! `crates/render/shaders/scene.wgsl`), and the light table (binding 15), which names
+//! `shaders/scene.wgsl`), and the light table (binding 15), which names
 //! emissive triangles by their place in that order.
 //!
 //! The BVH is rebuilt only when the geometry or its placement changes; the
@@ -15,7 +15,7 @@ use marbre_core::scene::{Change, MeshPlacement, Scene};
 use std::time::Duration;
 use wgpu::util::DeviceExt;
 
-/// `TriangleAttributes` of `crates/render/shaders/scene.wgsl`.
+/// `TriangleAttributes` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct TriangleAttributesGpu {

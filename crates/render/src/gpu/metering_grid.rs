@@ -1,18 +1,14 @@
 //! The grid of texels the metering passes read (auto exposure, the error
 //! meter): every texel of the traced region up to [`GRID`] per axis, a
 //! centred strided grid beyond, so one workgroup meters any image size in
-//! bounded time. The CPU twin of `crates/render/src/gpu/metering_grid.wgsl`.
+//! bounded time. The CPU twin of `shaders/metering_grid.wgsl`.
 
 use bytemuck::{Pod, Zeroable};
-
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/metering_grid.wgsl");
 
 /// At most this many texels are metered along each axis.
 pub const GRID: u32 = 256;
 
-/// `MeteringGrid` in `crates/render/src/gpu/metering_grid.wgsl`.
+/// `MeteringGrid` in `shaders/metering_grid.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
 pub struct MeteringGrid {
@@ -83,7 +79,7 @@ mod tests {
 
     #[test]
     fn the_shader_grid_is_the_cpu_twin() {
-        let source = WGSL.text;
+        let source = crate::gpu::shader_source::renderer_files::METERING_GRID.text;
         assert!(source.contains(&format!("const GRID: u32 = {GRID}u;")));
     }
 }

@@ -1,4 +1,4 @@
-//! The scene flattened into the std140/std430 structs of `crates/render/shaders/scene.wgsl`.
+//! The scene flattened into the std140/std430 structs of `shaders/scene.wgsl`.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -54,7 +54,7 @@ pub struct FrameUniform {
     pub russian_roulette_from: u32,
     pub triangle_count: u32,
     /// Always 1.0, but a uniform: see `compensated_mean_update` in
-    /// `crates/render/src/gpu/accumulation.wgsl`.
+    /// `shaders/accumulation.wgsl`.
     pub opaque_one: f32,
     /// The firefly clamp on a sample's largest channel; 0: off.
     pub sample_clamp: f32,
@@ -140,7 +140,7 @@ pub struct MaterialGpu {
     pub emitted_luminance: f32,
 }
 
-/// `Cylinder` of `crates/render/shaders/scene.wgsl`.
+/// `Cylinder` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct CylinderGpu {
@@ -150,7 +150,7 @@ pub struct CylinderGpu {
     pub _pad: [f32; 3],
 }
 
-/// `Polygon` of `crates/render/shaders/scene.wgsl`: vertices, plane and (u, v) frame.
+/// `Polygon` of `shaders/scene.wgsl`: vertices, plane and (u, v) frame.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
 pub struct PolygonGpu {

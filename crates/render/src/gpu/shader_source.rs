@@ -1,32 +1,47 @@
 //! Assembles a WGSL module for one program and one [`FeatureSet`] from the
 //! WGSL files, each kept beside its CPU twin (`marbre_core::noise::perlin`
 //! and `perlin.wgsl`, …) or, for the renderer's own passes, in
-//! `crates/render/shaders/`.
+//! `shaders/`.
 
 use super::features::{Feature, FeatureSet};
 use super::preprocess::{PreprocessError, preprocess};
 
-/// The renderer's own WGSL: the trace and display passes and what only
-/// they use (no CPU twin), in `crates/render/shaders/`.
-mod renderer_files {
+/// The renderer's own WGSL, in the repository's `shaders/`: the trace and
+/// display passes and what only they use, the compute passes (metering,
+/// error, denoise, bake, swatch) and, in `shaders/harness/`, the test
+/// harnesses' entry points. Listed here, not in the passes' modules, so
+/// that the passes import this table and it imports none of them.
+pub(crate) mod renderer_files {
     use marbre_core::wgsl::WgslFile;
     use marbre_core::wgsl_file;
 
-    pub const COMMON: WgslFile = wgsl_file!("crates/render/shaders/common.wgsl");
-    pub const FULLSCREEN: WgslFile = wgsl_file!("crates/render/shaders/fullscreen.wgsl");
-    pub const SCENE: WgslFile = wgsl_file!("crates/render/shaders/scene.wgsl");
-    pub const TEXTURES: WgslFile = wgsl_file!("crates/render/shaders/textures.wgsl");
-    pub const INTERSECT: WgslFile = wgsl_file!("crates/render/shaders/intersect.wgsl");
-    pub const RANDOM: WgslFile = wgsl_file!("crates/render/shaders/random.wgsl");
-    pub const SURFACE: WgslFile = wgsl_file!("crates/render/shaders/surface.wgsl");
-    pub const ENV_LOOKUP: WgslFile = wgsl_file!("crates/render/shaders/env_lookup.wgsl");
-    pub const BUMP: WgslFile = wgsl_file!("crates/render/shaders/bump.wgsl");
-    pub const VIEW: WgslFile = wgsl_file!("crates/render/shaders/view.wgsl");
-    pub const TRACE: WgslFile = wgsl_file!("crates/render/shaders/trace.wgsl");
-    pub const TONEMAP: WgslFile = wgsl_file!("crates/render/shaders/tonemap.wgsl");
+    pub const COMMON: WgslFile = wgsl_file!("shaders/common.wgsl");
+    pub const FULLSCREEN: WgslFile = wgsl_file!("shaders/fullscreen.wgsl");
+    pub const SCENE: WgslFile = wgsl_file!("shaders/scene.wgsl");
+    pub const TEXTURES: WgslFile = wgsl_file!("shaders/textures.wgsl");
+    pub const INTERSECT: WgslFile = wgsl_file!("shaders/intersect.wgsl");
+    pub const RANDOM: WgslFile = wgsl_file!("shaders/random.wgsl");
+    pub const SURFACE: WgslFile = wgsl_file!("shaders/surface.wgsl");
+    pub const ENV_LOOKUP: WgslFile = wgsl_file!("shaders/env_lookup.wgsl");
+    pub const BUMP: WgslFile = wgsl_file!("shaders/bump.wgsl");
+    pub const VIEW: WgslFile = wgsl_file!("shaders/view.wgsl");
+    pub const TRACE: WgslFile = wgsl_file!("shaders/trace.wgsl");
+    pub const TONEMAP: WgslFile = wgsl_file!("shaders/tonemap.wgsl");
+    pub const ACCUMULATION: WgslFile = wgsl_file!("shaders/accumulation.wgsl");
+    pub const METERING_GRID: WgslFile = wgsl_file!("shaders/metering_grid.wgsl");
+    pub const AUTO_EXPOSURE: WgslFile = wgsl_file!("shaders/auto_exposure.wgsl");
+    pub const ERROR_METER: WgslFile = wgsl_file!("shaders/error_meter.wgsl");
+    pub const DENOISE: WgslFile = wgsl_file!("shaders/denoise.wgsl");
+    pub const BAKE: WgslFile = wgsl_file!("shaders/bake.wgsl");
+    pub const SWATCH: WgslFile = wgsl_file!("shaders/swatch.wgsl");
+    pub const HARNESS_ACCUMULATION: WgslFile = wgsl_file!("shaders/harness/accumulation.wgsl");
+    pub const HARNESS_NOISE: WgslFile = wgsl_file!("shaders/harness/noise.wgsl");
+    pub const HARNESS_TEXTURE: WgslFile = wgsl_file!("shaders/harness/texture.wgsl");
+    pub const HARNESS_BVH: WgslFile = wgsl_file!("shaders/harness/bvh.wgsl");
+    pub const HARNESS_GEOMETRY: WgslFile = wgsl_file!("shaders/harness/geometry.wgsl");
+    pub const HARNESS_SAMPLING: WgslFile = wgsl_file!("shaders/harness/sampling.wgsl");
 }
 
-use super::harness;
 use marbre_core::wgsl::WgslFile;
 use marbre_core::{accel, bsdf, env_sampling, envmap, geometry, lights, mis, noise, texture};
 use renderer_files as r;
@@ -51,37 +66,40 @@ const SOURCES: &[WgslFile] = &[
     r::ENV_LOOKUP,
     r::VIEW,
     r::TRACE,
-    super::accumulation::WGSL,
-    harness::accumulation::WGSL,
+    r::ACCUMULATION,
+    r::HARNESS_ACCUMULATION,
     r::TONEMAP,
-    super::metering_grid::WGSL,
-    super::auto_exposure::WGSL,
-    super::error_meter::WGSL,
-    super::denoise::WGSL,
-    harness::noise::WGSL,
+    r::METERING_GRID,
+    r::AUTO_EXPOSURE,
+    r::ERROR_METER,
+    r::DENOISE,
+    r::HARNESS_NOISE,
     texture::PATTERNS_WGSL,
     r::BUMP,
     texture::SHADING_WGSL,
     texture::mapping::WGSL,
-    harness::texture::WGSL,
+    r::HARNESS_TEXTURE,
     texture::image::WGSL,
     env_sampling::WGSL,
     mis::WGSL,
     lights::WGSL,
     accel::traverse::WGSL,
-    harness::bvh::WGSL,
+    r::HARNESS_BVH,
     geometry::sphere::WGSL,
     geometry::ray_offset::WGSL,
     texture::bump::WGSL,
-    harness::geometry::WGSL,
-    harness::sampling::WGSL,
-    super::bake::WGSL,
-    super::swatch::WGSL,
+    r::HARNESS_GEOMETRY,
+    r::HARNESS_SAMPLING,
+    r::BAKE,
+    r::SWATCH,
 ];
 
-/// The folder `marbre --dev` watches for edited WGSL: the repository's
-/// `crates/`, where every file of [`SOURCES`] lives.
-pub const DEV_SOURCE_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+/// The repository's root, from which every file of [`SOURCES`] is named.
+pub const DEV_SOURCE_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+
+/// The folders under [`DEV_SOURCE_ROOT`] that hold the WGSL, which
+/// `marbre --dev` watches for edits: the renderer's own and the CPU twins'.
+pub const DEV_SOURCE_FOLDERS: [&str; 2] = ["shaders", "crates"];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Program {
@@ -176,22 +194,18 @@ impl Program {
                 if features.contains(Feature::EnvSampling) {
                     out.push(env_sampling::WGSL);
                 }
-                out.extend([r::FULLSCREEN, super::accumulation::WGSL, r::VIEW, r::TRACE]);
+                out.extend([r::FULLSCREEN, r::ACCUMULATION, r::VIEW, r::TRACE]);
                 if features.contains(Feature::Bump) {
                     out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP]);
                 }
             }
             Program::Display => out = vec![r::FULLSCREEN, r::TONEMAP],
-            Program::AutoExposure => {
-                out.extend([super::metering_grid::WGSL, super::auto_exposure::WGSL])
-            }
-            Program::ErrorMeter => {
-                out.extend([super::metering_grid::WGSL, super::error_meter::WGSL])
-            }
-            Program::Denoise => out.push(super::denoise::WGSL),
+            Program::AutoExposure => out.extend([r::METERING_GRID, r::AUTO_EXPOSURE]),
+            Program::ErrorMeter => out.extend([r::METERING_GRID, r::ERROR_METER]),
+            Program::Denoise => out.push(r::DENOISE),
             Program::NoiseHarness => {
                 noise(&mut out);
-                out.push(harness::noise::WGSL);
+                out.push(r::HARNESS_NOISE);
             }
             Program::TextureHarness => {
                 noise(&mut out);
@@ -200,7 +214,7 @@ impl Program {
                     texture::SHADING_WGSL,
                     texture::mapping::WGSL,
                     texture::image::WGSL,
-                    harness::texture::WGSL,
+                    r::HARNESS_TEXTURE,
                 ]);
             }
             Program::Swatch => {
@@ -209,25 +223,18 @@ impl Program {
                 if features.contains(Feature::IMAGE) {
                     out.push(texture::image::WGSL);
                 }
-                out.extend([
-                    r::TEXTURES,
-                    geometry::sphere::WGSL,
-                    r::INTERSECT,
-                    super::swatch::WGSL,
-                ]);
+                out.extend([r::TEXTURES, geometry::sphere::WGSL, r::INTERSECT, r::SWATCH]);
             }
-            Program::BvhHarness => out.extend([accel::traverse::WGSL, harness::bvh::WGSL]),
-            Program::AccumulationHarness => out.extend([
-                noise::hash::WGSL,
-                super::accumulation::WGSL,
-                harness::accumulation::WGSL,
-            ]),
+            Program::BvhHarness => out.extend([accel::traverse::WGSL, r::HARNESS_BVH]),
+            Program::AccumulationHarness => {
+                out.extend([noise::hash::WGSL, r::ACCUMULATION, r::HARNESS_ACCUMULATION])
+            }
             Program::GeometryHarness => out.extend([
                 texture::SHADING_WGSL,
                 geometry::sphere::WGSL,
                 geometry::ray_offset::WGSL,
                 texture::bump::WGSL,
-                harness::geometry::WGSL,
+                r::HARNESS_GEOMETRY,
             ]),
             Program::SamplingHarness => out.extend([
                 noise::hash::WGSL,
@@ -237,7 +244,7 @@ impl Program {
                 r::ENV_LOOKUP,
                 mis::WGSL,
                 env_sampling::WGSL,
-                harness::sampling::WGSL,
+                r::HARNESS_SAMPLING,
             ]),
             Program::Bake => {
                 noise(&mut out);
@@ -250,7 +257,7 @@ impl Program {
                     out.push(accel::traverse::WGSL);
                 }
                 // `Hit`, which textures.wgsl's footprint reads.
-                out.extend([geometry::sphere::WGSL, r::INTERSECT, super::bake::WGSL]);
+                out.extend([geometry::sphere::WGSL, r::INTERSECT, r::BAKE]);
             }
         }
         out
@@ -377,10 +384,16 @@ mod tests {
                 "{} differs from the copy built in",
                 file.name
             );
-            let from_root = root.join("..").join(file.name);
             assert!(
-                from_root.is_file(),
+                root.join(file.name).is_file(),
                 "{} is not under the repository",
+                file.name
+            );
+            assert!(
+                DEV_SOURCE_FOLDERS
+                    .iter()
+                    .any(|folder| file.name.starts_with(&format!("{folder}/"))),
+                "{} is in no folder `--dev` watches",
                 file.name
             );
         }
@@ -414,7 +427,7 @@ mod tests {
             + 1;
         assert_eq!(
             source_position(&module, module_line),
-            Some(("crates/render/shaders/trace.wgsl".to_owned(), file_line))
+            Some(("shaders/trace.wgsl".to_owned(), file_line))
         );
         let last = module.lines().count() as u32;
         assert_eq!(

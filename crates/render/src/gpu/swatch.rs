@@ -28,10 +28,6 @@ use marbre_core::scene::{MAX_MATERIALS, SurfacePoint, Texture};
 use marbre_core::texture::{ImageAtlas, ImageSet, mapping::sphere_uv};
 use std::collections::HashMap;
 
-/// The shader code this module is the GPU side of.
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/swatch.wgsl");
-
 /// Side of a swatch, in pixels.
 pub const SWATCH_SIZE: usize = 48;
 

@@ -20,7 +20,7 @@ use marbre_core::scene::{Child, Material, Scene, Texture};
 use marbre_core::texture::ImageSet;
 
 /// Entries in the `texture_params` uniform array (`MAX_TEXTURE_PARAMS` in
-/// crates/render/shaders/scene.wgsl): 16 KiB.
+/// shaders/scene.wgsl): 16 KiB.
 pub const MAX_TEXTURE_PARAMS: usize = 1024;
 
 /// Which number of a node a slot holds.

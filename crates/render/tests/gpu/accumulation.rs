@@ -1,5 +1,5 @@
 //! Long accumulation: the trace pass's running mean (Kahan-compensated,
-//! `crates/render/src/gpu/accumulation.wgsl`) keeps its rounding error at a few ulps over
+//! `shaders/accumulation.wgsl`) keeps its rounding error at a few ulps over
 //! 1e5 and 1e6 frames, where an uncompensated running mean and a plain f32
 //! sum drift. The streams are an HDR pixel's frames (mostly 0.01, one in
 //! ~1000 a firefly of 1000), the hard case for rounding. Runs on the CPU

@@ -1,4 +1,4 @@
-//! Runs the trace pass's accumulation update (`crates/render/src/gpu/accumulation.wgsl`)
+//! Runs the trace pass's accumulation update (`shaders/accumulation.wgsl`)
 //! over long streams of frames on the GPU, beside an uncompensated running
 //! mean and a plain f32 sum, and the CPU twins of the streams, for the
 //! long-accumulation tests: 1e5 frames and more in one dispatch, where the
@@ -13,10 +13,6 @@ use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
 use marbre_core::noise::hash::pcg3d;
-
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/accumulation.wgsl");
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -52,7 +48,7 @@ pub struct LongAccumulation {
 
 /// The value of frame `frame_index` of stream `seed`: an HDR pixel, mostly
 /// 0.01 and one frame in ~1000 (16777 in 2^24) a firefly of 1000. The twin
-/// of `frame_value` in `crates/render/src/gpu/harness/accumulation.wgsl`.
+/// of `frame_value` in `shaders/harness/accumulation.wgsl`.
 pub fn frame_value(seed: u32, frame_index: u32) -> f32 {
     let h = pcg3d(UVec3::new(seed, frame_index, 0)).x >> 8;
     if h < 16777 { 1000.0 } else { 0.01 }

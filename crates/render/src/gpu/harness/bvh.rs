@@ -2,7 +2,7 @@
 //! a compute pass, so the parity and watertightness tests can hold it to
 //! the CPU ([`marbre_core::accel`]) and `marbre bench-bvh` can time it.
 //!
-//! Bindings of `crates/render/src/gpu/harness/bvh.wgsl`: 0 its uniform (ray count, row
+//! Bindings of `shaders/harness/bvh.wgsl`: 0 its uniform (ray count, row
 //! pitch), 1 the rays, 2 the results, 3 `bvh_nodes`, 4 `mesh_triangles`.
 
 use super::dispatch;
@@ -15,10 +15,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use marbre_core::accel::{BvhNode, MeshHit, TriangleVerts};
 use std::time::{Duration, Instant};
-
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/bvh.wgsl");
 
 /// `NO_TRIANGLE` in accel/traverse.wgsl: the triangle of a miss.
 pub const NO_TRIANGLE: u32 = u32::MAX;

@@ -13,10 +13,6 @@ use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/geometry.wgsl");
-
 /// `QUERY_POINTS` in harness/geometry.wgsl: the inputs of one query.
 const QUERY_POINTS: usize = 5;
 

@@ -12,10 +12,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 use marbre_core::noise::{FractalShape, NoiseSettings};
 
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/noise.wgsl");
-
 /// What the harness evaluates at each point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Evaluate {

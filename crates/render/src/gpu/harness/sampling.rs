@@ -1,4 +1,4 @@
-//! Runs the shader's sampling functions (`crates/render/src/gpu/harness/sampling.wgsl`):
+//! Runs the shader's sampling functions (`shaders/harness/sampling.wgsl`):
 //! environment sampling and its pdf, the environment lookup, BSDF sampling
 //! and evaluation, and the MIS weights, on inputs given from the CPU. The
 //! chi² and stability tests feed the GPU's own samples and densities to
@@ -19,10 +19,6 @@ use marbre_core::env_sampling::EnvDistribution;
 use marbre_core::envmap::EnvImage;
 use marbre_core::scene::Strategy;
 use wgpu::util::DeviceExt;
-
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/sampling.wgsl");
 
 /// `SamplingFrame` in the shader.
 #[repr(C)]

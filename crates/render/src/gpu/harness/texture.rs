@@ -13,10 +13,6 @@ use glam::{Affine3A, Vec2, Vec3};
 use marbre_core::noise::{FractalShape, NoiseSettings};
 use marbre_core::texture::{ImageAtlas, ImageFilter, ImageWrap, MAX_RAMP_STOPS, RampStop};
 
-/// The shader code this module is the CPU twin of (or, for a harness, runs).
-pub const WGSL: marbre_core::wgsl::WgslFile =
-    marbre_core::wgsl_file!("crates/render/src/gpu/harness/texture.wgsl");
-
 /// One pattern with its parameters. 2D patterns read uv from the points'
 /// x and y; `Bump` reads the unbumped normal from the point.
 #[derive(Debug, Clone, PartialEq)]

@@ -461,7 +461,7 @@ pub(super) struct PipelineKey {
 }
 
 /// The render settings the trace shader reads as override constants
-/// (declared in crates/render/shaders/textures.wgsl).
+/// (declared in shaders/textures.wgsl).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(super) struct RenderSwitches {
     pub(super) filter_checkers: bool,

@@ -168,7 +168,7 @@ pub struct Renderer {
 const FRAME_SLOTS: u64 = 2 * trace_bands::MAX_PASSES as u64;
 
 /// The bytes of one frame-uniform slot: two copies of the settings (see
-/// `frame_slots` in crates/render/shaders/scene.wgsl).
+/// `frame_slots` in shaders/scene.wgsl).
 const FRAME_BYTES: u64 = 2 * std::mem::size_of::<FrameUniform>() as u64;
 
 /// What one trace call did.
