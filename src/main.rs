@@ -44,8 +44,9 @@ struct ViewerArgs {
     /// Save the whole window, UI included, as PNG just before exiting.
     #[arg(long)]
     window_screenshot: Option<PathBuf>,
-    /// Development mode: read the WGSL files from the source tree (each
-    /// beside its CPU twin under `crates/`) and rebuild the trace pipeline
+    /// Development mode: read the WGSL files from the source tree
+    /// (`shaders/`, and each CPU twin's beside it under `crates/`) and
+    /// rebuild the trace pipeline
     /// when one changes (a shader that fails to build leaves the old
     /// pipeline, and the panel shows the error).
     #[arg(long)]
