@@ -216,7 +216,7 @@ fn intersect_scene(o: vec3f, d: vec3f) -> Hit {
     }
 #endif
 #if MESH
-    let m = intersect_mesh(o, d, hit.t);
+    let m = slab_ray_intersect(o, d, hit.t);
     if m.t < hit.t {
         let tri = mesh_triangles[m.triangle];
         let a = mesh_attributes[m.triangle];
@@ -283,7 +283,7 @@ fn occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
     }
 #endif
 #if MESH
-    if mesh_occluded(o, d, t_max) {
+    if slab_ray_occluded(o, d, t_max) {
         return true;
     }
 #endif

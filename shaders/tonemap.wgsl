@@ -1,7 +1,7 @@
 // Display pass: exposure, tone mapping and (for non-sRGB targets) encoding,
 // from the accumulation target onto the window or an offscreen image.
 
-struct Display {
+struct DisplayUniform {
     // 2^exposure: the manual exposure, or with auto exposure the
     // compensation applied on top of the metered scale.
     exposure_scale: f32,
@@ -28,7 +28,7 @@ struct Metered {
     padding: u32,
 }
 
-@group(0) @binding(0) var<uniform> display: Display;
+@group(0) @binding(0) var<uniform> display: DisplayUniform;
 @group(0) @binding(1) var radiance: texture_2d<f32>;
 @group(0) @binding(2) var<uniform> metered: Metered;
 // The spread target: its alpha counts the pixel's dropped non-finite

@@ -1,7 +1,7 @@
 // Compute harness: sends rays through the mesh functions of accel/traverse.wgsl, for
 // the parity and watertightness tests and `marbre bench-bvh`.
 
-struct BvhHarness {
+struct BvhHarnessUniform {
     count: u32,
     row_pitch: u32, // invocations per row of workgroups (dispatches past 65535 groups)
     _pad0: u32,
@@ -15,7 +15,7 @@ struct HarnessRay {
 
 const NO_HIT: f32 = 3.0e38;
 
-@group(0) @binding(0) var<uniform> harness: BvhHarness;
+@group(0) @binding(0) var<uniform> harness: BvhHarnessUniform;
 @group(0) @binding(1) var<storage, read> rays: array<HarnessRay>;
 // Closest: (t, triangle, b1, b2) as bits; occluded: x = 1 or 0.
 @group(0) @binding(2) var<storage, read_write> results: array<vec4u>;
@@ -29,7 +29,7 @@ fn cs_closest(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let ray = rays[i];
-    let h = intersect_mesh(ray.origin.xyz, ray.direction.xyz, ray.origin.w);
+    let h = slab_ray_intersect(ray.origin.xyz, ray.direction.xyz, ray.origin.w);
     results[i] = vec4u(bitcast<u32>(h.t), h.triangle, bitcast<u32>(h.b1), bitcast<u32>(h.b2));
 }
 
@@ -40,6 +40,6 @@ fn cs_occluded(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let ray = rays[i];
-    let hit = mesh_occluded(ray.origin.xyz, ray.direction.xyz, ray.origin.w);
+    let hit = slab_ray_occluded(ray.origin.xyz, ray.direction.xyz, ray.origin.w);
     results[i] = vec4u(select(0u, 1u, hit), 0u, 0u, 0u);
 }

@@ -1,7 +1,7 @@
 // Compute harness: evaluates the same WGSL noise and mapping functions the
 // renderer uses at a list of points, for `marbre noise` and the parity tests.
 
-struct Harness {
+struct NoiseHarness {
     noise: NoiseParams,
     mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged,
                           // 7 footprint octaves
@@ -10,7 +10,7 @@ struct Harness {
     _pad: f32,
 }
 
-@group(0) @binding(0) var<uniform> harness: Harness;
+@group(0) @binding(0) var<uniform> harness: NoiseHarness;
 @group(0) @binding(1) var<storage, read> points: array<vec4f>;
 @group(0) @binding(2) var<storage, read_write> results: array<vec4f>;
 

@@ -25,7 +25,7 @@ pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/light
 /// `Light` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
-pub struct LightGpu {
+pub struct Light {
     /// [`LightKind`] as a number.
     pub kind: u32,
     /// The sphere's index, or the triangle's in the GPU triangle array.
@@ -47,7 +47,7 @@ pub enum LightKind {
 /// The lights of a scene and their power distribution.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LightTable {
-    pub lights: Vec<LightGpu>,
+    pub lights: Vec<Light>,
     pub total_power: f32,
     /// Emitters left out (zero area, no power), each named.
     pub notes: Vec<String>,
@@ -131,7 +131,7 @@ impl LightTable {
                 let area = triangle_area(&t.vertices);
                 // A subnormal area is zero where the GPU flushes it.
                 if area.is_normal() {
-                    table.lights.push(LightGpu {
+                    table.lights.push(Light {
                         kind: LightKind::Triangle as u32,
                         primitive: i as u32,
                         cdf: 0.0,
@@ -155,7 +155,7 @@ impl LightTable {
     /// zero, subnormal (GPUs flush it to zero) or not finite.
     fn push(&mut self, kind: LightKind, primitive: u32, power: f32, what: &str) {
         if power.is_normal() && power > 0.0 {
-            self.lights.push(LightGpu {
+            self.lights.push(Light {
                 kind: kind as u32,
                 primitive,
                 cdf: 0.0,

@@ -1,6 +1,8 @@
 // Triangle meshes: the watertight ray-triangle test (Woop, Benthin and
 // Wald, "Watertight Ray/Triangle Intersection", JCGT 2013) and the walk of
-// the BVH built by bvh.rs. traverse.rs is its CPU twin.
+// the BVH built by bvh.rs. traverse.rs is its CPU twin: `SlabRay` and
+// `slab_ray_new`, `_entry`, `_intersect`, `_occluded` are its `SlabRay`
+// and its methods (the WGSL ray also holds the watertight test's shear).
 //
 // The including program declares, at bindings of its choosing:
 //
@@ -68,7 +70,7 @@ const SLAB_INFLATE: f32 = 1.0000019;
 const BOX_MISS: f32 = 3.4e38;
 
 // What the tests need of a ray, computed once per traversal.
-struct MeshRay {
+struct SlabRay {
     o: vec3f,
     inv: vec3f,           // 1/d, 0 on parallel axes
     pad: vec3f,           // SLAB_PAD on parallel axes, else 0
@@ -86,7 +88,7 @@ fn mesh_unit(k: u32) -> vec3f {
     return vec3f(select(0.0, 1.0, k == 0u), select(0.0, 1.0, k == 1u), select(0.0, 1.0, k == 2u));
 }
 
-fn mesh_ray(o: vec3f, d: vec3f) -> MeshRay {
+fn slab_ray_new(o: vec3f, d: vec3f) -> SlabRay {
     let a = abs(d);
     let kz = select(select(2u, 1u, a.y >= a.z), 0u, a.x >= a.y && a.x >= a.z);
     let flip = d[kz] < 0.0;
@@ -99,7 +101,7 @@ fn mesh_ray(o: vec3f, d: vec3f) -> MeshRay {
     let sy = d[ky] / dz;
     let sz = 1.0 / dz;
     let ez = mesh_unit(kz);
-    var r: MeshRay;
+    var r: SlabRay;
     r.o = o;
     r.shear = mat3x3f(mesh_unit(kx) - sx * ez, mesh_unit(ky) - sy * ez, sz * ez);
     let largest = max(max(a.x, a.y), a.z);
@@ -133,7 +135,7 @@ fn mesh_edge(p: vec2f, q: vec2f) -> f32 {
 // ray) is missed. A fused multiply-add's different rounding can, in
 // principle, also flip the sign of an edge function within an ulp of zero;
 // each edge is still seen the same way by both of its triangles.
-fn mesh_triangle(r: MeshRay, index: u32, t_max: f32) -> vec3f {
+fn mesh_triangle(r: SlabRay, index: u32, t_max: f32) -> vec3f {
     let a = (mesh_triangles[index].v0.xyz - r.o) * r.shear;
     let b = (mesh_triangles[index].v1.xyz - r.o) * r.shear;
     let c = (mesh_triangles[index].v2.xyz - r.o) * r.shear;
@@ -150,16 +152,16 @@ fn mesh_triangle(r: MeshRay, index: u32, t_max: f32) -> vec3f {
 
 // Whether the ray may meet anything at all: a non-zero direction, a root
 // that is not the empty hierarchy (count 0, a 0), and the root's box.
-fn mesh_worth_walking(r: MeshRay, d: vec3f, t_far: f32) -> bool {
+fn mesh_worth_walking(r: SlabRay, d: vec3f, t_far: f32) -> bool {
     let empty = bvh_nodes[0].count == 0u & bvh_nodes[0].a == 0u;
-    return !(empty | all(d == vec3f(0.0))) & mesh_box_entry(r, 0u, t_far) < BOX_MISS;
+    return !(empty | all(d == vec3f(0.0))) & slab_ray_entry(r, 0u, t_far) < BOX_MISS;
 }
 
 // Where the ray enters node `index`'s box (clamped to 0), or BOX_MISS when
 // it does not before t_far. Near and far planes are picked by the
 // direction's sign, not by min/max of the two distances, so an inverted
 // (empty) box is rejected.
-fn mesh_box_entry(r: MeshRay, index: u32, t_far: f32) -> f32 {
+fn slab_ray_entry(r: SlabRay, index: u32, t_far: f32) -> f32 {
     let lo = bvh_nodes[index].min;
     let hi = bvh_nodes[index].max;
     let t_near = (select(lo, hi, r.negative) - r.o) * r.inv - r.pad;
@@ -178,9 +180,9 @@ fn mesh_box_entry(r: MeshRay, index: u32, t_far: f32) -> f32 {
 // step wait for each other at the end of each inner loop, so they test
 // triangles together rather than each iteration paying, under a mask, for
 // both a node step and a leaf.
-fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
+fn slab_ray_intersect(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
     var hit = MeshHit(NO_HIT, NO_TRIANGLE, 0.0, 0.0);
-    let r = mesh_ray(o, d);
+    let r = slab_ray_new(o, d);
     var t_far = min(t_max, NO_HIT);
     if !mesh_worth_walking(r, d, t_far) {
         return hit;
@@ -192,8 +194,8 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
         var a = bvh_nodes[node].a;
         var count = bvh_nodes[node].count;
         while count == 0u {
-            let tl = mesh_box_entry(r, a, t_far);
-            let tr = mesh_box_entry(r, a + 1u, t_far);
+            let tl = slab_ray_entry(r, a, t_far);
+            let tr = slab_ray_entry(r, a + 1u, t_far);
             // Near child first; the other waits on the stack. A missed
             // child's BOX_MISS sorts last.
             let right_first = tr < tl;
@@ -232,8 +234,8 @@ fn intersect_mesh(o: vec3f, d: vec3f, t_max: f32) -> MeshHit {
 // Whether any triangle is hit with t in (0, t_max): for shadow rays. The
 // same walk, stopping at the first hit. Near children first too: in a
 // closed mesh the near side is where a hit is likeliest.
-fn mesh_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
-    let r = mesh_ray(o, d);
+fn slab_ray_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
+    let r = slab_ray_new(o, d);
     let t_far = min(t_max, NO_HIT);
     if !mesh_worth_walking(r, d, t_far) {
         return false;
@@ -245,8 +247,8 @@ fn mesh_occluded(o: vec3f, d: vec3f, t_max: f32) -> bool {
         var a = bvh_nodes[node].a;
         var count = bvh_nodes[node].count;
         while count == 0u {
-            let tl = mesh_box_entry(r, a, t_far);
-            let tr = mesh_box_entry(r, a + 1u, t_far);
+            let tl = slab_ray_entry(r, a, t_far);
+            let tr = slab_ray_entry(r, a + 1u, t_far);
             let right_first = tr < tl;
             if max(tl, tr) < BOX_MISS {
                 stack[sp] = select(a + 1u, a, right_first);

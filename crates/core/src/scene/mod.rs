@@ -35,11 +35,11 @@ pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use pattern_table::{PATTERNS, PatternCode, PatternInfo, PatternKind};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon};
-pub use uv_frame::UvFrame;
 pub use render_settings::{DisplaySettings, Metering, RenderSettings, ToneMap};
 pub use render_view::View;
 pub use texture_tree::{Child, MathOp, Texture};
 pub use transport::{Integrator, LightPoints, Strategy, TransportSettings};
+pub use uv_frame::UvFrame;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};

@@ -49,10 +49,11 @@ mod tests {
     fn text_is_read_by_the_presets_reader_only() {
         let material = r#"(diffuse: "UNI CD 0.7 0 0 FTX")"#;
         let e = ron::from_str::<Material>(material).unwrap_err().to_string();
-        assert!(e.contains("diffuse: text is read only inside a preset"), "{e}");
-        let preset = format!(
-            "(format_version: 2, scene: (spheres: [(material: {material})]))"
+        assert!(
+            e.contains("diffuse: text is read only inside a preset"),
+            "{e}"
         );
+        let preset = format!("(format_version: 2, scene: (spheres: [(material: {material})]))");
         let loaded = crate::preset::parse(&preset, Path::new("p.ron")).unwrap();
         let diffuse = &loaded.preset.scene.spheres[0].material.diffuse;
         assert!((diffuse.eval(glam::Vec3::ZERO, glam::Vec2::ZERO).x - 0.448).abs() < 1e-3);

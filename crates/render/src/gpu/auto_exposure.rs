@@ -303,10 +303,21 @@ mod tests {
     fn structs_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::{module_of, twin_layout};
         let module = &module_of(Program::AutoExposure, &FeatureSet::default(), "");
-        twin_layout!(module, Metered => "Metered", [
-            log_average, stops, scale, count, rms, rms_stops, rms_scale, padding,
-        ]);
-        twin_layout!(module, MeteringGrid => "MeteringGrid", [region, grid]);
+        twin_layout!(
+            module,
+            Metered,
+            [
+                log_average,
+                stops,
+                scale,
+                count,
+                rms,
+                rms_stops,
+                rms_scale,
+                padding,
+            ]
+        );
+        twin_layout!(module, MeteringGrid, [region, grid]);
     }
 
     #[test]

@@ -17,7 +17,7 @@ use super::shader_source::Program;
 use super::texture_codegen;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
-use marbre_core::bake::{BakeProperty, BakeTexel, UvSurface};
+use marbre_core::bake::{self, BakeProperty, UvSurface};
 use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
 
@@ -36,7 +36,7 @@ struct BakeSettings {
 /// `BakeTexel` of bake.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct TexelGpu {
+struct BakeTexel {
     p: [f32; 3],
     material: u32,
     pw: [f32; 3],
@@ -45,8 +45,8 @@ struct TexelGpu {
     _pad1: [f32; 2],
 }
 
-impl From<&BakeTexel> for TexelGpu {
-    fn from(t: &BakeTexel) -> Self {
+impl From<&bake::BakeTexel> for BakeTexel {
+    fn from(t: &bake::BakeTexel) -> Self {
         Self {
             p: t.point.object.into(),
             material: t.material,
@@ -122,8 +122,8 @@ pub fn bake(
     let mut first = 0;
     while first < count {
         let last = (first + CHUNK).min(count);
-        let (indices, texels): (Vec<usize>, Vec<TexelGpu>) = (first..last)
-            .filter_map(|i| surface.texel(i, size).map(|t| (i, TexelGpu::from(&t))))
+        let (indices, texels): (Vec<usize>, Vec<BakeTexel>) = (first..last)
+            .filter_map(|i| surface.texel(i, size).map(|t| (i, BakeTexel::from(&t))))
             .unzip();
         first = last;
         if texels.is_empty() {
@@ -187,7 +187,7 @@ mod tests {
                 .unwrap()
                 .wgsl,
         );
-        twin_layout!(module, BakeSettings => "BakeSettings", [count, property]);
-        twin_layout!(module, TexelGpu => "BakeTexel", [p, material, pw, uv]);
+        twin_layout!(module, BakeSettings, [count, property]);
+        twin_layout!(module, BakeTexel, [p, material, pw, uv]);
     }
 }

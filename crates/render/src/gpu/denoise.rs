@@ -522,7 +522,19 @@ mod tests {
     fn the_parameters_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::{module_of, twin_layout};
         let module = &module_of(Program::Denoise, &FeatureSet::default(), "");
-        twin_layout!(module, DenoiseParams => "DenoiseParams", [size, step, frames, sigma_luminance, sigma_normal, sigma_albedo, pad]);
+        twin_layout!(
+            module,
+            DenoiseParams,
+            [
+                size,
+                step,
+                frames,
+                sigma_luminance,
+                sigma_normal,
+                sigma_albedo,
+                pad
+            ]
+        );
     }
 
     fn flat(n: usize, v: [f32; 4]) -> Vec<[f32; 4]> {

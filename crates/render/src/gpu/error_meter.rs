@@ -316,12 +316,24 @@ mod tests {
     fn structs_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::{module_of, twin_layout};
         let module = &module_of(Program::ErrorMeter, &FeatureSet::default(), "");
-        twin_layout!(module, ErrorParams => "ErrorParams", [
-            grid, frames, samples, seconds, generation,
-        ]);
-        twin_layout!(module, ErrorSums => "ErrorSums", [
-            spread, relative_spread, channels, frames, samples, seconds, generation,
-        ]);
+        twin_layout!(
+            module,
+            ErrorParams,
+            [grid, frames, samples, seconds, generation,]
+        );
+        twin_layout!(
+            module,
+            ErrorSums,
+            [
+                spread,
+                relative_spread,
+                channels,
+                frames,
+                samples,
+                seconds,
+                generation,
+            ]
+        );
     }
 
     #[test]

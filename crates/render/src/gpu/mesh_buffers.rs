@@ -10,7 +10,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use marbre_core::accel::{Bvh, TriangleVerts};
-use marbre_core::lights::{EmitterTriangle, LightGpu, LightTable};
+use marbre_core::lights::{EmitterTriangle, Light, LightTable};
 use marbre_core::scene::{Change, MeshPlacement, Scene};
 use std::time::Duration;
 use wgpu::util::DeviceExt;
@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt;
 /// `TriangleAttributes` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct TriangleAttributesGpu {
+pub struct TriangleAttributes {
     pub uv01: [f32; 4],
     pub uv2: [f32; 2],
     pub material: u32,
@@ -97,7 +97,7 @@ pub struct PreparedGeometry {
     key: GeometryKey,
     bvh: Bvh,
     verts: Vec<TriangleVerts>,
-    attributes: Vec<TriangleAttributesGpu>,
+    attributes: Vec<TriangleAttributes>,
     emitters: Vec<EmitterTriangle>,
 }
 
@@ -111,7 +111,7 @@ impl PreparedGeometry {
             positions.extend(mesh.world_positions());
             let g = &mesh.geometry.0;
             for (uv, &m) in g.uvs.iter().zip(&g.materials) {
-                attributes.push(TriangleAttributesGpu {
+                attributes.push(TriangleAttributes {
                     uv01: [uv[0].x, uv[0].y, uv[1].x, uv[1].y],
                     uv2: [uv[2].x, uv[2].y],
                     material: base + m.min(mesh.materials.len().saturating_sub(1) as u32),
@@ -214,7 +214,7 @@ impl MeshBuffers {
     fn rebuild_lights(&mut self, device: &wgpu::Device, scene: &Scene) {
         let table = LightTable::build(scene, &self.emitters);
         if table != self.table {
-            let entries: Vec<LightGpu> = table.lights.clone();
+            let entries: Vec<Light> = table.lights.clone();
             self.lights = storage_buffer(device, "lights", bytemuck::cast_slice(&entries));
             self.stats.lights = table.lights.len();
             self.table = table;

@@ -7,13 +7,13 @@ use marbre_core::noise::{FractalShape, HashKind, NoiseKind, NoiseSettings};
 use marbre_core::scene::pattern::MAX_SIGNALS;
 use marbre_core::scene::primitives::MAX_POLYGON_VERTICES;
 use marbre_core::scene::{
-    EnvSource, Ground, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES, MappingSpace,
-    Material, Scene,
+    self as model, EnvSource, Ground, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES,
+    MappingSpace, Scene,
 };
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct FrameUniform {
+pub struct Frame {
     pub cam_pos: [f32; 3],
     pub tan_half_fov: f32,
     pub cam_right: [f32; 3],
@@ -81,7 +81,7 @@ pub struct FrameUniform {
 /// `NoiseParams` of `crates/core/src/noise/fractal.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default, PartialEq)]
-pub struct NoiseParamsGpu {
+pub struct NoiseParams {
     pub kind: u32,
     pub hash: u32,
     pub octaves: f32,
@@ -100,7 +100,7 @@ pub struct NoiseParamsGpu {
     pub progression: u32,
 }
 
-impl NoiseParamsGpu {
+impl NoiseParams {
     pub fn new(n: &NoiseSettings, shape: FractalShape) -> Self {
         let f = &n.fractal;
         Self {
@@ -126,8 +126,8 @@ impl NoiseParamsGpu {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct MaterialGpu {
-    pub signals: [NoiseParamsGpu; MAX_SIGNALS],
+pub struct Material {
+    pub signals: [NoiseParams; MAX_SIGNALS],
     /// Each signal's mapping as three affine rows (identity without one).
     pub signal_rows: [[f32; 4]; 3 * MAX_SIGNALS],
     pub signal_count: u32,
@@ -143,7 +143,7 @@ pub struct MaterialGpu {
 /// `Cylinder` of `shaders/scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct CylinderGpu {
+pub struct Cylinder {
     pub base: [f32; 3],
     pub radius: f32,
     pub height: f32,
@@ -153,7 +153,7 @@ pub struct CylinderGpu {
 /// `Polygon` of `shaders/scene.wgsl`: vertices, plane and (u, v) frame.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct PolygonGpu {
+pub struct Polygon {
     pub vertices: [[f32; 4]; MAX_POLYGON_VERTICES],
     pub normal: [f32; 3],
     pub vertex_count: u32,
@@ -164,7 +164,7 @@ pub struct PolygonGpu {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
-pub struct SphereGpu {
+pub struct Sphere {
     pub center: [f32; 3],
     pub radius: f32,
 }
@@ -194,9 +194,9 @@ pub fn hash_id(h: HashKind) -> u32 {
 /// deduplicated so that rust's diffuse and specular colours share one
 /// evaluation per hit, gradient noise first) and its bump height. The
 /// textures themselves are generated code (`texture_codegen`).
-pub fn material(m: &Material) -> MaterialGpu {
+pub fn material(m: &model::Material) -> Material {
     let signals = m.signals();
-    let mut out = MaterialGpu {
+    let mut out = Material {
         signal_count: signals.len() as u32,
         first_perlin: signals
             .iter()
@@ -207,7 +207,7 @@ pub fn material(m: &Material) -> MaterialGpu {
         ..Default::default()
     };
     for (k, signal) in signals.iter().enumerate() {
-        out.signals[k] = NoiseParamsGpu::new(&signal.noise, signal.shape);
+        out.signals[k] = NoiseParams::new(&signal.noise, signal.shape);
         let mapping = signal.mapping.unwrap_or_default();
         out.signals[k].world = u32::from(mapping.space == MappingSpace::World);
         out.signals[k].footprint_scale = mapping.footprint_scale()[2];
@@ -218,9 +218,9 @@ pub fn material(m: &Material) -> MaterialGpu {
 
 /// Materials in the order the shader indexes them, padded to the uniform
 /// array's length.
-pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
+pub fn materials(scene: &Scene) -> Vec<Material> {
     let mut out: Vec<_> = scene.materials().map(material).collect();
-    out.resize(MAX_MATERIALS, MaterialGpu::default());
+    out.resize(MAX_MATERIALS, Material::default());
     out
 }
 
@@ -229,31 +229,31 @@ pub fn materials(scene: &Scene) -> Vec<MaterialGpu> {
 pub use marbre_core::scene::MAX_MATERIALS;
 
 /// Cylinders, padded to the uniform array's length.
-pub fn cylinders(scene: &Scene) -> Vec<CylinderGpu> {
+pub fn cylinders(scene: &Scene) -> Vec<Cylinder> {
     let mut out: Vec<_> = scene
         .cylinders
         .iter()
         .take(MAX_CYLINDERS)
-        .map(|c| CylinderGpu {
+        .map(|c| Cylinder {
             base: c.base.to_array(),
             radius: c.radius,
             height: c.height,
             _pad: [0.0; 3],
         })
         .collect();
-    out.resize(MAX_CYLINDERS, CylinderGpu::default());
+    out.resize(MAX_CYLINDERS, Cylinder::default());
     out
 }
 
 /// Polygons (those `Scene::sanitize` kept: convex, flat), padded to the
 /// uniform array's length.
-pub fn polygons(scene: &Scene) -> Vec<PolygonGpu> {
+pub fn polygons(scene: &Scene) -> Vec<Polygon> {
     let mut out: Vec<_> = scene
         .polygons
         .iter()
         .take(MAX_POLYGONS)
         .map(|p| {
-            let mut gpu = PolygonGpu {
+            let mut gpu = Polygon {
                 normal: p.normal().unwrap_or(Vec3::Y).to_array(),
                 vertex_count: p.vertices.len().min(MAX_POLYGON_VERTICES) as u32,
                 ..Default::default()
@@ -269,22 +269,22 @@ pub fn polygons(scene: &Scene) -> Vec<PolygonGpu> {
             gpu
         })
         .collect();
-    out.resize(MAX_POLYGONS, PolygonGpu::default());
+    out.resize(MAX_POLYGONS, Polygon::default());
     out
 }
 
 /// Spheres, padded to the uniform array's length.
-pub fn spheres(scene: &Scene) -> Vec<SphereGpu> {
+pub fn spheres(scene: &Scene) -> Vec<Sphere> {
     let mut out: Vec<_> = scene
         .spheres
         .iter()
-        .map(|s| SphereGpu {
+        .map(|s| Sphere {
             center: s.center.to_array(),
             radius: s.radius,
         })
         .take(MAX_SPHERES)
         .collect();
-    out.resize(MAX_SPHERES, SphereGpu::default());
+    out.resize(MAX_SPHERES, Sphere::default());
     out
 }
 
@@ -294,7 +294,7 @@ pub fn frame_uniform(
     render_size: (u32, u32),
     frame_index: u32,
     accumulated: u32,
-) -> FrameUniform {
+) -> Frame {
     let cam = scene.camera.frame();
     let (w, h) = (render_size.0.max(1) as f32, render_size.1.max(1) as f32);
     // No light: zero power, so an uber shader that compiles the light in adds nothing.
@@ -313,7 +313,7 @@ pub fn frame_uniform(
         .ground
         .as_ref()
         .map_or_else(|| Ground::default().frame(), Ground::frame);
-    FrameUniform {
+    Frame {
         cam_pos: cam.position.to_array(),
         tan_half_fov: cam.tan_half_fov,
         cam_right: cam.right.to_array(),
@@ -409,37 +409,99 @@ mod tests {
     fn structs_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::twin_layout;
         let module = &trace_module();
-        twin_layout!(module, FrameUniform => "Frame", [
-            cam_pos, tan_half_fov, cam_right, aspect, cam_up, frame_index, cam_forward,
-            accumulated, light_pos, env_intensity, light_power, env_rotation, env_constant,
-            background_visible, ground_height, sphere_count, samples_per_frame, max_bounces,
-            render_size, env_kind, has_ground, cylinder_count, polygon_count, pixel_spread,
-            env_sampling, env_distribution_size, light_count, light_selection,
-            light_total_power, light_samples, strategy, russian_roulette_from, triangle_count,
-            opaque_one, sample_clamp, band_start, band_end, view, light_points, depth_scale,
-            ground_uv_origin, ground_uv_u, ground_uv_v,
-        ]);
-        twin_layout!(module, NoiseParamsGpu => "NoiseParams", [
-            kind, hash, octaves, frequency, amplitude, persistence, lacunarity, shape,
-            distortion, world, footprint_scale, progression,
-        ]);
-        twin_layout!(module, MaterialGpu => "Material", [
-            signals, signal_rows, signal_count, first_perlin, bump_height, emitted_luminance,
-        ]);
-        twin_layout!(module, CylinderGpu => "Cylinder", [base, radius, height]);
-        twin_layout!(module, PolygonGpu => "Polygon", [
-            vertices, normal, vertex_count, uv_origin, uv_u, uv_v,
-        ]);
-        twin_layout!(module, SphereGpu => "Sphere", [center, radius]);
-        use crate::gpu::mesh_buffers::TriangleAttributesGpu;
+        twin_layout!(
+            module,
+            Frame,
+            [
+                cam_pos,
+                tan_half_fov,
+                cam_right,
+                aspect,
+                cam_up,
+                frame_index,
+                cam_forward,
+                accumulated,
+                light_pos,
+                env_intensity,
+                light_power,
+                env_rotation,
+                env_constant,
+                background_visible,
+                ground_height,
+                sphere_count,
+                samples_per_frame,
+                max_bounces,
+                render_size,
+                env_kind,
+                has_ground,
+                cylinder_count,
+                polygon_count,
+                pixel_spread,
+                env_sampling,
+                env_distribution_size,
+                light_count,
+                light_selection,
+                light_total_power,
+                light_samples,
+                strategy,
+                russian_roulette_from,
+                triangle_count,
+                opaque_one,
+                sample_clamp,
+                band_start,
+                band_end,
+                view,
+                light_points,
+                depth_scale,
+                ground_uv_origin,
+                ground_uv_u,
+                ground_uv_v,
+            ]
+        );
+        twin_layout!(
+            module,
+            NoiseParams,
+            [
+                kind,
+                hash,
+                octaves,
+                frequency,
+                amplitude,
+                persistence,
+                lacunarity,
+                shape,
+                distortion,
+                world,
+                footprint_scale,
+                progression,
+            ]
+        );
+        twin_layout!(
+            module,
+            Material,
+            [
+                signals,
+                signal_rows,
+                signal_count,
+                first_perlin,
+                bump_height,
+                emitted_luminance,
+            ]
+        );
+        twin_layout!(module, Cylinder, [base, radius, height]);
+        twin_layout!(
+            module,
+            Polygon,
+            [vertices, normal, vertex_count, uv_origin, uv_u, uv_v,]
+        );
+        twin_layout!(module, Sphere, [center, radius]);
+        use crate::gpu::mesh_buffers::TriangleAttributes;
         use marbre_core::accel::{BvhNode, TriangleVerts};
-        use marbre_core::lights::LightGpu;
-        twin_layout!(module, LightGpu => "Light", [kind, primitive, cdf, power]);
-        twin_layout!(module, TriangleAttributesGpu => "TriangleAttributes", [
-            uv01, uv2, material,
-        ]);
-        twin_layout!(module, BvhNode => "BvhNode", [min, a, max, count]);
-        twin_layout!(module, TriangleVerts => "TriangleVerts", [v0, v1, v2]);
+        use marbre_core::lights::Light;
+        twin_layout!(module, Light, [kind, primitive, cdf, power]);
+        twin_layout!(module, TriangleAttributes, [uv01, uv2, material,]);
+        twin_layout!(module, BvhNode, [min, a, max, count]);
+        twin_layout!(module, TriangleVerts, [v0, v1, v2]);
     }
 
     /// The element count of a uniform array global in the trace shader.
@@ -489,7 +551,7 @@ mod tests {
     #[test]
     fn textures_reading_the_same_sum_share_one_signal() {
         let noise = NoiseSettings::default();
-        let mut m = Material {
+        let mut m = model::Material {
             diffuse: fbm_texture(noise),
             specular: fbm_texture(noise),
             ..Default::default()
@@ -508,7 +570,7 @@ mod tests {
             kind: NoiseKind::Perlin,
             ..Default::default()
         };
-        let m = Material {
+        let m = model::Material {
             diffuse: fbm_texture(perlin),
             specular: fbm_texture(NoiseSettings::default()),
             ..Default::default()
@@ -535,7 +597,7 @@ mod tests {
             fbm_texture(at(2.0)),
             fbm_texture(at(3.0)),
         );
-        let mut m = Material {
+        let mut m = model::Material {
             diffuse: nested,
             specular: fbm_texture(at(4.0)),
             roughness: fbm_texture(at(5.0)),

@@ -23,7 +23,7 @@ pub(crate) mod renderer_files {
     pub const RANDOM: WgslFile = wgsl_file!("shaders/random.wgsl");
     pub const SURFACE: WgslFile = wgsl_file!("shaders/surface.wgsl");
     pub const ENV_LOOKUP: WgslFile = wgsl_file!("shaders/env_lookup.wgsl");
-    pub const BUMP: WgslFile = wgsl_file!("shaders/bump.wgsl");
+    pub const BUMP_MAPPING: WgslFile = wgsl_file!("shaders/bump_mapping.wgsl");
     pub const VIEW: WgslFile = wgsl_file!("shaders/view.wgsl");
     pub const TRACE: WgslFile = wgsl_file!("shaders/trace.wgsl");
     pub const TONEMAP: WgslFile = wgsl_file!("shaders/tonemap.wgsl");
@@ -75,7 +75,7 @@ const SOURCES: &[WgslFile] = &[
     r::DENOISE,
     r::HARNESS_NOISE,
     texture::PATTERNS_WGSL,
-    r::BUMP,
+    r::BUMP_MAPPING,
     texture::SHADING_WGSL,
     texture::mapping::WGSL,
     r::HARNESS_TEXTURE,
@@ -196,7 +196,7 @@ impl Program {
                 }
                 out.extend([r::FULLSCREEN, r::ACCUMULATION, r::VIEW, r::TRACE]);
                 if features.contains(Feature::Bump) {
-                    out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP]);
+                    out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP_MAPPING]);
                 }
             }
             Program::Display => out = vec![r::FULLSCREEN, r::TONEMAP],

@@ -17,7 +17,7 @@ use super::harness::dispatch;
 use super::pipelines::{
     compute_pipeline_with, entry, float_texture, permutation_table, storage, uniform, upload_atlas,
 };
-use super::scene_gpu::{self, MaterialGpu};
+use super::scene_gpu::{self, Material};
 use super::shader_source::Program;
 use super::texture_codegen::{self, swatch_material};
 use anyhow::{Result, ensure};
@@ -61,14 +61,14 @@ pub fn sample_points() -> Vec<Option<SurfacePoint>> {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct SwatchPointGpu {
+struct SwatchPoint {
     p: [f32; 4],
     uv: [f32; 4],
 }
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct SwatchBatchGpu {
+struct SwatchBatch {
     points: u32,
     swatches: u32,
     _pad: [u32; 2],
@@ -93,14 +93,14 @@ pub struct SwatchRenderer {
 
 impl SwatchRenderer {
     pub fn new(ctx: GpuContext) -> Result<Self> {
-        let points: Vec<SwatchPointGpu> = sample_points()
+        let points: Vec<SwatchPoint> = sample_points()
             .into_iter()
             .map(|s| match s {
-                Some(s) => SwatchPointGpu {
+                Some(s) => SwatchPoint {
                     p: [s.object.x, s.object.y, s.object.z, 1.0],
                     uv: [s.uv.x, s.uv.y, 0.0, 0.0],
                 },
-                None => SwatchPointGpu::zeroed(),
+                None => SwatchPoint::zeroed(),
             })
             .collect();
         let points = dispatch::upload(
@@ -139,11 +139,11 @@ impl SwatchRenderer {
             textures.len()
         );
         let generated = texture_codegen::generate_swatches(textures, &ImageSet::default())?;
-        let mut materials: Vec<MaterialGpu> = textures
+        let mut materials: Vec<Material> = textures
             .iter()
             .map(|t| scene_gpu::material(&swatch_material(t)))
             .collect();
-        materials.resize(MAX_MATERIALS, MaterialGpu::default());
+        materials.resize(MAX_MATERIALS, Material::default());
         let features = FeatureSet::for_textures(textures);
         let key = format!("{:?}\n{}", features.defines(), generated.wgsl);
         if !self.pipelines.contains_key(&key) {
@@ -173,7 +173,7 @@ impl SwatchRenderer {
         }
         let pipeline = &self.pipelines[&key];
         let count = SWATCH_SIZE * SWATCH_SIZE;
-        let batch = SwatchBatchGpu {
+        let batch = SwatchBatch {
             points: count as u32,
             swatches: textures.len() as u32,
             _pad: [0; 2],
@@ -255,7 +255,7 @@ mod tests {
             .unwrap()
             .wgsl,
         );
-        twin_layout!(module, SwatchPointGpu => "SwatchPoint", [p, uv]);
-        twin_layout!(module, SwatchBatchGpu => "SwatchBatch", [points, swatches]);
+        twin_layout!(module, SwatchPoint, [p, uv]);
+        twin_layout!(module, SwatchBatch, [points, swatches]);
     }
 }

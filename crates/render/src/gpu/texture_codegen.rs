@@ -126,7 +126,7 @@ pub fn generate(scene: &Scene, images: &ImageSet) -> Result<GeneratedTextures> {
         .any(|p| p.signal().is_some());
     write!(
         wgsl,
-        "\n// Whether a bump height reads noise (bump.wgsl then evaluates the\n// signals at its offset points).\nconst BUMP_READS_NOISE: bool = {bump_reads_noise};\n"
+        "\n// Whether a bump height reads noise (bump_mapping.wgsl then evaluates the\n// signals at its offset points).\nconst BUMP_READS_NOISE: bool = {bump_reads_noise};\n"
     )?;
     // Always defined, so that a shader with the bump feature forced on (the
     // uber shader) builds for any scene.

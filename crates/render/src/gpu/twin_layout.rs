@@ -4,13 +4,14 @@
 //! side; the size covers them). Nothing is computed by hand, so a field added on
 //! one side only, or moved, fails the test that names both structs.
 
-/// Asserts the twin layout: `twin_layout!(module, RustType => "WgslName",
-/// [field, …])`, listing every Rust field but the padding.
+/// Asserts the twin layout: `twin_layout!(module, Name, [field, …])`,
+/// listing every Rust field but the padding. The WGSL struct has the Rust
+/// struct's name (the twins' naming rule, issue 27): the macro takes one
+/// name for both, so a twin named otherwise cannot be checked.
 macro_rules! twin_layout {
-    ($module:expr, $rust:ty => $wgsl:expr, [$($field:ident),* $(,)?]) => {
+    ($module:expr, $rust:ident, [$($field:ident),* $(,)?]) => {
         $crate::gpu::twin_layout::check(
             $module,
-            $wgsl,
             stringify!($rust),
             std::mem::size_of::<$rust>(),
             &[$((stringify!($field), std::mem::offset_of!($rust, $field))),*],
@@ -20,25 +21,16 @@ macro_rules! twin_layout {
 pub(crate) use twin_layout;
 
 /// The body of [`twin_layout!`].
-pub(crate) fn check(
-    module: &naga::Module,
-    wgsl: &str,
-    rust: &str,
-    rust_size: usize,
-    fields: &[(&str, usize)],
-) {
+pub(crate) fn check(module: &naga::Module, name: &str, rust_size: usize, fields: &[(&str, usize)]) {
     let (_, ty) = module
         .types
         .iter()
-        .find(|(_, t)| t.name.as_deref() == Some(wgsl))
-        .unwrap_or_else(|| panic!("no WGSL struct {wgsl} (twin of {rust})"));
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no WGSL struct {name} (the Rust struct's twin)"));
     let naga::TypeInner::Struct { members, span } = &ty.inner else {
-        panic!("WGSL {wgsl} is not a struct");
+        panic!("WGSL {name} is not a struct");
     };
-    assert_eq!(
-        *span as usize, rust_size,
-        "size of WGSL {wgsl} and Rust {rust}"
-    );
+    assert_eq!(*span as usize, rust_size, "size of {name} in WGSL and Rust");
     let wgsl_fields: Vec<(&str, usize)> = members
         .iter()
         .map(|m| (m.name.as_deref().unwrap_or("?"), m.offset as usize))
@@ -46,7 +38,7 @@ pub(crate) fn check(
         .collect();
     assert_eq!(
         wgsl_fields, fields,
-        "fields and offsets of WGSL {wgsl} against Rust {rust}"
+        "fields and offsets of {name} in WGSL against Rust"
     );
 }
 

@@ -16,7 +16,7 @@ use marbre_core::noise::hash::pcg3d;
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct HarnessUniform {
+struct AccumulationHarness {
     first_frame: u32,
     frames: u32,
     spp: u32,
@@ -26,7 +26,7 @@ struct HarnessUniform {
 /// A stream's seed and state, as `Stream` in the shader.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct StreamState {
+struct Stream {
     seed: u32,
     padding: [u32; 3],
     values: [f32; 4],
@@ -100,9 +100,9 @@ pub fn run(
         &[entry(0, uniform()), entry(1, storage(false))],
         "cs_accumulate",
     )?;
-    let states: Vec<StreamState> = seeds
+    let states: Vec<Stream> = seeds
         .iter()
-        .map(|&seed| StreamState {
+        .map(|&seed| Stream {
             seed,
             padding: [0; 3],
             values: [0.0; 4],
@@ -116,7 +116,7 @@ pub fn run(
     );
     let mut encoder = device.create_command_encoder(&Default::default());
     for first_frame in (0..frames).step_by(CHUNK as usize) {
-        let chunk = HarnessUniform {
+        let chunk = AccumulationHarness {
             first_frame,
             frames: CHUNK.min(frames - first_frame),
             spp,
@@ -136,7 +136,7 @@ pub fn run(
         let groups = ((seeds.len() as u32).div_ceil(64), 1);
         dispatch::record(&mut encoder, &pipeline, &bind_group, groups);
     }
-    let states: Vec<StreamState> = dispatch::read_back(ctx, encoder, &streams)?;
+    let states: Vec<Stream> = dispatch::read_back(ctx, encoder, &streams)?;
     Ok(states
         .iter()
         .map(|s| LongAccumulation {
@@ -156,7 +156,7 @@ mod tests {
     fn the_uniform_and_stream_have_their_wgsl_twins_layout() {
         use crate::gpu::twin_layout::{module_of, twin_layout};
         let module = &module_of(Program::AccumulationHarness, &FeatureSet::default(), "");
-        twin_layout!(module, HarnessUniform => "AccumulationHarness", [first_frame, frames, spp, one]);
-        twin_layout!(module, StreamState => "Stream", [seed, values]);
+        twin_layout!(module, AccumulationHarness, [first_frame, frames, spp, one]);
+        twin_layout!(module, Stream, [seed, values]);
     }
 }

@@ -30,15 +30,15 @@ pub struct Ray {
 /// `struct HarnessRay` in harness/bvh.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuRay {
+struct HarnessRay {
     origin: [f32; 4],
     direction: [f32; 4],
 }
 
-/// `struct BvhHarness` in harness/bvh.wgsl.
+/// `struct BvhHarnessUniform` in harness/bvh.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct HarnessUniform {
+struct BvhHarnessUniform {
     count: u32,
     row_pitch: u32,
     _pad: [u32; 2],
@@ -47,9 +47,9 @@ struct HarnessUniform {
 /// Which query the rays make.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Query {
-    /// `intersect_mesh`: the closest hit.
+    /// `slab_ray_intersect`: the closest hit.
     Closest,
-    /// `mesh_occluded`: any hit.
+    /// `slab_ray_occluded`: any hit.
     Occluded,
 }
 
@@ -211,14 +211,14 @@ impl BvhHarness {
             "too many rays for one dispatch: {}",
             rays.len()
         );
-        let params = HarnessUniform {
+        let params = BvhHarnessUniform {
             count: rays.len() as u32,
             row_pitch: per_row * 64,
             _pad: [0; 2],
         };
-        let gpu_rays: Vec<GpuRay> = rays
+        let gpu_rays: Vec<HarnessRay> = rays
             .iter()
-            .map(|r| GpuRay {
+            .map(|r| HarnessRay {
                 origin: r.origin.extend(r.t_max).to_array(),
                 direction: r.direction.extend(0.0).to_array(),
             })
@@ -272,10 +272,10 @@ mod tests {
         let source = assemble(Program::BvhHarness, &FeatureSet::default(), "").unwrap();
         validate(&source).unwrap();
         let module = &naga::front::wgsl::parse_str(&source).unwrap();
-        twin_layout!(module, BvhNode => "BvhNode", [min, a, max, count]);
-        twin_layout!(module, TriangleVerts => "TriangleVerts", [v0, v1, v2]);
-        twin_layout!(module, GpuRay => "HarnessRay", [origin, direction]);
-        twin_layout!(module, HarnessUniform => "BvhHarness", [count, row_pitch]);
+        twin_layout!(module, BvhNode, [min, a, max, count]);
+        twin_layout!(module, TriangleVerts, [v0, v1, v2]);
+        twin_layout!(module, HarnessRay, [origin, direction]);
+        twin_layout!(module, BvhHarnessUniform, [count, row_pitch]);
     }
 
     /// The shader's constants are the CPU traversal's.

@@ -19,7 +19,7 @@ const QUERY_POINTS: usize = 5;
 /// `struct GeometryHarness` in harness/geometry.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct HarnessUniform {
+struct GeometryHarness {
     mode: u32,
     count: u32,
     _pad: [u32; 2],
@@ -57,7 +57,7 @@ pub struct ShadingNormal {
 }
 
 fn run(ctx: &GpuContext, mode: u32, queries: Vec<[Vec3; QUERY_POINTS]>) -> Result<Vec<[Vec3; 2]>> {
-    let uniform = HarnessUniform {
+    let uniform = GeometryHarness {
         mode,
         count: queries.len() as u32,
         _pad: [0; 2],
@@ -140,9 +140,7 @@ mod tests {
         let source = assemble(Program::GeometryHarness, &FeatureSet::default(), "").unwrap();
         validate(&source).unwrap();
         let module = naga::front::wgsl::parse_str(&source).unwrap();
-        crate::gpu::twin_layout::twin_layout!(&module, HarnessUniform => "GeometryHarness", [
-            mode, count,
-        ]);
+        crate::gpu::twin_layout::twin_layout!(&module, GeometryHarness, [mode, count,]);
         let constant = |name: &str| {
             let (_, c) = module
                 .constants

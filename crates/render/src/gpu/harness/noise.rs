@@ -5,7 +5,7 @@
 use super::points;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::FeatureSet;
-use crate::gpu::scene_gpu::NoiseParamsGpu;
+use crate::gpu::scene_gpu::NoiseParams;
 use crate::gpu::shader_source::Program;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -51,8 +51,8 @@ impl Evaluate {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct HarnessUniform {
-    noise: NoiseParamsGpu,
+struct NoiseHarness {
+    noise: NoiseParams,
     mode: u32,
     count: u32,
     param: f32,
@@ -68,8 +68,8 @@ pub fn evaluate(
     points: &[Vec3],
 ) -> Result<Vec<[f32; 4]>> {
     let (mode, param) = what.mode_and_param();
-    let params = HarnessUniform {
-        noise: NoiseParamsGpu::new(noise, FractalShape::Signed),
+    let params = NoiseHarness {
+        noise: NoiseParams::new(noise, FractalShape::Signed),
         mode,
         count: points.len() as u32,
         param,
@@ -121,6 +121,6 @@ mod tests {
             &FeatureSet::for_noise_harness(&Default::default()),
             "",
         );
-        twin_layout!(module, HarnessUniform => "Harness", [noise, mode, count, param]);
+        twin_layout!(module, NoiseHarness, [noise, mode, count, param]);
     }
 }

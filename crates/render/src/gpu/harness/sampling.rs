@@ -350,6 +350,27 @@ mod tests {
             &FeatureSet([Feature::EnvMap].into_iter().collect()),
             "",
         );
-        twin_layout!(module, SamplingFrame => "SamplingFrame", [env_constant, env_intensity, env_distribution_size, env_rotation, env_kind, strategy, mode, count, alpha, diffuse, mirror, specular, uniform_diffuse, normal, wo, diffuse_transmission]);
+        twin_layout!(
+            module,
+            SamplingFrame,
+            [
+                env_constant,
+                env_intensity,
+                env_distribution_size,
+                env_rotation,
+                env_kind,
+                strategy,
+                mode,
+                count,
+                alpha,
+                diffuse,
+                mirror,
+                specular,
+                uniform_diffuse,
+                normal,
+                wo,
+                diffuse_transmission
+            ]
+        );
     }
 }

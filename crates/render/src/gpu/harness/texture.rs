@@ -5,7 +5,7 @@
 use super::points;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::FeatureSet;
-use crate::gpu::scene_gpu::NoiseParamsGpu;
+use crate::gpu::scene_gpu::NoiseParams;
 use crate::gpu::shader_source::Program;
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
@@ -172,8 +172,8 @@ impl Mode {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct HarnessUniform {
-    noise: NoiseParamsGpu,
+struct TextureHarness {
+    noise: NoiseParams,
     mode: u32,
     count: u32,
     sides: u32,
@@ -185,8 +185,8 @@ struct HarnessUniform {
 }
 
 impl PatternQuery {
-    fn uniform(&self, count: u32) -> Result<HarnessUniform> {
-        let mut u = HarnessUniform::zeroed();
+    fn uniform(&self, count: u32) -> Result<TextureHarness> {
+        let mut u = TextureHarness::zeroed();
         u.count = count;
         let v2 = |v: Vec2, z: f32, w: f32| [v.x, v.y, z, w];
         let v3 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
@@ -241,7 +241,7 @@ impl PatternQuery {
                 noise,
             } => {
                 u.mode = Mode::Wood as u32;
-                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.noise = NoiseParams::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *ring_width);
                 u.b[0] = *turbulence_amount;
             }
@@ -252,7 +252,7 @@ impl PatternQuery {
                 noise,
             } => {
                 u.mode = Mode::MarbleVeins as u32;
-                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.noise = NoiseParams::new(noise, FractalShape::Absolute);
                 u.a = v3(*axis, *frequency);
                 u.b[0] = *turbulence_amount;
             }
@@ -261,7 +261,7 @@ impl PatternQuery {
                 noise,
             } => {
                 u.mode = Mode::MassalMarble as u32;
-                u.noise = NoiseParamsGpu::new(noise, FractalShape::Absolute);
+                u.noise = NoiseParams::new(noise, FractalShape::Absolute);
                 u.a[0] = *stripe_frequency;
             }
             PatternQuery::WavesGradient {
@@ -384,7 +384,11 @@ mod tests {
             &FeatureSet::for_texture_library(&Default::default()),
             "",
         );
-        twin_layout!(module, HarnessUniform => "TextureHarness", [noise, mode, count, sides, a, b, c, stops]);
+        twin_layout!(
+            module,
+            TextureHarness,
+            [noise, mode, count, sides, a, b, c, stops]
+        );
     }
 
     /// Every mode has its named constant in texture.wgsl, of its value:

@@ -11,7 +11,7 @@ use crate::gpu::context::GpuContext;
 use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
 use crate::gpu::pipelines::fullscreen_pipeline;
-use crate::gpu::scene_gpu::FrameUniform;
+use crate::gpu::scene_gpu::Frame;
 use crate::gpu::trace_bands::TraceBudget;
 use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
 use crate::gpu::{non_finite, scene_gpu, trace_bands};
@@ -159,7 +159,7 @@ impl Renderer {
         (index, count): (usize, usize),
         timestamps: Option<PassTimestamps<'_>>,
     ) {
-        let mut uniform: FrameUniform = scene_gpu::frame_uniform(
+        let mut uniform: Frame = scene_gpu::frame_uniform(
             &self.scene,
             size,
             self.frame_index,

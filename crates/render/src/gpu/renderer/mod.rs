@@ -29,7 +29,7 @@ use super::pipelines::{
     entry, float_texture, permutation_table, shader_module, storage, uniform, upload_atlas,
     upload_rgba16f,
 };
-use super::scene_gpu::FrameUniform;
+use super::scene_gpu::Frame;
 use super::shader_source::{Program, sources_generation};
 use super::texture_codegen;
 use super::trace_bands::{self};
@@ -169,7 +169,7 @@ const FRAME_SLOTS: u64 = 2 * trace_bands::MAX_PASSES as u64;
 
 /// The bytes of one frame-uniform slot: two copies of the settings (see
 /// `frame_slots` in shaders/scene.wgsl).
-const FRAME_BYTES: u64 = 2 * std::mem::size_of::<FrameUniform>() as u64;
+const FRAME_BYTES: u64 = 2 * std::mem::size_of::<Frame>() as u64;
 
 /// What one trace call did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -499,6 +499,19 @@ mod tests {
     fn the_display_uniform_has_its_wgsl_twins_layout() {
         use crate::gpu::twin_layout::{module_of, twin_layout};
         let module = &module_of(Program::Display, &FeatureSet::default(), "");
-        twin_layout!(module, DisplayUniform => "Display", [exposure_scale, tone_map, encode_srgb, auto_exposure, origin, scale, show_non_finite, padding]);
+        twin_layout!(
+            module,
+            DisplayUniform,
+            [
+                exposure_scale,
+                tone_map,
+                encode_srgb,
+                auto_exposure,
+                origin,
+                scale,
+                show_non_finite,
+                padding
+            ]
+        );
     }
 }
