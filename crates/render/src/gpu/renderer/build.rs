@@ -6,19 +6,18 @@
 //! numbers from the code's [`ParamPlan`] and never generates code; only a
 //! structural one generates it, and only a new key builds a pipeline.
 
-use super::{Renderer, upload_env, upload_env_distribution};
+use super::Renderer;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::{Feature, FeatureSet};
 use crate::gpu::kernel;
 use crate::gpu::kernel::Kernel;
 use crate::gpu::mesh_buffers::PreparedGeometry;
 use crate::gpu::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
-use crate::gpu::pipelines::{compile_wgsl, upload_atlas, validate};
+use crate::gpu::pipelines::{compile_wgsl, validate};
 use crate::gpu::shader_source::{Program, assemble, sources_generation};
 use crate::gpu::texture_codegen::{self, ParamPlan};
 use crate::gpu::trace_pass::{TraceLayouts, TracePipeline};
 use anyhow::Result;
-use marbre_core::envmap;
 use marbre_core::envmap::EnvImage;
 use marbre_core::scene::{Change, Scene};
 use marbre_core::texture::ImageSet;
@@ -65,7 +64,8 @@ impl Renderer {
     /// The scene last requested: the build's under way, else the one
     /// drawing. The viewer works out each frame's [`Change`] against it.
     pub fn requested_scene(&self) -> &Scene {
-        self.pending
+        self.trace
+            .pending
             .as_ref()
             .map_or(&self.scene, |p| &p.target.scene)
     }
@@ -79,17 +79,17 @@ impl Renderer {
     }
 
     fn choose_kernel(&mut self, ctx: &GpuContext, kernel: Kernel) -> Result<()> {
-        if kernel == Kernel::Compute && !self.compute_supported {
+        if kernel == Kernel::Compute && !self.trace.compute_supported {
             kernel::resolve(ctx, kernel::KernelChoice::Compute)?;
         }
-        self.kernel = kernel;
+        self.trace.kernel = kernel;
         Ok(())
     }
 
     /// Geometry prepared off the render thread for the next scene set
     /// (see [`PreparedGeometry`]): that scene's BVH is not built again.
     pub fn provide_geometry(&mut self, prepared: PreparedGeometry) {
-        self.meshes.provide(prepared);
+        self.bindings.meshes.provide(prepared);
     }
 
     /// Applies an edited scene and waits for any shader it needs: for
@@ -100,7 +100,7 @@ impl Renderer {
         // Waiting here, the first draw may as well compile on this device:
         // no warm-up.
         self.start_scene(ctx, scene, change, false)?;
-        match self.pending.take() {
+        match self.trace.pending.take() {
             Some(mut pending) => {
                 let built = pending.build.wait()?;
                 self.install(ctx, built, &mut pending);
@@ -135,18 +135,23 @@ impl Renderer {
         warm_up: bool,
     ) -> Result<()> {
         let features = self
+            .trace
             .feature_override
             .clone()
             .unwrap_or_else(|| FeatureSet::for_scene(scene));
         let switches = RenderSwitches::of(scene);
         let (textures, params) = self.texture_numbers(scene, change)?;
-        let latest = self.pending.as_ref().map_or(&self.key, |p| &p.key);
+        let latest = self
+            .trace
+            .pending
+            .as_ref()
+            .map_or(&self.trace.key, |p| &p.key);
         let same_pipeline = textures
             .as_ref()
             .is_none_or(|(wgsl, _)| *wgsl == latest.code)
             && features == latest.features
             && switches == latest.switches
-            && self.kernel == latest.kernel
+            && self.trace.kernel == latest.kernel
             && sources_generation() == latest.sources;
         let target = Target {
             scene: scene.clone(),
@@ -154,7 +159,7 @@ impl Renderer {
             change,
         };
         if same_pipeline {
-            match &mut self.pending {
+            match &mut self.trace.pending {
                 Some(pending) => {
                     pending.target.join(target);
                     self.follow_camera(scene, change);
@@ -172,13 +177,13 @@ impl Renderer {
             code,
             switches,
             sources: sources_generation(),
-            kernel: self.kernel,
+            kernel: self.trace.kernel,
         };
-        if key == self.key {
+        if key == self.trace.key {
             // Back to the pipeline in place (an edit undone while its build
             // ran): the scene differs from the installed one by more than
             // this edit, so everything is written.
-            self.pending = None;
+            self.trace.pending = None;
             self.apply(
                 ctx,
                 Target {
@@ -188,7 +193,7 @@ impl Renderer {
             );
             return Ok(());
         }
-        if let Some(pending) = &mut self.pending
+        if let Some(pending) = &mut self.trace.pending
             && pending.key == key
         {
             pending.target.join(target);
@@ -204,18 +209,18 @@ impl Renderer {
             let warm_up = ShaderWarmUp {
                 ctx: warm,
                 scene: scene.clone(),
-                images: self.images.clone(),
-                features: self.feature_override.clone(),
-                kernel: self.kernel,
+                images: self.bindings.images.clone(),
+                features: self.trace.feature_override.clone(),
+                kernel: self.trace.kernel,
             };
             Box::new(move || warm_up.run()) as WarmUp
         });
-        let (device, layouts) = (ctx.device.clone(), self.trace_layouts.clone());
+        let (device, layouts) = (ctx.device.clone(), self.trace.layouts.clone());
         let build_key = key.clone();
-        let build = self.builder.start(warm_up, move || {
+        let build = self.trace.builder.start(warm_up, move || {
             Self::build_trace_pipeline(&device, &layouts, &build_key)
         });
-        self.pending = Some(PendingScene {
+        self.trace.pending = Some(PendingScene {
             build,
             key,
             plan,
@@ -228,9 +233,10 @@ impl Renderer {
     /// The plan of the latest requested texture code: the build's under
     /// way, else the one drawing.
     fn latest_plan(&self) -> &ParamPlan {
-        self.pending
+        self.trace
+            .pending
             .as_ref()
-            .map_or(&self.texture_plan, |p| &p.plan)
+            .map_or(&self.trace.texture_plan, |p| &p.plan)
     }
 
     /// The texture code (with its plan) and numbers `scene` needs after
@@ -239,7 +245,7 @@ impl Renderer {
     /// for an edit away from the materials.
     fn texture_numbers(&mut self, scene: &Scene, change: Change) -> Result<TextureNumbers> {
         if !change.regenerates_code() && change.contains(Change::MATERIAL_PARAMETERS) {
-            if let Some(params) = self.latest_plan().evaluate(scene, &self.images) {
+            if let Some(params) = self.latest_plan().evaluate(scene, &self.bindings.images) {
                 return Ok((None, Some(params)));
             }
             // The change was worked out against another scene than the
@@ -248,22 +254,22 @@ impl Renderer {
         } else if !change.regenerates_code() {
             return Ok((None, None));
         }
-        let textures = texture_codegen::generate(scene, &self.images)?;
-        self.code_generations += 1;
+        let textures = texture_codegen::generate(scene, &self.bindings.images)?;
+        self.trace.code_generations += 1;
         Ok((Some((textures.wgsl, textures.plan)), Some(textures.params)))
     }
 
     /// Whether a pipeline build is under way.
     pub fn is_building(&self) -> bool {
-        self.pending.is_some()
+        self.trace.pending.is_some()
     }
 
     /// Installs a finished build and its scene. Returns how long the build
     /// took, or why it failed (the old pipeline and scene then stay); None
     /// while nothing has finished.
     pub fn poll_build(&mut self, ctx: &GpuContext) -> Option<Result<Duration>> {
-        let result = self.pending.as_ref()?.build.poll()?;
-        let mut pending = self.pending.take()?;
+        let result = self.trace.pending.as_ref()?.build.poll()?;
+        let mut pending = self.trace.pending.take()?;
         Some(result.map(|built| {
             let took = built.took;
             self.install(ctx, built, &mut pending);
@@ -274,15 +280,15 @@ impl Renderer {
     /// How long the last pipeline build took, from the edit to the new
     /// pipeline (the Stats panel shows it).
     pub fn last_build(&self) -> Option<Duration> {
-        self.last_build
+        self.trace.last_build
     }
 
     fn install(&mut self, ctx: &GpuContext, built: BuiltPipeline, pending: &mut PendingScene) {
-        self.trace_pipeline = built.pipeline;
-        self.trace_shader_bytes = built.shader_bytes;
-        self.last_build = Some(built.took);
-        self.key = std::mem::take(&mut pending.key);
-        self.texture_plan = std::mem::take(&mut pending.plan);
+        self.trace.pipeline = built.pipeline;
+        self.trace.shader_bytes = built.shader_bytes;
+        self.trace.last_build = Some(built.took);
+        self.trace.key = std::mem::take(&mut pending.key);
+        self.trace.texture_plan = std::mem::take(&mut pending.plan);
         // The installed scene may be several edits behind: everything is
         // written. A new pipeline draws a new image even for the same scene
         // (a feature compiled out): the samples of the old one must go.
@@ -300,16 +306,15 @@ impl Renderer {
     /// lights and the render settings, is written at each trace.)
     fn apply(&mut self, ctx: &GpuContext, target: Target) {
         if let Some(params) = &target.params {
-            ctx.queue
-                .write_buffer(&self.texture_param_buffer, 0, bytemuck::cast_slice(params));
+            self.bindings.write_texture_params(ctx, params);
         }
         let (scene, change) = (&target.scene, target.change);
         if change
             .intersects(Change::GEOMETRY | Change::MATERIAL_PARAMETERS | Change::MATERIAL_STRUCTURE)
         {
-            self.geometry.write(&ctx.queue, scene);
+            self.bindings.geometry.write(&ctx.queue, scene);
         }
-        self.meshes.update(&ctx.device, scene, change);
+        self.bindings.meshes.update(&ctx.device, scene, change);
         // Display-only edits (exposure, auto exposure, tone map, the debug
         // view) keep the samples.
         if change.resets_accumulation() {
@@ -333,10 +338,10 @@ impl Renderer {
         if !ctx.is_cpu() {
             return None;
         }
-        if self.warm_up.is_none() {
-            self.warm_up = ctx.sibling().ok().map(Arc::new);
+        if self.trace.warm_up.is_none() {
+            self.trace.warm_up = ctx.sibling().ok().map(Arc::new);
         }
-        self.warm_up.clone()
+        self.trace.warm_up.clone()
     }
 
     /// Builds the shader with `features` instead of the scene's own set
@@ -346,7 +351,7 @@ impl Renderer {
         ctx: &GpuContext,
         features: Option<FeatureSet>,
     ) -> Result<()> {
-        self.feature_override = features;
+        self.trace.feature_override = features;
         let scene = self.scene.clone();
         self.set_scene(ctx, &scene)
     }
@@ -361,16 +366,17 @@ impl Renderer {
         features: Option<FeatureSet>,
     ) -> Result<()> {
         let code = self
+            .trace
             .pending
             .as_ref()
-            .map_or(&self.key.code, |p| &p.key.code);
+            .map_or(&self.trace.key.code, |p| &p.key.code);
         if let Some(set) = &features {
             let source = assemble(Program::Trace, set, code)?;
             validate(&source).map_err(|e| {
                 anyhow::anyhow!("this scene's shader cannot be built with those features: {e}")
             })?;
         }
-        self.feature_override = features;
+        self.trace.feature_override = features;
         self.rebuild(ctx)
     }
 
@@ -378,7 +384,7 @@ impl Renderer {
     /// without building anything now (the caller is about to request a
     /// scene whose features changed).
     pub fn forget_feature_override(&mut self) {
-        self.feature_override = None;
+        self.trace.feature_override = None;
     }
 
     /// Replaces the images the scene's image textures read (loaded by
@@ -386,29 +392,24 @@ impl Renderer {
     /// code, which holds where each image lies. A pending build is finished
     /// first (its code assumed the old images).
     pub fn set_images(&mut self, ctx: &GpuContext, images: ImageSet) -> Result<()> {
-        if let Some(mut pending) = self.pending.take() {
+        if let Some(mut pending) = self.trace.pending.take() {
             let built = pending.build.wait()?;
             self.install(ctx, built, &mut pending);
         }
         let textures = texture_codegen::generate(&self.scene, &images)?;
-        self.code_generations += 1;
-        self.texture_plan = textures.plan;
-        if textures.wgsl != self.key.code {
+        self.trace.code_generations += 1;
+        self.trace.texture_plan = textures.plan;
+        if textures.wgsl != self.trace.key.code {
             let key = PipelineKey {
                 code: textures.wgsl,
-                ..self.key.clone()
+                ..self.trace.key.clone()
             };
-            (self.trace_pipeline, self.trace_shader_bytes) =
-                Self::build_trace_pipeline(&ctx.device, &self.trace_layouts, &key)?;
-            self.key = key;
+            (self.trace.pipeline, self.trace.shader_bytes) =
+                Self::build_trace_pipeline(&ctx.device, &self.trace.layouts, &key)?;
+            self.trace.key = key;
         }
-        ctx.queue.write_buffer(
-            &self.texture_param_buffer,
-            0,
-            bytemuck::cast_slice(&textures.params),
-        );
-        self.image_atlas_view = upload_atlas(ctx, images.atlas());
-        self.images = images;
+        self.bindings.write_texture_params(ctx, &textures.params);
+        self.bindings.set_images(ctx, images);
         self.reset_accumulation();
         Ok(())
     }
@@ -417,9 +418,7 @@ impl Renderer {
     /// larger than the GPU's textures is downscaled to fit (as
     /// `session::load_environment` does with a note), never refused.
     pub fn set_environment(&mut self, ctx: &GpuContext, env: Option<&EnvImage>) {
-        let env = env.map(|e| envmap::fit_within(e, ctx.device.limits().max_texture_dimension_2d));
-        self.env_view = upload_env(ctx, env.as_deref());
-        self.env_distribution = upload_env_distribution(ctx, env.as_deref());
+        self.bindings.set_environment(ctx, env);
         self.reset_accumulation();
     }
 }

@@ -15,7 +15,8 @@ impl Renderer {
     /// and the installed pipeline accumulates the guides (while its build
     /// is pending, the raw image shows).
     pub fn denoises(&self) -> bool {
-        self.scene.render.display.denoise && self.key.features.contains(Feature::DenoiseGuides)
+        self.scene.render.display.denoise
+            && self.trace.key.features.contains(Feature::DenoiseGuides)
     }
 
     /// Records the filter of the latest image if it has not been filtered
@@ -39,11 +40,11 @@ impl Renderer {
             render_size: self.shown_size(),
         };
         let settings = DenoiseSettings::default();
-        let denoiser = match &mut self.denoiser {
+        let denoiser = match &mut self.display.denoiser {
             Some(d) => d,
             slot => slot.insert(Denoiser::new(&ctx.device)?),
         };
-        if self.denoised_from != Some(from) {
+        if self.display.denoised_from != Some(from) {
             let (mean, spread) = self.accumulation.latest_views();
             let sources = DenoiseSources {
                 mean,
@@ -54,7 +55,7 @@ impl Renderer {
                 size: from.render_size,
             };
             denoiser.record(ctx, encoder, &sources, &settings);
-            self.denoised_from = Some(from);
+            self.display.denoised_from = Some(from);
         }
         Ok(denoiser.output(&settings).map(|(_, view)| view.clone()))
     }
@@ -79,7 +80,11 @@ impl Renderer {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let recorded = self.record_denoise(ctx, &mut encoder)?.is_some();
         let settings = DenoiseSettings::default();
-        let output = self.denoiser.as_ref().and_then(|d| d.output(&settings));
+        let output = self
+            .display
+            .denoiser
+            .as_ref()
+            .and_then(|d| d.output(&settings));
         let (true, Some((texture, _))) = (recorded, output) else {
             bail!("no denoised image: the scene's display does not have denoise on");
         };

@@ -2,10 +2,9 @@
 //! allows, with a preview for a new accumulation), the meters (auto
 //! exposure, error) and the display pass onto any colour target.
 
-use super::{
-    DisplayTarget, DisplayUniform, FRAME_BYTES, FRAME_SLOTS, MeteredFrom, Renderer, TraceWork,
-    bind, frame_stride, pixel_count, scaled,
-};
+use super::display_stage::DisplayUniform;
+use super::trace_stage::{FRAME_BYTES, FRAME_SLOTS, frame_stride};
+use super::{DisplayTarget, MeteredFrom, Renderer, TraceWork, bind, pixel_count, scaled};
 use crate::gpu::accumulation::Accumulation;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::Feature;
@@ -43,7 +42,7 @@ impl Renderer {
         let size = (size.0.max(1), size.1.max(1));
         if size != self.size {
             self.size = size;
-            self.accumulation = Accumulation::new(&ctx.device, size, self.compute_supported);
+            self.accumulation = Accumulation::new(&ctx.device, size, self.trace.compute_supported);
             self.reset_accumulation();
         }
     }
@@ -165,34 +164,40 @@ impl Renderer {
             self.frame_index,
             self.accumulation.samples(),
         );
-        uniform.env_distribution_size = self.env_distribution.1;
-        let table = self.meshes.table();
+        uniform.env_distribution_size = self.bindings.env_distribution.1;
+        let table = self.bindings.meshes.table();
         uniform.light_count = table.lights.len() as u32;
         uniform.light_total_power = table.total_power;
-        uniform.triangle_count = self.meshes.stats().triangles as u32;
+        uniform.triangle_count = self.bindings.meshes.stats().triangles as u32;
         uniform.band_start = rows.start;
         uniform.band_end = rows.end;
         let stride = frame_stride(&ctx.device);
-        let offset = self.frame_slot * stride;
-        self.frame_slot = (self.frame_slot + 1) % FRAME_SLOTS;
+        let offset = self.trace.frame_slot * stride;
+        self.trace.frame_slot = (self.trace.frame_slot + 1) % FRAME_SLOTS;
         ctx.queue.write_buffer(
-            &self.frame_buffer,
+            &self.trace.frame_buffer,
             offset,
             bytemuck::cast_slice(&[uniform; 2]),
         );
-        let guides = self.key.features.contains(Feature::DenoiseGuides);
+        let guides = self.trace.key.features.contains(Feature::DenoiseGuides);
         self.accumulation.set_guides(&ctx.device, guides);
         let [previous_albedo, previous_normal] = self.accumulation.previous_guide_views();
         let (previous_mean, previous_spread) = self.accumulation.latest_views();
         let frame = wgpu::BufferBinding {
-            buffer: &self.frame_buffer,
+            buffer: &self.trace.frame_buffer,
             offset: 0,
             size: wgpu::BufferSize::new(FRAME_BYTES),
         };
         let mut entries = vec![
             bind(0, wgpu::BindingResource::Buffer(frame)),
-            bind(3, wgpu::BindingResource::TextureView(&self.env_view)),
-            bind(4, wgpu::BindingResource::Sampler(&self.env_sampler)),
+            bind(
+                3,
+                wgpu::BindingResource::TextureView(&self.bindings.env_view),
+            ),
+            bind(
+                4,
+                wgpu::BindingResource::Sampler(&self.bindings.env_sampler),
+            ),
             bind(5, wgpu::BindingResource::TextureView(previous_mean)),
             bind(16, wgpu::BindingResource::TextureView(previous_spread)),
             bind(
@@ -201,38 +206,38 @@ impl Renderer {
             ),
             bind(19, wgpu::BindingResource::TextureView(previous_albedo)),
             bind(20, wgpu::BindingResource::TextureView(previous_normal)),
-            bind(6, self.perm_buffer.as_entire_binding()),
-            bind(7, self.texture_param_buffer.as_entire_binding()),
+            bind(6, self.bindings.perm_buffer.as_entire_binding()),
+            bind(7, self.bindings.texture_param_buffer.as_entire_binding()),
             bind(
                 8,
-                wgpu::BindingResource::TextureView(&self.image_atlas_view),
+                wgpu::BindingResource::TextureView(&self.bindings.image_atlas_view),
             ),
-            bind(11, self.env_distribution.0.as_entire_binding()),
+            bind(11, self.bindings.env_distribution.0.as_entire_binding()),
             bind(
                 non_finite::BINDING,
                 self.non_finite.buffer().as_entire_binding(),
             ),
         ];
-        entries.extend(self.geometry.entries());
-        entries.extend(self.meshes.entries());
+        entries.extend(self.bindings.geometry.entries());
+        entries.extend(self.bindings.meshes.entries());
         let scene_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("trace"),
-            layout: &self.trace_layouts.scene,
+            layout: &self.trace.layouts.scene,
             entries: &entries,
         });
-        let outputs = matches!(self.trace_pipeline, TracePipeline::Compute(_)).then(|| {
+        let outputs = matches!(self.trace.pipeline, TracePipeline::Compute(_)).then(|| {
             let entries: Vec<_> = (0u32..)
                 .zip(self.accumulation.write_views())
                 .map(|(i, view)| bind(i, wgpu::BindingResource::TextureView(view)))
                 .collect();
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("trace outputs"),
-                layout: self.trace_layouts.outputs(guides),
+                layout: self.trace.layouts.outputs(guides),
                 entries: &entries,
             })
         });
         BandPass {
-            pipeline: &self.trace_pipeline,
+            pipeline: &self.trace.pipeline,
             scene: &scene_group,
             frame_offset: offset as u32,
             outputs: outputs.as_ref(),
@@ -260,15 +265,15 @@ impl Renderer {
             size: self.size,
             render_size,
         };
-        if self.metered_from != Some(from) {
-            self.auto_exposure.record(
+        if self.display.metered_from != Some(from) {
+            self.display.auto_exposure.record(
                 ctx,
                 encoder,
                 self.accumulation.latest_views().0,
                 render_size,
                 timer.and_then(|t| t.compute_pass(Pass::AutoExposure)),
             );
-            self.metered_from = Some(from);
+            self.display.metered_from = Some(from);
         }
     }
 
@@ -304,17 +309,17 @@ impl Renderer {
             viewport,
             load,
         } = *target;
-        if !self.display_pipelines.contains_key(&format) {
+        if !self.display.pipelines.contains_key(&format) {
             let p = fullscreen_pipeline(
                 &ctx.device,
                 "display",
-                &self.display_module,
-                &self.display_layout,
+                &self.display.module,
+                &self.display.layout,
                 "fs_display",
                 &[format],
                 &[],
             )?;
-            self.display_pipelines.insert(format, p);
+            self.display.pipelines.insert(format, p);
         }
         // A view's values are shown as they are (RenderSettings::shown_display).
         let shown = self.scene.render.shown_display();
@@ -346,19 +351,19 @@ impl Renderer {
             padding: 0,
         };
         ctx.queue
-            .write_buffer(&self.display_buffer, 0, bytemuck::bytes_of(&uniform));
+            .write_buffer(&self.display.buffer, 0, bytemuck::bytes_of(&uniform));
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display"),
-            layout: &self.display_layout,
+            layout: &self.display.layout,
             entries: &[
-                bind(0, self.display_buffer.as_entire_binding()),
+                bind(0, self.display.buffer.as_entire_binding()),
                 bind(
                     1,
                     wgpu::BindingResource::TextureView(
                         source.unwrap_or(self.accumulation.latest_views().0),
                     ),
                 ),
-                bind(2, self.auto_exposure.result().as_entire_binding()),
+                bind(2, self.display.auto_exposure.result().as_entire_binding()),
                 bind(
                     3,
                     wgpu::BindingResource::TextureView(self.accumulation.latest_views().1),
@@ -389,7 +394,7 @@ impl Renderer {
             0.0,
             1.0,
         );
-        pass.set_pipeline(&self.display_pipelines[&format]);
+        pass.set_pipeline(&self.display.pipelines[&format]);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
         Ok(())

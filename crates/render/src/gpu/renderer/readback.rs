@@ -49,7 +49,7 @@ impl Renderer {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.meter(ctx, &mut encoder, None);
         ctx.queue.submit([encoder.finish()]);
-        self.auto_exposure.read(ctx)
+        self.display.auto_exposure.read(ctx)
     }
 
     /// Records the error meter on the latest frame (skip it before the
