@@ -8,7 +8,7 @@
 // noise explains (SVGF's exp(-|ΔL| / (σ_l √var + ε))). The colour's alpha
 // carries the variance of its luminance, filtered with the squared weights
 // so that the next iteration reads the variance of what this one made.
-// CPU twin: crates/render/src/gpu/denoise.rs (`iterate`).
+// CPU twin: crates/render/src/gpu/passes/denoise.rs (`iterate`).
 
 struct DenoiseParams {
     size: vec2u,
@@ -105,7 +105,7 @@ fn guide_weight(a: vec3f, b: vec3f, sigma: f32) -> f32 {
 // The filter's input from the accumulation's mean (colour_in) and spread:
 // the mean with the variance of its luminance in alpha. With two frames or
 // more, spread / (F - 1) per channel is the variance of the mean
-// (gpu/error_meter.rs), the channels taken as fully correlated, as a
+// (gpu/passes/error_meter.rs), the channels taken as fully correlated, as a
 // path's are; with one, the variance of the luminances of the 3 x 3
 // neighbourhood, as SVGF does before it has a history.
 @compute @workgroup_size(8, 8)

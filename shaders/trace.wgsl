@@ -13,7 +13,7 @@
 @group(0) @binding(18) var previous_compensation: texture_2d<f32>;
 
 // Samples dropped for being NaN or infinite since the accumulation began
-// (gpu/non_finite.rs; cleared before its first frame). A correct renderer
+// (gpu/passes/non_finite.rs; cleared before its first frame). A correct renderer
 // never adds to them: the tests and the Stats panel read them.
 struct NonFiniteCounters {
     nan: atomic<u32>,
@@ -36,7 +36,7 @@ struct Accumulated {
 }
 
 #if DENOISE_GUIDES
-// The denoiser's guides (gpu/denoise.rs): the first hit's albedo (plus its
+// The denoiser's guides (gpu/passes/denoise.rs): the first hit's albedo (plus its
 // emission) and shading normal, as the albedo and normal views record them
 // (view_at_hit), averaged over the pixel's samples like the radiance.
 @group(0) @binding(19) var previous_albedo: texture_2d<f32>;

@@ -1,38 +1,31 @@
-//! Everything that talks to wgpu: device creation, shader assembly and
-//! specialisation, the progressive renderer, auto exposure, and (in
-//! `harness/`) the compute passes that run shader functions for tests and
-//! tools.
+//! Everything that talks to wgpu, in folders by job: `shader/` (from a
+//! scene to a pipeline: features, WGSL assembly, generated texture code),
+//! `passes/` (the trace pass, the meters, the denoiser, swatches and
+//! bakes), `transfer/` (the scene's buffers, read-backs), `renderer/` (the
+//! progressive renderer built from those parts), and `harness/` (compute
+//! passes that run shader functions for tests and tools). Each module is
+//! also re-exported here by name (`gpu::features`, `gpu::scene_gpu`…), the
+//! paths callers and the tests use.
 
-pub mod accumulation;
-pub mod async_readback;
-pub mod auto_exposure;
-pub mod bake;
 pub mod context;
-pub mod denoise;
-pub mod error_meter;
-pub mod features;
-pub mod geometry_buffers;
 pub mod harness;
 pub mod kernel;
-pub mod mesh_buffers;
-pub mod metering_grid;
-pub mod non_finite;
-pub mod pass_timer;
-pub mod pipeline_build;
-pub mod pipelines;
-pub mod preprocess;
-pub mod readback;
+pub mod passes;
 pub mod renderer;
-pub mod scene_gpu;
-pub mod shader_source;
-pub mod swatch;
+pub mod shader;
 pub mod testing;
-pub mod texture_codegen;
-pub mod texture_params;
-pub mod trace_bands;
-pub mod trace_pass;
+pub mod transfer;
 #[cfg(test)]
 pub(crate) mod twin_layout;
+
+pub use passes::{
+    accumulation, auto_exposure, bake, denoise, error_meter, metering_grid, non_finite, pass_timer,
+    swatch, trace_bands, trace_pass,
+};
+pub use shader::{
+    features, pipeline_build, pipelines, preprocess, shader_source, texture_codegen, texture_params,
+};
+pub use transfer::{async_readback, geometry_buffers, mesh_buffers, readback, scene_gpu};
 
 pub use context::GpuContext;
 pub use features::{Feature, FeatureSet};

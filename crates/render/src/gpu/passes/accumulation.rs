@@ -3,8 +3,8 @@
 //! Three images per pixel, each ping-ponged (a frame reads the latest set
 //! and writes the other): the running mean of every sample, which is the
 //! image; the running spread of the frames' means about it, from which
-//! [`super::error_meter`] estimates the image's error (its alpha counts the
-//! pixel's dropped non-finite samples, see [`super::non_finite`]); and the
+//! [`crate::gpu::error_meter`] estimates the image's error (its alpha counts the
+//! pixel's dropped non-finite samples, see [`crate::gpu::non_finite`]); and the
 //! Kahan compensation of the mean, the low-order bits its updates lost.
 //! Averages rather than sums, and the mean compensated, so that rounding
 //! error does not grow with the frame count: a plain f32 running mean
@@ -12,7 +12,7 @@
 //! one stays within 1e-7 (`crates/render/tests/gpu/accumulation.rs`).
 //!
 //! A frame may trace only part of a round (a band of rows,
-//! [`super::trace_bands`]): the round writes the other set band by band,
+//! [`crate::gpu::trace_bands`]): the round writes the other set band by band,
 //! and the latest set, which the display shows, flips only when the round
 //! is complete. So the window always shows a whole image: the last
 //! complete round, or the preview of a new accumulation at a reduced size.

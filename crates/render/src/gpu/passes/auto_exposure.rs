@@ -9,16 +9,16 @@
 //!
 //! [`AutoExposure`] meters the accumulation target on the GPU
 //! (`shaders/auto_exposure.wgsl`): one workgroup reads a grid of texels
-//! spread over the traced region ([`super::metering_grid`]) and reduces it,
+//! spread over the traced region ([`crate::gpu::metering_grid`]) and reduces it,
 //! and the result stays in a buffer that the display pass binds, so the
 //! frame never waits for a readback. The free functions are its CPU twin.
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::metering_grid::MeteringGrid;
-use super::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
-use super::readback::read_buffer;
-use super::shader_source::Program;
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::metering_grid::MeteringGrid;
+use crate::gpu::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
+use crate::gpu::readback::read_buffer;
+use crate::gpu::shader_source::Program;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use marbre_core::scene::Metering;
@@ -506,16 +506,13 @@ mod tests {
 
     #[test]
     fn the_program_validates() {
-        let source = super::super::shader_source::assemble(
-            Program::AutoExposure,
-            &FeatureSet::default(),
-            "",
-        )
-        .unwrap();
-        super::super::pipelines::validate(&source).unwrap();
-        let display =
-            super::super::shader_source::assemble(Program::Display, &FeatureSet::default(), "")
+        let source =
+            crate::gpu::shader_source::assemble(Program::AutoExposure, &FeatureSet::default(), "")
                 .unwrap();
-        super::super::pipelines::validate(&display).unwrap();
+        crate::gpu::pipelines::validate(&source).unwrap();
+        let display =
+            crate::gpu::shader_source::assemble(Program::Display, &FeatureSet::default(), "")
+                .unwrap();
+        crate::gpu::pipelines::validate(&display).unwrap();
     }
 }

@@ -5,16 +5,16 @@
 //! the harnesses' plumbing (`harness::dispatch`). Its CPU oracle is
 //! `marbre_core::bake::reference`.
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::harness::dispatch;
-use super::pipelines::{
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::harness::dispatch;
+use crate::gpu::pipelines::{
     buffer_entry, compute_pipeline_with, entry, float_texture, permutation_table, storage, uniform,
     upload_atlas,
 };
-use super::scene_gpu;
-use super::shader_source::Program;
-use super::texture_codegen;
+use crate::gpu::scene_gpu;
+use crate::gpu::shader_source::Program;
+use crate::gpu::texture_codegen;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use marbre_core::bake::{self, BakeProperty, UvSurface};

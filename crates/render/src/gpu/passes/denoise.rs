@@ -18,11 +18,11 @@
 //! (`session::trace_guides`). Saved EXRs stay the raw accumulation unless
 //! asked: the filter is biased (it trades noise for blur).
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::pipelines::{checked, entry, float_texture, shader_module, uniform};
-use super::readback::read_texture;
-use super::shader_source::Program;
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::pipelines::{checked, entry, float_texture, shader_module, uniform};
+use crate::gpu::readback::read_texture;
+use crate::gpu::shader_source::Program;
 use anyhow::{Result, ensure};
 use wgpu::util::DeviceExt;
 
@@ -100,7 +100,7 @@ fn luminance(c: [f32; 3]) -> f32 {
 
 /// The filter's input, the CPU twin of `cs_denoise_input`: the mean with
 /// the variance of its luminance in alpha, from the spread of the frames'
-/// means (`spread / (F − 1)` per channel, see [`super::error_meter`]; the
+/// means (`spread / (F − 1)` per channel, see [`crate::gpu::error_meter`]; the
 /// channels taken as fully correlated) with two frames or more, else from
 /// the luminances of the pixel's 3 × 3 neighbourhood.
 pub fn filter_input(image: &DenoiseImage<'_>) -> Vec<[f32; 4]> {

@@ -16,14 +16,14 @@
 //! (`shaders/error_meter.wgsl`) and reads the sums back without stalling;
 //! [`estimate`] is its CPU twin.
 
-use super::async_readback::AsyncReadback;
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::metering_grid::{MeteringGrid, grid_pixels};
-use super::pass_timer::{Pass, PassTimer};
-use super::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
-use super::readback::read_buffer;
-use super::shader_source::Program;
+use crate::gpu::async_readback::AsyncReadback;
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::metering_grid::{MeteringGrid, grid_pixels};
+use crate::gpu::pass_timer::{Pass, PassTimer};
+use crate::gpu::pipelines::{compute_pipeline, entry, float_texture, storage, uniform};
+use crate::gpu::readback::read_buffer;
+use crate::gpu::shader_source::Program;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
@@ -404,9 +404,9 @@ mod tests {
     #[test]
     fn the_program_validates_and_its_structs_match() {
         let source =
-            super::super::shader_source::assemble(Program::ErrorMeter, &FeatureSet::default(), "")
+            crate::gpu::shader_source::assemble(Program::ErrorMeter, &FeatureSet::default(), "")
                 .unwrap();
-        super::super::pipelines::validate(&source).unwrap();
+        crate::gpu::pipelines::validate(&source).unwrap();
         assert_eq!(std::mem::size_of::<ErrorParams>(), 32);
         assert_eq!(std::mem::size_of::<ErrorSums>(), 28);
         let constant = format!("const REL_EPSILON: f32 = {REL_EPSILON};");

@@ -10,9 +10,9 @@
 //! (`tonemap.wgsl`). A correct renderer keeps them at zero; the tests and
 //! the Stats panel read them.
 
-use super::async_readback::AsyncReadback;
-use super::context::GpuContext;
-use super::readback::read_buffer;
+use crate::gpu::async_readback::AsyncReadback;
+use crate::gpu::context::GpuContext;
+use crate::gpu::readback::read_buffer;
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use std::cell::Cell;

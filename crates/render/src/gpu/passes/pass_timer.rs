@@ -4,9 +4,9 @@
 //! not timed. Each pass's time is smoothed, so the panel shows a steady
 //! figure rather than one frame's jitter.
 
-use super::async_readback::AsyncReadback;
-use super::context::GpuContext;
-use super::trace_pass::PassTimestamps;
+use crate::gpu::async_readback::AsyncReadback;
+use crate::gpu::context::GpuContext;
+use crate::gpu::trace_pass::PassTimestamps;
 use std::cell::Cell;
 
 /// The passes of a viewer frame, in the order they run.

@@ -11,15 +11,15 @@
 //! rewrites buffers only; a new structure compiles a pipeline (the costly
 //! part on lavapipe, see docs/PERFORMANCE.md).
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::harness::dispatch;
-use super::pipelines::{
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::harness::dispatch;
+use crate::gpu::pipelines::{
     compute_pipeline_with, entry, float_texture, permutation_table, storage, uniform, upload_atlas,
 };
-use super::scene_gpu::{self, Material};
-use super::shader_source::Program;
-use super::texture_codegen::{self, swatch_material};
+use crate::gpu::scene_gpu::{self, Material};
+use crate::gpu::shader_source::Program;
+use crate::gpu::texture_codegen::{self, swatch_material};
 use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;

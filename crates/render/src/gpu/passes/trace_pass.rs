@@ -1,13 +1,13 @@
 //! Recording one band of a trace round with either kernel
-//! ([`super::kernel::Kernel`]): the fragment kernel draws the full-screen
+//! ([`crate::gpu::kernel::Kernel`]): the fragment kernel draws the full-screen
 //! triangle with a scissor around the band, the compute kernel dispatches
 //! workgroups over it. Both read the scene through bind group 0 (its frame
 //! uniform at a dynamic offset, so several passes in one submit each see
 //! their own); the compute kernel writes the accumulation through group 1.
 
-use super::accumulation::{ACCUMULATION_FORMAT, Accumulation};
-use super::kernel::{Kernel, WORKGROUP};
-use super::pipelines::{checked, entry, fullscreen_pipeline};
+use crate::gpu::accumulation::{ACCUMULATION_FORMAT, Accumulation};
+use crate::gpu::kernel::{Kernel, WORKGROUP};
+use crate::gpu::pipelines::{checked, entry, fullscreen_pipeline};
 use anyhow::Result;
 use std::ops::Range;
 

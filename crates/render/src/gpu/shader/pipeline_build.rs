@@ -12,7 +12,7 @@
 //! stores the compiled shader in its disk cache, and the real device's
 //! first draw then finds it there.
 
-use super::trace_pass::TracePipeline;
+use crate::gpu::trace_pass::TracePipeline;
 use crate::worker::{Worker, names};
 use anyhow::{Result, anyhow};
 use std::sync::{Arc, Condvar, Mutex, mpsc};

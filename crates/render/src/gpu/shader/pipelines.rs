@@ -1,9 +1,9 @@
 //! Shader modules and pipelines, with validation errors caught instead of
 //! panicking, so a bad shader never takes the app down.
 
-use super::context::GpuContext;
-use super::features::FeatureSet;
-use super::shader_source::{Program, assemble};
+use crate::gpu::context::GpuContext;
+use crate::gpu::features::FeatureSet;
+use crate::gpu::shader_source::{Program, assemble};
 use anyhow::{Result, anyhow};
 use marbre_core::texture::ImageAtlas;
 use wgpu::util::DeviceExt;
@@ -101,7 +101,7 @@ pub fn validate(source: &str) -> Result<(), String> {
 /// naga counts lines in the assembled module, which no one edits.
 fn located(source: &str, location: Option<naga::SourceLocation>, report: String) -> String {
     let position = location.and_then(|at| {
-        super::shader_source::source_position(source, at.line_number)
+        crate::gpu::shader_source::source_position(source, at.line_number)
             .map(|(file, line)| format!("{file}:{line}:{}", at.line_position))
     });
     match position {

@@ -3,8 +3,8 @@
 //! and `perlin.wgsl`, …) or, for the renderer's own passes, in
 //! `shaders/`.
 
-use super::features::{Feature, FeatureSet};
-use super::preprocess::{PreprocessError, preprocess};
+use crate::gpu::features::{Feature, FeatureSet};
+use crate::gpu::preprocess::{PreprocessError, preprocess};
 
 /// The renderer's own WGSL, in the repository's `shaders/`: the trace and
 /// display passes and what only they use, the compute passes (metering,
@@ -327,7 +327,7 @@ pub fn sources_fingerprint() -> u64 {
 
 /// The WGSL text of `program` specialised for `features`. The trace and
 /// bake and swatch programs also take generated texture code
-/// ([`super::texture_codegen::generate`]); the others ignore it.
+/// ([`crate::gpu::texture_codegen::generate`]); the others ignore it.
 pub fn assemble(
     program: Program,
     features: &FeatureSet,

@@ -22,8 +22,8 @@ use marbre_core::scene::{
 use marbre_core::texture::{ImageFilter, ImageSet, ImageWrap};
 use std::fmt::Write;
 
-use super::texture_params::{Field, Place, Slot};
-pub use super::texture_params::{MAX_TEXTURE_PARAMS, ParamPlan};
+use crate::gpu::texture_params::{Field, Place, Slot};
+pub use crate::gpu::texture_params::{MAX_TEXTURE_PARAMS, ParamPlan};
 use marbre_core::scene::node_path::{NodePath, Root, Socket};
 
 /// The generated code and the parameters it reads.

@@ -2,7 +2,7 @@
 //! They are fixed-size arrays (see `shaders/scene.wgsl`), so an edit only
 //! rewrites them; they never grow.
 
-use super::scene_gpu;
+use crate::gpu::scene_gpu;
 use marbre_core::scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -62,7 +62,7 @@ impl GeometryBuffers {
     /// The trace bind group's entries for these buffers (bindings 1, 2, 9
     /// and 10 of `shaders/scene.wgsl`).
     pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
-        use super::pipelines::buffer_entry as entry;
+        use crate::gpu::pipelines::buffer_entry as entry;
         [
             entry(1, &self.spheres),
             entry(2, &self.materials),

@@ -231,7 +231,7 @@ impl MeshBuffers {
 
     /// The trace bind group's entries (bindings 12 to 15).
     pub fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
-        use super::pipelines::buffer_entry as entry;
+        use crate::gpu::pipelines::buffer_entry as entry;
         [
             entry(12, &self.nodes),
             entry(13, &self.triangles),
