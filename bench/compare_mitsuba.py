@@ -272,7 +272,7 @@ def mitsuba_scene(mi, setup, size, folder):
     cam = setup["camera"]
     # How the two count path length. marbre's max_bounces B counts
     # reflections: it samples the lights at the first B surfaces the path
-    # meets and adds the emission of the first B + 1 (crates/render/shaders/trace.wgsl:
+    # meets and adds the emission of the first B + 1 (shaders/trace.wgsl:
     # the loop stops at `bounces >= max_bounces` after adding emission).
     # Mitsuba's max_depth counts path segments from the camera (1: emitters
     # seen directly, 2: direct light): the same paths are max_depth = B + 1.
@@ -471,7 +471,7 @@ def measure(args, mi, np, setup, folder):
 
 def material_regions(np, setup, size):
     """Which material each pixel sees, by casting marbre's camera rays
-    (crates/render/shaders/trace.wgsl: camera_ray) through the pixel's centre and four
+    (shaders/trace.wgsl: camera_ray) through the pixel's centre and four
     points near its corners against the triangles: -1 where they disagree
     (an edge) or miss."""
     width, height = size
