@@ -1,14 +1,15 @@
 //! Environment maps: the first byte picks the file type (its low seven bits
 //! index `SUPPORTED_EXTENSIONS`, modulo its length) and, by its top bit, how
 //! 8- and 16-bit codes decode; the rest is the file. Decoded through
-//! `envmap::decode_bytes`, the decoder `envmap::load_with` uses, then the
-//! importance-sampling table the renderer builds from every map, and one
-//! sample drawn from it.
+//! `image_decode::decode_bytes`, the decoder every map and image texture
+//! loads through, then the importance-sampling table the renderer builds
+//! from every map, and one sample drawn from it.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use marbre_core::env_sampling::EnvDistribution;
-use marbre_core::envmap::{IntegerDecode, SUPPORTED_EXTENSIONS, decode_bytes};
+use marbre_core::envmap::EnvLoad;
+use marbre_core::image_decode::{IntegerDecode, SUPPORTED_EXTENSIONS, decode_bytes};
 use std::path::PathBuf;
 
 fuzz_target!(|data: &[u8]| {
@@ -22,8 +23,8 @@ fuzz_target!(|data: &[u8]| {
         IntegerDecode::Linear
     };
     let path = PathBuf::from(format!("/fuzz/envmaps/input.{extension}"));
-    if let Ok(loaded) = decode_bytes(file, &path, decode) {
-        let distribution = EnvDistribution::new(&loaded.image);
+    if let Ok(decoded) = decode_bytes(file, &path, decode) {
+        let distribution = EnvDistribution::new(&EnvLoad::from(decoded).image);
         let (t, _) = distribution.sample(0.5, 0.5);
         distribution.pdf_texel_uv(t);
     }

@@ -6,7 +6,7 @@
 //! the panel and to dropping a file on the window; [`dialogs_available`]
 //! says which route to take before anything hangs.
 
-use marbre_core::envmap::SUPPORTED_EXTENSIONS;
+use marbre_core::image_decode::SUPPORTED_EXTENSIONS;
 use std::path::PathBuf;
 use std::sync::mpsc;
 

@@ -76,8 +76,8 @@ use glam::{Vec2, Vec3};
 use thiserror::Error;
 
 use crate::env_sampling::EnvDistribution;
-use crate::envmap::{self, EnvImage, EnvLoad, EnvMapError};
-use crate::scene::{EnvSource, LdrImages};
+use crate::envmap::{self, EnvImage, EnvLoad, EnvMapError, LdrImages};
+use crate::scene::EnvSource;
 
 /// The widest lat-long image [`CubeMap::to_latlong`] makes (then 2048
 /// rows): faces above 1024 texels are resampled at this size, which bounds
@@ -268,7 +268,7 @@ pub struct CubeMap {
 }
 
 /// A loaded cube map and one note per kind of repair the loader made to
-/// each file (see [`EnvImage::sanitize`]).
+/// each file (see [`DecodedImage::sanitize`](crate::image_decode::DecodedImage::sanitize)).
 #[derive(Debug, Clone)]
 pub struct CubeLoad {
     pub cube: CubeMap,

@@ -11,6 +11,7 @@ pub mod cubemap;
 pub mod env_sampling;
 pub mod envmap;
 pub mod geometry;
+pub mod image_decode;
 pub mod image_io;
 pub mod lexical_path;
 pub mod lights;

@@ -4,6 +4,8 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
+use crate::envmap::LdrImages;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub enum EnvSource {
     /// Black: no light from infinity.
@@ -53,20 +55,6 @@ impl EnvSource {
             EnvSource::CubeFaces { faces } => faces.iter_mut().collect(),
         }
     }
-}
-
-/// How the 8- and 16-bit images of a map (PNG, JPEG, PPM/PGM) become
-/// radiance. Float files (EXR, HDR) are radiance already either way.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum LdrImages {
-    /// The codes are sRGB: decoded exactly to linear values in [0, 1].
-    #[default]
-    Srgb,
-    /// Massal's tutorial (annex II): the image was stored after his
-    /// exposure curve `1 − exp(−x)`, so each channel `c` (code / max) is
-    /// taken to the power 2.2, then un-exposed by `−ln(1.001 − c)`: white
-    /// comes back as ln(1000) ≈ 6.9, bright enough to light a scene.
-    Exposed,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -28,7 +28,7 @@ pub mod uv_frame;
 pub use camera::{OrbitCamera, SavedView};
 pub use change::Change;
 pub use color_encoding::ColorEncoding;
-pub use environment::{EnvSource, Environment, LdrImages};
+pub use environment::{EnvSource, Environment};
 pub use graph_layout::{GraphLayout, MaterialKey, MaterialLayout};
 pub use material::{Layer, Material, Property};
 pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
@@ -40,6 +40,9 @@ pub use render_view::View;
 pub use texture_tree::{Child, MathOp, Texture};
 pub use transport::{Integrator, LightPoints, Strategy, TransportSettings};
 pub use uv_frame::UvFrame;
+// An environment's `ldr_images` setting, defined beside the loader that
+// reads it (`envmap::load_ldr`) so that `envmap` imports nothing from here.
+pub use crate::envmap::LdrImages;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};

@@ -30,8 +30,8 @@
 //! and the atlas layout then follow from the level-0 size alone, which is
 //! all the shader is told.
 //!
-//! Images are decoded by [`crate::envmap`]'s loaders and sanitised the same
-//! way; alpha is 1 (the loaders drop it).
+//! Images are decoded and sanitised by [`crate::image_decode`], as
+//! environment maps are; alpha is 1 (the decoder drops it).
 
 use std::path::{Path, PathBuf};
 
@@ -40,7 +40,7 @@ use half::f16;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::envmap::{self, EnvMapError, IntegerDecode};
+use crate::image_decode::{self, DecodeError, IntegerDecode};
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/texture/image.wgsl");
@@ -155,14 +155,14 @@ pub enum ImageError {
     },
 }
 
-impl From<EnvMapError> for ImageError {
-    fn from(error: EnvMapError) -> ImageError {
+impl From<DecodeError> for ImageError {
+    fn from(error: DecodeError) -> ImageError {
         match error {
-            EnvMapError::Io { path, cause } => ImageError::Io { path, cause },
-            EnvMapError::UnsupportedExtension { path, extension } => {
+            DecodeError::Io { path, cause } => ImageError::Io { path, cause },
+            DecodeError::UnsupportedExtension { path, extension } => {
                 ImageError::UnsupportedExtension { path, extension }
             }
-            EnvMapError::Decode {
+            DecodeError::Decode {
                 path,
                 format,
                 message,
@@ -171,7 +171,7 @@ impl From<EnvMapError> for ImageError {
                 format,
                 message,
             },
-            EnvMapError::ExrCompression {
+            DecodeError::ExrCompression {
                 path,
                 compression,
                 message,
@@ -180,10 +180,10 @@ impl From<EnvMapError> for ImageError {
                 format: "OpenEXR",
                 message: format!(
                     "{compression} compression: {message}; {}",
-                    envmap::EXR_RESAVE_HINT
+                    image_decode::EXR_RESAVE_HINT
                 ),
             },
-            EnvMapError::Empty {
+            DecodeError::Empty {
                 path,
                 width,
                 height,
@@ -475,14 +475,14 @@ pub struct ImageLoad {
 /// become 0 and values above the half-float maximum are clamped (each noted);
 /// sides that are not powers of two are resampled (noted).
 pub fn load_image(path: &Path, space: ColorSpace) -> Result<ImageLoad, ImageError> {
-    let loaded = envmap::load_with(path, space.integer_decode())?;
-    let (width, height) = (loaded.image.width, loaded.image.height);
+    let decoded = image_decode::decode_file(path, space.integer_decode())?;
+    let (width, height) = (decoded.width, decoded.height);
     let image = MipImage::new(ImageLevel {
         width,
         height,
-        texels: loaded.image.pixels,
+        texels: decoded.pixels,
     });
-    let mut notes = loaded.notes;
+    let mut notes = decoded.notes;
     let size = image.size();
     if size != UVec2::new(width, height) {
         let file_name = path
@@ -975,7 +975,11 @@ mod tests {
             ["odd.png: 300×200 resampled to 256×256 for mipmapping"]
         );
         // The tent weights sum to 1: a flat image stays flat.
-        let flat = Vec4::from(envmap::load(&odd).unwrap().image.texel(0, 0));
+        let flat = Vec4::from(
+            image_decode::decode_file(&odd, IntegerDecode::Srgb)
+                .unwrap()
+                .pixels[0],
+        );
         for &t in &loaded.image.levels()[0].texels {
             assert!(near(Vec4::from(t), flat, 1e-6), "{t:?} vs {flat}");
         }
@@ -1003,7 +1007,9 @@ mod tests {
         assert!(loaded.notes.is_empty(), "{:?}", loaded.notes);
         assert_eq!(
             loaded.image.levels()[0].texels,
-            envmap::load(&even).unwrap().image.pixels
+            image_decode::decode_file(&even, IntegerDecode::Srgb)
+                .unwrap()
+                .pixels
         );
     }
 

@@ -4,7 +4,8 @@
 //! must name the file, and a result must keep the loader's promises.
 
 use marbre_core::env_sampling::EnvDistribution;
-use marbre_core::envmap::{F16_MAX, IntegerDecode, MAX_TEXELS, SUPPORTED_EXTENSIONS};
+use marbre_core::envmap::EnvLoad;
+use marbre_core::image_decode::{F16_MAX, IntegerDecode, MAX_TEXELS, SUPPORTED_EXTENSIONS};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
@@ -143,9 +144,9 @@ fn envmap_inputs_decode_to_clean_images_or_give_an_error_naming_the_file() {
             return Err("empty input".into());
         };
         let file_name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let image = match marbre_core::envmap::decode_bytes(file, &path, decode) {
+        let image = match marbre_core::image_decode::decode_bytes(file, &path, decode) {
             Err(e) => return names_the_file(e.to_string(), &file_name),
-            Ok(loaded) => loaded.image,
+            Ok(decoded) => EnvLoad::from(decoded).image,
         };
         let texels = u64::from(image.width) * u64::from(image.height);
         if texels == 0 || texels > MAX_TEXELS || image.pixels.len() as u64 != texels {
@@ -190,7 +191,7 @@ fn oversized_envmap_headers_are_refused_with_their_size() {
         let stem = file.file_stem().unwrap().to_string_lossy().into_owned();
         let size = stem.trim_start_matches("too_large_");
         let (path, decode, data) = envmap_path_and_file(&bytes).unwrap();
-        let e = marbre_core::envmap::decode_bytes(data, &path, decode)
+        let e = marbre_core::image_decode::decode_bytes(data, &path, decode)
             .unwrap_err()
             .to_string();
         assert!(
@@ -217,9 +218,8 @@ fn envmap_seeds_decode_to_their_size() {
             continue;
         }
         let (path, decode, data) = envmap_path_and_file(&bytes).unwrap();
-        let image = marbre_core::envmap::decode_bytes(data, &path, decode)
-            .unwrap_or_else(|e| panic!("{}: {e}", file.display()))
-            .image;
+        let image = marbre_core::image_decode::decode_bytes(data, &path, decode)
+            .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         assert_eq!(
             format!("{}x{}", image.width, image.height),
             size,

@@ -12,7 +12,8 @@
 mod corpus;
 
 use glam::Vec3;
-use marbre_core::envmap::{EnvImage, MAX_TEXELS};
+use marbre_core::envmap::EnvImage;
+use marbre_core::image_decode::MAX_TEXELS;
 use marbre_core::scene::{EnvSource, LdrImages, Material, Mesh, Pattern, Scene, Sphere, Texture};
 use marbre_core::texture::{ColorSpace, ImageSource, load_image};
 use marbre_render::session::{

@@ -10,6 +10,7 @@ use crate::common;
 use glam::{Vec2, Vec3};
 use marbre_core::cubemap::{self, CubeMap, CubeMapError, Face};
 use marbre_core::envmap::{self, EnvImage};
+use marbre_core::image_decode;
 use marbre_core::scene::{EnvSource, LdrImages, OrbitCamera, Scene};
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -686,7 +687,7 @@ fn faces_are_sanitised_like_lat_long_maps() {
     let loaded = CubeMap::load_faces(&paths, LdrImages::Srgb).unwrap();
     assert_eq!(
         loaded.cube.texel(Face::PosY, 0, 0),
-        [0.0, 0.0, envmap::F16_MAX]
+        [0.0, 0.0, image_decode::F16_MAX]
     );
     assert!(
         loaded

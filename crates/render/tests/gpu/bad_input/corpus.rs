@@ -18,7 +18,7 @@ pub const CODE16: u16 = 32768;
 /// The 8-bit code of `grey.png`.
 pub const GREY8: u8 = 100;
 /// The declared side of `huge_header.png` and `huge_header.exr`, far beyond
-/// `envmap::MAX_TEXELS`.
+/// `image_decode::MAX_TEXELS`.
 pub const HUGE_SIDE: u32 = 100_000;
 
 pub fn write_all(bad: &Path) {
