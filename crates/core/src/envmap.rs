@@ -358,34 +358,8 @@ pub fn texel_for_direction(image: &EnvImage, d: Vec3, rotation_degrees: f32) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::image_decode::F16_MAX;
+    use crate::image_decode::test_support::{assert_clean, close, shipped_map};
     use std::f32::consts::PI;
-    use std::path::PathBuf;
-
-    /// A map shipped in `envmaps/`, else the shared copy; `None` if neither.
-    fn shipped_map(name: &str) -> Option<PathBuf> {
-        let root = Path::new(crate::REPO);
-        [
-            root.join("envmaps").join(name),
-            root.join("../shared/envmaps").join(name),
-        ]
-        .into_iter()
-        .find(|p| p.is_file())
-    }
-
-    fn assert_clean(image: &EnvImage) {
-        assert_eq!(image.pixels.len(), (image.width * image.height) as usize);
-        for px in &image.pixels {
-            for &c in &px[..3] {
-                assert!((0.0..=F16_MAX).contains(&c), "bad value {c}");
-            }
-            assert_eq!(px[3], 1.0);
-        }
-    }
-
-    fn close(a: f32, b: f32, tol: f32) -> bool {
-        (a - b).abs() <= tol
-    }
 
     /// Circular distance between two u values (u wraps at 1).
     fn u_dist(a: f32, b: f32) -> f32 {
@@ -612,7 +586,11 @@ mod tests {
         };
         let loaded = load(&path).unwrap();
         eprintln!("esplanade notes: {:?}", loaded.notes);
-        assert_clean(&loaded.image);
+        assert_clean(
+            &loaded.image.pixels,
+            loaded.image.width,
+            loaded.image.height,
+        );
         assert_eq!((loaded.image.width, loaded.image.height), (512, 256));
         let max = loaded.image.max_value();
         assert!(max > 10000.0, "max {max}");
@@ -636,7 +614,11 @@ mod tests {
             "cube/studio-cross.exr",
         ] {
             let loaded = load(&root.join(name)).unwrap();
-            assert_clean(&loaded.image);
+            assert_clean(
+                &loaded.image.pixels,
+                loaded.image.width,
+                loaded.image.height,
+            );
             assert_eq!(loaded.notes, Vec::<String>::new(), "{name}");
         }
     }

@@ -837,12 +837,14 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 static SRGB8_TO_LINEAR: std::sync::LazyLock<[f32; 256]> =
     std::sync::LazyLock::new(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)));
 
+/// What the decoder's and the env maps' tests share.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod test_support {
+    use super::F16_MAX;
+    use std::path::{Path, PathBuf};
 
     /// A map shipped in `envmaps/`, else the shared copy; `None` if neither.
-    fn shipped_map(name: &str) -> Option<PathBuf> {
+    pub(crate) fn shipped_map(name: &str) -> Option<PathBuf> {
         let root = Path::new(crate::REPO);
         [
             root.join("envmaps").join(name),
@@ -852,9 +854,10 @@ mod tests {
         .find(|p| p.is_file())
     }
 
-    fn assert_clean(image: &DecodedImage) {
-        assert_eq!(image.pixels.len(), (image.width * image.height) as usize);
-        for px in &image.pixels {
+    /// `width × height` pixels, each finite, in [0, F16_MAX], alpha 1.
+    pub(crate) fn assert_clean(pixels: &[[f32; 4]], width: u32, height: u32) {
+        assert_eq!(pixels.len(), (width * height) as usize);
+        for px in pixels {
             for &c in &px[..3] {
                 assert!((0.0..=F16_MAX).contains(&c), "bad value {c}");
             }
@@ -862,9 +865,16 @@ mod tests {
         }
     }
 
-    fn close(a: f32, b: f32, tol: f32) -> bool {
+    pub(crate) fn close(a: f32, b: f32, tol: f32) -> bool {
         (a - b).abs() <= tol
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use super::test_support::{assert_clean, close, shipped_map};
 
     /// The texel at column `x`, row `y` (row 0 = top).
     fn texel_at(image: &DecodedImage, x: u32, y: u32) -> [f32; 4] {
@@ -894,7 +904,7 @@ mod tests {
             }
         );
         assert_eq!(counts.total(), 6);
-        assert_clean(&img);
+        assert_clean(&img.pixels, img.width, img.height);
         assert_eq!(img.pixels[1], [0.0, 0.0, F16_MAX, 1.0]);
         assert!(img.pixels[1][1].is_sign_positive());
         assert_eq!(img.pixels[2], [F16_MAX, 1.0, F16_MAX, 1.0]);
@@ -934,7 +944,7 @@ mod tests {
         let loaded = decode_file(&path, IntegerDecode::Srgb).unwrap();
         let img = &loaded;
         assert_eq!((img.width, img.height), (4, 2));
-        assert_clean(img);
+        assert_clean(&img.pixels, img.width, img.height);
         assert_eq!(texel_at(img, 0, 0), [0.0, 0.0, 1.0, 1.0]);
         assert_eq!(texel_at(img, 1, 0), [0.0, 0.0, 2.0, 1.0]);
         assert_eq!(texel_at(img, 2, 0), [0.0, 0.0, 0.0, 1.0]);
@@ -1078,7 +1088,7 @@ mod tests {
             .save_with_format(&hdr, image::ImageFormat::Hdr)
             .unwrap();
         let loaded = decode_file(&hdr, IntegerDecode::Srgb).unwrap();
-        assert_clean(&loaded);
+        assert_clean(&loaded.pixels, loaded.width, loaded.height);
         assert_eq!(texel_at(&loaded, 0, 0)[0], F16_MAX);
         assert!(close(texel_at(&loaded, 1, 0)[2], 4.0, 0.05));
         assert_eq!(

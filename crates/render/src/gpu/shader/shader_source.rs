@@ -166,14 +166,19 @@ impl Program {
             out.push(noise::fractal::WGSL);
             out.push(envmap::WGSL);
         };
+        // The scene and its generated texture code's library, which the
+        // trace, swatches and bakes all evaluate.
+        let texture_code = |out: &mut Vec<WgslFile>| {
+            noise(out);
+            out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
+            if features.contains(Feature::IMAGE) {
+                out.push(texture::image::WGSL);
+            }
+        };
         let mut out = vec![r::COMMON];
         match self {
             Program::Trace => {
-                noise(&mut out);
-                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::IMAGE) {
-                    out.push(texture::image::WGSL);
-                }
+                texture_code(&mut out);
                 out.push(r::TEXTURES);
                 if features.contains(Feature::Mesh) {
                     out.push(accel::traverse::WGSL);
@@ -218,11 +223,7 @@ impl Program {
                 ]);
             }
             Program::Swatch => {
-                noise(&mut out);
-                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::IMAGE) {
-                    out.push(texture::image::WGSL);
-                }
+                texture_code(&mut out);
                 out.extend([r::TEXTURES, geometry::sphere::WGSL, r::INTERSECT, r::SWATCH]);
             }
             Program::BvhHarness => out.extend([accel::traverse::WGSL, r::HARNESS_BVH]),
@@ -247,11 +248,7 @@ impl Program {
                 r::HARNESS_SAMPLING,
             ]),
             Program::Bake => {
-                noise(&mut out);
-                out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-                if features.contains(Feature::IMAGE) {
-                    out.push(texture::image::WGSL);
-                }
+                texture_code(&mut out);
                 out.push(r::TEXTURES);
                 if features.contains(Feature::Mesh) {
                     out.push(accel::traverse::WGSL);
