@@ -8,6 +8,9 @@
 // -ln(0.6) / L_rms; the display picks one of the two.
 // CPU twin: auto_exposure.rs.
 
+#import shaders/common.wgsl
+#import shaders/metering_grid.wgsl
+
 const DELTA: f32 = 1e-4;
 const KEY: f32 = 0.18;
 const MAX_STOPS: f32 = 20.0;

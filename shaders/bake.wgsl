@@ -4,6 +4,12 @@
 // shades a hit (surface.wgsl's surface_at), before its clamping and with no
 // footprint: each texel is a point sample.
 
+#import shaders/common.wgsl
+#import shaders/scene.wgsl
+#import shaders/textures.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import shaders/intersect.wgsl
+
 struct BakeSettings {
     count: u32,
     property: u32, // gpu::bake::property_id

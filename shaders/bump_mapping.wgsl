@@ -6,6 +6,12 @@
 // otherwise the hit's own signals serve, and the four extra sums are
 // compiled out.
 
+#import shaders/scene.wgsl
+#import shaders/intersect.wgsl
+#import shaders/textures.wgsl
+#import crates/core/src/texture/shading.wgsl
+#import crates/core/src/texture/bump.wgsl
+
 const BUMP_STEP: f32 = 1e-3;
 
 fn height_at(hit: Hit, fp: Footprint, signals: vec4f, du: f32, dv: f32) -> f32 {

@@ -10,6 +10,8 @@
 // so that the next iteration reads the variance of what this one made.
 // CPU twin: crates/render/src/gpu/passes/denoise.rs (`iterate`).
 
+#import shaders/common.wgsl
+
 struct DenoiseParams {
     size: vec2u,
     step: u32,

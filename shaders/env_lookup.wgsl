@@ -1,6 +1,10 @@
 // Radiance arriving from direction d out of the scene.
 
 #if ENV_MAP
+#import crates/core/src/envmap.wgsl
+#endif
+
+#if ENV_MAP
 @group(0) @binding(3) var env_texture: texture_2d<f32>;
 @group(0) @binding(4) var env_sampler: sampler;
 #endif

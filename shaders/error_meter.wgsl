@@ -7,6 +7,9 @@
 // relMSE of the benchmarks); the CPU divides by F - 1 and the texel count
 // (error_meter.rs, which also holds the CPU twin).
 
+#import shaders/common.wgsl
+#import shaders/metering_grid.wgsl
+
 const REL_EPSILON: f32 = 0.01;
 
 struct ErrorParams {

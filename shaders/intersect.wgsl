@@ -2,6 +2,11 @@
 // offset_ray in geometry/ray_offset.wgsl), so t > 0 is the only lower
 // bound needed.
 
+#import shaders/common.wgsl
+#import shaders/scene.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import crates/core/src/texture/mapping.wgsl
+
 struct Hit {
     t: f32,
     p: vec3f,

@@ -1,5 +1,7 @@
 // Per-sample random numbers: a PCG state seeded by pcg3d of (pixel, sample).
 
+#import crates/core/src/noise/hash.wgsl
+
 var<private> rng_state: u32;
 
 fn rng_seed(pixel: vec2u, sample_index: u32) {

@@ -1,5 +1,10 @@
 // Scene data shared by the trace pass: the frame uniform, spheres, materials.
 
+#import crates/core/src/noise/fractal.wgsl
+#if MESH
+#import crates/core/src/accel/traverse.wgsl
+#endif
+
 struct Frame {
     cam_pos: vec3f,
     tan_half_fov: f32,

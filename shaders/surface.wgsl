@@ -1,6 +1,15 @@
 // The material at a hit: its textures evaluated, clamped to what the BSDF
 // (bsdf.wgsl) accepts.
 
+#import crates/core/src/bsdf.wgsl
+#import crates/core/src/mis.wgsl
+#import shaders/scene.wgsl
+#import shaders/intersect.wgsl
+#import shaders/textures.wgsl
+#if BUMP
+#import shaders/bump_mapping.wgsl
+#endif
+
 // The surface at a hit reached by a ray cone `width` wide, along `d`.
 fn surface_at(hit: Hit, width: f32, d: vec3f) -> SurfacePoint {
     let p = hit.texture_point;

@@ -3,6 +3,12 @@
 // evaluated at the swatch's sample points, point sampled. Workgroup row y
 // is swatch y: its noise signals come from material slot y.
 
+#import shaders/common.wgsl
+#import shaders/scene.wgsl
+#import shaders/textures.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import shaders/intersect.wgsl
+
 struct SwatchPoint {
     // The point on the unit sphere (object = world), w: 1 inside the
     // swatch's disc, 0 outside.

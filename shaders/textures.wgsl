@@ -8,6 +8,15 @@
 // (lavapipe runs every branch, taken or not), so a sum written inside each
 // pattern would be paid for by every pattern in the scene.
 
+#import shaders/scene.wgsl
+#import shaders/intersect.wgsl
+#import crates/core/src/noise/fractal.wgsl
+#import crates/core/src/texture/mapping.wgsl
+#import crates/core/src/texture/patterns.wgsl
+#if IMAGE
+#import crates/core/src/texture/image.wgsl
+#endif
+
 // The generated code's result for one hit.
 struct SurfaceTextures {
     diffuse: vec3f,

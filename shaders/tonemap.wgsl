@@ -1,6 +1,8 @@
 // Display pass: exposure, tone mapping and (for non-sRGB targets) encoding,
 // from the accumulation target onto the window or an offscreen image.
 
+#import shaders/fullscreen.wgsl
+
 struct DisplayUniform {
     // 2^exposure: the manual exposure, or with auto exposure the
     // compensation applied on top of the metered scale.

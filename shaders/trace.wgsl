@@ -8,6 +8,27 @@
 // storage textures). Which one runs faster depends on the adapter
 // (gpu/kernel.rs); both give the same image.
 
+#import shaders/common.wgsl
+#import shaders/scene.wgsl
+#import shaders/textures.wgsl
+#import shaders/intersect.wgsl
+#import shaders/random.wgsl
+#import crates/core/src/bsdf.wgsl
+#import shaders/surface.wgsl
+#import shaders/env_lookup.wgsl
+#import crates/core/src/mis.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import crates/core/src/geometry/ray_offset.wgsl
+#import shaders/fullscreen.wgsl
+#import shaders/accumulation.wgsl
+#import shaders/view.wgsl
+#if POINT_LIGHT || AREA_LIGHT
+#import crates/core/src/lights.wgsl
+#endif
+#if ENV_SAMPLING
+#import crates/core/src/env_sampling.wgsl
+#endif
+
 @group(0) @binding(5) var previous: texture_2d<f32>;
 @group(0) @binding(16) var previous_spread: texture_2d<f32>;
 @group(0) @binding(18) var previous_compensation: texture_2d<f32>;

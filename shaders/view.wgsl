@@ -5,6 +5,9 @@
 // value in [0, 1] averaged over the pixel's jittered samples like the
 // radiance, and shown unexposed and clamped (RenderSettings::shown_display).
 
+#import shaders/scene.wgsl
+#import shaders/intersect.wgsl
+
 const VIEW_LIT: u32 = 0u;
 const VIEW_HIT_MASK: u32 = 1u;
 const VIEW_PRIMITIVE: u32 = 2u;

@@ -6,6 +6,9 @@
 // after 65535 passes in all (llvmpipe's guard against hangs), which would
 // silently stop a stream there.
 
+#import crates/core/src/noise/hash.wgsl
+#import shaders/accumulation.wgsl
+
 struct AccumulationHarness {
     // The chunk: frames first_frame .. first_frame + frames.
     first_frame: u32,

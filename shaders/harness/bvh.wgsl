@@ -1,6 +1,8 @@
 // Compute harness: sends rays through the mesh functions of accel/traverse.wgsl, for
 // the parity and watertightness tests and `marbre bench-bvh`.
 
+#import crates/core/src/accel/traverse.wgsl
+
 struct BvhHarnessUniform {
     count: u32,
     row_pitch: u32, // invocations per row of workgroups (dispatches past 65535 groups)
@@ -12,8 +14,6 @@ struct HarnessRay {
     origin: vec4f,    // w: t_max
     direction: vec4f, // w unused
 }
-
-const NO_HIT: f32 = 3.0e38;
 
 @group(0) @binding(0) var<uniform> harness: BvhHarnessUniform;
 @group(0) @binding(1) var<storage, read> rays: array<HarnessRay>;

@@ -13,6 +13,11 @@
 //           → xyz = the shading normal; the next slot the bumped normal
 //             before the facing fallback
 
+#import crates/core/src/texture/shading.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import crates/core/src/geometry/ray_offset.wgsl
+#import crates/core/src/texture/bump.wgsl
+
 const QUERY_POINTS: u32 = 5u;
 
 struct GeometryHarness {

@@ -1,6 +1,10 @@
 // Compute harness: evaluates the same WGSL noise and mapping functions the
 // renderer uses at a list of points, for `marbre noise` and the parity tests.
 
+#import shaders/common.wgsl
+#import crates/core/src/noise/fractal.wgsl
+#import crates/core/src/envmap.wgsl
+
 struct NoiseHarness {
     noise: NoiseParams,
     mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged,

@@ -3,6 +3,15 @@
 // CPU, so tests can feed the shader's own samples and densities to the
 // chi² test and compare them with the CPU twins (sampling.rs).
 
+#import shaders/common.wgsl
+#import crates/core/src/noise/hash.wgsl
+#import shaders/random.wgsl
+#import crates/core/src/envmap.wgsl
+#import crates/core/src/bsdf.wgsl
+#import shaders/env_lookup.wgsl
+#import crates/core/src/mis.wgsl
+#import crates/core/src/env_sampling.wgsl
+
 // The fields of the trace pass's Frame these files read, then the
 // harness's own: what to run and the surface the BSDF modes use.
 struct SamplingFrame {

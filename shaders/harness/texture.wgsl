@@ -3,6 +3,13 @@
 // of points, for the GPU parity tests.
 // 2D patterns read uv from the point's x and y.
 
+#import shaders/common.wgsl
+#import crates/core/src/noise/fractal.wgsl
+#import crates/core/src/texture/patterns.wgsl
+#import crates/core/src/texture/shading.wgsl
+#import crates/core/src/texture/mapping.wgsl
+#import crates/core/src/texture/image.wgsl
+
 // The functions the harness runs: `Mode` in texture.rs, value for value.
 const MODE_CHECKER_2D: u32 = 0u;
 const MODE_CHECKER_3D: u32 = 1u;

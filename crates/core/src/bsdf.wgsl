@@ -5,6 +5,9 @@
 // the surface these functions read is built by surface_at (surface.wgsl),
 // so this file needs nothing of the scene and the sampling harness runs it.
 
+#import shaders/common.wgsl
+#import shaders/random.wgsl
+
 struct SurfacePoint {
     // The shading normal: the geometric one, tilted by the bump texture.
     n: vec3f,

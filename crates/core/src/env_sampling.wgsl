@@ -3,6 +3,9 @@
 // (height + 1 values) then one CDF per row over its columns (width + 1
 // values each), over the image's texel uv (row 0 at the top).
 
+#import shaders/common.wgsl
+#import crates/core/src/envmap.wgsl
+
 @group(0) @binding(11) var<storage, read> env_distribution: array<f32>;
 
 // The cell i of cdf[offset .. offset + count + 1] with cdf[i] <= x < cdf[i + 1]

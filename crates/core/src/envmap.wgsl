@@ -3,6 +3,8 @@
 // v is taken as atan2(|xz|, -y) / π, the same angle, because acos of a y
 // near ±1 (which rounds in steps of 6e-8) loses θ's digits at the poles.
 
+#import shaders/common.wgsl
+
 fn env_uv(d: vec3f) -> vec2f {
     // atan2(0, 0) is undefined: at the poles every u is the same texel row.
     var u = 0.5;

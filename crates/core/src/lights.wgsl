@@ -5,6 +5,16 @@
 // (as OBJ scenes and Mitsuba expect); spheres, like every analytic
 // primitive, on both, so a closed emissive sphere lights its inside.
 
+#import shaders/common.wgsl
+#import crates/core/src/noise/hash.wgsl
+#import shaders/random.wgsl
+#if AREA_LIGHT
+#import crates/core/src/bsdf.wgsl
+#import crates/core/src/geometry/sphere.wgsl
+#import crates/core/src/texture/mapping.wgsl
+#import shaders/intersect.wgsl
+#endif
+
 // The chance of choosing light `index` (Rust: LightTable::pmf).
 fn light_pmf(index: u32) -> f32 {
     if frame.light_selection == 0u {

@@ -4,6 +4,8 @@
 // weight pair sums to one wherever both estimators can produce a sample,
 // so every setting is unbiased.
 
+#import shaders/common.wgsl
+
 const STRATEGY_LIGHT: u32 = 0u;
 const STRATEGY_BSDF: u32 = 1u;
 const STRATEGY_MIS_BALANCE: u32 = 2u;

@@ -31,6 +31,8 @@
 // down the tree reads 14 components (two child boxes, then the next node's
 // a and count), a triangle 9.
 
+#import crates/core/src/geometry/sphere.wgsl
+
 struct BvhNode {
     min: vec3f,
     a: u32,       // leaf: first triangle; interior: left child (right is a + 1)

@@ -1,5 +1,13 @@
 // Fractal sums; twin of fractal.rs.
 
+#import crates/core/src/noise/hash.wgsl
+#if NOISE_GRADIENT
+#import crates/core/src/noise/gradient.wgsl
+#endif
+#if NOISE_PERLIN
+#import crates/core/src/noise/perlin.wgsl
+#endif
+
 struct NoiseParams {
     kind: u32,        // 0 gradient, 1 Perlin
     // Gradient noise: 0 pcg3d, 1 sin, 2 pcg3d tiled every 256 cells.

@@ -1,5 +1,7 @@
 // The lab's gradient noise; twin of gradient.rs.
 
+#import crates/core/src/noise/hash.wgsl
+
 fn corner_gradient(cell: vec3i, hash: u32) -> vec3f {
 #if HASH_SIN
     if hash == 1u {

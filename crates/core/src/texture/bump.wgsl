@@ -12,6 +12,8 @@
 // Mitsuba; Schüßler et al. 2017 discuss the energy this costs). Where even
 // the bent normal is unusable (a non-finite input), `n_g` serves.
 
+#import shaders/common.wgsl
+
 const FACING_MIN_COS: f32 = 0.01;
 
 fn facing_shading_normal(n_s: vec3f, n_g: vec3f, wo: vec3f) -> vec3f {

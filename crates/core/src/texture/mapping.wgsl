@@ -2,6 +2,9 @@
 // Needs env_uv (envmap.wgsl): a sphere's (u, v) is the lab's lat-long
 // mapping of the direction from its centre.
 
+#import shaders/common.wgsl
+#import crates/core/src/envmap.wgsl
+
 fn sphere_uv(offset: vec3f) -> vec2f {
     let len2 = dot(offset, offset);
     let d = select(vec3f(0.0, -1.0, 0.0), offset * inverseSqrt(len2), len2 > 0.0);

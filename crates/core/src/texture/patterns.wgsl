@@ -4,6 +4,9 @@
 // falls (which child, which cell-local point). Each pattern is compiled in
 // only when the scene uses it (its PATTERN_* feature).
 
+#import shaders/common.wgsl
+#import crates/core/src/noise/fractal.wgsl
+
 // Where a 2D point falls in a board of cells: `select` 0 for the first
 // child, 1 for the second, and the point in the cell's own [0, 1)² space.
 struct Cell {

@@ -1,6 +1,8 @@
 // The texture library's shading helpers: normal perturbation by a height
 // gradient, and colour ramps; twin of crates/core/src/texture/{waves,bump,ramp}.rs.
 
+#import shaders/common.wgsl
+
 fn waves_gradient(uv: vec2f, frequency: f32, amplitude: f32, direction: vec2f) -> vec2f {
     let phase = TWO_PI * frequency * dot(direction, uv);
     return amplitude * TWO_PI * frequency * cos(phase) * direction;

@@ -1,9 +1,12 @@
 //! Assembles a WGSL module for one program and one [`FeatureSet`] from the
 //! WGSL files, each kept beside its CPU twin (`marbre_core::noise::perlin`
 //! and `perlin.wgsl`, …) or, for the renderer's own passes, in
-//! `shaders/`.
+//! `shaders/`. A program names its root file (its entry points); every file
+//! says what it needs with `#import` lines ([`preprocess`]), so the table
+//! below only registers files and the module is the root's imports,
+//! followed depth first.
 
-use crate::gpu::features::{Feature, FeatureSet};
+use crate::gpu::features::FeatureSet;
 use crate::gpu::preprocess::{PreprocessError, preprocess};
 
 /// The renderer's own WGSL, in the repository's `shaders/`: the trace and
@@ -153,112 +156,76 @@ impl Program {
         Program::Swatch,
     ];
 
-    /// The files this program is made of, in order, for a feature set.
-    fn files(self, features: &FeatureSet) -> Vec<WgslFile> {
-        let noise = |out: &mut Vec<WgslFile>| {
-            out.push(noise::hash::WGSL);
-            if features.contains(Feature::NoiseGradient) {
-                out.push(noise::gradient::WGSL);
-            }
-            if features.contains(Feature::NoisePerlin) {
-                out.push(noise::perlin::WGSL);
-            }
-            out.push(noise::fractal::WGSL);
-            out.push(envmap::WGSL);
-        };
-        // The scene and its generated texture code's library, which the
-        // trace, swatches and bakes all evaluate.
-        let texture_code = |out: &mut Vec<WgslFile>| {
-            noise(out);
-            out.extend([r::SCENE, texture::PATTERNS_WGSL, texture::mapping::WGSL]);
-            if features.contains(Feature::IMAGE) {
-                out.push(texture::image::WGSL);
-            }
-        };
-        let mut out = vec![r::COMMON];
+    /// The file holding this program's entry points; it and the files it
+    /// imports, transitively, make the program.
+    fn root(self) -> WgslFile {
         match self {
-            Program::Trace => {
-                texture_code(&mut out);
-                out.push(r::TEXTURES);
-                if features.contains(Feature::Mesh) {
-                    out.push(accel::traverse::WGSL);
-                }
-                out.extend([
-                    geometry::sphere::WGSL,
-                    geometry::ray_offset::WGSL,
-                    r::INTERSECT,
-                    r::RANDOM,
-                    bsdf::WGSL,
-                    r::SURFACE,
-                    r::ENV_LOOKUP,
-                    mis::WGSL,
-                ]);
-                if features.contains(Feature::PointLight) || features.contains(Feature::AreaLight) {
-                    out.push(lights::WGSL);
-                }
-                if features.contains(Feature::EnvSampling) {
-                    out.push(env_sampling::WGSL);
-                }
-                out.extend([r::FULLSCREEN, r::ACCUMULATION, r::VIEW, r::TRACE]);
-                if features.contains(Feature::Bump) {
-                    out.extend([texture::SHADING_WGSL, texture::bump::WGSL, r::BUMP_MAPPING]);
-                }
-            }
-            Program::Display => out = vec![r::FULLSCREEN, r::TONEMAP],
-            Program::AutoExposure => out.extend([r::METERING_GRID, r::AUTO_EXPOSURE]),
-            Program::ErrorMeter => out.extend([r::METERING_GRID, r::ERROR_METER]),
-            Program::Denoise => out.push(r::DENOISE),
-            Program::NoiseHarness => {
-                noise(&mut out);
-                out.push(r::HARNESS_NOISE);
-            }
-            Program::TextureHarness => {
-                noise(&mut out);
-                out.extend([
-                    texture::PATTERNS_WGSL,
-                    texture::SHADING_WGSL,
-                    texture::mapping::WGSL,
-                    texture::image::WGSL,
-                    r::HARNESS_TEXTURE,
-                ]);
-            }
-            Program::Swatch => {
-                texture_code(&mut out);
-                out.extend([r::TEXTURES, geometry::sphere::WGSL, r::INTERSECT, r::SWATCH]);
-            }
-            Program::BvhHarness => out.extend([accel::traverse::WGSL, r::HARNESS_BVH]),
-            Program::AccumulationHarness => {
-                out.extend([noise::hash::WGSL, r::ACCUMULATION, r::HARNESS_ACCUMULATION])
-            }
-            Program::GeometryHarness => out.extend([
-                texture::SHADING_WGSL,
-                geometry::sphere::WGSL,
-                geometry::ray_offset::WGSL,
-                texture::bump::WGSL,
-                r::HARNESS_GEOMETRY,
-            ]),
-            Program::SamplingHarness => out.extend([
-                noise::hash::WGSL,
-                r::RANDOM,
-                envmap::WGSL,
-                bsdf::WGSL,
-                r::ENV_LOOKUP,
-                mis::WGSL,
-                env_sampling::WGSL,
-                r::HARNESS_SAMPLING,
-            ]),
-            Program::Bake => {
-                texture_code(&mut out);
-                out.push(r::TEXTURES);
-                if features.contains(Feature::Mesh) {
-                    out.push(accel::traverse::WGSL);
-                }
-                // `Hit`, which textures.wgsl's footprint reads.
-                out.extend([geometry::sphere::WGSL, r::INTERSECT, r::BAKE]);
-            }
+            Program::Trace => r::TRACE,
+            Program::Display => r::TONEMAP,
+            Program::AutoExposure => r::AUTO_EXPOSURE,
+            Program::ErrorMeter => r::ERROR_METER,
+            Program::Denoise => r::DENOISE,
+            Program::NoiseHarness => r::HARNESS_NOISE,
+            Program::TextureHarness => r::HARNESS_TEXTURE,
+            Program::BvhHarness => r::HARNESS_BVH,
+            Program::AccumulationHarness => r::HARNESS_ACCUMULATION,
+            Program::GeometryHarness => r::HARNESS_GEOMETRY,
+            Program::SamplingHarness => r::HARNESS_SAMPLING,
+            Program::Bake => r::BAKE,
+            Program::Swatch => r::SWATCH,
         }
-        out
     }
+
+    /// Whether generated texture code completes this program (its root
+    /// calls what [`crate::gpu::texture_codegen`] writes).
+    fn takes_generated_textures(self) -> bool {
+        matches!(self, Program::Trace | Program::Bake | Program::Swatch)
+    }
+}
+
+/// The files `root` needs under `defines`, preprocessed: each import before
+/// the file importing it, depth first in the order the imports are written,
+/// each file once.
+fn files_from(
+    root: WgslFile,
+    defines: &std::collections::BTreeSet<&str>,
+) -> Result<Vec<(WgslFile, String)>, PreprocessError> {
+    fn visit(
+        file: WgslFile,
+        defines: &std::collections::BTreeSet<&str>,
+        open: &mut Vec<&'static str>,
+        done: &mut Vec<(WgslFile, String)>,
+    ) -> Result<(), PreprocessError> {
+        if done.iter().any(|(f, _)| f.name == file.name) {
+            return Ok(());
+        }
+        if let Some(at) = open.iter().position(|name| *name == file.name) {
+            let mut chain: Vec<String> = open[at..].iter().map(|n| n.to_string()).collect();
+            chain.push(file.name.to_owned());
+            return Err(PreprocessError::ImportCycle {
+                file: file.name.to_owned(),
+                chain,
+            });
+        }
+        let out = preprocess(&source_text(&file), file.name, defines)?;
+        open.push(file.name);
+        for (name, line) in &out.imports {
+            let Some(import) = SOURCES.iter().find(|f| f.name == name) else {
+                return Err(PreprocessError::UnknownImport {
+                    file: file.name.to_owned(),
+                    line: *line,
+                    name: name.clone(),
+                });
+            };
+            visit(*import, defines, open, done)?;
+        }
+        open.pop();
+        done.push((file, out.text));
+        Ok(())
+    }
+    let mut done = Vec::new();
+    visit(root, defines, &mut Vec::new(), &mut done)?;
+    Ok(done)
 }
 
 /// WGSL read from a folder at run time (`marbre --dev`), replacing the
@@ -330,13 +297,12 @@ pub fn assemble(
     features: &FeatureSet,
     generated_textures: &str,
 ) -> Result<String, PreprocessError> {
-    let defines = features.defines();
     let mut module = String::new();
-    for file in program.files(features) {
+    for (file, text) in files_from(program.root(), &features.defines())? {
         module.push_str(&format!("{SECTION_HEADER}{}\n", file.name));
-        module.push_str(&preprocess(&source_text(&file), file.name, &defines)?);
+        module.push_str(&text);
     }
-    if matches!(program, Program::Trace | Program::Bake | Program::Swatch) {
+    if program.takes_generated_textures() {
         module.push_str(&format!("{SECTION_HEADER}generated textures\n"));
         module.push_str(generated_textures);
     }
@@ -398,15 +364,132 @@ mod tests {
         names.sort();
         names.dedup();
         assert_eq!(names.len(), SOURCES.len(), "a file is listed twice");
+        let defines = FeatureSet::all().defines();
+        let mut reached = std::collections::BTreeSet::new();
         for program in Program::ALL {
-            for file in program.files(&FeatureSet::all()) {
-                assert!(
-                    SOURCES.contains(&file),
-                    "{program:?} uses {} unlisted",
-                    file.name
-                );
+            for (file, _) in files_from(program.root(), &defines).unwrap() {
+                reached.insert(file.name);
             }
         }
+        for file in SOURCES {
+            assert!(
+                reached.contains(file.name),
+                "{} is imported by no program",
+                file.name
+            );
+        }
+    }
+
+    /// The module of `program` from its files but `skip`.
+    fn module_without(
+        program: Program,
+        features: &FeatureSet,
+        generated: &str,
+        skip: &str,
+    ) -> String {
+        let mut module = String::new();
+        for (file, text) in files_from(program.root(), &features.defines()).unwrap() {
+            if file.name != skip {
+                module.push_str(&text);
+            }
+        }
+        if program.takes_generated_textures() {
+            module.push_str(generated);
+        }
+        module
+    }
+
+    /// Texture code that calls every pattern of the table, the image one
+    /// reading a (missing, so placeholder) image: the surface textures of a
+    /// scene with a sphere per pattern, or the swatches of those textures.
+    fn every_pattern_texture_code(program: Program) -> String {
+        use marbre_core::scene::{Pattern, PatternKind, Scene, Sphere, Texture};
+        use marbre_core::texture::ImageSource;
+        let textures: Vec<Texture> = PatternKind::all()
+            .map(|kind| Texture {
+                image: (kind == PatternKind::Image).then(|| ImageSource {
+                    path: "missing.png".into(),
+                    color_space: Default::default(),
+                }),
+                ..Texture::blend(Pattern::fresh(kind, None), 0.0, 1.0)
+            })
+            .collect();
+        let scene = Scene {
+            spheres: textures
+                .iter()
+                .map(|texture| {
+                    let mut sphere = Sphere::default();
+                    sphere.material.diffuse = texture.clone();
+                    sphere
+                })
+                .collect(),
+            ..Scene::default()
+        };
+        let images = crate::session::load_images(&scene, &mut Vec::new()).unwrap();
+        let code = match program {
+            Program::Swatch => crate::gpu::texture_codegen::generate_swatches(&textures, &images),
+            _ => crate::gpu::texture_codegen::generate(&scene, &images),
+        };
+        code.unwrap().wgsl
+    }
+
+    /// The imports are what each program needs, no less and no more: with
+    /// every feature on and texture code that calls every pattern, each
+    /// program validates, and leaving out any file but one holding entry
+    /// points (the root, or `fullscreen.wgsl`'s vertex stage, which the
+    /// pipeline names from Rust) breaks it: something left refers to what
+    /// the file declares.
+    #[test]
+    fn every_program_takes_the_files_it_needs_and_no_other() {
+        let features = FeatureSet::all();
+        let mut unneeded = Vec::new();
+        for program in Program::ALL {
+            let generated = every_pattern_texture_code(program);
+            let whole = module_without(program, &features, &generated, "");
+            if let Err(e) = crate::gpu::pipelines::validate(&whole) {
+                panic!("{program:?} is invalid:\n{e}");
+            }
+            for (file, text) in files_from(program.root(), &features.defines()).unwrap() {
+                if ["@vertex", "@fragment", "@compute"]
+                    .iter()
+                    .any(|stage| text.contains(stage))
+                {
+                    continue;
+                }
+                let without = module_without(program, &features, &generated, file.name);
+                if crate::gpu::pipelines::validate(&without).is_ok() {
+                    unneeded.push(format!("{program:?}: {}", file.name));
+                }
+            }
+        }
+        assert!(
+            unneeded.is_empty(),
+            "these validate without the file, so nothing needs it:\n{}",
+            unneeded.join("\n")
+        );
+    }
+
+    #[test]
+    fn an_unknown_import_and_a_cycle_are_named() {
+        let defines = Default::default();
+        let missing = WgslFile {
+            name: "shaders/missing_import.wgsl",
+            source_path: "",
+            text: "fn f() {}\n#import shaders/nowhere.wgsl\n",
+        };
+        assert_eq!(
+            files_from(missing, &defines).unwrap_err().to_string(),
+            "shaders/missing_import.wgsl:2: `#import shaders/nowhere.wgsl` names no WGSL file marbre has"
+        );
+        let looping = WgslFile {
+            name: "shaders/common.wgsl",
+            source_path: "",
+            text: "#import shaders/fullscreen.wgsl\n#import shaders/common.wgsl\n",
+        };
+        assert!(matches!(
+            files_from(looping, &defines),
+            Err(PreprocessError::ImportCycle { .. })
+        ));
     }
 
     #[test]
