@@ -8,6 +8,7 @@
 
 use crate::panel::swatches::{SharedSwatchBook, SwatchRequest, install};
 use anyhow::Result;
+use marbre_core::scene::{Change, Scene};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::swatch::{MAX_BATCH, SWATCH_SIZE, SwatchPixels, SwatchRenderer, to_srgba8};
 use marbre_render::worker::{Worker, names};
@@ -31,11 +32,14 @@ pub struct Swatches {
     worker: Option<Worker>,
     finished: Receiver<Finished>,
     in_flight: bool,
+    /// Changes the scene went through outside a frame's edits (a preset
+    /// loaded, an undo), for the next [`Swatches::after_frame`].
+    pending: Change,
     /// Set by `MARBRE_SWATCH_TIMES=1`: each batch's time is printed, and at
-    /// the end the UI thread's time in [`Swatches::after_ui`] per frame
+    /// the end the UI thread's time in [`Swatches::after_frame`] per frame
     /// (docs/PERFORMANCE.md's numbers).
     print_times: bool,
-    /// The UI thread's seconds in `after_ui`, and its calls.
+    /// The UI thread's seconds in `after_frame`, and its calls.
     ui_time: (f64, u64),
 }
 
@@ -98,22 +102,42 @@ impl Swatches {
             finished,
             in_flight: false,
             print_times: std::env::var_os("MARBRE_SWATCH_TIMES").is_some(),
+            pending: Change::empty(),
             ui_time: (0.0, 0),
         }
     }
 
-    /// After the panels ran: uploads a finished batch's swatches, sends the
-    /// next nodes that changed if no batch is rendering, and ends the
-    /// book's frame. Returns an error to show, if a batch failed.
-    pub fn after_ui(&mut self, egui_ctx: &egui::Context) -> Option<String> {
+    /// Notes a change made outside a frame's edits (a preset loaded, an
+    /// undo): the next frame's change does not hold it.
+    pub fn note(&mut self, change: Change) {
+        self.pending |= change;
+    }
+
+    /// After the frame's edits, with what they changed: uploads a finished
+    /// batch's swatches, lets the book read the subtrees `change` may have
+    /// altered, sends the next nodes that changed if no batch is rendering,
+    /// and ends the book's frame. Returns an error to show, if a batch
+    /// failed.
+    pub fn after_frame(
+        &mut self,
+        egui_ctx: &egui::Context,
+        scene: &Scene,
+        change: Change,
+    ) -> Option<String> {
         let start = Instant::now();
-        let error = self.exchange(egui_ctx);
+        let change = change | std::mem::replace(&mut self.pending, Change::empty());
+        let error = self.exchange(egui_ctx, scene, change);
         self.ui_time.0 += start.elapsed().as_secs_f64();
         self.ui_time.1 += 1;
         error
     }
 
-    fn exchange(&mut self, egui_ctx: &egui::Context) -> Option<String> {
+    fn exchange(
+        &mut self,
+        egui_ctx: &egui::Context,
+        scene: &Scene,
+        change: Change,
+    ) -> Option<String> {
         let mut error = None;
         match self.finished.try_recv() {
             Ok(done) => {
@@ -126,6 +150,7 @@ impl Swatches {
         let Ok(mut book) = self.book.lock() else {
             return error;
         };
+        book.observe(scene, change);
         if !self.in_flight
             && let Some(jobs) = &self.jobs
         {
@@ -163,7 +188,7 @@ impl Swatches {
                 .collect();
             let image = egui::ColorImage::from_rgba_unmultiplied([SWATCH_SIZE, SWATCH_SIZE], &rgba);
             let handle = egui_ctx.load_texture("swatch", image, egui::TextureOptions::LINEAR);
-            book.deliver(request.id, handle);
+            book.deliver(&request.place, handle);
         }
         egui_ctx.request_repaint();
         None

@@ -1,7 +1,7 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
-use super::swatches;
+use super::swatches::{self, SwatchPlace};
 use super::tx_ui::{has_tx_section, tx_ui};
 use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
@@ -9,6 +9,8 @@ use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
 use marbre_core::bake::BakeProperty;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
+use marbre_core::scene::MaterialKey;
+use marbre_core::scene::texture_graph::{NodePath, Root, Socket};
 use marbre_core::scene::{
     Child, Layer, MappingSpace, Material, MathOp, PATTERNS, Pattern, PatternKind, Property,
     Texture, TextureMapping, UvFrame,
@@ -21,11 +23,22 @@ use std::path::PathBuf;
 
 /// Every property's texture, the bump, the emission strength and layers;
 /// returns the property whose Bake… button was pressed.
-pub fn material_ui(ui: &mut Ui, m: &mut Material) -> Option<BakeProperty> {
+pub fn material_ui(ui: &mut Ui, key: MaterialKey, m: &mut Material) -> Option<BakeProperty> {
     let mut bake = None;
+    let place = |root| SwatchPlace {
+        key,
+        path: NodePath::root(root),
+    };
     for property in Property::ALL {
         let (kind, hint) = property_ui_info(property);
-        texture_ui(ui, property.label(), hint, m.texture_mut(property), kind, 1);
+        texture_ui(
+            ui,
+            property.label(),
+            hint,
+            m.texture_mut(property),
+            kind,
+            &place(Root::Property(property)),
+        );
         let bakeable = BakeProperty::ALL
             .into_iter()
             .find(|b| b.material_property() == Some(property));
@@ -51,7 +64,7 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) -> Option<BakeProperty> {
         "A height field that tilts the shading normal (tiles with a bevel, waves, noise)",
         &mut m.bump,
         ValueKind::Scalar,
-        1,
+        &place(Root::Bump),
     );
     bake = bake.or(Some(BakeProperty::Bump).filter(|&b| bake_button(ui, b)));
     ui.add(typed_beyond(slider(
@@ -63,7 +76,7 @@ pub fn material_ui(ui: &mut Ui, m: &mut Material) -> Option<BakeProperty> {
         "Height in scene units of a bump value of 1; 0 turns the bump off (drag within ±0.5, \
          or type any value: a steep bump bends shading normals away, and marbre falls back)",
     );
-    layers_ui(ui, &mut m.layers);
+    layers_ui(ui, key, &mut m.layers);
     bake
 }
 
@@ -119,7 +132,11 @@ fn property_ui_info(property: Property) -> (ValueKind, &'static str) {
 
 /// The material's layers, each over everything before it: a mask and the
 /// properties it sets.
-fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
+fn layers_ui(ui: &mut Ui, key: MaterialKey, layers: &mut Vec<Layer>) {
+    let place = |root| SwatchPlace {
+        key,
+        path: NodePath::root(root),
+    };
     let mut remove = None;
     for (i, layer) in layers.iter_mut().enumerate() {
         ui.push_id(("layer", i), |ui| {
@@ -143,7 +160,7 @@ fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
                         "Where the layer lies: 1 replaces what is below, 0 leaves it",
                         &mut layer.mask,
                         ValueKind::Scalar,
-                        1,
+                        &place(Root::Mask(i)),
                     );
                     for property in Property::ALL {
                         let (kind, hint) = property_ui_info(property);
@@ -160,7 +177,14 @@ fn layers_ui(ui: &mut Ui, layers: &mut Vec<Layer>) {
                             });
                         }
                         if let Some(texture) = slot {
-                            texture_ui(ui, property.label(), hint, texture, kind, 1);
+                            texture_ui(
+                                ui,
+                                property.label(),
+                                hint,
+                                texture,
+                                kind,
+                                &place(Root::Layer(i, property)),
+                            );
                         }
                     }
                 });
@@ -195,22 +219,22 @@ fn clipboard_id() -> egui::Id {
 }
 
 /// A texture: its pattern, then its two children (a constant pattern only
-/// uses the first), then its math steps. `depth` is 1 for a property's own
-/// texture. Right-click the header to copy, paste over or reset the subtree.
+/// uses the first), then its math steps. `place` is where it is in the
+/// scene (a property's own texture is a root). Right-click the header to copy, paste over or reset the subtree.
 fn texture_ui(
     ui: &mut Ui,
     title: &str,
     hint: &str,
     texture: &mut Texture,
     kind: ValueKind,
-    depth: usize,
+    place: &SwatchPlace,
 ) {
     ui.push_id(title, |ui| {
         let header = CollapsingHeader::new(title)
             .id_salt("texture")
-            .default_open(depth == 1)
+            .default_open(place.path.steps.is_empty())
             .show(ui, |ui| {
-                swatch_ui(ui, texture, kind);
+                swatch_ui(ui, texture, place);
                 pattern_ui(ui, texture);
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
@@ -226,7 +250,7 @@ fn texture_ui(
                         "How much of b: its first channel, 0 to 1",
                         factor,
                         ValueKind::Scalar,
-                        depth + 1,
+                        &place.child(Socket::Factor),
                     );
                 }
                 ramp_ui(ui, texture);
@@ -234,10 +258,22 @@ fn texture_ui(
                 let is_image = matches!(texture.pattern, Pattern::Image { .. });
                 if texture.ramp.is_empty() && !is_image {
                     if texture.pattern == Pattern::Constant {
-                        child_ui(ui, "value", &mut texture.a, kind, depth);
+                        child_ui(ui, "value", &mut texture.a, kind, &place.child(Socket::A));
                     } else {
-                        child_ui(ui, "a (t = 0)", &mut texture.a, kind, depth);
-                        child_ui(ui, "b (t = 1)", &mut texture.b, kind, depth);
+                        child_ui(
+                            ui,
+                            "a (t = 0)",
+                            &mut texture.a,
+                            kind,
+                            &place.child(Socket::A),
+                        );
+                        child_ui(
+                            ui,
+                            "b (t = 1)",
+                            &mut texture.b,
+                            kind,
+                            &place.child(Socket::B),
+                        );
                     }
                 }
                 math_ui(ui, &mut texture.ops);
@@ -288,12 +324,11 @@ const SWATCH_POINTS: f32 = 48.0;
 
 /// The node's preview swatch, its output on a unit sphere, once the viewer
 /// has rendered it; none for a constant, whose value shows as it is.
-fn swatch_ui(ui: &mut Ui, texture: &Texture, kind: ValueKind) {
+fn swatch_ui(ui: &mut Ui, texture: &Texture, place: &SwatchPlace) {
     if texture.as_constant().is_some() {
         return;
     }
-    let scalar = kind == ValueKind::Scalar;
-    if let Some(id) = swatches::swatch(ui.ctx(), ui.scope_id(), texture, scalar) {
+    if let Some(id) = swatches::swatch(ui.ctx(), place.clone()) {
         ui.add(egui::Image::new((id, egui::Vec2::splat(SWATCH_POINTS))))
             .on_hover_text(
                 "This node's output on the front of a unit sphere, point sampled (image nodes \
@@ -543,11 +578,13 @@ pub(super) fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
 /// One side of a blend: its value, or (ticked "texture") a nested texture
 /// edited in place. Unticking keeps the nested texture's colour at the
 /// origin as the value.
-fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth: usize) {
+/// A child of a texture, at `place` (its socket's path).
+fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, place: &SwatchPlace) {
     ui.push_id(label, |ui| {
         ui.horizontal(|ui| {
             let mut nested = matches!(child, Child::Texture(_));
-            let can_nest = depth < Texture::MAX_DEPTH;
+            // The holder's depth (1 for a root) is the sockets down to here.
+            let can_nest = place.path.steps.len() < Texture::MAX_DEPTH;
             if (can_nest || nested)
                 && ui
                     .checkbox(&mut nested, "texture")
@@ -590,7 +627,7 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, depth:
             }
         });
         if let Child::Texture(t) = child {
-            texture_ui(ui, label, "A nested texture", t, kind, depth + 1);
+            texture_ui(ui, label, "A nested texture", t, kind, place);
         }
     });
 }

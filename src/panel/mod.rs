@@ -269,9 +269,14 @@ pub fn draw(
         });
     // The graph's nodes show the same preview swatches as the tree's.
     let ctx = ui.ctx().clone();
-    let swatch = |key: MaterialKey, path: &NodePath, texture: &Texture| {
-        let id = egui::Id::NULL.with(("node graph swatch", key.to_string(), path.to_string()));
-        swatches::swatch(&ctx, id, texture, !path.is_color())
+    let swatch = |key: MaterialKey, path: &NodePath, _: &Texture| {
+        swatches::swatch(
+            &ctx,
+            swatches::SwatchPlace {
+                key,
+                path: path.clone(),
+            },
+        )
     };
     node_graph::window(ui.ctx(), scene, &mut state.node_graph, &swatch);
     actions
@@ -439,12 +444,16 @@ mod tests {
         swatches::install(&ctx, book.clone());
         let draw_once = |scene: &mut Scene| {
             ctx.run_ui(egui::RawInput::default(), |ui| {
-                egui::CentralPanel::default()
-                    .show(ui, |ui| material_ui(ui, &mut scene.spheres[0].material));
+                egui::CentralPanel::default().show(ui, |ui| {
+                    material_ui(ui, MaterialKey::Sphere(0), &mut scene.spheres[0].material)
+                });
             })
             .drop_without_applying_deltas();
         };
         draw_once(&mut scene);
+        book.lock()
+            .unwrap()
+            .observe(&scene, marbre_core::scene::Change::empty());
         let asked = book.lock().unwrap().take_requests(64);
         assert!(
             !asked.is_empty(),
@@ -452,9 +461,12 @@ mod tests {
         );
         for request in &asked {
             let image = ctx.load_texture("s", egui::ColorImage::example(), Default::default());
-            book.lock().unwrap().deliver(request.id, image);
+            book.lock().unwrap().deliver(&request.place, image);
         }
         draw_once(&mut scene);
+        book.lock()
+            .unwrap()
+            .observe(&scene, marbre_core::scene::Change::empty());
         assert_eq!(book.lock().unwrap().shown(), asked.len());
         assert!(book.lock().unwrap().take_requests(64).is_empty());
         assert_eq!(scene, before);
@@ -487,10 +499,14 @@ mod tests {
             let before = scene.clone();
             let mut actions = Vec::new();
             frame(|ui| {
-                for s in &mut scene.spheres {
-                    material_ui(ui, &mut s.material);
+                for (i, s) in scene.spheres.iter_mut().enumerate() {
+                    material_ui(ui, MaterialKey::Sphere(i), &mut s.material);
                 }
-                material_ui(ui, &mut scene.ground.as_mut().unwrap().material);
+                material_ui(
+                    ui,
+                    MaterialKey::Ground,
+                    &mut scene.ground.as_mut().unwrap().material,
+                );
                 environment_ui(ui, &mut scene.environment, &mut state, &mut actions);
                 point_light_ui(ui, &mut scene.point_light);
                 camera_ui(ui, &mut scene, &mut actions);

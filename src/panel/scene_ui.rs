@@ -38,7 +38,7 @@ pub(super) fn materials_ui(
             format!("sphere “{}”", sphere.name),
             &mut |ui| {
                 node_graph::toggle(ui, graph, MaterialKey::Sphere(i));
-                let pressed = material_ui(ui, &mut sphere.material);
+                let pressed = material_ui(ui, MaterialKey::Sphere(i), &mut sphere.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Sphere(i), p)));
             },
         );
@@ -63,7 +63,7 @@ pub(super) fn materials_ui(
                         "Along +y; the side's v runs from 0 at the base to 1 at the top",
                     );
                 node_graph::toggle(ui, graph, MaterialKey::Cylinder(i));
-                let pressed = material_ui(ui, &mut cylinder.material);
+                let pressed = material_ui(ui, MaterialKey::Cylinder(i), &mut cylinder.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Cylinder(i), p)));
             },
         );
@@ -75,7 +75,7 @@ pub(super) fn materials_ui(
             format!("polygon “{}”", polygon.name),
             &mut |ui| {
                 node_graph::toggle(ui, graph, MaterialKey::Polygon(i));
-                let pressed = material_ui(ui, &mut polygon.material);
+                let pressed = material_ui(ui, MaterialKey::Polygon(i), &mut polygon.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Polygon(i), p)));
             },
         );
@@ -92,7 +92,7 @@ pub(super) fn materials_ui(
                 default,
             );
             node_graph::toggle(ui, graph, MaterialKey::Ground);
-            let pressed = material_ui(ui, &mut ground.material);
+            let pressed = material_ui(ui, MaterialKey::Ground, &mut ground.material);
             bake = bake.or(pressed.map(|p| (ObjectRef::Ground, p)));
         });
     }
@@ -152,7 +152,7 @@ pub(super) fn mesh_ui(
                         material: k,
                     };
                     node_graph::toggle(ui, graph, key);
-                    bake = bake.or(material_ui(ui, &mut m.material));
+                    bake = bake.or(material_ui(ui, key, &mut m.material));
                 });
         });
     }

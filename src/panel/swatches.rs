@@ -1,15 +1,19 @@
 //! Preview swatches of texture nodes as the panels see them: a node asks
-//! for the swatch of its subtree while it is drawn and gets the latest one
-//! rendered (an earlier version's while an edit's renders), never waiting.
-//! The viewer (`app/swatches.rs`) renders what was asked on a worker thread
-//! and hands the images back. The book travels in egui's memory, so a view
-//! needs no GPU handle to ask, and without a viewer (tests) no swatch shows.
+//! for the swatch of its place (a material and a node path) while it is
+//! drawn and gets the latest one rendered (an earlier version's while an
+//! edit's renders), never waiting. The viewer (`app/swatches.rs`) hands
+//! the book each frame's [`Change`] with the scene: only when it touches
+//! the materials (or shifts which material a key names) are the asked
+//! places' subtrees read again, and those that changed are rendered on a
+//! worker thread. The book travels in egui's memory, so a view needs no GPU
+//! handle to ask, and without a viewer (tests) no swatch shows.
 //!
-//! The one call a view makes is [`swatch`]: the tree panel passes its
-//! node's header id; another view (the node graph) passes its own node ids.
+//! The one call a view makes is [`swatch`]: the tree panel and the node
+//! graph name the same place the same way, so they share a swatch.
 
 use egui::{Context, Id, TextureHandle, TextureId};
-use marbre_core::scene::Texture;
+use marbre_core::scene::texture_graph::{NodePath, Socket, texture_at};
+use marbre_core::scene::{Change, MaterialKey, Scene, Texture};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
@@ -17,11 +21,28 @@ use std::sync::{Arc, Mutex};
 /// before its swatch is dropped.
 const KEPT_UNASKED_FRAMES: u64 = 300;
 
+/// Where a swatch's subtree is: a material of the scene and a node in it.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SwatchPlace {
+    pub key: MaterialKey,
+    pub path: NodePath,
+}
+
+impl SwatchPlace {
+    /// The place of the input `socket` of the node here.
+    pub fn child(&self, socket: Socket) -> SwatchPlace {
+        SwatchPlace {
+            key: self.key,
+            path: self.path.child(socket),
+        }
+    }
+}
+
 /// What a swatch shows: a subtree, and whether its property is a scalar
 /// (shown as grey from the first channel, as the renderer reads it).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SwatchRequest {
-    pub id: Id,
+    pub place: SwatchPlace,
     pub texture: Texture,
     pub scalar: bool,
 }
@@ -32,15 +53,18 @@ pub type SharedSwatchBook = Arc<Mutex<SwatchBook>>;
 
 #[derive(Default)]
 pub struct SwatchBook {
-    nodes: HashMap<Id, Node>,
+    nodes: HashMap<SwatchPlace, Node>,
     frame: u64,
 }
 
 struct Node {
-    /// What the node shows now.
-    asked: (Texture, bool),
-    /// What was last handed to the viewer to render.
-    sent: Option<(Texture, bool)>,
+    /// The subtree at the place when the scene was last read; `None`
+    /// before the first reading or where the place no longer exists.
+    shows: Option<Texture>,
+    /// Whether the scene was read since the node was first asked for.
+    read: bool,
+    /// Whether `shows` changed since it was last sent to render.
+    unsent: bool,
     image: Option<TextureHandle>,
     last_asked: u64,
 }
@@ -54,50 +78,73 @@ pub fn install(ctx: &Context, book: SharedSwatchBook) {
     ctx.data_mut(|d| d.insert_temp(book_id(), book));
 }
 
-/// The swatch of node `id`, which shows `texture` (`scalar`: a scalar
-/// property's): the latest rendered, if any; the request is noted, and a
-/// changed subtree is rendered again. `None` without a viewer.
-pub fn swatch(ctx: &Context, id: Id, texture: &Texture, scalar: bool) -> Option<TextureId> {
+/// The swatch of the node at `place`: the latest rendered, if any. The
+/// request is noted; the book reads the subtree itself when it observes
+/// the scene. `None` without a viewer.
+pub fn swatch(ctx: &Context, place: SwatchPlace) -> Option<TextureId> {
     let book: SharedSwatchBook = ctx.data(|d| d.get_temp(book_id()))?;
     let mut book = book.lock().ok()?;
     let frame = book.frame;
-    let node = book.nodes.entry(id).or_insert_with(|| Node {
-        asked: (texture.clone(), scalar),
-        sent: None,
+    let node = book.nodes.entry(place).or_insert_with(|| Node {
+        shows: None,
+        read: false,
+        unsent: false,
         image: None,
         last_asked: frame,
     });
     node.last_asked = frame;
-    if node.asked.0 != *texture || node.asked.1 != scalar {
-        node.asked = (texture.clone(), scalar);
-    }
     node.image.as_ref().map(TextureHandle::id)
 }
 
 impl SwatchBook {
+    /// After the frame's edits, with what they changed (worked out once,
+    /// by the viewer): reads the subtree of each place asked for the first
+    /// time, and of every place when `change` touches a material or moves
+    /// the objects (a key may then name another material); a subtree that
+    /// differs from what the node shows is to be rendered.
+    pub fn observe(&mut self, scene: &Scene, change: Change) {
+        let materials_changed = change.intersects(
+            Change::MATERIAL_PARAMETERS | Change::MATERIAL_STRUCTURE | Change::GEOMETRY,
+        );
+        for (place, node) in &mut self.nodes {
+            if node.read && !materials_changed {
+                continue;
+            }
+            node.read = true;
+            let now = scene
+                .material(place.key)
+                .and_then(|material| texture_at(material, &place.path));
+            if now != node.shows.as_ref() {
+                node.shows = now.cloned();
+                node.unsent = node.shows.is_some();
+            }
+        }
+    }
+
     /// Up to `max` nodes whose subtree changed since it was last sent,
     /// marked sent.
     pub fn take_requests(&mut self, max: usize) -> Vec<SwatchRequest> {
         let mut out = Vec::new();
-        for (id, node) in &mut self.nodes {
+        for (place, node) in &mut self.nodes {
             if out.len() == max {
                 break;
             }
-            if node.sent.as_ref() != Some(&node.asked) {
-                node.sent = Some(node.asked.clone());
+            if let (true, Some(texture)) = (node.unsent, &node.shows) {
+                node.unsent = false;
                 out.push(SwatchRequest {
-                    id: *id,
-                    texture: node.asked.0.clone(),
-                    scalar: node.asked.1,
+                    place: place.clone(),
+                    texture: texture.clone(),
+                    scalar: !place.path.is_color(),
                 });
             }
         }
         out
     }
 
-    /// Node `id`'s new swatch (ignored if the node was dropped meanwhile).
-    pub fn deliver(&mut self, id: Id, image: TextureHandle) {
-        if let Some(node) = self.nodes.get_mut(&id) {
+    /// The new swatch of the node at `place` (ignored if the node was
+    /// dropped meanwhile).
+    pub fn deliver(&mut self, place: &SwatchPlace, image: TextureHandle) {
+        if let Some(node) = self.nodes.get_mut(place) {
             node.image = Some(image);
         }
     }
@@ -121,35 +168,62 @@ impl SwatchBook {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use marbre_core::scene::Pattern;
+    use marbre_core::scene::texture_graph::Root;
+    use marbre_core::scene::{Pattern, Property};
 
-    /// A node is sent once per version of its subtree; its swatch shows
-    /// once delivered, an edit keeps showing it while the new one renders,
-    /// and a node unasked long enough is dropped.
+    /// A node is read from the scene and sent once per version of its
+    /// subtree; a version the book is not told of (an empty change) is not
+    /// looked for; its swatch shows once delivered, an edit keeps showing
+    /// it while the new one renders, and a node unasked long enough is
+    /// dropped.
     #[test]
     fn a_node_is_rendered_once_per_version_and_dropped_when_unasked() {
         let ctx = Context::default();
         let book = SharedSwatchBook::default();
         install(&ctx, book.clone());
-        let id = Id::NULL.with("node");
-        let mut t = Texture::color(Vec3::splat(0.5)).with_pattern_contrasting(Pattern::fresh(
-            marbre_core::scene::PatternKind::Checker,
-            None,
-        ));
-        assert_eq!(swatch(&ctx, id, &t, false), None);
+        let mut sphere = marbre_core::scene::Sphere::default();
+        sphere.material.diffuse = Texture::color(Vec3::splat(0.5)).with_pattern_contrasting(
+            Pattern::fresh(marbre_core::scene::PatternKind::Checker, None),
+        );
+        let mut scene = Scene {
+            spheres: vec![sphere],
+            ..Scene::default()
+        };
+        let place = SwatchPlace {
+            key: MaterialKey::Sphere(0),
+            path: NodePath::root(Root::Property(Property::Diffuse)),
+        };
+        let diffuse = |scene: &Scene| scene.spheres[0].material.diffuse.clone();
+        assert_eq!(swatch(&ctx, place.clone()), None);
+        book.lock().unwrap().observe(&scene, Change::empty());
         let sent = book.lock().unwrap().take_requests(8);
         assert_eq!(sent.len(), 1);
-        assert_eq!(sent[0].texture, t);
+        assert_eq!(sent[0].texture, diffuse(&scene));
+        assert!(!sent[0].scalar);
         // Asked again unchanged: nothing more to render.
-        swatch(&ctx, id, &t, false);
+        swatch(&ctx, place.clone());
+        book.lock().unwrap().observe(&scene, Change::empty());
         assert!(book.lock().unwrap().take_requests(8).is_empty());
         let image = ctx.load_texture("s", egui::ColorImage::example(), Default::default());
-        book.lock().unwrap().deliver(id, image.clone());
-        assert_eq!(swatch(&ctx, id, &t, false), Some(image.id()));
-        // An edit: the old swatch shows until the new one arrives.
-        t.b = Vec3::ONE.into();
-        assert_eq!(swatch(&ctx, id, &t, false), Some(image.id()));
-        assert_eq!(book.lock().unwrap().take_requests(8)[0].texture, t);
+        book.lock().unwrap().deliver(&place, image.clone());
+        assert_eq!(swatch(&ctx, place.clone()), Some(image.id()));
+        // An edit: the old swatch shows until the new one arrives, and the
+        // book reads the subtree only when the change says a material moved.
+        scene.spheres[0].material.diffuse.b = Vec3::ONE.into();
+        assert_eq!(swatch(&ctx, place.clone()), Some(image.id()));
+        book.lock().unwrap().observe(&scene, Change::CAMERA);
+        assert!(book.lock().unwrap().take_requests(8).is_empty());
+        book.lock()
+            .unwrap()
+            .observe(&scene, Change::MATERIAL_PARAMETERS);
+        assert_eq!(
+            book.lock().unwrap().take_requests(8)[0].texture,
+            diffuse(&scene)
+        );
+        // The place gone (the sphere removed): nothing to render.
+        scene.spheres.clear();
+        book.lock().unwrap().observe(&scene, Change::GEOMETRY);
+        assert!(book.lock().unwrap().take_requests(8).is_empty());
         for _ in 0..=KEPT_UNASKED_FRAMES {
             book.lock().unwrap().end_frame();
         }

@@ -255,6 +255,7 @@ impl Viewer {
         self.scene = scene;
         self.edits.history.observe(&self.scene, change, false);
         self.edits.document.observe(&self.scene, change);
+        self.swatches.note(change);
         Ok(())
     }
 

@@ -162,6 +162,12 @@ impl Viewer {
             || self.egui_ctx.egui_wants_keyboard_input();
         self.edits.history.observe(&self.scene, change, gesture);
         self.edits.document.observe(&self.scene, change);
+        if let Some(error) = self
+            .swatches
+            .after_frame(&self.egui_ctx, &self.scene, change)
+        {
+            self.panel.error(error);
+        }
         // Only an edit can add an image or change a path.
         if change.edits_document() {
             self.reload_images_if_needed();

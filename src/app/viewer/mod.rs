@@ -666,7 +666,10 @@ impl Viewer {
                 // frame's change is the edits made after it, not the undo.
                 let change = scene.changes_from(self.renderer.requested_scene());
                 match self.renderer.request_scene(&self.ctx, &scene, change) {
-                    Ok(()) => self.scene = scene,
+                    Ok(()) => {
+                        self.scene = scene;
+                        self.swatches.note(change);
+                    }
                     Err(e) => self.panel.error(format!("{e:#}")),
                 }
             }
@@ -856,9 +859,6 @@ impl Viewer {
             }
         });
         self.show_help = show_help;
-        if let Some(error) = self.swatches.after_ui(&self.egui_ctx) {
-            self.panel.error(error);
-        }
         self.handle_actions(actions);
         self.handle_shortcuts(pressed);
         if let Some(answer) = answer {
