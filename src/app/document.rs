@@ -13,6 +13,7 @@
 //! imported file never saved; [`Document::save`] refuses to write a preset
 //! over an OBJ or MTL file whatever the route.
 
+use marbre_core::capped_read::{self, read_capped_to_string};
 use marbre_core::preset::{self, Header, Preset, PresetError};
 use marbre_core::scene::{Change, Scene};
 use std::path::{Path, PathBuf};
@@ -42,7 +43,7 @@ impl Document {
             path: path.to_owned(),
             header,
             saved: scene.clone(),
-            saved_text: std::fs::read_to_string(path).ok(),
+            saved_text: read_capped_to_string(path, capped_read::PRESET).ok(),
             unsaved: false,
         }
     }
@@ -116,7 +117,7 @@ impl Document {
     /// Whether the file on disk now differs from what this document last
     /// read or wrote there: an edit made outside the app.
     pub fn changed_on_disk(&self) -> bool {
-        std::fs::read_to_string(&self.path).ok() != self.saved_text
+        read_capped_to_string(&self.path, capped_read::PRESET).ok() != self.saved_text
     }
 }
 

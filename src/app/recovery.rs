@@ -12,6 +12,7 @@
 //! edits, and a file whose writer is still running is not offered.
 
 use marbre_core::atomic_write::write_atomic;
+use marbre_core::capped_read::{self, read_capped_to_string};
 use marbre_core::preset::{self, Preset};
 use marbre_core::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -110,7 +111,7 @@ pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
         .filter_map(|entry| info_file_pid(entry.ok()?.file_name().to_str()?))
         .filter(|&pid| !process_alive(pid))
         .filter_map(|pid| {
-            let text = std::fs::read_to_string(info_file(dir, pid)).ok()?;
+            let text = read_capped_to_string(&info_file(dir, pid), capped_read::SMALL_TEXT).ok()?;
             let info: RecoveryInfo = ron::from_str(&text).ok()?;
             let preset = preset_file(dir, pid);
             preset.exists().then(|| RecoveryOffer {

@@ -6,6 +6,7 @@
 //! the file (atomically, so a crash mid-save keeps the old one).
 
 use marbre_core::atomic_write::write_atomic;
+use marbre_core::capped_read::{self, read_capped_to_string};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -51,7 +52,7 @@ impl Settings {
     /// exists but cannot be used) otherwise.
     pub fn load(dir: &Path) -> (Settings, Option<String>) {
         let path = Self::file(dir);
-        let text = match std::fs::read_to_string(&path) {
+        let text = match read_capped_to_string(&path, capped_read::SMALL_TEXT) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 return (Settings::default(), None);

@@ -8,6 +8,7 @@ use crate::render::parse_size;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::Vec3;
+use marbre_core::capped_read::{self, read_capped_to_string};
 use marbre_core::image_io;
 use marbre_core::scene::{
     Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere, Texture,
@@ -73,7 +74,7 @@ pub fn run(args: &TxArgs) -> Result<()> {
 
 /// The parsed file; a syntax error names the file, the line and column.
 fn read(file: &Path) -> Result<tx::Document> {
-    let text = std::fs::read_to_string(file)
+    let text = read_capped_to_string(file, capped_read::TX)
         .with_context(|| format!("{}: cannot read", file.display()))?;
     tx::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))
 }
@@ -189,7 +190,7 @@ struct Entry {
 
 fn gallery(folder: &Path, out: &Path, markdown: &Path, size: (u32, u32), spp: u32) -> Result<()> {
     let index = folder.join("gallery.ron");
-    let text = std::fs::read_to_string(&index)
+    let text = read_capped_to_string(&index, capped_read::TX)
         .with_context(|| format!("{}: cannot read", index.display()))?;
     let entries: Vec<Entry> =
         ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", index.display()))?;
@@ -211,7 +212,7 @@ fn gallery(folder: &Path, out: &Path, markdown: &Path, size: (u32, u32), spp: u3
         let png = out.join(&stem);
         render(&ctx, &doc, &file, &png, size, spp)?;
         let link = pathdiff::diff_paths(&png, page_dir).unwrap_or(png.clone());
-        let source = std::fs::read_to_string(&file)?;
+        let source = read_capped_to_string(&file, capped_read::TX)?;
         page.push_str(&format!(
             "## {}\n\n![{}]({})\n\n{}\n\n```\n{}\n```\n\n",
             entry.title,

@@ -247,10 +247,13 @@ impl IntegerDecode {
 pub fn decode_file(path: &Path, decode: IntegerDecode) -> Result<DecodedImage, DecodeError> {
     // An unsupported type is refused before the file is read.
     supported_extension(path)?;
-    let bytes = std::fs::read(path).map_err(|cause| DecodeError::Io {
-        path: path.to_path_buf(),
-        cause,
-    })?;
+    let bytes =
+        crate::capped_read::read_capped(path, crate::capped_read::IMAGE).map_err(|cause| {
+            DecodeError::Io {
+                path: path.to_path_buf(),
+                cause,
+            }
+        })?;
     decode_bytes(&bytes, path, decode)
 }
 
@@ -875,6 +878,26 @@ mod tests {
     use super::*;
 
     use super::test_support::{assert_clean, close, shipped_map};
+
+    /// An image that is a device or a FIFO is refused by its file type,
+    /// not read until memory runs out or waited on forever.
+    #[test]
+    fn a_device_or_fifo_image_is_refused() {
+        use crate::capped_read::test_support::{make_fifo, within_10_s};
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe.png");
+        make_fifo(&fifo);
+        let zero = dir.path().join("zero.exr");
+        std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+        for path in [fifo, zero] {
+            let error = within_10_s(move || {
+                decode_file(&path, IntegerDecode::Srgb)
+                    .unwrap_err()
+                    .to_string()
+            });
+            assert!(error.contains("not a regular file"), "{error}");
+        }
+    }
 
     /// The texel at column `x`, row `y` (row 0 = top).
     fn texel_at(image: &DecodedImage, x: u32, y: u32) -> [f32; 4] {

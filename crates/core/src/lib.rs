@@ -7,6 +7,7 @@ pub mod accel;
 pub mod atomic_write;
 pub mod bake;
 pub mod bsdf;
+pub mod capped_read;
 pub mod cubemap;
 pub mod env_sampling;
 pub mod envmap;

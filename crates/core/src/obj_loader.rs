@@ -8,6 +8,7 @@
 //! paths are relative to the .mtl file; a missing one keeps the magenta
 //! placeholder of image textures and a note naming it.
 
+use crate::capped_read::{self, read_capped};
 use crate::obj_syntax;
 use crate::scene::mesh::{Geometry, MeshMaterial, TriangleMesh};
 use crate::scene::{Material, Pattern, Scene, Texture};
@@ -54,11 +55,13 @@ pub struct LoadedObj {
 const DEFAULT_MATERIAL: &str = "(default)";
 
 pub fn load(path: &Path) -> Result<LoadedObj, ObjError> {
-    let bytes = std::fs::read(path).map_err(|cause| ObjError::Read {
+    let bytes = read_capped(path, capped_read::OBJ).map_err(|cause| ObjError::Read {
         path: path.to_owned(),
         cause,
     })?;
-    parse_bytes(&bytes, path, |library| std::fs::read(library))
+    parse_bytes(&bytes, path, |library| {
+        read_capped(library, capped_read::MTL)
+    })
 }
 
 /// Reads the bytes of an OBJ file. `path` names it in messages, and its
@@ -393,6 +396,34 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), Obj
 mod tests {
     use super::*;
     use crate::scene::{Mesh, Property};
+
+    /// A library that is a device or a FIFO is refused (its note says why)
+    /// instead of read until memory runs out or blocked on forever; an OBJ
+    /// that is one is an error naming it.
+    #[test]
+    fn a_device_or_fifo_library_or_obj_is_refused_without_blocking() {
+        use crate::capped_read::test_support::{make_fifo, within_10_s};
+        let dir = tempfile::tempdir().unwrap();
+        make_fifo(&dir.path().join("pipe.mtl"));
+        std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.mtl")).unwrap();
+        for library in ["pipe.mtl", "zero.mtl"] {
+            let obj = write(&dir, "m.obj", &format!("mtllib {library}\n{QUAD}f 1 2 3\n"));
+            let notes = within_10_s(move || load(&obj).unwrap().notes);
+            assert!(
+                notes
+                    .iter()
+                    .any(|n| n.contains(library) && n.contains("not a regular file")),
+                "{library}: {notes:?}"
+            );
+        }
+        let fifo = dir.path().join("pipe.obj");
+        make_fifo(&fifo);
+        let error = within_10_s(move || load(&fifo).unwrap_err().to_string());
+        assert!(
+            error.contains("pipe.obj") && error.contains("it is a FIFO"),
+            "{error}"
+        );
+    }
 
     const CORNELL: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -219,10 +219,13 @@ fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> Pre
 
 /// Reads and parses a preset file.
 pub fn load(path: &Path) -> Result<Loaded, PresetError> {
-    let bytes = std::fs::read(path).map_err(|cause| PresetError::Read {
-        path: path.to_owned(),
-        cause,
-    })?;
+    let bytes =
+        crate::capped_read::read_capped(path, crate::capped_read::PRESET).map_err(|cause| {
+            PresetError::Read {
+                path: path.to_owned(),
+                cause,
+            }
+        })?;
     parse_bytes(&bytes, path)
 }
 
@@ -304,6 +307,23 @@ fn absolute(p: &Path) -> PathBuf {
 mod tests {
     use super::*;
     use crate::scene::EnvSource;
+
+    /// `/dev/zero` as a preset grew marbre to 24 GB; a FIFO blocked it.
+    #[test]
+    fn a_device_or_fifo_preset_is_refused_naming_it() {
+        use crate::capped_read::test_support::{make_fifo, within_10_s};
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe.ron");
+        make_fifo(&fifo);
+        for path in [std::path::PathBuf::from("/dev/zero"), fifo] {
+            let shown = path.display().to_string();
+            let error = within_10_s(move || load(&path).unwrap_err().to_string());
+            assert!(
+                error.contains(&shown) && error.contains("not a regular file"),
+                "{error}"
+            );
+        }
+    }
 
     #[test]
     fn round_trips_the_default_scene() {
