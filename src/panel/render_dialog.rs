@@ -97,6 +97,9 @@ impl RenderDialog {
             output,
             // As `marbre render`: an EXR is the raw accumulation.
             denoise_exr: false,
+            // The viewer shows the placeholder and its note: it renders
+            // what it shows.
+            allow_placeholders: true,
         })
     }
 

@@ -31,6 +31,11 @@ pub struct BakeArgs {
     /// mapping goes to <output>.mapping.ron.
     #[arg(short = 'o', long)]
     pub output: PathBuf,
+    /// Bake even if an image or material library the scene reads cannot
+    /// be loaded (a placeholder or grey is baked in its place); without it
+    /// the bake fails before it starts, naming the files.
+    #[arg(long)]
+    pub allow_placeholders: bool,
 }
 
 fn parse_property(s: &str) -> Result<BakeProperty, String> {
@@ -44,6 +49,9 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let loaded = load_scene(&args.preset, None)?;
     for note in &loaded.notes {
         eprintln!("note: {note}");
+    }
+    if !args.allow_placeholders {
+        marbre_render::final_render::refuse_substitutes(&loaded)?;
     }
     let object = ObjectRef::find(&loaded.scene, &args.object)
         .with_context(|| format!("{}", args.preset.display()))?;
@@ -143,6 +151,39 @@ mod tests {
             output.to_str().unwrap(),
         ])
         .unwrap()
+    }
+
+    /// A missing image texture fails the bake before it starts (no GPU
+    /// is needed to see it), naming the file, unless placeholders are
+    /// allowed; nothing is written.
+    #[test]
+    fn a_missing_image_fails_the_bake_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = preset(dir.path());
+        let mut loaded = marbre_core::preset::load(&path).unwrap().preset;
+        let missing = dir.path().join("missing.png");
+        loaded.scene.polygons[0].material.diffuse = Texture {
+            image: Some(marbre_core::texture::ImageSource {
+                path: missing.clone(),
+                color_space: Default::default(),
+            }),
+            ..Texture::blend(
+                Pattern::fresh(marbre_core::scene::PatternKind::Image, None),
+                0.0,
+                1.0,
+            )
+        };
+        save(&loaded, &path).unwrap();
+        let output = dir.path().join("diffuse.png");
+        let error = format!(
+            "{:#}",
+            run(&bake_args(&path, "diffuse", &output)).unwrap_err()
+        );
+        assert!(
+            error.contains(missing.to_str().unwrap()) && error.contains("--allow-placeholders"),
+            "{error}"
+        );
+        assert!(!output.exists());
     }
 
     fn read_exr(path: &Path) -> Vec<[f32; 4]> {

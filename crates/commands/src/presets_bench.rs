@@ -346,6 +346,7 @@ fn anti_aliasing_table(
             env: None,
             images: ImageSet::empty(),
             notes: Vec::new(),
+            substitutes: Vec::new(),
         };
         let (kernel, _) = pick_kernel(ctx, &loaded, size, choice)?;
         let mut renderer = Renderer::with_kernel(ctx, &point, None, size, kernel)?;

@@ -133,6 +133,7 @@ fn render(
         env: loaded.env.clone(),
         images: loaded.images.clone(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     };
     let mut renderer = renderer_for(ctx, &reference, size)?;
     accumulate(ctx, &mut renderer, spp, progress)?;

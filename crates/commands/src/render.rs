@@ -74,6 +74,11 @@ pub struct RenderArgs {
     /// noise for some blur).
     #[arg(long, requires = "denoise")]
     pub denoise_exr: bool,
+    /// Render even if an image or material library the scene reads cannot
+    /// be loaded (it shows as a magenta-and-black placeholder, or grey);
+    /// without it such a render fails before tracing, naming the files.
+    #[arg(long)]
+    pub allow_placeholders: bool,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -151,6 +156,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         kernel: args.kernel,
         output: args.output.clone(),
         denoise_exr: args.denoise_exr,
+        allow_placeholders: args.allow_placeholders,
     };
     let ctx = GpuContext::headless()?;
     let mut bar = Bar::new(spp, ctx.describe());

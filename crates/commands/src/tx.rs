@@ -14,6 +14,7 @@ use marbre_core::scene::{
     Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere, Texture,
 };
 use marbre_core::tx;
+use marbre_render::final_render::refuse_substitutes;
 use marbre_render::gpu::{GpuContext, Kernel};
 use marbre_render::session::{accumulate, prepare_scene, renderer_with};
 use serde::Deserialize;
@@ -42,6 +43,11 @@ pub struct TxArgs {
     /// The gallery's Markdown page (its images linked relative to it).
     #[arg(long, default_value = "docs/gallery.md")]
     pub markdown: PathBuf,
+    /// Render even if an image the text reads cannot be loaded (it shows
+    /// as a magenta-and-black placeholder); without it such a render
+    /// fails before tracing, naming the file.
+    #[arg(long)]
+    pub allow_placeholders: bool,
 }
 
 pub fn run(args: &TxArgs) -> Result<()> {
@@ -69,7 +75,12 @@ pub fn run(args: &TxArgs) -> Result<()> {
         .as_deref()
         .context("give -o OUT.png (or --print)")?;
     let ctx = GpuContext::headless()?;
-    render(&ctx, &doc, file, output, args.size, args.spp)
+    let preview = Preview {
+        size: args.size,
+        spp: args.spp,
+        allow_placeholders: args.allow_placeholders,
+    };
+    render(&ctx, &doc, file, output, &preview)
 }
 
 /// The parsed file; a syntax error names the file, the line and column.
@@ -155,14 +166,25 @@ pub fn preview_scene(doc: &tx::Document, base_dir: &Path) -> Result<Scene, tx::T
     Ok(scene)
 }
 
+/// How a TX text's preview is rendered.
+struct Preview {
+    size: (u32, u32),
+    spp: u32,
+    allow_placeholders: bool,
+}
+
 fn render(
     ctx: &GpuContext,
     doc: &tx::Document,
     file: &Path,
     output: &Path,
-    size: (u32, u32),
-    spp: u32,
+    preview: &Preview,
 ) -> Result<()> {
+    let Preview {
+        size,
+        spp,
+        allow_placeholders,
+    } = *preview;
     let base_dir = file.parent().unwrap_or(Path::new("."));
     let mut scene =
         preview_scene(doc, base_dir).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
@@ -170,6 +192,9 @@ fn render(
     let loaded = prepare_scene(scene, notes)?;
     for note in &loaded.notes {
         eprintln!("note: {}: {note}", file.display());
+    }
+    if !allow_placeholders {
+        refuse_substitutes(&loaded).with_context(|| file.display().to_string())?;
     }
     let mut renderer = renderer_with(ctx, &loaded, size, Kernel::Fragment)?;
     accumulate(ctx, &mut renderer, spp, |_| {})?;
@@ -210,7 +235,12 @@ fn gallery(folder: &Path, out: &Path, markdown: &Path, size: (u32, u32), spp: u3
         let doc = read(&file)?;
         let stem = Path::new(&entry.file).with_extension("png");
         let png = out.join(&stem);
-        render(&ctx, &doc, &file, &png, size, spp)?;
+        let preview = Preview {
+            size,
+            spp,
+            allow_placeholders: false,
+        };
+        render(&ctx, &doc, &file, &png, &preview)?;
         let link = pathdiff::diff_paths(&png, page_dir).unwrap_or(png.clone());
         let source = read_capped_to_string(&file, capped_read::TX)?;
         page.push_str(&format!(

@@ -49,6 +49,9 @@ pub struct LoadedObj {
     pub materials: Vec<MeshMaterial>,
     /// What was skipped or replaced, each naming the file.
     pub notes: Vec<String>,
+    /// The files that could not be read and were replaced (a material
+    /// library, by grey): a note says why.
+    pub substitutes: Vec<PathBuf>,
 }
 
 /// The material of faces the OBJ gives none, or whose MTL is unreadable.
@@ -97,17 +100,20 @@ pub fn parse_bytes(
         let text = match read_library(&mtl) {
             Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
             Err(e) => {
-                *library_problem.borrow_mut() = Some(format!(
-                    "its material library {} cannot be read: {e}",
-                    mtl.display()
+                *library_problem.borrow_mut() = Some((
+                    mtl.clone(),
+                    format!("its material library {} cannot be read: {e}", mtl.display()),
                 ));
                 return Err(tobj::LoadError::OpenFileFailed);
             }
         };
         if let Some((line, statement)) = obj_syntax::first_bad_mtl_line(&text) {
-            *library_problem.borrow_mut() = Some(format!(
-                "its material library {}:{line} cannot be read: `{statement}`",
-                mtl.display()
+            *library_problem.borrow_mut() = Some((
+                mtl.clone(),
+                format!(
+                    "its material library {}:{line} cannot be read: `{statement}`",
+                    mtl.display()
+                ),
             ));
             return Err(tobj::LoadError::MaterialParseError);
         }
@@ -124,17 +130,25 @@ pub fn parse_bytes(
         cause,
     })?;
     let mut notes = Vec::new();
+    let mut substitutes = Vec::new();
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
-            let why = library_problem
-                .into_inner()
-                .unwrap_or_else(|| format!("its material library cannot be read ({e})"));
+            let (library, why) = library_problem.into_inner().unwrap_or_else(|| {
+                (
+                    path.to_owned(),
+                    format!("its material library cannot be read ({e})"),
+                )
+            });
             notes.push(format!("{}: {why}; grey is used instead", path.display()));
+            substitutes.push(library);
             Vec::new()
         }
     };
-    let mut out = LoadedObj::default();
+    let mut out = LoadedObj {
+        substitutes,
+        ..LoadedObj::default()
+    };
     for m in &mtl {
         let (material, material_notes) = convert_material(m, mtl_folder);
         notes.extend(
@@ -366,10 +380,14 @@ pub fn convert_material(m: &tobj::Material, folder: &Path) -> (Material, Vec<Str
 /// Reads every mesh's OBJ file into the scene: its triangles and its
 /// materials, with the preset's overrides kept (matched by name). A
 /// preset override naming no MTL material is kept too, with a note.
-pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), ObjError> {
+/// Returns the files replaced because they could not be read
+/// ([`LoadedObj::substitutes`]).
+pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<Vec<PathBuf>, ObjError> {
+    let mut substitutes = Vec::new();
     for mesh in &mut scene.meshes {
         let loaded = load(&mesh.obj)?;
         notes.extend(loaded.notes);
+        substitutes.extend(loaded.substitutes);
         let overrides = std::mem::take(&mut mesh.materials);
         let mut materials = loaded.materials;
         for o in overrides {
@@ -389,7 +407,7 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<(), Obj
         mesh.materials = materials;
         mesh.geometry = Geometry(Arc::new(loaded.triangles));
     }
-    Ok(())
+    Ok(substitutes)
 }
 
 #[cfg(test)]
@@ -644,7 +662,7 @@ mod tests {
             ..Scene::default()
         };
         let mut notes = Vec::new();
-        load_meshes(&mut scene, &mut notes).unwrap();
+        assert!(load_meshes(&mut scene, &mut notes).unwrap().is_empty());
         let mesh = &scene.meshes[0];
         assert_eq!(mesh.materials.len(), 8);
         let left = mesh

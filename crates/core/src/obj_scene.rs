@@ -23,6 +23,9 @@ use std::sync::Arc;
 pub struct ObjScene {
     pub scene: Scene,
     pub notes: Vec<String>,
+    /// The files replaced because they could not be read
+    /// ([`LoadedObj::substitutes`]).
+    pub substitutes: Vec<std::path::PathBuf>,
 }
 
 /// Paths of up to this many bounces: OBJ scenes are often rooms, lit
@@ -54,6 +57,7 @@ pub fn scene_from_obj(path: &Path, aspect: f32) -> Result<ObjScene, ObjError> {
 /// The scene around the already loaded OBJ `loaded`, read from `path`.
 pub fn scene_around(path: &Path, loaded: LoadedObj, aspect: f32) -> ObjScene {
     let mut notes = loaded.notes;
+    let substitutes = loaded.substitutes;
     // The loader never returns a mesh without triangles.
     let (lo, hi) = loaded
         .triangles
@@ -97,7 +101,11 @@ pub fn scene_around(path: &Path, loaded: LoadedObj, aspect: f32) -> ObjScene {
             path.display()
         ));
     }
-    ObjScene { scene, notes }
+    ObjScene {
+        scene,
+        notes,
+        substitutes,
+    }
 }
 
 #[cfg(test)]

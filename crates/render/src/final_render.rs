@@ -69,6 +69,12 @@ pub struct FinalRender {
     /// on); otherwise an EXR is the raw accumulation. A PNG is what the
     /// display shows, denoised when the scene's display says so.
     pub denoise_exr: bool,
+    /// Render even when a file the scene reads could not be loaded and was
+    /// replaced (a placeholder image, a grey material): the viewer does,
+    /// so that the scene it shows can be rendered; `marbre render` does
+    /// only with `--allow-placeholders`, so that a script or a farm never
+    /// takes such an image as good.
+    pub allow_placeholders: bool,
 }
 
 /// How far a render has come, after each frame.
@@ -120,11 +126,30 @@ pub fn snapshot(scene: Scene, images: ImageSet) -> Result<LoadedScene> {
         l.image
     });
     Ok(LoadedScene {
+        substitutes: images.placeholders().to_vec(),
         scene,
         env,
         images,
         notes,
     })
+}
+
+/// An error naming the files of `loaded` that could not be read and were
+/// replaced (see the notes for why), if any.
+pub fn refuse_substitutes(loaded: &LoadedScene) -> Result<()> {
+    if loaded.substitutes.is_empty() {
+        return Ok(());
+    }
+    let files: Vec<String> = loaded
+        .substitutes
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    bail!(
+        "{} could not be loaded (the notes above say why); nothing was rendered. Fix the \
+         file, or pass --allow-placeholders to render with a placeholder in its place",
+        files.join(", ")
+    )
 }
 
 /// Renders `loaded` as `job` says on `ctx` and writes the image to
@@ -156,6 +181,9 @@ pub fn render_to_file(
     let loaded = loaded.fit_environment(max_texture_side(ctx));
     for note in &loaded.notes {
         observer.note(&format!("note: {note}"));
+    }
+    if !job.allow_placeholders {
+        refuse_substitutes(&loaded)?;
     }
     let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));

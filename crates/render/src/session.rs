@@ -24,6 +24,11 @@ pub struct LoadedScene {
     pub images: ImageSet,
     /// Clamped values and sanitised pixels, for the user to see.
     pub notes: Vec<String>,
+    /// The files that could not be read and were replaced (an image by a
+    /// placeholder, a material library by grey), each with a note: the
+    /// viewer shows the scene anyway, a command line render refuses it
+    /// unless told otherwise.
+    pub substitutes: Vec<PathBuf>,
 }
 
 impl LoadedScene {
@@ -35,6 +40,7 @@ impl LoadedScene {
             env: None,
             images: ImageSet::empty(),
             notes: Vec::new(),
+            substitutes: Vec::new(),
         }
     }
 }
@@ -114,7 +120,7 @@ pub fn load_obj_reporting(
     }
     let mut notes = opened.notes;
     let env = load_scene_environment(&scene, &mut notes)?;
-    finish_scene(scene, env, notes, report)
+    finish_scene(scene, env, notes, opened.substitutes, report)
 }
 
 fn prepare_scene_reporting(
@@ -125,8 +131,8 @@ fn prepare_scene_reporting(
     report(LoadStage::Environment);
     let env = load_scene_environment(&scene, &mut notes)?;
     report(LoadStage::Meshes);
-    marbre_core::obj_loader::load_meshes(&mut scene, &mut notes)?;
-    finish_scene(scene, env, notes, report)
+    let substitutes = marbre_core::obj_loader::load_meshes(&mut scene, &mut notes)?;
+    finish_scene(scene, env, notes, substitutes, report)
 }
 
 /// The environment image `scene` names, its notes added to `notes`.
@@ -141,11 +147,12 @@ fn load_scene_environment(scene: &Scene, notes: &mut Vec<String>) -> Result<Opti
 }
 
 /// The last stages of a load, once the meshes are in: clamping what they
-/// brought, and the images.
+/// brought, and the images; `substitutes` are the files already replaced.
 fn finish_scene(
     mut scene: Scene,
     env: Option<EnvImage>,
     mut notes: Vec<String>,
+    mut substitutes: Vec<PathBuf>,
     report: &mut dyn FnMut(LoadStage),
 ) -> Result<LoadedScene> {
     // The meshes' materials arrive with their files: clamp them as the
@@ -153,11 +160,13 @@ fn finish_scene(
     notes.extend(scene.sanitize());
     report(LoadStage::Images);
     let images = load_images(&scene, &mut notes)?;
+    substitutes.extend_from_slice(images.placeholders());
     Ok(LoadedScene {
         scene,
         env,
         images,
         notes,
+        substitutes,
     })
 }
 

@@ -38,6 +38,7 @@ impl Viewer {
             env,
             images: self.renderer.images().clone(),
             notes: Vec::new(),
+            substitutes: Vec::new(),
         };
         let size = self.renderer.size();
         self.renderer = renderer_with(&ctx, &loaded, size, self.renderer.kernel())?;

@@ -517,6 +517,7 @@ impl Viewer {
                     env: None,
                     images: self.renderer.images().clone(),
                     notes: Vec::new(),
+                    substitutes: Vec::new(),
                 };
                 self.kernels
                     .time_if_needed(&self.ctx, &loaded, self.renderer.size());
@@ -946,6 +947,7 @@ impl Viewer {
                     kernel: marbre_render::gpu::KernelChoice::Auto,
                     output,
                     denoise_exr: false,
+                    allow_placeholders: true,
                 })
             }
         }

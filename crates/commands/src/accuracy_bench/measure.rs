@@ -213,5 +213,6 @@ fn with_scene(sweep: &Sweep, scene: Scene) -> LoadedScene {
         env: sweep.env.clone(),
         images: sweep.images.clone(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     }
 }

@@ -85,6 +85,7 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         strategy: None,
         denoise: false,
         denoise_exr: false,
+        allow_placeholders: false,
     }
 }
 
@@ -96,6 +97,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         kernel: KernelChoice::Fragment,
         output,
         denoise_exr: false,
+        allow_placeholders: false,
     }
 }
 
@@ -219,4 +221,41 @@ fn denoise_filters_the_png_and_the_exr_only_when_asked() {
     let raw_exr = run("raw.exr", false, false);
     assert_eq!(raw_exr, run("asked-png-only.exr", true, false));
     assert_ne!(raw_exr, run("denoised.exr", true, true));
+}
+
+/// A preset whose image texture is missing renders a placeholder in the
+/// viewer, but `marbre render` fails naming the file and writes nothing
+/// (a script or a farm would take the image as good), unless
+/// `--allow-placeholders` is given.
+#[test]
+fn a_missing_image_fails_the_render_unless_placeholders_are_allowed() {
+    if gpu_or_skip("a_missing_image_fails_the_render_unless_placeholders_are_allowed").is_none() {
+        return;
+    }
+    let dir = Scratch::new("render-placeholder");
+    let missing = dir.0.join("missing.png");
+    let sky = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../envmaps/sky.exr");
+    let text = std::fs::read_to_string(preset())
+        .unwrap()
+        .replace("images/uv_grid.png", missing.to_str().unwrap())
+        .replace("../envmaps/sky.exr", sky.to_str().unwrap());
+    let broken = dir.0.join("broken.ron");
+    std::fs::write(&broken, text).unwrap();
+    let output = dir.0.join("out.png");
+    let args = RenderArgs {
+        preset: broken,
+        ..cli_args(output.clone(), false)
+    };
+    let error = format!("{:#}", render::run(&args).unwrap_err());
+    assert!(
+        error.contains(missing.to_str().unwrap()) && error.contains("--allow-placeholders"),
+        "{error}"
+    );
+    assert_eq!(dir.files(), ["broken.ron"], "nothing written");
+    render::run(&RenderArgs {
+        allow_placeholders: true,
+        ..args
+    })
+    .unwrap();
+    assert!(output.is_file());
 }

@@ -21,6 +21,8 @@ pub struct ImageSource {
 pub struct ImageSet {
     sources: Vec<ImageSource>,
     atlas: ImageAtlas,
+    /// The files that could not be read, shown as placeholders.
+    placeholders: Vec<PathBuf>,
 }
 
 impl Default for ImageSet {
@@ -35,6 +37,7 @@ impl ImageSet {
         Self {
             sources: Vec::new(),
             atlas: ImageAtlas::pack(&[], 1).expect("an empty atlas fits"),
+            placeholders: Vec::new(),
         }
     }
 
@@ -48,6 +51,7 @@ impl ImageSet {
         max_side: u32,
         notes: &mut Vec<String>,
     ) -> Result<Self, super::image::AtlasTooLarge> {
+        let mut placeholders = Vec::new();
         let images: Vec<MipImage> = sources
             .iter()
             .map(
@@ -58,6 +62,7 @@ impl ImageSet {
                     }
                     Err(e) => {
                         notes.push(format!("{e}; showing a placeholder"));
+                        placeholders.push(source.path.clone());
                         placeholder()
                     }
                 },
@@ -67,7 +72,14 @@ impl ImageSet {
         Ok(Self {
             sources: sources.to_vec(),
             atlas: ImageAtlas::pack(&refs, max_side)?,
+            placeholders,
         })
+    }
+
+    /// The files that could not be read and show as placeholders (a
+    /// command line render refuses them unless told otherwise).
+    pub fn placeholders(&self) -> &[PathBuf] {
+        &self.placeholders
     }
 
     pub fn sources(&self) -> &[ImageSource] {
