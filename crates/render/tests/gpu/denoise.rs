@@ -247,6 +247,7 @@ fn reading_a_denoised_image_without_denoise_is_an_error() {
         env: None,
         images: Default::default(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     };
     let mut renderer = accumulated(&ctx, &loaded, (8, 8), 1, Kernel::Fragment);
     let e = renderer.read_denoised(&ctx).unwrap_err();

@@ -1307,6 +1307,7 @@ fn degenerate_obj_geometry_is_reported_and_renders_as_without_it() {
         env: None,
         images: loaded.images.clone(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     };
     let keep: Vec<usize> = (0..geometry.len())
         .filter(|&i| triangle_area(&geometry.positions[i]) > 0.0)
@@ -1372,6 +1373,7 @@ fn bumps_that_vanish_or_face_away_shade_finite_with_their_fallbacks() {
         env: None,
         images: loaded.images.clone(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     };
     steep.scene.spheres[0].material.bump_height = 1.0e3;
     let (_, steep) = render_loaded(&ctx, &steep, size, 16);

@@ -319,6 +319,7 @@ fn infinite_emitter() -> LoadedScene {
         env: None,
         images: marbre_core::texture::ImageSet::empty(),
         notes: Vec::new(),
+        substitutes: Vec::new(),
     }
 }
 

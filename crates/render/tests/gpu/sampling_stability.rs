@@ -802,6 +802,7 @@ fn sampling_presets_render_without_non_finite_samples() {
                 env: scene.env.clone(),
                 images: scene.images.clone(),
                 notes: Vec::new(),
+                substitutes: Vec::new(),
             };
             view.scene.camera = camera;
             let mut renderer = marbre_render::session::renderer_for(&ctx, &view, (32, 32)).unwrap();
