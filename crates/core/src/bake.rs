@@ -11,8 +11,8 @@
 //! world coordinates and the (u, v) it would compute there, so 2D and 3D
 //! patterns alike come out as the render shows them on the object.
 
-use crate::atomic_write::write_atomic;
-use crate::image_io::{ImageFormat, save_exr, save_png};
+use crate::atomic_write::write_atomic_pair;
+use crate::image_io::{self, ImageFormat, encode_exr, encode_png};
 use crate::scene::color_encoding::srgb_encode;
 use crate::scene::{Material, Property, Scene, SurfacePoint, UvFrame};
 use crate::texture::{cylinder_uv, plane_uv, sphere_uv};
@@ -572,31 +572,25 @@ impl BakeMapping {
         PathBuf::from(name)
     }
 
-    /// Writes it beside `image` (atomically), returning its path.
-    pub fn write_beside(&self, image: &Path) -> Result<PathBuf> {
+    /// Writes `image_bytes` to `image` and this mapping beside it, as one
+    /// atomic pair: if either cannot be written, neither changes (an image
+    /// never goes beside a sidecar that describes another). Returns the
+    /// sidecar's path.
+    pub fn write_with_image(&self, image: &Path, image_bytes: &[u8]) -> Result<PathBuf> {
         let path = Self::path_for(image);
         let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())?;
-        write_atomic(&path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        write_atomic_pair((image, image_bytes), (&path, text.as_bytes()))
+            .with_context(|| format!("cannot write {} and {}", image.display(), path.display()))?;
         Ok(path)
     }
 }
 
-/// The format of a bake's output file, from its extension, once its
-/// folder is known to exist (a bake creates no folders).
+/// The format of a bake's output file, from its extension, once the image
+/// and its sidecar are known to be writable (a bake creates no folders).
 pub fn check_output(path: &Path) -> Result<ImageFormat> {
     let format = ImageFormat::from_path(path)?;
-    let folder = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !folder.is_dir() {
-        bail!(
-            "cannot write {}: the folder {} does not exist",
-            path.display(),
-            folder.display()
-        );
-    }
+    image_io::check_output(path)?;
+    image_io::check_output(&BakeMapping::path_for(path))?;
     Ok(format)
 }
 
@@ -610,18 +604,17 @@ pub fn color_space(property: BakeProperty, format: ImageFormat) -> &'static str 
     }
 }
 
-/// Writes baked texels (linear RGBA, row 0 at the top) to `path`: an EXR
-/// as they are (32-bit float), a PNG clamped to [0, 1] in 8 bits, colours
-/// sRGB-encoded (see [`color_space`]), alpha linear.
-pub fn write_image(
-    path: &Path,
+/// The file of baked texels (linear RGBA, row 0 at the top) in `format`:
+/// an EXR as they are (32-bit float), a PNG clamped to [0, 1] in 8 bits,
+/// colours sRGB-encoded (see [`color_space`]), alpha linear.
+pub fn encode_image(
+    format: ImageFormat,
     property: BakeProperty,
     size: u32,
     texels: &[[f32; 4]],
-) -> Result<()> {
-    let format = check_output(path)?;
-    let written = match format {
-        ImageFormat::Exr => save_exr(size, size, texels, path),
+) -> Result<Vec<u8>> {
+    match format {
+        ImageFormat::Exr => encode_exr(size, size, texels),
         ImageFormat::Png => {
             let srgb = color_space(property, format) == "srgb";
             let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -630,10 +623,9 @@ pub fn write_image(
                 let c = |v: f32| byte(if srgb { srgb_encode(v.max(0.0)) } else { v });
                 image::Rgba([c(t[0]), c(t[1]), c(t[2]), byte(t[3])])
             });
-            save_png(&image, path)
+            encode_png(&image)
         }
-    };
-    written.with_context(|| format!("cannot write {}", path.display()))
+    }
 }
 
 /// How texels read (u, v), for the sidecar.

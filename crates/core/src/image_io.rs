@@ -1,10 +1,12 @@
 //! Writing rendered images, atomically.
 //!
-//! A render's output folder must exist (`check_output_folder`): a typo in
-//! a path is named before any rendering rather than made into folders,
-//! and a path through a file names the file.
+//! A render's output is checked before any rendering (`check_output`): its
+//! folder must exist (a typo in a path is named rather than made into
+//! folders, and a path through a file names the file), and a file must be
+//! writable there (not a folder, not read-only, not on a read-only
+//! filesystem).
 
-use crate::atomic_write::write_atomic;
+use crate::atomic_write::{check_writable, write_atomic};
 use anyhow::{Result, bail};
 use std::io::ErrorKind;
 use std::path::Path;
@@ -32,9 +34,10 @@ impl ImageFormat {
     }
 }
 
-/// Fails unless the folder `path` goes in exists, naming the cause: the
-/// path component that is a file, or the topmost folder missing.
-pub fn check_output_folder(path: &Path) -> Result<()> {
+/// Fails unless a file can be written at `path`, naming the cause: the
+/// path component that is a file, the topmost folder missing, or why the
+/// file itself cannot be written.
+pub fn check_output(path: &Path) -> Result<()> {
     let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) else {
         return Ok(());
     };
@@ -54,27 +57,38 @@ pub fn check_output_folder(path: &Path) -> Result<()> {
             Err(e) => bail!("cannot write {}: {}: {e}", path.display(), folder.display()),
         }
     }
-    match missing {
-        Some(folder) => bail!(
+    if let Some(folder) = missing {
+        bail!(
             "cannot write {}: the folder {} does not exist",
             path.display(),
             folder.display()
-        ),
-        None => Ok(()),
+        );
     }
+    check_writable(path).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
 }
 
 pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
+    write_atomic(path, &encode_png(image)?)?;
+    Ok(())
+}
+
+/// The PNG file of `image`.
+pub fn encode_png(image: &image::RgbaImage) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     image.write_to(
         &mut std::io::Cursor::new(&mut bytes),
         image::ImageFormat::Png,
     )?;
-    write_atomic(path, &bytes)?;
-    Ok(())
+    Ok(bytes)
 }
 
 pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Result<()> {
+    write_atomic(path, &encode_exr(width, height, pixels)?)?;
+    Ok(())
+}
+
+/// The EXR file (32-bit float RGBA) of `pixels`, row 0 at the top.
+pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let (w, h) = (width as usize, height as usize);
     let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
@@ -84,8 +98,7 @@ pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Re
     let image = Image::from_channels((w, h), channels);
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut bytes)?;
-    write_atomic(path, bytes.get_ref())?;
-    Ok(())
+    Ok(bytes.into_inner())
 }
 
 #[cfg(test)]
@@ -97,7 +110,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("renders/today/x.png");
         assert_eq!(
-            check_output_folder(&out).unwrap_err().to_string(),
+            check_output(&out).unwrap_err().to_string(),
             format!(
                 "cannot write {}: the folder {} does not exist",
                 out.display(),
@@ -106,7 +119,7 @@ mod tests {
         );
         assert!(!dir.path().join("renders").exists());
         std::fs::create_dir_all(dir.path().join("renders/today")).unwrap();
-        check_output_folder(&out).unwrap();
+        check_output(&out).unwrap();
     }
 
     #[test]
@@ -116,7 +129,7 @@ mod tests {
         std::fs::write(&file, "not a folder").unwrap();
         for out in [file.join("x.png"), file.join("a/b/x.exr")] {
             assert_eq!(
-                check_output_folder(&out).unwrap_err().to_string(),
+                check_output(&out).unwrap_err().to_string(),
                 format!(
                     "cannot write {}: {} is a file, not a folder",
                     out.display(),
@@ -126,8 +139,32 @@ mod tests {
         }
     }
 
+    /// An output that is a folder, or a read-only file, is refused before
+    /// a render (which used to trace fully, then fail or replace it).
+    #[test]
+    fn a_folder_or_a_read_only_file_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = dir.path().join("out.png");
+        std::fs::create_dir(&folder).unwrap();
+        assert_eq!(
+            check_output(&folder).unwrap_err().to_string(),
+            format!("cannot write {}: it is a folder", folder.display())
+        );
+        let kept = dir.path().join("kept.exr");
+        std::fs::write(&kept, b"old").unwrap();
+        let mut permissions = std::fs::metadata(&kept).unwrap().permissions();
+        permissions.set_readonly(true);
+        std::fs::set_permissions(&kept, permissions).unwrap();
+        assert!(
+            check_output(&kept)
+                .unwrap_err()
+                .to_string()
+                .contains("read-only")
+        );
+    }
+
     #[test]
     fn a_bare_file_name_goes_in_the_current_folder() {
-        check_output_folder(Path::new("x.png")).unwrap();
+        check_output(Path::new("x.png")).unwrap();
     }
 }

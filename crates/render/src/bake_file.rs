@@ -7,7 +7,7 @@ use crate::gpu::bake::bake;
 use anyhow::Result;
 use marbre_core::bake::{
     BakeMapping, BakeProperty, ObjectRef, TEXEL_CONVENTION, UvSurface, check_output, check_size,
-    color_space, write_image,
+    color_space, encode_image,
 };
 use marbre_core::scene::Scene;
 use marbre_core::texture::ImageSet;
@@ -46,7 +46,7 @@ pub fn bake_to_file(
     let format = check_output(output)?;
     let surface = UvSurface::new(scene, *object, *size)?;
     let texels = bake(ctx, scene, images, &surface, *property, *size)?;
-    write_image(output, *property, *size, &texels)?;
+    let image_bytes = encode_image(format, *property, *size, &texels)?;
     let bump_height = (*property == BakeProperty::Bump).then(|| {
         scene
             .materials()
@@ -64,6 +64,6 @@ pub fn bake_to_file(
         color_space: color_space(*property, format).into(),
         bump_height,
     };
-    mapping.write_beside(output)?;
+    mapping.write_with_image(output, &image_bytes)?;
     Ok(mapping)
 }

@@ -164,7 +164,7 @@ pub fn render_to_file(
     let format = ImageFormat::from_path(&job.output)?;
     // Found before the render, not after it, and never created by
     // surprise; a file in the way is named.
-    image_io::check_output_folder(&job.output)?;
+    image_io::check_output(&job.output)?;
     if job.stop.max_samples() == 0 {
         bail!("a render needs at least 1 sample per pixel");
     }
