@@ -160,13 +160,72 @@ pub struct Frame {
     pub v: [f32; 3],
 }
 
+impl Tex {
+    /// The textures inside this one, in the order the text writes them.
+    pub fn children(&self) -> Vec<&Tex> {
+        match self {
+            Tex::Quad { even, odd, .. } => vec![even, odd],
+            Tex::Tuile { centre, .. } => vec![centre],
+            Tex::Mult(layers) => layers.iter().collect(),
+            Tex::Decoupage {
+                inside, outside, ..
+            } => vec![inside, outside],
+            Tex::Brique { brick, mortar, .. } => vec![brick, mortar],
+            Tex::Uni(_)
+            | Tex::Image { .. }
+            | Tex::Noise { .. }
+            | Tex::Turbulence { .. }
+            | Tex::Bois { .. }
+            | Tex::Marbre { .. }
+            | Tex::Vague { .. } => Vec::new(),
+        }
+    }
+
+    /// The keyword that opens it.
+    pub fn keyword(&self) -> &'static str {
+        match self {
+            Tex::Uni(_) => "UNI",
+            Tex::Quad { .. } => "QUAD",
+            Tex::Tuile { .. } => "TUILE",
+            Tex::Mult(_) => "MULT",
+            Tex::Image { .. } => "IMAGE",
+            Tex::Decoupage { .. } => "DECOUPAGE",
+            Tex::Noise { .. } => "NOISE",
+            Tex::Turbulence { .. } => "TURBULENCE",
+            Tex::Bois { .. } => "BOIS",
+            Tex::Marbre { .. } => "MARBRE",
+            Tex::Brique { .. } => "BRIQUE",
+            Tex::Vague { .. } => "VAGUE",
+        }
+    }
+}
+
 /// A TX text at the attribute level: optional frames, then the texture.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Document {
     pub polygon_frame: Option<Frame>,
     pub plane_frame: Option<Frame>,
     pub space_frame: Option<Frame>,
     pub texture: Tex,
+    /// Where the text wrote each texture of `texture`: the line and column
+    /// of its keyword, in the order the keywords come (the tree's
+    /// pre-order), so that lowering can point at a construct the way the
+    /// parser points at a word. Empty for a document not read from text;
+    /// only the parser fills it, for the tree it read (a tree replaced
+    /// afterwards keeps the places of the text).
+    pub(super) places: Vec<(usize, usize)>,
+}
+
+/// Documents are equal when they say the same thing: where their words
+/// were written (`places`) is layout, as blanks are, so a printed document
+/// parses back equal.
+impl PartialEq for Document {
+    fn eq(&self, other: &Self) -> bool {
+        self.polygon_frame == other.polygon_frame
+            && self.plane_frame == other.plane_frame
+            && self.space_frame == other.space_frame
+            && self.texture == other.texture
+    }
 }
 
 impl Document {
@@ -176,7 +235,25 @@ impl Document {
             plane_frame: None,
             space_frame: None,
             texture,
+            places: Vec::new(),
         }
+    }
+
+    /// The line and column where the text wrote `t`, a texture of this
+    /// document's tree (the very node, found by address: equal textures
+    /// written at two places are two nodes); `None` for a document not
+    /// read from text.
+    pub fn place_of(&self, t: &Tex) -> Option<(usize, usize)> {
+        /// `t`'s index in pre-order below `node`, counting from `next`.
+        fn find(node: &Tex, t: &Tex, next: &mut usize) -> Option<usize> {
+            if std::ptr::eq(node, t) {
+                return Some(*next);
+            }
+            *next += 1;
+            node.children().into_iter().find_map(|c| find(c, t, next))
+        }
+        let index = find(&self.texture, t, &mut 0)?;
+        self.places.get(index).copied()
     }
 
     pub fn frame(&self, kind: FrameKind) -> Option<&Frame> {

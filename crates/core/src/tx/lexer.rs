@@ -21,26 +21,46 @@ impl Token {
     /// How a message quotes it: `keyword `QUAD``, `number `0.5``.
     pub fn describe(&self) -> String {
         match &self.tok {
-            Tok::Word(w) => format!("`{w}`"),
+            Tok::Word(w) => format!("`{}`", shown(w)),
             Tok::Number(n) => format!("number `{n}`"),
         }
     }
 }
 
+/// A word of the text as a message shows it: its control characters
+/// escaped (ESC as `\u{1b}`), so that a text cannot drive the terminal or
+/// the log that prints the message; everything else, accents included, as
+/// written.
+pub fn shown(word: &str) -> String {
+    let mut out = String::with_capacity(word.len());
+    for c in word.chars() {
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// Splits `text` at blanks. A run is a number if Rust reads it as a
 /// finite f32 and it starts like one (a digit, a sign or a point), so
 /// that `inf` and `NaN` stay words (and are refused where numbers belong).
+///
+/// Columns are counted as the line is scanned (each character's place
+/// comes with it), not from the line's start for each token: a preset's
+/// text is one line, and counting from its start made a long one quadratic.
 pub fn tokenize(text: &str) -> Vec<Token> {
     let mut out = Vec::new();
     for (index, line) in text.lines().enumerate() {
-        let mut chars = line.char_indices().peekable();
-        while let Some(&(start, c)) = chars.peek() {
+        let mut chars = line.char_indices().enumerate().peekable();
+        while let Some(&(before, (start, c))) = chars.peek() {
             if c.is_whitespace() {
                 chars.next();
                 continue;
             }
             let mut end = start;
-            while let Some(&(i, c)) = chars.peek() {
+            while let Some(&(_, (i, c))) = chars.peek() {
                 if c.is_whitespace() {
                     break;
                 }
@@ -56,7 +76,7 @@ pub fn tokenize(text: &str) -> Vec<Token> {
             out.push(Token {
                 tok,
                 line: index + 1,
-                column: line[..start].chars().count() + 1,
+                column: before + 1,
             });
         }
     }
@@ -90,5 +110,39 @@ mod tests {
                 (w("1e400"), 3, 14),
             ]
         );
+    }
+
+    /// A preset's text is one line: 200,000 tokens on it tokenize with
+    /// their columns in characters (`é` is two bytes, one column).
+    #[test]
+    fn a_long_line_keeps_its_columns_in_characters() {
+        let pairs = 100_000;
+        let text = format!("{}FTX", "é 0.5 ".repeat(pairs));
+        let t = tokenize(&text);
+        assert_eq!(t.len(), 2 * pairs + 1);
+        for (k, pair) in t.chunks_exact(2).enumerate() {
+            // "é 0.5 " is six characters: the word at 6k + 1, the number at 6k + 3.
+            assert_eq!(
+                (&pair[0].tok, pair[0].line, pair[0].column),
+                (&Tok::Word("é".into()), 1, 6 * k + 1)
+            );
+            assert_eq!(
+                (&pair[1].tok, pair[1].line, pair[1].column),
+                (&Tok::Number(0.5), 1, 6 * k + 3)
+            );
+        }
+        let last = t.last().unwrap();
+        assert_eq!(
+            (&last.tok, last.line, last.column),
+            (&Tok::Word("FTX".into()), 1, 6 * pairs + 1)
+        );
+    }
+
+    #[test]
+    fn control_characters_are_escaped_in_messages_and_accents_kept() {
+        let t = tokenize("\x1b[2J\u{9b}31m éèô\x07");
+        let shown: Vec<String> = t.iter().map(Token::describe).collect();
+        assert_eq!(shown, ["`\\u{1b}[2J\\u{9b}31m`", "`éèô\\u{7}`"]);
+        assert!(shown.iter().all(|s| !s.chars().any(char::is_control)));
     }
 }

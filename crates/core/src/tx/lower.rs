@@ -10,6 +10,7 @@
 
 use super::TxError;
 use super::ast::{Attr, Document, Frame, Rgb, Tex};
+use super::lexer::shown;
 use crate::noise::{FractalParams, NoiseSettings};
 use crate::scene::{
     Child, ColorEncoding, Material, Pattern, Property, Texture, TextureMapping, UvFrame,
@@ -212,17 +213,31 @@ pub fn lower_channel(
         Some(value) => value.clone(),
         None => Child::Texture(Box::new(base.clone())),
     };
-    let mut texture = Texture::from(lower(&doc.texture, &below, true, &ctx)?);
+    // The text sets the channel, so the value is made by one of its
+    // constructs, never `base` passed through whole: each node made is
+    // within the depth a material holds, and a construct that would go
+    // deeper is refused here, where the text wrote it.
+    let mut texture = match lower(&doc.texture, &Made::Value(below), true, &ctx)? {
+        Made::Value(child) => Texture::from(child),
+        Made::TooDeep { construct, depth } => {
+            let message = format!(
+                "{} would nest the {} texture {depth} deep; a material's textures nest at most {} deep",
+                construct.keyword(),
+                channel.name(),
+                Texture::MAX_DEPTH
+            );
+            return Err(match doc.place_of(construct) {
+                Some((line, column)) => TxError::LowerAt {
+                    line,
+                    column,
+                    message,
+                },
+                None => TxError::Lower(message),
+            });
+        }
+    };
     if texture.mapping.is_none() && texture.pattern != Pattern::Constant {
         texture.mapping = top;
-    }
-    if texture.depth() > Texture::MAX_DEPTH {
-        return Err(TxError::Lower(format!(
-            "the {} texture nests {} deep; a material holds at most {}",
-            channel.name(),
-            texture.depth(),
-            Texture::MAX_DEPTH
-        )));
     }
     Ok(texture)
 }
@@ -270,22 +285,67 @@ fn leaf(typed: Rgb, ctx: &Ctx) -> Child {
     }
 }
 
-/// `pattern` over two children; equal values make a value.
-fn blend(pattern: Pattern, a: Child, b: Child) -> Child {
-    if a == b && !matches!(a, Child::Texture(_)) {
-        return a;
+/// What lowering makes of a texture: its value, or the first construct
+/// whose node would have nested the tree deeper than a material holds
+/// ([`Texture::MAX_DEPTH`]), and how deep. That node is never built, so
+/// no value lowering holds is deeper than the limit: each has at most
+/// 2^MAX_DEPTH − 1 nodes of lowering's making, and each construct of the
+/// text costs a few copies of one at most. (The depth used to be checked on the
+/// finished tree, after each MULT layer over a DECOUPAGE or TUILE had
+/// doubled it: 22 layers, two kilobytes of text, took 3 GB.) It is carried
+/// rather than returned as an error at once because a later MULT layer may
+/// cover it: a text whose final tree fits lowers as it did before.
+#[derive(Clone)]
+enum Made<'a> {
+    Value(Child),
+    TooDeep { construct: &'a Tex, depth: usize },
+}
+
+impl From<Child> for Made<'_> {
+    fn from(child: Child) -> Self {
+        Made::Value(child)
     }
-    Child::Texture(Box::new(Texture::blend(pattern, a, b)))
+}
+
+/// `construct`'s `pattern` over two children; equal values make a value,
+/// and a node deeper than a material holds is not made.
+fn blend<'a>(
+    construct: &'a Tex,
+    pattern: Pattern,
+    a: impl Into<Made<'a>>,
+    b: impl Into<Made<'a>>,
+) -> Made<'a> {
+    let (a, b) = match (a.into(), b.into()) {
+        (Made::Value(a), Made::Value(b)) => (a, b),
+        (too_deep @ Made::TooDeep { .. }, _) | (_, too_deep @ Made::TooDeep { .. }) => {
+            return too_deep;
+        }
+    };
+    if a == b && !matches!(a, Child::Texture(_)) {
+        return Made::Value(a);
+    }
+    let depth = 1 + [&a, &b]
+        .into_iter()
+        .filter_map(Child::texture)
+        .map(Texture::depth)
+        .max()
+        .unwrap_or(0);
+    if depth > Texture::MAX_DEPTH {
+        return Made::TooDeep { construct, depth };
+    }
+    Made::Value(Child::Texture(Box::new(Texture::blend(pattern, a, b))))
 }
 
 /// What a cell's texture sees below it: a varying value from the surface's
 /// space gets the surface's mapping back.
-fn in_cell(below: &Child, surface: bool, ctx: &Ctx) -> Child {
+fn in_cell<'a>(below: &Made<'a>, surface: bool, ctx: &Ctx) -> Made<'a> {
     match below {
-        Child::Texture(t) if surface && t.mapping.is_none() => Child::Texture(Box::new(Texture {
-            mapping: Some(ctx.surface),
-            ..(**t).clone()
-        })),
+        Made::Value(Child::Texture(t)) if surface && t.mapping.is_none() => {
+            Made::Value(Child::Texture(Box::new(Texture {
+                mapping: Some(ctx.surface),
+                ..(**t).clone()
+            })))
+        }
         other => other.clone(),
     }
 }
@@ -350,13 +410,13 @@ pub fn brick_mortar(size: Vec2) -> f32 {
 
 /// `t` lowered for one channel over `below`; `surface` says whether the
 /// coordinates here are the surface's (not a cell's).
-fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxError> {
+fn lower<'a>(t: &'a Tex, below: &Made<'a>, surface: bool, ctx: &Ctx) -> Result<Made<'a>, TxError> {
     if !sets(t, ctx.channel) {
         return Ok(below.clone());
     }
     let attr = ctx.channel.attr();
     Ok(match t {
-        Tex::Uni(a) => leaf(attr.and_then(|x| a.get(x)).unwrap_or_default(), ctx),
+        Tex::Uni(a) => leaf(attr.and_then(|x| a.get(x)).unwrap_or_default(), ctx).into(),
         Tex::Quad {
             even,
             odd,
@@ -370,6 +430,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             );
             let inner = in_cell(below, surface, ctx);
             blend(
+                t,
                 Pattern::Checker2d {
                     size,
                     phase: phase.unwrap_or(0.0),
@@ -391,16 +452,17 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             };
             if ctx.channel == Channel::Bump {
                 blend(
+                    t,
                     pattern,
                     Child::Scalar(0.0),
                     Child::Scalar(level(*niv3d, "TUILE's NIV3D")?),
                 )
             } else {
                 let joint = match attr.and_then(|x| mortar.get(x)) {
-                    Some(c) => leaf(c, ctx),
+                    Some(c) => leaf(c, ctx).into(),
                     None => below.clone(),
                 };
-                blend(pattern, joint, lower(centre, below, surface, ctx)?)
+                blend(t, pattern, joint, lower(centre, below, surface, ctx)?)
             }
         }
         Tex::Mult(layers) => {
@@ -412,7 +474,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
         }
         Tex::Image { file, attrs } => {
             let typed = attr.and_then(|x| attrs.get(x)).unwrap_or_default();
-            image(file, typed, ctx)?
+            image(file, typed, ctx)?.into()
         }
         Tex::Decoupage {
             inside,
@@ -420,6 +482,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             sides,
             radius,
         } => blend(
+            t,
             Pattern::Cutout {
                 sides: *sides,
                 radius: radius.unwrap_or(DECOUPAGE_DEFAULT_RADIUS),
@@ -432,6 +495,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             frequency,
             amplitude,
         } => blend(
+            t,
             Pattern::Fbm {
                 noise: noise_settings(*frequency, *amplitude),
             },
@@ -443,6 +507,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             frequency,
             amplitude,
         } => blend(
+            t,
             Pattern::Turbulence {
                 noise: turbulence_settings(*frequency, *amplitude),
             },
@@ -455,6 +520,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             ring_width,
             turbulence,
         } => blend(
+            t,
             Pattern::Wood {
                 noise: wood_settings(),
                 ring_width: positive(
@@ -473,6 +539,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             turbulence,
             turbulence_frequency,
         } => blend(
+            t,
             Pattern::Veins {
                 noise: marble_settings(*turbulence_frequency),
                 frequency: *frequency,
@@ -493,6 +560,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             );
             let inner = in_cell(below, surface, ctx);
             blend(
+                t,
                 Pattern::Brick {
                     size,
                     mortar: brick_mortar(size),
@@ -506,6 +574,7 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
             frequency,
             amplitude,
         } => blend(
+            t,
             Pattern::Waves {
                 frequency: *frequency,
                 direction: Vec2::X,
@@ -521,12 +590,14 @@ fn lower(t: &Tex, below: &Child, surface: bool, ctx: &Ctx) -> Result<Child, TxEr
 fn image(file: &str, typed: Rgb, ctx: &Ctx) -> Result<Child, TxError> {
     if matches!(ctx.channel, Channel::Opacity | Channel::Transmission) {
         return Err(TxError::Lower(format!(
-            "IMAGE {file}: CT through an image has no form in the material (opacity and tint from one picture)"
+            "IMAGE {}: CT through an image has no form in the material (opacity and tint from one picture)",
+            shown(file)
         )));
     }
     if typed[0] != typed[1] || typed[1] != typed[2] {
         return Err(TxError::Lower(format!(
-            "IMAGE {file}: {} {} {} {} is not a grey; an image can only be scaled by a grey",
+            "IMAGE {}: {} {} {} {} is not a grey; an image can only be scaled by a grey",
+            shown(file),
             ctx.channel.attr().map_or("", Attr::keyword),
             typed[0],
             typed[1],

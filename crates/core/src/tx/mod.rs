@@ -34,6 +34,13 @@ pub enum TxError {
     },
     #[error("TX: {0}")]
     Lower(String),
+    /// What cannot be lowered, where the text wrote it.
+    #[error("TX line {line}, column {column}: {message}")]
+    LowerAt {
+        line: usize,
+        column: usize,
+        message: String,
+    },
     #[error("{0}")]
     Raise(String),
 }

@@ -23,6 +23,7 @@ pub fn parse(text: &str) -> Result<Document, TxError> {
         toks: tokenize(text),
         pos: 0,
         end: end_position(text),
+        places: Vec::new(),
     };
     let mut frames: Vec<(FrameKind, Frame)> = Vec::new();
     while let Some(kind) = p.peek_word().and_then(frame_kind) {
@@ -56,7 +57,10 @@ pub fn parse(text: &str) -> Result<Document, TxError> {
             &t.describe(),
         ));
     }
-    let mut doc = Document::new(texture);
+    let mut doc = Document {
+        places: p.places,
+        ..Document::new(texture)
+    };
     for (kind, frame) in frames {
         *doc.frame_mut(kind) = Some(frame);
     }
@@ -85,6 +89,9 @@ struct Parser {
     toks: Vec<Token>,
     pos: usize,
     end: (usize, usize),
+    /// Each texture's keyword's line and column, in pre-order
+    /// ([`Document`]'s `places`).
+    places: Vec<(usize, usize)>,
 }
 
 impl Parser {
@@ -152,8 +159,16 @@ impl Parser {
                 "at most {MAX_NESTING} nested textures, not another one"
             )));
         }
-        let Some(word) = self.peek_word().map(str::to_owned) else {
-            return Err(self.error_here(A_TEXTURE));
+        let word = match self.toks.get(self.pos) {
+            Some(Token {
+                tok: Tok::Word(w),
+                line,
+                column,
+            }) => {
+                self.places.push((*line, *column));
+                w.clone()
+            }
+            _ => return Err(self.error_here(A_TEXTURE)),
         };
         let inner = depth + 1;
         let parsed = match word.as_str() {

@@ -151,6 +151,95 @@ fn deep_nesting_is_refused_not_overflowed() {
     assert!(e.to_string().contains("at most 64 nested"), "{e}");
 }
 
+/// Issue 28's text: MULT layers of a tile whose centre is a cutout, each
+/// holding the layer below twice and two levels deeper.
+const LAYERS_HEAD: &str = "MULT UNI CD .5 .5 .5 FTX ";
+const LAYER: &str =
+    "TUILE DMORTIER 0.1 DPENTE 0 NIV3D 0 DECOUPAGE UNI CD 1 1 1 FTX UNI FTX NBCOTE 3 FTX FTX ";
+
+fn layers(n: usize) -> String {
+    format!("{LAYERS_HEAD}{}FTX", LAYER.repeat(n))
+}
+
+/// Each layer used to double the lowered tree, and its depth was checked
+/// once the tree was whole: 22 layers took 3 GB, 40 would take 2^40 nodes.
+/// Now no node deeper than a material holds is made: the fourth layer's
+/// DECOUPAGE (depth 7) is refused where it is written, whatever follows.
+#[test]
+fn a_text_nesting_deeper_than_a_material_is_refused_where_it_goes_too_deep() {
+    let base = crate::scene::Material::default();
+    let fourth = LAYERS_HEAD.len() + 3 * LAYER.len() + LAYER.find("DECOUPAGE").unwrap() + 1;
+    let message = "DECOUPAGE would nest the diffuse texture 7 deep; \
+                   a material's textures nest at most 6 deep";
+    assert_eq!(Texture::MAX_DEPTH, 6, "the message above names the limit");
+    for n in [4, 22, 40] {
+        let doc = parse(&layers(n)).unwrap();
+        let want = TxError::LowerAt {
+            line: 1,
+            column: fourth,
+            message: message.into(),
+        };
+        assert_eq!(
+            lower_document(&doc, &base, Path::new("")).unwrap_err(),
+            want,
+            "{n} layers"
+        );
+        let mut m = base.clone();
+        let e = apply_to_property(&mut m, Property::Diffuse, &layers(n), Path::new(""));
+        assert_eq!(e.unwrap_err(), want, "{n} layers");
+        assert_eq!(m, base);
+    }
+    assert_eq!(
+        TxError::LowerAt {
+            line: 1,
+            column: fourth,
+            message: message.into()
+        }
+        .to_string(),
+        format!("TX line 1, column {fourth}: {message}")
+    );
+    // Three layers make a tree of exactly the depth a material holds.
+    let three = lower_document(&parse(&layers(3)).unwrap(), &base, Path::new("")).unwrap();
+    assert_eq!(three.material.diffuse.depth(), Texture::MAX_DEPTH);
+    // A layer that would be too deep but that a later layer covers whole
+    // is not in the tree: the text lowers, as it always did.
+    let covered = format!("MULT {} UNI CD 1 0 0 FTX FTX", LAYER.repeat(22));
+    let m = lower_document(&parse(&covered).unwrap(), &base, Path::new("")).unwrap();
+    assert_eq!(m.material.diffuse, Texture::color(Vec3::X));
+    // A document built in code, not read from text, has no place to name.
+    let built = Document::new(parse(&layers(4)).unwrap().texture);
+    let e = lower_document(&built, &base, Path::new(""));
+    assert_eq!(e.unwrap_err(), TxError::Lower(message.into()));
+}
+
+/// A word of the text is echoed in messages with its control characters
+/// escaped (a text must not clear the terminal that shows its error), its
+/// accents as written.
+#[test]
+fn control_characters_in_a_text_are_escaped_in_its_messages() {
+    let e = parse("UNI CD 1 1 1 \x1b[2J FTX").unwrap_err();
+    let TxError::Syntax { found, .. } = &e else {
+        panic!("{e:?}")
+    };
+    assert_eq!(found, "`\\u{1b}[2J`");
+    let e = parse("UNI CD 1 1 1 Pâté FTX").unwrap_err();
+    assert!(e.to_string().ends_with("found `Pâté`"), "{e}");
+    let mut m = crate::scene::Material::default();
+    let e = apply_to_property(
+        &mut m,
+        Property::Diffuse,
+        "IMAGE \x1b]0;owned\x07é.ppm CD 1 0 0 FTX",
+        Path::new(""),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("TX: IMAGE \\u{1b}]0;owned\\u{7}é.ppm: CD 1 0 0 is not a grey"),
+        "{e}"
+    );
+    assert!(!e.chars().any(char::is_control), "{e:?}");
+}
+
 #[test]
 fn the_grammar_order_of_tuile_and_one_brick_size_are_read_too() {
     let grammar =
@@ -449,7 +538,7 @@ fn document() -> impl Strategy<Value = Document> {
             polygon_frame,
             plane_frame,
             space_frame,
-            texture,
+            ..Document::new(texture)
         },
     )
 }
@@ -588,6 +677,28 @@ proptest! {
     fn printed_documents_parse_back_equal(doc in document()) {
         let text = print(&doc);
         prop_assert_eq!(parse(&text).map_err(|e| format!("{e}\n{text}")), Ok(doc));
+    }
+
+    /// Each texture of a text read back is placed at its own keyword (the
+    /// parser's order of places is `Tex::children`'s).
+    #[test]
+    fn every_texture_is_placed_at_its_keyword(doc in document()) {
+        fn all<'a>(t: &'a Tex, out: &mut Vec<&'a Tex>) {
+            out.push(t);
+            for c in t.children() {
+                all(c, out);
+            }
+        }
+        let text = print(&doc);
+        let read = parse(&text).unwrap();
+        let mut nodes = Vec::new();
+        all(&read.texture, &mut nodes);
+        for t in nodes {
+            let (line, column) = read.place_of(t).unwrap();
+            let at: String = text.lines().nth(line - 1).unwrap().chars().skip(column - 1).collect();
+            prop_assert!(at.starts_with(t.keyword()), "{} at {}:{}: {}", t.keyword(), line, column, at);
+        }
+        prop_assert_eq!(doc.place_of(&doc.texture), None);
     }
 
     /// Lower(raise(t)) == t for the trees lowering makes, property by
