@@ -124,6 +124,10 @@ fn main() -> ExitCode {
         .is_some_and(|c| !matches!(c, Command::Soak(_)))
     {
         marbre::headless::quiet_device_select();
+        // A save stopped half way leaves no temporary behind.
+        if let Err(e) = marbre_commands::interrupt::remove_temporaries_on_signal() {
+            eprintln!("marbre: warning: {e:#}");
+        }
     }
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),

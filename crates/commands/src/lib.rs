@@ -5,6 +5,7 @@ pub mod bake;
 pub mod bvh_bench;
 pub mod convergence_bench;
 pub mod edit_bench;
+pub mod interrupt;
 pub mod noise;
 pub mod noise_figure;
 pub mod presets_bench;
