@@ -134,6 +134,54 @@ pub fn snapshot(scene: Scene, images: ImageSet) -> Result<LoadedScene> {
     })
 }
 
+/// The renderer of a final render, or one clear error before any tracing
+/// if the GPU cannot hold its images: its targets and the buffer the
+/// largest read-back (an EXR's float radiance) needs are allocated under an
+/// out-of-memory error scope, which wgpu would otherwise treat as fatal
+/// (a 16384² render panicked on lavapipe, whose largest allocation is
+/// smaller than one of its 4 GiB targets).
+fn renderer_fitting(
+    ctx: &GpuContext,
+    loaded: &LoadedScene,
+    size: (u32, u32),
+    kernel: crate::gpu::Kernel,
+) -> Result<crate::gpu::Renderer> {
+    let memory = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    // What follows a failed allocation (a view of the texture that is not
+    // there) is invalid too: caught, and reported as the allocation.
+    let validity = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let renderer = renderer_with(ctx, loaded, size, kernel);
+    let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("read-back size probe"),
+        size: u64::from(size.0) * u64::from(size.1) * RADIANCE_BYTES_PER_PIXEL,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let invalid = pollster::block_on(validity.pop());
+    let out_of_memory = pollster::block_on(memory.pop());
+    readback.destroy();
+    if let Some(e) = out_of_memory {
+        bail!(
+            "a {} × {} render does not fit in the memory of {} ({e}); nothing was traced: \
+             render a smaller size",
+            size.0,
+            size.1,
+            ctx.adapter.get_info().name
+        );
+    }
+    if let Some(e) = invalid {
+        bail!(
+            "the GPU refused the images of a {} × {} render ({e}); nothing was traced",
+            size.0,
+            size.1
+        );
+    }
+    renderer
+}
+
+/// Bytes per pixel of the float radiance an EXR is read back as (RGBA f32).
+const RADIANCE_BYTES_PER_PIXEL: u64 = 16;
+
 /// An error naming the files of `loaded` that could not be read and were
 /// replaced (see the notes for why), if any.
 pub fn refuse_substitutes(loaded: &LoadedScene) -> Result<()> {
@@ -187,7 +235,7 @@ pub fn render_to_file(
     }
     let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
-    let mut renderer = renderer_with(ctx, &loaded, job.size, kernel)?;
+    let mut renderer = renderer_fitting(ctx, &loaded, job.size, kernel)?;
     let flow = match job.stop {
         Stop::Samples(spp) => accumulate(ctx, &mut renderer, spp, observer)?,
         Stop::TargetError { target, max_spp } => {

@@ -259,3 +259,32 @@ fn a_missing_image_fails_the_render_unless_placeholders_are_allowed() {
     .unwrap();
     assert!(output.is_file());
 }
+
+/// The largest size the command accepts, 16384 × 16384: on an adapter
+/// that cannot hold its images (lavapipe, whose largest allocation is under
+/// one 4 GiB target) it fails with one line before tracing, where wgpu's
+/// out-of-memory error used to panic; where it fits, it renders.
+#[test]
+fn the_largest_size_renders_or_fails_before_tracing() {
+    if gpu_or_skip("the_largest_size_renders_or_fails_before_tracing").is_none() {
+        return;
+    }
+    let dir = Scratch::new("render-largest");
+    let output = dir.0.join("huge.png");
+    let result = render::run(&RenderArgs {
+        size: (16384, 16384),
+        spp: Some(1),
+        ..cli_args(output.clone(), false)
+    });
+    match result {
+        Ok(()) => assert_eq!(image::image_dimensions(&output).unwrap(), (16384, 16384)),
+        Err(e) => {
+            let message = format!("{e:#}");
+            assert!(
+                message.contains("16384 × 16384") && message.contains("nothing was traced"),
+                "{message}"
+            );
+            assert!(dir.files().is_empty(), "{:?}", dir.files());
+        }
+    }
+}
