@@ -23,6 +23,7 @@ pub mod obj_scene;
 pub mod obj_syntax;
 pub mod preset;
 pub mod scene;
+pub mod shown;
 pub mod texture;
 pub mod tx;
 pub mod wgsl;

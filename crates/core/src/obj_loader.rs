@@ -12,6 +12,7 @@ use crate::capped_read::{self, read_capped};
 use crate::obj_syntax;
 use crate::scene::mesh::{Geometry, MeshMaterial, TriangleMesh};
 use crate::scene::{Material, Pattern, Scene, Texture};
+use crate::shown::shown;
 use crate::texture::{ColorSpace, ImageSource};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -83,7 +84,7 @@ pub fn parse_bytes(
         return Err(ObjError::Syntax {
             path: path.to_owned(),
             line,
-            statement,
+            statement: shown(&statement),
         });
     }
     let options = tobj::LoadOptions {
@@ -111,8 +112,9 @@ pub fn parse_bytes(
             *library_problem.borrow_mut() = Some((
                 mtl.clone(),
                 format!(
-                    "its material library {}:{line} cannot be read: `{statement}`",
-                    mtl.display()
+                    "its material library {}:{line} cannot be read: `{}`",
+                    mtl.display(),
+                    shown(&statement)
                 ),
             ));
             return Err(tobj::LoadError::MaterialParseError);
@@ -145,6 +147,17 @@ pub fn parse_bytes(
             Vec::new()
         }
     };
+    // A library that failed has its own note; else each `usemtl` naming
+    // none of its materials gets one (tobj gives such faces no material).
+    if substitutes.is_empty() {
+        for (line, name) in undefined_materials(&text, &mtl) {
+            notes.push(format!(
+                "{}:{line}: `usemtl {}` names no material of its library; grey is used",
+                path.display(),
+                shown(name)
+            ));
+        }
+    }
     let mut out = LoadedObj {
         substitutes,
         ..LoadedObj::default()
@@ -243,8 +256,36 @@ pub fn roughness_from_ns(ns: f32) -> f32 {
     alpha.sqrt().clamp(0.0, 1.0)
 }
 
-fn rgb(c: Option<[f32; 3]>) -> Option<Vec3> {
-    c.map(Vec3::from_array).filter(|v| v.is_finite())
+/// The MTL colour `key` (`default` when absent): one with a component that
+/// is not finite is replaced by `default`, one outside 0 to `max` (no upper
+/// bound for `None`) clamped, each with a note, so that nothing an MTL
+/// says is changed without a word.
+fn checked_color(
+    key: &str,
+    value: Option<[f32; 3]>,
+    default: Vec3,
+    max: Option<f32>,
+    notes: &mut Vec<String>,
+) -> Vec3 {
+    let Some(c) = value.map(Vec3::from_array) else {
+        return default;
+    };
+    if !c.is_finite() {
+        notes.push(format!(
+            "`{key} {} {} {}` is not finite; {} {} {} is used",
+            c.x, c.y, c.z, default.x, default.y, default.z
+        ));
+        return default;
+    }
+    let clamped = c.clamp(Vec3::ZERO, Vec3::splat(max.unwrap_or(f32::MAX)));
+    if clamped != c {
+        let range = max.map_or("at least 0".to_owned(), |m| format!("0 to {m}"));
+        notes.push(format!(
+            "`{key} {} {} {}` is outside {range}; {} {} {} is used",
+            c.x, c.y, c.z, clamped.x, clamped.y, clamped.z
+        ));
+    }
+    clamped
 }
 
 /// An image texture of `file` (relative to the MTL's folder), scaled by
@@ -312,52 +353,91 @@ fn strip_options(statement: &str) -> (&str, Option<f32>) {
     (file, bump_multiplier)
 }
 
+/// The `usemtl` statements of `text` naming none of `materials`: their
+/// line and the name, the first use of each name only.
+fn undefined_materials<'t>(text: &'t str, materials: &[tobj::Material]) -> Vec<(usize, &'t str)> {
+    let mut seen = std::collections::HashSet::new();
+    text.lines()
+        .enumerate()
+        .filter_map(|(i, line)| {
+            let (key, name) = line.trim().split_once(char::is_whitespace)?;
+            let name = name.trim();
+            if key != "usemtl" {
+                return None;
+            }
+            let undefined = !name.is_empty() && !materials.iter().any(|m| m.name == name);
+            (undefined && seen.insert(name)).then_some((i + 1, name))
+        })
+        .collect()
+}
+
 /// One MTL material as a marbre material, and notes on what was replaced.
 pub fn convert_material(m: &tobj::Material, folder: &Path) -> (Material, Vec<String>) {
     let mut notes = Vec::new();
-    let kd = rgb(m.diffuse).unwrap_or(Vec3::splat(0.8));
-    let ks = rgb(m.specular).unwrap_or(Vec3::ZERO);
-    let ke = rgb(m.emissive).unwrap_or(Vec3::ZERO);
+    let kd = checked_color("Kd", m.diffuse, Vec3::splat(0.8), Some(1.0), &mut notes);
+    let ks = checked_color("Ks", m.specular, Vec3::ZERO, Some(1.0), &mut notes);
+    // No upper bound: the emission's brightness goes into its strength.
+    let ke = checked_color("Ke", m.emissive, Vec3::ZERO, None, &mut notes);
     let params: HashMap<&str, &str> = m
         .unknown_param
         .iter()
         .map(|(k, v)| (k.as_str(), v.as_str()))
         .collect();
-    let opacity = m
-        .dissolve
-        .or_else(|| {
+    let (dissolve_key, dissolve) = match m.dissolve {
+        Some(d) => ("d", Some(d)),
+        None => (
+            "Tr",
             params
                 .get("Tr")
                 .and_then(|t| t.parse::<f32>().ok())
-                .map(|tr| 1.0 - tr)
-        })
-        .filter(|d| d.is_finite())
-        .unwrap_or(1.0)
-        .clamp(0.0, 1.0);
-    let transmission = params
-        .get("Tf")
-        .and_then(|t| {
-            let v: Vec<f32> = t
-                .split_whitespace()
-                .filter_map(|x| x.parse().ok())
-                .collect();
-            match v.as_slice() {
-                [g] => Some(Vec3::splat(*g)),
-                [r, g, b, ..] => Some(Vec3::new(*r, *g, *b)),
-                _ => None,
-            }
-        })
-        .unwrap_or(if opacity < 1.0 { kd } else { Vec3::ONE });
+                .map(|tr| 1.0 - tr),
+        ),
+    };
+    let opacity = match dissolve {
+        None => 1.0,
+        Some(d) if !d.is_finite() => {
+            notes.push(format!(
+                "`{dissolve_key}` is not a finite number; opaque is used"
+            ));
+            1.0
+        }
+        Some(d) if !(0.0..=1.0).contains(&d) => {
+            notes.push(format!(
+                "`{dissolve_key}` gives an opacity of {d}, outside 0 to 1; {} is used",
+                d.clamp(0.0, 1.0)
+            ));
+            d.clamp(0.0, 1.0)
+        }
+        Some(d) => d,
+    };
+    let tf = params.get("Tf").and_then(|t| {
+        let v: Vec<f32> = t
+            .split_whitespace()
+            .filter_map(|x| x.parse().ok())
+            .collect();
+        match v.as_slice() {
+            [g] => Some([*g; 3]),
+            [r, g, b, ..] => Some([*r, *g, *b]),
+            _ => None,
+        }
+    });
+    let transmission = checked_color(
+        "Tf",
+        tf,
+        if opacity < 1.0 { kd } else { Vec3::ONE },
+        Some(1.0),
+        &mut notes,
+    );
     let mut material = Material {
-        diffuse: Texture::color(kd.clamp(Vec3::ZERO, Vec3::ONE)),
-        specular: Texture::color(ks.clamp(Vec3::ZERO, Vec3::ONE)),
+        diffuse: Texture::color(kd),
+        specular: Texture::color(ks),
         roughness: Texture::scalar(m.shininess.map_or(1.0, roughness_from_ns)),
         mirror: Texture::scalar(0.0),
         opacity: Texture::scalar(opacity),
-        transmission: Texture::color(transmission.clamp(Vec3::ZERO, Vec3::ONE)),
+        transmission: Texture::color(transmission),
         // Colours stay within [0, 1] (the panel's colour editor): the
         // emission's brightness goes into its strength.
-        emission: Texture::color(ke.max(Vec3::ZERO) / ke.max_element().max(1.0)),
+        emission: Texture::color(ke / ke.max_element().max(1.0)),
         emission_strength: ke.max_element().max(1.0),
         ..Material::default()
     };
@@ -414,6 +494,54 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<Vec<Pat
 mod tests {
     use super::*;
     use crate::scene::{Mesh, Property};
+
+    /// What an MTL or a `usemtl` says that marbre cannot take is replaced
+    /// with a note each, never silently: non-finite colours, colours and an
+    /// opacity out of range, an undefined material.
+    #[test]
+    fn replaced_values_and_undefined_materials_get_notes() {
+        let dir = tempfile::tempdir().unwrap();
+        write(
+            &dir,
+            "m.mtl",
+            "newmtl a\nKd nan inf -1\nKs 2 0.5 0.5\nKe 1e39 0 0\nd 2\n",
+        );
+        let obj = write(
+            &dir,
+            "m.obj",
+            &format!("mtllib m.mtl\n{QUAD}usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n"),
+        );
+        let loaded = load(&obj).unwrap();
+        let has = |parts: &[&str]| {
+            assert!(
+                loaded
+                    .notes
+                    .iter()
+                    .any(|n| parts.iter().all(|p| n.contains(p))),
+                "no note with {parts:?}: {:#?}",
+                loaded.notes
+            )
+        };
+        has(&[
+            "material `a`",
+            "`Kd NaN inf -1` is not finite; 0.8 0.8 0.8 is used",
+        ]);
+        has(&["`Ks 2 0.5 0.5` is outside 0 to 1; 1 0.5 0.5 is used"]);
+        has(&["`Ke inf 0 0` is not finite"]);
+        has(&["`d` gives an opacity of 2, outside 0 to 1; 1 is used"]);
+        has(&["m.obj:12: `usemtl b` names no material of its library; grey is used"]);
+        let a = &loaded
+            .materials
+            .iter()
+            .find(|m| m.name == "a")
+            .unwrap()
+            .material;
+        assert_eq!(a.diffuse.eval(Vec3::ZERO, Vec2::ZERO), Vec3::splat(0.8));
+        assert_eq!(
+            a.specular.eval(Vec3::ZERO, Vec2::ZERO),
+            Vec3::new(1.0, 0.5, 0.5)
+        );
+    }
 
     /// A library that is a device or a FIFO is refused (its note says why)
     /// instead of read until memory runs out or blocked on forever; an OBJ

@@ -500,23 +500,21 @@ impl Texture {
         for (name, child) in [("a", &mut self.a), ("b", &mut self.b)] {
             let path = format!("{what}.{name}");
             match child {
+                // An infinite value clamps like a large finite one (a TX
+                // `CD 1e20` whose lowering overflows is white, as `CD 2`
+                // is); only NaN, which has no side, becomes 0.
                 Child::Scalar(v) => {
-                    let s = if v.is_finite() {
-                        v.clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
+                    let s = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
                     if s != *v {
                         notes.push(format!("{path}: {v} clamped to [0, 1]"));
                         *v = s;
                     }
                 }
                 Child::Color(c) => {
-                    let s = if c.is_finite() {
-                        c.clamp(Vec3::ZERO, Vec3::ONE)
-                    } else {
-                        Vec3::ZERO
-                    };
+                    let s = Vec3::from_array(
+                        c.to_array()
+                            .map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) }),
+                    );
                     if s != *c {
                         notes.push(format!("{path}: colour {c} clamped to [0, 1]"));
                         *c = s;

@@ -1,6 +1,8 @@
 //! TX tokens: words (keywords and file names) and numbers, each with the
 //! line and column (1-based, in characters) where it starts, for messages.
 
+use crate::shown::shown;
+
 /// What a token is.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Tok {
@@ -25,22 +27,6 @@ impl Token {
             Tok::Number(n) => format!("number `{n}`"),
         }
     }
-}
-
-/// A word of the text as a message shows it: its control characters
-/// escaped (ESC as `\u{1b}`), so that a text cannot drive the terminal or
-/// the log that prints the message; everything else, accents included, as
-/// written.
-pub fn shown(word: &str) -> String {
-    let mut out = String::with_capacity(word.len());
-    for c in word.chars() {
-        if c.is_control() {
-            out.extend(c.escape_debug());
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }
 
 /// Splits `text` at blanks. A run is a number if Rust reads it as a

@@ -10,11 +10,11 @@
 
 use super::TxError;
 use super::ast::{Attr, Document, Frame, Rgb, Tex};
-use super::lexer::shown;
 use crate::noise::{FractalParams, NoiseSettings};
 use crate::scene::{
     Child, ColorEncoding, Material, Pattern, Property, Texture, TextureMapping, UvFrame,
 };
+use crate::shown::shown;
 use crate::texture::ImageSource;
 use glam::{Vec2, Vec3};
 use std::path::Path;

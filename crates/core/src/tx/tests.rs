@@ -290,6 +290,33 @@ fn a_typed_tx_colour_lowers_to_its_linear_value() {
     assert_eq!(kept, Texture::color(Vec3::new(0.54, 0.27, 0.0742)));
 }
 
+/// Colours beyond 1 are clamped alike once the scene is sanitised: `CD 2`,
+/// `CD 1e15` and `CD 1e20` (whose sRGB decoding overflows to infinity,
+/// once made black) all render white, each with a note.
+#[test]
+fn large_tx_colours_all_clamp_to_white() {
+    for text in [
+        "UNI CD 2 2 2 FTX",
+        "UNI CD 1e15 1e15 1e15 FTX",
+        "UNI CD 1e20 1e20 1e20 FTX",
+    ] {
+        let doc = parse(text).unwrap();
+        let base = crate::scene::Material::default();
+        let mut t = lower_channel(
+            &doc,
+            Channel::Diffuse,
+            &base.diffuse,
+            Path::new(""),
+            Colors::Linear,
+        )
+        .unwrap();
+        let mut notes = Vec::new();
+        t.sanitize("diffuse", &mut notes, 1);
+        assert_eq!(t.eval(Vec3::ZERO, glam::Vec2::ZERO), Vec3::ONE, "{text}");
+        assert!(!notes.is_empty(), "{text}: clamped without a note");
+    }
+}
+
 #[test]
 fn ct_splits_into_opacity_and_a_normalised_tint() {
     let mut m = crate::scene::Material::default();
