@@ -24,12 +24,12 @@ pub struct RenderArgs {
     pub env: Option<PathBuf>,
     /// Samples per pixel (default 64); with --target-error, the most it
     /// may take (default 16384).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_spp)]
     pub spp: Option<u32>,
     /// Stop as soon as the estimated relative error (√relMSE, from the
     /// spread of each pixel's frames, as the viewer's Quality panel shows
     /// it) is at or below this, e.g. 0.01 for 1 %.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_target_error)]
     pub target_error: Option<f64>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]

@@ -31,7 +31,7 @@ pub struct TxArgs {
     #[arg(long, default_value = "256x192", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Samples per pixel.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, allow_negative_numbers = true, value_parser = crate::parse_spp)]
     pub spp: u32,
     /// Print the parsed text back as TX instead of rendering.
     #[arg(long)]

@@ -77,6 +77,10 @@ pub enum PresetError {
     },
     #[error("{path}: not UTF-8 text (byte {offset}); a preset is a RON text file")]
     NotText { path: PathBuf, offset: usize },
+    #[error(
+        "{path}: the file is empty; a preset is a RON text such as presets/default.ron, starting with `(`"
+    )]
+    Empty { path: PathBuf },
     #[error("{path}:{line}:{column}: {field}{message}")]
     Syntax {
         path: PathBuf,
@@ -111,6 +115,11 @@ pub struct Loaded {
 /// Parses preset text. `path` is used in messages and to resolve the relative
 /// paths inside the file.
 pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
+    if text.trim().is_empty() {
+        return Err(PresetError::Empty {
+            path: path.to_owned(),
+        });
+    }
     let mut de =
         ron::Deserializer::from_str(text).map_err(|e| syntax_error(path, &e, String::new()))?;
     // Fields this build does not know (from a newer minor version, or a
@@ -129,7 +138,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
     let mut preset = match parsed {
         Ok(p) => p,
         Err(e) => {
+            // serde_path_to_error writes a field it had not yet named as
+            // `?` (the text ended before its name): the path stops at the
+            // last field that was named.
             let field = e.path().to_string();
+            let field = field.trim_end_matches(".?").trim_end_matches('?');
             let field = if field == "." || field.is_empty() {
                 String::new()
             } else {
@@ -208,12 +221,20 @@ fn field_path(path: &serde_ignored::Path) -> String {
 }
 
 fn syntax_error(path: &Path, e: &ron::error::SpannedError, field: String) -> PresetError {
+    let message = match e.code {
+        ron::Error::Eof => {
+            "the file ends here, in the middle of the preset (truncated? compare with a saved \
+             preset such as presets/default.ron)"
+                .to_owned()
+        }
+        ref code => code.to_string(),
+    };
     PresetError::Syntax {
         path: path.to_owned(),
         line: e.span.start.line,
         column: e.span.start.col,
         field,
-        message: e.code.to_string(),
+        message,
     }
 }
 
@@ -307,6 +328,27 @@ fn absolute(p: &Path) -> PathBuf {
 mod tests {
     use super::*;
     use crate::scene::EnvSource;
+
+    /// An empty file and a truncated one say so, naming the last field
+    /// reached (not `…camera.?` and "Unexpected end of RON").
+    #[test]
+    fn an_empty_or_truncated_preset_says_so() {
+        let path = Path::new("p.ron");
+        assert_eq!(
+            parse(" \n", path).unwrap_err().to_string(),
+            "p.ron: the file is empty; a preset is a RON text such as presets/default.ron, \
+             starting with `(`"
+        );
+        let whole = to_text(&Preset::default(), path).unwrap();
+        let line = whole.find("yaw_degrees").unwrap();
+        let cut = &whole[..line + whole[line..].find('\n').unwrap() + 1];
+        let message = parse(cut, path).unwrap_err().to_string();
+        assert!(
+            message.contains("in field `scene.camera`: the file ends here"),
+            "{message}"
+        );
+        assert!(!message.contains(".?"), "{message}");
+    }
 
     /// `/dev/zero` as a preset grew marbre to 24 GB; a FIFO blocked it.
     #[test]
