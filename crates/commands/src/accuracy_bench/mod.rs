@@ -54,8 +54,9 @@ pub struct AccuracyBenchArgs {
     /// Where references are kept between runs.
     #[arg(long, default_value = "target/marbre-references")]
     pub cache: PathBuf,
-    /// The folder holding presets/ and envmaps/.
-    #[arg(long, default_value = ".")]
+    /// The folder holding presets/ and envmaps/ (default: the repository
+    /// this marbre was built from, wherever it is run).
+    #[arg(long, default_value_os_t = repository_root())]
     pub root: PathBuf,
     /// The trace kernel: fragment, compute, or auto (the faster of the two
     /// on each sweep's scene, timed first; all the sweep's variants then
@@ -80,7 +81,22 @@ pub struct BenchResults {
     pub findings: Vec<(Knob, Vec<String>)>,
 }
 
+/// The repository marbre was built from: its scenes and maps are what the
+/// benchmark's figures are about, whatever the working folder.
+fn repository_root() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .canonicalize()
+        .unwrap_or_else(|_| PathBuf::from("."))
+}
+
 pub fn run(args: &AccuracyBenchArgs) -> Result<()> {
+    if !args.root.join("presets").is_dir() {
+        anyhow::bail!(
+            "{}: no presets/ folder here; give --root, the folder holding presets/ and envmaps/",
+            args.root.display()
+        );
+    }
+    eprintln!("scenes from {} (--root to change)", args.root.display());
     let ctx = GpuContext::headless()?;
     let results = run_on(&ctx, args, true)?;
     println!(
