@@ -160,9 +160,10 @@ pub enum DecodeError {
     },
     /// The extension is not one of [`SUPPORTED_EXTENSIONS`].
     #[error(
-        "{}: unsupported file type {}; supported: .exr, .hdr, .png, .jpg, .jpeg",
+        "{}: unsupported file type {}; supported: {}",
         .path.display(),
-        if .extension.is_empty() { "(no extension)".to_string() } else { format!(".{}", .extension) }
+        if .extension.is_empty() { "(no extension)".to_string() } else { format!(".{}", .extension) },
+        supported_list()
     )]
     UnsupportedExtension { path: PathBuf, extension: String },
     /// The decoder rejected the file; `message` is the decoder's own.
@@ -257,6 +258,11 @@ pub fn decode_file(path: &Path, decode: IntegerDecode) -> Result<DecodedImage, D
     decode_bytes(&bytes, path, decode)
 }
 
+/// [`SUPPORTED_EXTENSIONS`] as messages list them: `.exr, .hdr, …`.
+pub fn supported_list() -> String {
+    SUPPORTED_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
+}
+
 /// The lower-case extension of `path`, if it is one of
 /// [`SUPPORTED_EXTENSIONS`].
 pub fn supported_extension(path: &Path) -> Result<String, DecodeError> {
@@ -289,6 +295,7 @@ pub fn decode_bytes(
         "png" => decode_with_image(path, bytes, image::ImageFormat::Png, "PNG", decode)?,
         // The texture report's IMAGE format (P2, P3 in text; P5, P6 binary).
         "ppm" | "pgm" | "pnm" => {
+            let bytes = &clean_pnm_header(bytes);
             check_pnm_samples(bytes).map_err(|message| DecodeError::Decode {
                 path: path.to_path_buf(),
                 format: "PPM/PGM",
@@ -730,6 +737,61 @@ fn decode_message(message: &str) -> String {
     }
 }
 
+/// A netpbm file with its header rewritten plainly (`P6\nW H\nMAXVAL\n`,
+/// then the samples as they were): the format lets a `#` comment start
+/// anywhere in the header, right after a number too (`4#c`), which the
+/// `image` decoder refuses. A header that does not parse is left as it
+/// is, for the decoder to name what is wrong.
+fn clean_pnm_header(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    let mut at = 0;
+    let mut token = || -> Option<&[u8]> {
+        loop {
+            while bytes.get(at).is_some_and(u8::is_ascii_whitespace) {
+                at += 1;
+            }
+            if bytes.get(at) != Some(&b'#') {
+                break;
+            }
+            while bytes.get(at).is_some_and(|&b| b != b'\n') {
+                at += 1;
+            }
+        }
+        let start = at;
+        while bytes
+            .get(at)
+            .is_some_and(|&b| !b.is_ascii_whitespace() && b != b'#')
+        {
+            at += 1;
+        }
+        (at > start).then(|| &bytes[start..at])
+    };
+    let number = |t: Option<&[u8]>| std::str::from_utf8(t?).ok()?.parse::<u64>().ok();
+    let fields = match token() {
+        Some(magic @ (b"P2" | b"P3" | b"P5" | b"P6")) => {
+            let (w, h, max) = (number(token()), number(token()), number(token()));
+            (magic, w, h, Some(max))
+        }
+        Some(magic @ (b"P1" | b"P4")) => (magic, number(token()), number(token()), None),
+        _ => return bytes.into(),
+    };
+    let header = match fields {
+        (magic, Some(w), Some(h), None) => format!("{}\n{w} {h}\n", String::from_utf8_lossy(magic)),
+        (magic, Some(w), Some(h), Some(Some(max))) => {
+            format!("{}\n{w} {h}\n{max}\n", String::from_utf8_lossy(magic))
+        }
+        _ => return bytes.into(),
+    };
+    // The header's last number may be followed by a comment; then comes
+    // one white-space byte before the samples.
+    if bytes.get(at) == Some(&b'#') {
+        while bytes.get(at).is_some_and(|&b| b != b'\n') {
+            at += 1;
+        }
+    }
+    let samples = bytes.get(at + 1..).unwrap_or_default();
+    [header.as_bytes(), samples].concat().into()
+}
+
 /// An error if a PGM or PPM file (P2, P3, P5, P6) holds a sample above its
 /// maxval, which the `image` decoder would clamp without a word: such a
 /// file was written wrong, and its picture is not the one meant. Other
@@ -1152,7 +1214,9 @@ mod tests {
         let err = decode_file(&path, IntegerDecode::Srgb).unwrap_err();
         assert!(matches!(err, DecodeError::UnsupportedExtension { .. }));
         let msg = err.to_string();
-        for needle in ["sky.tga", ".tga", ".exr", ".hdr", ".png", ".jpg", ".jpeg"] {
+        for needle in [
+            "sky.tga", ".tga", ".exr", ".hdr", ".png", ".jpg", ".jpeg", ".ppm", ".pgm", ".pnm",
+        ] {
             assert!(msg.contains(needle), "{needle} not in {msg}");
         }
         let err = decode_file(Path::new("noext"), IntegerDecode::Srgb).unwrap_err();
@@ -1242,6 +1306,13 @@ mod tests {
         assert_eq!(p5.pixels[0][0], 32768.0 / 65535.0);
         assert_eq!(p5.pixels[1], [1.0, 1.0, 1.0, 1.0]);
         // sRGB codes by default, as for PNG: mid grey 188 is 0.5 linear.
+        // A comment right after a number, which the format allows.
+        let commented = linear(&write("f.pgm", b"P2\n1#c\n2 15#max\n0\n15\n"));
+        assert_eq!(commented.pixels, p2.pixels);
+        let mut binary = b"P5 2 1 255#c\n".to_vec();
+        binary.extend([0, 255]);
+        let binary = linear(&write("g.pgm", &binary));
+        assert_eq!(binary.pixels, [[0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0]]);
         let srgb = decode_file(&write("e.pgm", b"P2 1 1 255\n188\n"), IntegerDecode::Srgb).unwrap();
         assert!(
             (srgb.pixels[0][0] - 0.5029).abs() < 1e-3,

@@ -134,9 +134,10 @@ pub enum ImageError {
     },
     /// The extension is not one [`load_image`] understands.
     #[error(
-        "image texture {}: unsupported file type {}; supported: .png, .jpg, .jpeg, .hdr, .exr",
+        "image texture {}: unsupported file type {}; supported: {}",
         .path.display(),
-        if .extension.is_empty() { "(no extension)".to_string() } else { format!(".{}", .extension) }
+        if .extension.is_empty() { "(no extension)".to_string() } else { format!(".{}", .extension) },
+        crate::image_decode::supported_list()
     )]
     UnsupportedExtension { path: PathBuf, extension: String },
     /// The decoder rejected the file; `message` says why.
