@@ -6,6 +6,10 @@ use super::TxError;
 use super::ast::{Attr, Attrs, Document, Frame, FrameKind, Rgb, Tex};
 use super::lexer::{Tok, Token, tokenize};
 
+/// The most sides a DECOUPAGE polygon may have: past this it is a disc to
+/// any image, and f32 still holds every whole number up to it exactly.
+const MAX_SIDES: f32 = 1e6;
+
 /// What a message says is expected where a texture belongs.
 const A_TEXTURE: &str = "a texture (UNI, QUAD, TUILE, MULT, IMAGE, DECOUPAGE, NOISE, TURBULENCE, BOIS, MARBRE, BRIQUE or VAGUE)";
 
@@ -19,6 +23,9 @@ const MAX_NESTING: usize = 64;
 /// NOISE or TURBULENCE may be left out at the very end, as in the report's
 /// examples of those two).
 pub fn parse(text: &str) -> Result<Document, TxError> {
+    // A byte-order mark (Windows editors write one) is no part of the text:
+    // read as a word, it made an error about an invisible character.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut p = Parser {
         toks: tokenize(text),
         pos: 0,
@@ -239,13 +246,21 @@ impl Parser {
                 let sides_at = self.peek().cloned();
                 let [sides, radius] = self.params("DECOUPAGE", &["NBCOTE", "RAYON"], &[0])?;
                 let sides = sides.unwrap_or_default();
-                if sides < 0.0 || sides.fract() != 0.0 || sides > 1e6 {
+                if sides < 0.0 || sides.fract() != 0.0 || sides > MAX_SIDES {
                     let at = sides_at.map_or(self.end, |t| (t.line, t.column));
+                    // Numbers are read as f32: past 2^24 one may not be
+                    // the one typed (16777217 reads 16777216), so a number
+                    // over the limit is not echoed.
+                    let found = if sides > MAX_SIDES {
+                        format!("NBCOTE above {MAX_SIDES}")
+                    } else {
+                        format!("NBCOTE {sides}")
+                    };
                     return Err(TxError::syntax(
                         at.0,
                         at.1,
-                        "NBCOTE followed by a whole number of sides, 0 or more",
-                        &format!("NBCOTE {sides}"),
+                        &format!("NBCOTE followed by a whole number of sides, 0 to {MAX_SIDES}"),
+                        &found,
                     ));
                 }
                 Tex::Decoupage {

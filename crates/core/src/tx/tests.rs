@@ -62,6 +62,13 @@ const MALFORMED: &[(&str, usize, usize, &str)] = &[
         27,
         "whole number",
     ),
+    // Not echoed as the f32 it reads as (16777216).
+    (
+        "DECOUPAGE UNI FTX UNI FTX NBCOTE 16777217 FTX",
+        1,
+        27,
+        "0 to 1000000",
+    ),
     ("NOISE FREQ 1 AMPL 1 FTX", 1, 7, "CD1"),
     ("NOISE CD1 1 1 1 FREQ 1 FTX", 1, 24, "AMPL"),
     ("TURBULENCE CD1 1 1 1 AMPL 1", 1, 28, "FREQ"),
@@ -315,6 +322,16 @@ fn large_tx_colours_all_clamp_to_white() {
         assert_eq!(t.eval(Vec3::ZERO, glam::Vec2::ZERO), Vec3::ONE, "{text}");
         assert!(!notes.is_empty(), "{text}: clamped without a note");
     }
+}
+
+/// A text saved with a byte-order mark reads as the same text.
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_text() {
+    let plain = "UNI CD 1 0 0 FTX";
+    assert_eq!(
+        parse(&format!("\u{feff}{plain}")).unwrap(),
+        parse(plain).unwrap()
+    );
 }
 
 #[test]
