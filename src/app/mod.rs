@@ -143,9 +143,24 @@ impl ApplicationHandler for App {
     }
 }
 
+/// Whether the environment names no display server winit could reach.
+fn no_display() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+        .iter()
+        .all(|name| std::env::var_os(name).is_none_or(|v| v.is_empty()))
+}
+
 /// Opens the window and runs until it is closed (or the frame limit is hit).
 pub fn run(options: ViewerOptions) -> Result<()> {
-    let event_loop = EventLoop::new()?;
+    let event_loop = EventLoop::new().map_err(|e| match e {
+        // winit's message carries its own source path; say what to do.
+        winit::error::EventLoopError::Os(_) if no_display() => anyhow::anyhow!(
+            "no display to open a window on (neither DISPLAY nor WAYLAND_DISPLAY is set): run \
+             marbre in a desktop session, or under Xvfb (`xvfb-run marbre …`); the commands \
+             render, tx, bake and noise need no display"
+        ),
+        e => anyhow::anyhow!("cannot open a window: {e}"),
+    })?;
     // Progressive rendering: draw continuously while there is work to do.
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
