@@ -41,6 +41,8 @@ pub enum ObjError {
     Crashed { path: PathBuf },
     #[error("{path}: no triangle left to draw ({reason})")]
     Empty { path: PathBuf, reason: String },
+    #[error("{path}: not a text file ({what}); an OBJ file is text (`v`, `vt`, `f` lines)")]
+    NotText { path: PathBuf, what: &'static str },
 }
 
 /// An OBJ file's triangles (in the file's coordinates) and materials.
@@ -77,6 +79,12 @@ pub fn parse_bytes(
     path: &Path,
     read_library: impl Fn(&Path) -> std::io::Result<Vec<u8>>,
 ) -> Result<LoadedObj, ObjError> {
+    if let Some(what) = binary_kind(bytes) {
+        return Err(ObjError::NotText {
+            path: path.to_owned(),
+            what,
+        });
+    }
     let text = String::from_utf8_lossy(bytes);
     // tobj says what is wrong but not where, and panics on some malformed
     // statements: the syntax check runs first and names the line.
@@ -353,6 +361,23 @@ fn strip_options(statement: &str) -> (&str, Option<f32>) {
     (file, bump_multiplier)
 }
 
+/// What binary file `bytes` look like, if they are not text: an image
+/// renamed `.obj` gave tobj's "face parse error" with no line.
+fn binary_kind(bytes: &[u8]) -> Option<&'static str> {
+    const MAGIC: [(&[u8], &str); 4] = [
+        (b"\x89PNG", "a PNG image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (b"\x76\x2f\x31\x01", "an EXR image"),
+        (b"PK\x03\x04", "a ZIP archive"),
+    ];
+    let head = &bytes[..bytes.len().min(4096)];
+    MAGIC
+        .iter()
+        .find(|(magic, _)| bytes.starts_with(magic))
+        .map(|&(_, what)| what)
+        .or_else(|| head.contains(&0).then_some("it holds NUL bytes"))
+}
+
 /// The `usemtl` statements of `text` naming none of `materials`: their
 /// line and the name, the first use of each name only.
 fn undefined_materials<'t>(text: &'t str, materials: &[tobj::Material]) -> Vec<(usize, &'t str)> {
@@ -494,6 +519,21 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<Vec<Pat
 mod tests {
     use super::*;
     use crate::scene::{Mesh, Property};
+
+    /// An image renamed `.obj` is named as what it is, not "face parse
+    /// error" without a line.
+    #[test]
+    fn a_binary_file_is_refused_as_not_text() {
+        let png = parse_bytes(b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR", Path::new("p.obj"), |_| {
+            Ok(Vec::new())
+        });
+        assert_eq!(
+            png.unwrap_err().to_string(),
+            "p.obj: not a text file (a PNG image); an OBJ file is text (`v`, `vt`, `f` lines)"
+        );
+        let nul = parse_bytes(b"v 0 0 0\n\0\0", Path::new("n.obj"), |_| Ok(Vec::new()));
+        assert!(nul.unwrap_err().to_string().contains("NUL bytes"));
+    }
 
     /// What an MTL or a `usemtl` says that marbre cannot take is replaced
     /// with a note each, never silently: non-finite colours, colours and an
