@@ -111,7 +111,10 @@ pub fn parse_bytes(
             Err(e) => {
                 *library_problem.borrow_mut() = Some((
                     mtl.clone(),
-                    format!("its material library {} cannot be read: {e}", mtl.display()),
+                    format!(
+                        "its material library {} cannot be read: {e}",
+                        shown(&mtl.display().to_string())
+                    ),
                 ));
                 return Err(tobj::LoadError::OpenFileFailed);
             }
@@ -121,7 +124,7 @@ pub fn parse_bytes(
                 mtl.clone(),
                 format!(
                     "its material library {}:{line} cannot be read: `{}`",
-                    mtl.display(),
+                    shown(&mtl.display().to_string()),
                     shown(&statement)
                 ),
             ));
@@ -175,7 +178,7 @@ pub fn parse_bytes(
         notes.extend(
             material_notes
                 .into_iter()
-                .map(|n| format!("{}: material `{}`: {n}", path.display(), m.name)),
+                .map(|n| format!("{}: material `{}`: {n}", path.display(), shown(&m.name))),
         );
         out.materials.push(MeshMaterial {
             name: m.name.clone(),
@@ -310,7 +313,7 @@ fn image_texture(
     if !path.exists() {
         notes.push(format!(
             "texture {} not found: shown as the magenta placeholder",
-            path.display()
+            shown(&path.display().to_string())
         ));
     }
     let mut t = Texture::blend(
@@ -519,6 +522,25 @@ pub fn load_meshes(scene: &mut Scene, notes: &mut Vec<String>) -> Result<Vec<Pat
 mod tests {
     use super::*;
     use crate::scene::{Mesh, Property};
+
+    /// Names from the file (a library, a material, a texture) reach the
+    /// notes with their control characters escaped: an OBJ cannot drive
+    /// the terminal that prints them.
+    #[test]
+    fn control_characters_from_the_file_are_escaped_in_notes() {
+        let dir = tempfile::tempdir().unwrap();
+        let obj = write(
+            &dir,
+            "e.obj",
+            &format!("mtllib \u{1b}[2Jx.mtl\n{QUAD}usemtl \u{1b}[31m\nf 1 2 3\n"),
+        );
+        let notes = load(&obj).unwrap().notes;
+        assert!(!notes.is_empty());
+        for note in &notes {
+            assert!(!note.contains('\u{1b}'), "{note}");
+            assert!(note.contains("\\u{1b}"), "{note}");
+        }
+    }
 
     /// An image renamed `.obj` is named as what it is, not "face parse
     /// error" without a line.
