@@ -135,11 +135,11 @@ pub fn snapshot(scene: Scene, images: ImageSet) -> Result<LoadedScene> {
 }
 
 /// The renderer of a final render, or one clear error before any tracing
-/// if the GPU cannot hold its images: its targets and the buffer the
-/// largest read-back (an EXR's float radiance) needs are allocated under an
-/// out-of-memory error scope, which wgpu would otherwise treat as fatal
-/// (a 16384² render panicked on lavapipe, whose largest allocation is
-/// smaller than one of its 4 GiB targets).
+/// if the GPU cannot hold its images: its targets are allocated under an
+/// out-of-memory error scope, which wgpu would otherwise treat as fatal (a
+/// 16384² render panicked on lavapipe, whose largest allocation is smaller
+/// than one of its 4 GiB targets). The read-back after the render goes in
+/// bands of bounded size (`gpu::readback`), so it needs no large buffer.
 fn renderer_fitting(
     ctx: &GpuContext,
     loaded: &LoadedScene,
@@ -151,15 +151,8 @@ fn renderer_fitting(
     // there) is invalid too: caught, and reported as the allocation.
     let validity = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let renderer = renderer_with(ctx, loaded, size, kernel);
-    let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("read-back size probe"),
-        size: u64::from(size.0) * u64::from(size.1) * RADIANCE_BYTES_PER_PIXEL,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
     let invalid = pollster::block_on(validity.pop());
     let out_of_memory = pollster::block_on(memory.pop());
-    readback.destroy();
     if let Some(e) = out_of_memory {
         bail!(
             "a {} × {} render does not fit in the memory of {} ({e}); nothing was traced: \
@@ -178,9 +171,6 @@ fn renderer_fitting(
     }
     renderer
 }
-
-/// Bytes per pixel of the float radiance an EXR is read back as (RGBA f32).
-const RADIANCE_BYTES_PER_PIXEL: u64 = 16;
 
 /// An error naming the files of `loaded` that could not be read and were
 /// replaced (see the notes for why), if any.

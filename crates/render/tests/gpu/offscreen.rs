@@ -524,3 +524,46 @@ fn a_feature_can_be_compiled_out_unless_the_texture_code_needs_it() {
     let bottom = |image: &[[f32; 4]]| image[image.len() - size.0 as usize..].to_vec();
     assert_ne!(bottom(&with_ground), bottom(&without_ground));
 }
+
+/// A texture read back in bands of a few rows (as a 16384² image is, in
+/// bands of 256 MiB) comes back as written, rows tightly packed, whatever
+/// the band: one row, three rows with a short last band, all at once.
+#[test]
+fn a_texture_read_in_bands_comes_back_as_written() {
+    let Some(ctx) = gpu_or_skip("a_texture_read_in_bands_comes_back_as_written") else {
+        return;
+    };
+    let (w, h) = (70u32, 11u32);
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bands"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let written: Vec<u8> = (0..w * h * 4).map(|i| (i * 7 % 251) as u8).collect();
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        &written,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(w * 4),
+            rows_per_image: Some(h),
+        },
+        texture.size(),
+    );
+    use marbre_render::gpu::readback::read_texture_in_bands;
+    // A row is padded to 512 bytes in the buffer: 512 bytes is one row a
+    // band, 1536 three, and a megabyte all eleven.
+    for band in [512, 1536, 1 << 20] {
+        let read = read_texture_in_bands(&ctx.device, &ctx.queue, &texture, 4, band).unwrap();
+        assert!(read == written, "band of {band} bytes");
+    }
+}
