@@ -187,6 +187,19 @@ pub fn check_writable(path: &Path) -> std::io::Result<()> {
 }
 
 #[cfg(test)]
+pub(crate) mod test_support {
+    /// A file at `path` holding `bytes`, marked read-only (which root,
+    /// running the tests in CI, could still write: the saves check the
+    /// mark itself).
+    pub fn read_only_file(path: &std::path::Path, bytes: &[u8]) {
+        std::fs::write(path, bytes).unwrap();
+        let mut permissions = std::fs::metadata(path).unwrap().permissions();
+        permissions.set_readonly(true);
+        std::fs::set_permissions(path, permissions).unwrap();
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -234,9 +247,7 @@ mod tests {
         write_atomic_pair((&image, b"image 2"), (&sidecar, b"size: 64")).unwrap();
         assert_eq!(std::fs::read(&image).unwrap(), b"image 2");
         assert_eq!(std::fs::read(&sidecar).unwrap(), b"size: 64");
-        let mut permissions = std::fs::metadata(&sidecar).unwrap().permissions();
-        permissions.set_readonly(true);
-        std::fs::set_permissions(&sidecar, permissions).unwrap();
+        test_support::read_only_file(&sidecar, b"size: 64");
         assert!(write_atomic_pair((&image, b"image 3"), (&sidecar, b"size: 16")).is_err());
         assert_eq!(std::fs::read(&image).unwrap(), b"image 2");
         assert_eq!(std::fs::read(&sidecar).unwrap(), b"size: 64");
@@ -253,10 +264,7 @@ mod tests {
     fn a_read_only_file_and_a_folder_are_refused() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("kept.exr");
-        std::fs::write(&path, b"old").unwrap();
-        let mut permissions = std::fs::metadata(&path).unwrap().permissions();
-        permissions.set_readonly(true);
-        std::fs::set_permissions(&path, permissions).unwrap();
+        test_support::read_only_file(&path, b"old");
         assert!(
             check_writable(&path)
                 .unwrap_err()

@@ -737,59 +737,82 @@ fn decode_message(message: &str) -> String {
     }
 }
 
+/// A netpbm file's tokens: runs of non-blank bytes, each ended by a blank
+/// or a `#`, with `#` comments (to the end of the line) skipped.
+struct NetpbmTokens<'b> {
+    bytes: &'b [u8],
+    at: usize,
+}
+
+impl<'b> NetpbmTokens<'b> {
+    fn new(bytes: &'b [u8]) -> Self {
+        Self { bytes, at: 0 }
+    }
+
+    fn skip_comment(&mut self) {
+        while self.bytes.get(self.at).is_some_and(|&b| b != b'\n') {
+            self.at += 1;
+        }
+    }
+
+    fn next_token(&mut self) -> Option<&'b [u8]> {
+        loop {
+            while self.bytes.get(self.at).is_some_and(u8::is_ascii_whitespace) {
+                self.at += 1;
+            }
+            if self.bytes.get(self.at) != Some(&b'#') {
+                break;
+            }
+            self.skip_comment();
+        }
+        let start = self.at;
+        while self
+            .bytes
+            .get(self.at)
+            .is_some_and(|&b| !b.is_ascii_whitespace() && b != b'#')
+        {
+            self.at += 1;
+        }
+        (self.at > start).then(|| &self.bytes[start..self.at])
+    }
+
+    fn number(&mut self) -> Option<u64> {
+        std::str::from_utf8(self.next_token()?).ok()?.parse().ok()
+    }
+
+    /// The binary samples, once the header's last number is read: past a
+    /// comment right after it, then the one white-space byte before them.
+    fn samples(&mut self) -> &'b [u8] {
+        if self.bytes.get(self.at) == Some(&b'#') {
+            self.skip_comment();
+        }
+        self.bytes.get(self.at + 1..).unwrap_or_default()
+    }
+}
+
 /// A netpbm file with its header rewritten plainly (`P6\nW H\nMAXVAL\n`,
 /// then the samples as they were): the format lets a `#` comment start
 /// anywhere in the header, right after a number too (`4#c`), which the
 /// `image` decoder refuses. A header that does not parse is left as it
 /// is, for the decoder to name what is wrong.
 fn clean_pnm_header(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
-    let mut at = 0;
-    let mut token = || -> Option<&[u8]> {
-        loop {
-            while bytes.get(at).is_some_and(u8::is_ascii_whitespace) {
-                at += 1;
-            }
-            if bytes.get(at) != Some(&b'#') {
-                break;
-            }
-            while bytes.get(at).is_some_and(|&b| b != b'\n') {
-                at += 1;
-            }
-        }
-        let start = at;
-        while bytes
-            .get(at)
-            .is_some_and(|&b| !b.is_ascii_whitespace() && b != b'#')
-        {
-            at += 1;
-        }
-        (at > start).then(|| &bytes[start..at])
-    };
-    let number = |t: Option<&[u8]>| std::str::from_utf8(t?).ok()?.parse::<u64>().ok();
-    let fields = match token() {
+    let mut tokens = NetpbmTokens::new(bytes);
+    let header = match tokens.next_token() {
         Some(magic @ (b"P2" | b"P3" | b"P5" | b"P6")) => {
-            let (w, h, max) = (number(token()), number(token()), number(token()));
-            (magic, w, h, Some(max))
+            match (tokens.number(), tokens.number(), tokens.number()) {
+                (Some(w), Some(h), Some(max)) => {
+                    format!("{}\n{w} {h}\n{max}\n", String::from_utf8_lossy(magic))
+                }
+                _ => return bytes.into(),
+            }
         }
-        Some(magic @ (b"P1" | b"P4")) => (magic, number(token()), number(token()), None),
+        Some(magic @ (b"P1" | b"P4")) => match (tokens.number(), tokens.number()) {
+            (Some(w), Some(h)) => format!("{}\n{w} {h}\n", String::from_utf8_lossy(magic)),
+            _ => return bytes.into(),
+        },
         _ => return bytes.into(),
     };
-    let header = match fields {
-        (magic, Some(w), Some(h), None) => format!("{}\n{w} {h}\n", String::from_utf8_lossy(magic)),
-        (magic, Some(w), Some(h), Some(Some(max))) => {
-            format!("{}\n{w} {h}\n{max}\n", String::from_utf8_lossy(magic))
-        }
-        _ => return bytes.into(),
-    };
-    // The header's last number may be followed by a comment; then comes
-    // one white-space byte before the samples.
-    if bytes.get(at) == Some(&b'#') {
-        while bytes.get(at).is_some_and(|&b| b != b'\n') {
-            at += 1;
-        }
-    }
-    let samples = bytes.get(at + 1..).unwrap_or_default();
-    [header.as_bytes(), samples].concat().into()
+    [header.as_bytes(), tokens.samples()].concat().into()
 }
 
 /// An error if a PGM or PPM file (P2, P3, P5, P6) holds a sample above its
@@ -797,35 +820,14 @@ fn clean_pnm_header(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
 /// file was written wrong, and its picture is not the one meant. Other
 /// files, and headers the decoder will refuse itself, pass.
 fn check_pnm_samples(bytes: &[u8]) -> Result<(), String> {
-    let mut at = 0;
-    // The header: magic, width, height, maxval, each after white space or
-    // `#` comments, then one white-space byte before binary samples.
-    let mut token = || -> Option<&[u8]> {
-        loop {
-            while bytes.get(at).is_some_and(u8::is_ascii_whitespace) {
-                at += 1;
-            }
-            if bytes.get(at) != Some(&b'#') {
-                break;
-            }
-            while bytes.get(at).is_some_and(|&b| b != b'\n') {
-                at += 1;
-            }
-        }
-        let start = at;
-        while bytes.get(at).is_some_and(|b| !b.is_ascii_whitespace()) {
-            at += 1;
-        }
-        (at > start).then(|| &bytes[start..at])
-    };
-    let magic = token();
-    let number = |t: Option<&[u8]>| std::str::from_utf8(t?).ok()?.parse::<u64>().ok();
-    let text = match magic {
+    // The header: magic, width, height, maxval, then the samples.
+    let mut tokens = NetpbmTokens::new(bytes);
+    let text = match tokens.next_token() {
         Some(b"P2" | b"P3") => true,
         Some(b"P5" | b"P6") => false,
         _ => return Ok(()),
     };
-    let (Some(_), Some(_), Some(maxval)) = (number(token()), number(token()), number(token()))
+    let (Some(_), Some(_), Some(maxval)) = (tokens.number(), tokens.number(), tokens.number())
     else {
         return Ok(());
     };
@@ -834,14 +836,17 @@ fn check_pnm_samples(bytes: &[u8]) -> Result<(), String> {
     };
     if text {
         let mut index = 0;
-        while let Some(t) = token() {
-            match number(Some(t)) {
+        while let Some(t) = tokens.next_token() {
+            let value = std::str::from_utf8(t)
+                .ok()
+                .and_then(|t| t.parse::<u64>().ok());
+            match value {
                 Some(v) if v > maxval => return Err(above(index, v)),
                 _ => index += 1,
             }
         }
     } else if maxval < 255 {
-        let samples = bytes.get(at + 1..).unwrap_or_default();
+        let samples = tokens.samples();
         if let Some((index, &v)) = samples
             .iter()
             .enumerate()
@@ -850,7 +855,7 @@ fn check_pnm_samples(bytes: &[u8]) -> Result<(), String> {
             return Err(above(index, v.into()));
         }
     } else if maxval > 255 && maxval < 65535 {
-        let samples = bytes.get(at + 1..).unwrap_or_default();
+        let samples = tokens.samples();
         let values = samples
             .chunks_exact(2)
             .map(|b| u64::from(u16::from_be_bytes([b[0], b[1]])));

@@ -151,10 +151,7 @@ mod tests {
             format!("cannot write {}: it is a folder", folder.display())
         );
         let kept = dir.path().join("kept.exr");
-        std::fs::write(&kept, b"old").unwrap();
-        let mut permissions = std::fs::metadata(&kept).unwrap().permissions();
-        permissions.set_readonly(true);
-        std::fs::set_permissions(&kept, permissions).unwrap();
+        crate::atomic_write::test_support::read_only_file(&kept, b"old");
         assert!(
             check_output(&kept)
                 .unwrap_err()
