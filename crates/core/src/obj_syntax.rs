@@ -4,29 +4,37 @@
 //! statements marbre reads; others are skipped as `tobj` skips them.
 
 /// The 1-based number and text of the first line of an OBJ file that `tobj`
-/// would refuse: numbers that do not parse, faces with fewer than three
-/// corners, or indices that point at no vertex.
+/// would refuse: numbers that do not parse, a vertex with other than three
+/// coordinates (four with a non-zero w, or six with a colour), a texture
+/// coordinate without two, a face with fewer than three corners, or an
+/// index that points at no element declared on an earlier line.
+///
+/// Indices count only what earlier lines declared, as the OBJ format
+/// defines them and as `tobj` resolves negative ones: counted over the
+/// whole file instead, `f 1/-1 2/-1 3/-1` before the file's first `vt`
+/// passed, `tobj` (4.0.5) turned -1 into `usize::MAX` and multiplied it
+/// (an overflow, or in a release build "face texcoord index out of
+/// bounds" with no line).
 pub fn first_bad_obj_line(text: &str) -> Option<(usize, String)> {
-    let count = |key: &str| {
-        text.lines()
-            .filter(|l| statement(l).next() == Some(key))
-            .count() as i64
-    };
-    let (vertices, texcoords, normals) = (count("v"), count("vt"), count("vn"));
+    // Positions, texture coordinates and normals declared so far.
+    let mut declared = [0u64; 3];
     text.lines().enumerate().find_map(|(i, line)| {
         let mut words = statement(line);
-        let ok = match words.next() {
-            Some("v") | Some("vn") => floats(words).is_some_and(|n| n >= 3),
-            Some("vt") => floats(words).is_some_and(|n| n >= 1),
+        let (ok, declares) = match words.next() {
+            Some("v") => (vertex_ok(words), Some(0)),
+            // tobj reads two numbers and fails on fewer.
+            Some("vt") => (floats(words).is_some_and(|n| n >= 2), Some(1)),
+            Some("vn") => (floats(words).is_some_and(|n| n >= 3), Some(2)),
             Some("f") => {
                 let corners: Vec<&str> = words.collect();
-                corners.len() >= 3
-                    && corners
-                        .iter()
-                        .all(|c| corner_ok(c, [vertices, texcoords, normals]))
+                let ok = corners.len() >= 3 && corners.iter().all(|c| corner_ok(c, declared));
+                (ok, None)
             }
-            _ => true,
+            _ => (true, None),
         };
+        if let Some(kind) = declares {
+            declared[kind] += 1;
+        }
         (!ok).then(|| (i + 1, line.trim().to_owned()))
     })
 }
@@ -63,24 +71,44 @@ fn floats<'a>(words: impl Iterator<Item = &'a str>) -> Option<usize> {
     Some(n)
 }
 
-/// Whether a face corner `v`, `v/t`, `v//n` or `v/t/n` names existing
-/// elements (negative indices count back from the end, as OBJ allows).
-fn corner_ok(corner: &str, counts: [i64; 3]) -> bool {
+/// Whether a `v` statement's words are what `tobj` takes: x y z, then
+/// nothing, a w it divides them by (not zero), or an r g b colour.
+fn vertex_ok<'a>(words: impl Iterator<Item = &'a str>) -> bool {
+    let mut values = Vec::new();
+    for w in words {
+        match w.parse::<f32>() {
+            Ok(v) => values.push(v),
+            Err(_) => return false,
+        }
+    }
+    match values.len() {
+        3 | 6 => true,
+        4 => values[3] != 0.0,
+        _ => false,
+    }
+}
+
+/// Whether a face corner `v`, `v/t`, `v//n` or `v/t/n` names elements
+/// among the `declared` ones (negative indices count back from the last,
+/// as OBJ allows).
+fn corner_ok(corner: &str, declared: [u64; 3]) -> bool {
     let parts: Vec<&str> = corner.split('/').collect();
     if parts.is_empty() || parts.len() > 3 {
         return false;
     }
-    parts.iter().zip(counts).enumerate().all(|(k, (p, count))| {
-        if p.is_empty() {
-            // Only the texture slot of `v//n` may be empty.
-            return k == 1 && parts.len() == 3;
-        }
-        match p.parse::<i64>() {
-            Ok(i) if i > 0 => i <= count,
-            Ok(i) if i < 0 => -i <= count,
-            _ => false,
-        }
-    })
+    parts
+        .iter()
+        .zip(declared)
+        .enumerate()
+        .all(|(k, (p, count))| {
+            if p.is_empty() {
+                // Only the texture slot of `v//n` may be empty.
+                return k == 1 && parts.len() == 3;
+            }
+            // 0 is no index; i64::MIN has no negation, hence unsigned_abs.
+            p.parse::<i64>()
+                .is_ok_and(|i| i != 0 && i.unsigned_abs() <= count)
+        })
 }
 
 #[cfg(test)]
@@ -111,5 +139,45 @@ mod tests {
         assert_eq!(first_bad_mtl_line("newmtl a\nmap_Kd\n").unwrap().0, 2);
         assert_eq!(first_bad_mtl_line("newmtl a\nNs ten\n").unwrap().0, 2);
         assert_eq!(first_bad_mtl_line("newmtl a\nKa 0.6 0.1 0.1 # red\n"), None);
+    }
+
+    /// Indices point only at what earlier lines declared. The texture
+    /// coordinates counted back from before the first `vt` are the input
+    /// that overflowed `tobj` 4.0.5 (`vt * 2`, lib.rs:852).
+    #[test]
+    fn indices_point_only_at_elements_declared_before_the_face() {
+        let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let bad = |obj: &str| first_bad_obj_line(obj).map(|(line, _)| line);
+        assert_eq!(
+            first_bad_obj_line(&format!("{triangle}f 1/-2 2/-2 3/-2\nvt 0 0\nvt 1 1\n")),
+            Some((4, "f 1/-2 2/-2 3/-2".into()))
+        );
+        assert_eq!(
+            bad(&format!("{triangle}f 1//-1 2//-1 3//-1\nvn 0 0 1\n")),
+            Some(4)
+        );
+        assert_eq!(bad("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"), Some(3));
+        assert_eq!(
+            bad(&format!("{triangle}vt 0 0\nvt 1 1\nf 1/-2 2/-1 3/2\n")),
+            None
+        );
+        // No negation of i64::MIN to overflow here either.
+        assert_eq!(
+            bad(&format!("{triangle}f 1 2 -9223372036854775808\n")),
+            Some(4)
+        );
+        assert_eq!(bad(&format!("{triangle}f 0 1 2\n")), Some(4));
+    }
+
+    /// `v` takes three coordinates, then a non-zero w or an r g b colour;
+    /// `vt` two numbers: anything else `tobj` refuses without a line.
+    #[test]
+    fn vertices_and_texture_coordinates_have_the_counts_tobj_reads() {
+        let bad = |obj: &str| first_bad_obj_line(obj).map(|(line, _)| line);
+        assert_eq!(bad("v 0 0 0 2\nv 0 0 0 1 0.5 0\n"), None);
+        assert_eq!(bad("v 0 0 0\nv 0 0 0 0\n"), Some(2));
+        assert_eq!(bad("v 0 0 0 1 1\n"), Some(1));
+        assert_eq!(bad("v 0 0 0 1 1 1 1\n"), Some(1));
+        assert_eq!(bad("vt 0.5 0.5 0\nvt 0.5\n"), Some(2));
     }
 }

@@ -119,6 +119,30 @@ fn obj_inputs_load_or_give_an_error_naming_the_file() {
     });
 }
 
+/// The input that overflowed `tobj` 4.0.5 (`f 1/-2 …` before the file's
+/// `vt` lines: counted back from none, the index wrapped to nearly
+/// `usize::MAX` and `tobj` multiplied it) is refused before `tobj` reads
+/// it, naming the file and the face's line.
+#[test]
+fn the_tobj_overflow_is_refused_with_its_line() {
+    let (file, bytes) = inputs("obj")
+        .into_iter()
+        .find(|(file, _)| file.ends_with("tobj_overflow_texcoord_before_declared"))
+        .expect("the regression file");
+    let (obj, _) = obj_and_library(&bytes);
+    let e = marbre_core::obj_loader::parse_bytes(obj, Path::new("/fuzz/obj/input.obj"), |_| {
+        Err(std::io::ErrorKind::NotFound.into())
+    })
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("input.obj:4: not a valid OBJ statement: `f 1/-2 2/-2 3/-2`"),
+        "{}: {e}",
+        file.display()
+    );
+}
+
 /// The fuzz target's split: the first byte picks the extension (by its low
 /// seven bits) and how integer codes decode (by its top bit), the rest is the
 /// file.
