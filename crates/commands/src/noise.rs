@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use marbre_core::noise::fractal::{FractalShape, fractal_sum_f64, noise_f64};
+use marbre_core::noise::points::read_points;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
@@ -61,8 +62,8 @@ pub struct NoiseArgs {
     /// Print turbulence (a sum of |noise|) instead of one octave of noise.
     #[arg(long)]
     pub turbulence: bool,
-    /// Evaluate with the CPU reference (double precision, 12 decimals)
-    /// instead of the shader (single precision, 9 decimals).
+    /// Evaluate with the CPU reference (double precision) instead of the
+    /// shader (single precision); both print 9 significant digits.
     #[arg(long)]
     pub cpu: bool,
     /// Instead of reading points, draw the far-from-the-origin figure (the
@@ -110,37 +111,6 @@ impl NoiseArgs {
     }
 }
 
-/// Parses `x,y,z` lines (spaces allowed, blank lines and `#` comments
-/// skipped), in double precision.
-pub fn parse_points(input: impl BufRead) -> Result<Vec<DVec3>> {
-    let mut points = Vec::new();
-    for (i, line) in input.lines().enumerate() {
-        let line = line.context("reading stdin")?;
-        let t = line.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        let values: Vec<f64> = t
-            .split([',', ' ', '\t'])
-            .filter(|s| !s.is_empty())
-            .map(str::parse)
-            .collect::<Result<_, _>>()
-            .with_context(|| format!("line {}: `{t}` is not x,y,z", i + 1))?;
-        let [x, y, z] = values[..] else {
-            bail!(
-                "line {}: expected 3 numbers x,y,z, found {}",
-                i + 1,
-                values.len()
-            );
-        };
-        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-            bail!("line {}: coordinates must be finite", i + 1);
-        }
-        points.push(DVec3::new(x, y, z));
-    }
-    Ok(points)
-}
-
 /// The CPU reference for the same request, in double precision.
 pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[DVec3]) -> Vec<f64> {
     points
@@ -157,21 +127,100 @@ pub fn run(args: &NoiseArgs) -> Result<()> {
     if let Some(path) = &args.stability_figure {
         return super::noise_figure::write(path);
     }
-    let points = parse_points(std::io::stdin().lock())?;
     let settings = args.settings();
-    let mut out = std::io::stdout().lock();
-    if args.cpu {
-        for v in evaluate_cpu(&settings, args.what(), &points) {
-            writeln!(out, "{v:.12}")?;
-        }
-    } else {
-        let ctx = GpuContext::headless()?;
-        let points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
-        for v in evaluate_scalar(&ctx, &settings, args.what(), &points)? {
-            writeln!(out, "{v:.9}")?;
+    evaluate_input(
+        std::io::stdin().lock(),
+        &mut std::io::stdout().lock(),
+        &mut std::io::stderr().lock(),
+        |points| {
+            if args.cpu {
+                Ok(evaluate_cpu(&settings, args.what(), points))
+            } else {
+                evaluate_gpu(&GpuContext::headless()?, &settings, args.what(), points)
+            }
+        },
+    )
+}
+
+/// The shader's values at `points` (rounded to f32 first, as the shader
+/// sees them), widened to f64 exactly.
+fn evaluate_gpu(
+    ctx: &GpuContext,
+    settings: &NoiseSettings,
+    what: Evaluate,
+    points: &[DVec3],
+) -> Result<Vec<f64>> {
+    let points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
+    Ok(evaluate_scalar(ctx, settings, what, &points)?
+        .into_iter()
+        .map(f64::from)
+        .collect())
+}
+
+/// Reads the points of `input`, reporting each bad line on `err` by its
+/// number and what is wrong with it, then writes the value `evaluate`
+/// gives at each good one to `out`, one a line in their order (`evaluate`
+/// is not called when there is none: no GPU is opened for nothing). Any
+/// bad line fails the run at the end, once the good ones are written, so
+/// that one typo neither hides the other values nor passes unnoticed.
+fn evaluate_input(
+    input: impl BufRead,
+    out: &mut impl Write,
+    err: &mut impl Write,
+    evaluate: impl FnOnce(&[DVec3]) -> Result<Vec<f64>>,
+) -> Result<()> {
+    let mut points = Vec::new();
+    let mut bad = 0usize;
+    for line in read_points(input) {
+        let line = line.context("reading stdin")?;
+        match line.point {
+            Ok(p) => points.push(p),
+            Err(why) => {
+                bad += 1;
+                writeln!(err, "marbre noise: line {}: {why}", line.number)?;
+            }
         }
     }
+    if !points.is_empty() {
+        for v in evaluate(&points)? {
+            writeln!(out, "{}", format_value(v))?;
+        }
+    }
+    if bad > 0 {
+        bail!(
+            "{bad} input line(s) were not points x,y,z (listed above); the {} others were evaluated",
+            points.len()
+        );
+    }
     Ok(())
+}
+
+/// How many significant digits both paths print. The shader computes in
+/// f32, and 9 significant digits tell every f32 apart (they read back to
+/// the same f32): fewer would drop digits it computed, more would print
+/// digits it never computed. The CPU's f64 values print the same way, so
+/// the two outputs compare line by line.
+const SIGNIFICANT_DIGITS: usize = 9;
+
+/// `v` with [`SIGNIFICANT_DIGITS`] significant digits: positional between
+/// 1e-4 and 1e9, as C's `%g` chooses, scientific outside (far-out
+/// amplitudes, values that round to tiny numbers); non-finite values as
+/// Rust writes them.
+fn format_value(v: f64) -> String {
+    let scientific = format!("{v:.*e}", SIGNIFICANT_DIGITS - 1);
+    let Some(exponent) = scientific
+        .split_once('e')
+        .and_then(|(_, e)| e.parse::<i32>().ok())
+    else {
+        return scientific;
+    };
+    let digits = SIGNIFICANT_DIGITS as i32;
+    if (-4..digits).contains(&exponent) {
+        let decimals = (digits - 1 - exponent) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        scientific
+    }
 }
 
 #[cfg(test)]
@@ -179,6 +228,7 @@ mod tests {
     use super::*;
     use clap::Parser;
     use marbre_core::noise::improved_noise_f32;
+    use marbre_render::gpu::testing::gpu_or_skip;
 
     #[derive(Parser)]
     struct Cli {
@@ -203,7 +253,9 @@ mod tests {
             .iter()
             .map(|r| format!("{},{},{}\n", r[0], r[1], r[2]))
             .collect();
-        let points = parse_points(input.as_bytes()).unwrap();
+        let points = read_points(input.as_bytes())
+            .map(|line| line.unwrap().point.unwrap())
+            .collect();
         (points, rows.iter().map(|r| r[3]).collect())
     }
 
@@ -278,5 +330,109 @@ mod tests {
                 .sum();
             assert!((got - his).abs() < 1e-12, "{p}: {got} vs {his}");
         }
+    }
+
+    /// `evaluate_input` on `input` with `evaluate`: (its result, stdout,
+    /// stderr).
+    fn evaluate_text(
+        input: &str,
+        evaluate: impl FnOnce(&[DVec3]) -> Result<Vec<f64>>,
+    ) -> (Result<()>, String, String) {
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let result = evaluate_input(input.as_bytes(), &mut out, &mut err, evaluate);
+        let text = |bytes| String::from_utf8(bytes).unwrap();
+        (result, text(out), text(err))
+    }
+
+    /// A bad line is reported by its number and what is wrong, the good
+    /// lines around it are still evaluated and printed, and the run fails
+    /// at the end.
+    #[test]
+    fn bad_lines_are_reported_and_the_good_ones_still_evaluated() {
+        let args = args(&["--kind", "perlin", "--cpu"]);
+        let input = "3.14,42,7\n1,2\n# a comment\n0.5 x 0.5\n0.25,0.5,0.75\n";
+        let (result, out, err) = evaluate_text(input, |points| {
+            Ok(evaluate_cpu(&args.settings(), args.what(), points))
+        });
+        // The same input without its bad lines.
+        let good: Vec<DVec3> = read_points("3.14,42,7\n0.25,0.5,0.75\n".as_bytes())
+            .map(|line| line.unwrap().point.unwrap())
+            .collect();
+        let expected: Vec<String> = evaluate_cpu(&args.settings(), args.what(), &good)
+            .into_iter()
+            .map(format_value)
+            .collect();
+        assert_eq!(out.lines().collect::<Vec<_>>(), expected);
+        // Perlin's own value at (3.14, 42, 7) is 0.136919958784.
+        assert_eq!(expected[0], "0.136919959");
+        assert_eq!(
+            err,
+            "marbre noise: line 2: expected 3 numbers x,y,z, found 2\n\
+             marbre noise: line 4: `x` is not a number (a line is x,y,z)\n"
+        );
+        let e = result.unwrap_err().to_string();
+        assert!(e.starts_with("2 input line(s) were not points"), "{e}");
+        assert!(e.ends_with("the 2 others were evaluated"), "{e}");
+    }
+
+    #[test]
+    fn good_input_succeeds_and_no_points_evaluate_nothing() {
+        let (result, out, err) = evaluate_text("1,2,3\n", |points| Ok(vec![0.5; points.len()]));
+        assert!(result.is_ok());
+        assert_eq!((out.as_str(), err.as_str()), ("0.500000000\n", ""));
+        let (result, out, _) = evaluate_text("# nothing\nx\n", |_| panic!("evaluated"));
+        assert!(result.is_err());
+        assert_eq!(out, "");
+    }
+
+    /// Nine significant digits, positional where `%g` would be, and
+    /// every f32 reads back from its text exactly: the precision the
+    /// shader's values justify.
+    #[test]
+    fn values_print_with_nine_significant_digits_that_keep_every_f32() {
+        assert_eq!(format_value(0.136919958784), "0.136919959");
+        assert_eq!(format_value(-1.5), "-1.50000000");
+        assert_eq!(format_value(0.0), "0.00000000");
+        assert_eq!(format_value(123.456), "123.456000");
+        assert_eq!(format_value(0.00012345678912), "0.000123456789");
+        assert_eq!(format_value(1.0e-5), "1.00000000e-5");
+        assert_eq!(format_value(2.5e9), "2.50000000e9");
+        assert_eq!(format_value(f64::NAN), "NaN");
+        let mut x = 1.0e-30_f32;
+        while x < 1.0e30 {
+            for v in [x, -x, x.next_up(), x * 1.234_567_9] {
+                let text = format_value(f64::from(v));
+                assert_eq!(text.parse::<f32>().unwrap(), v, "{v:e} printed {text}");
+            }
+            x *= 1.37;
+        }
+    }
+
+    /// The GPU path prints the shader's f32 values in the same format,
+    /// each reading back to exactly the value the shader returned.
+    #[test]
+    fn the_gpu_path_prints_the_shaders_values_exactly() {
+        let Some(ctx) = gpu_or_skip("the_gpu_path_prints_the_shaders_values_exactly") else {
+            return;
+        };
+        let args = args(&["--kind", "perlin"]);
+        let (points, _) = reference();
+        let input: String = points
+            .iter()
+            .map(|p| format!("{},{},{}\n", p.x, p.y, p.z))
+            .collect();
+        let (result, out, err) = evaluate_text(&input, |points| {
+            evaluate_gpu(&ctx, &args.settings(), args.what(), points)
+        });
+        result.unwrap();
+        assert_eq!(err, "");
+        let f32_points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
+        let shader = evaluate_scalar(&ctx, &args.settings(), args.what(), &f32_points).unwrap();
+        let printed: Vec<f32> = out.lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(printed, shader);
+        assert!(
+            out.lines().all(|l| l == format_value(l.parse().unwrap())),
+            "{out}"
+        );
     }
 }

@@ -10,6 +10,7 @@ pub mod fractal;
 pub mod gradient;
 pub mod hash;
 pub mod perlin;
+pub mod points;
 pub mod rebase;
 
 pub use fractal::{
