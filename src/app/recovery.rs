@@ -7,31 +7,22 @@
 //! The copy is a preset (written by `preset::save`, so its paths are made
 //! relative to the recovery folder and it loads like any other), beside a
 //! small info file naming the preset it was edited from, when, and the
-//! process that wrote it. Each process writes its own pair of files, named
-//! by its pid, so two marbres open at once never overwrite each other's
-//! edits, and a file whose writer is still running is not offered.
+//! process that wrote it (`viewer_files::RecoveryInfo`, in core, where the
+//! fuzz target reaches its reader). Each process writes its own pair of
+//! files, named by its pid, so two marbres open at once never overwrite
+//! each other's edits, and a file whose writer is still running is not
+//! offered.
 
 use marbre_core::atomic_write::write_atomic;
 use marbre_core::capped_read::{self, read_capped_to_string};
 use marbre_core::preset::{self, Preset};
 use marbre_core::scene::Scene;
-use serde::{Deserialize, Serialize};
+use marbre_core::viewer_files::RecoveryInfo;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// How often unsaved edits are copied to the recovery file.
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(20);
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct RecoveryInfo {
-    /// The preset the scene was loaded from (Save writes there).
-    source: PathBuf,
-    /// Local time of the autosave, for the offer's text; as
-    /// "YYYY-MM-DD HH:MM:SS" it also sorts in time order.
-    saved_at: String,
-    /// The marbre process that wrote it.
-    pid: u32,
-}
 
 /// A recovery file left by a run that did not end cleanly.
 #[derive(Debug, Clone, PartialEq)]
@@ -112,7 +103,7 @@ pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
         .filter(|&pid| !process_alive(pid))
         .filter_map(|pid| {
             let text = read_capped_to_string(&info_file(dir, pid), capped_read::SMALL_TEXT).ok()?;
-            let info: RecoveryInfo = ron::from_str(&text).ok()?;
+            let info = RecoveryInfo::parse(&text).ok()?;
             let preset = preset_file(dir, pid);
             preset.exists().then(|| RecoveryOffer {
                 preset,
@@ -183,7 +174,7 @@ impl Autosave {
             saved_at: chrono::Local::now().format("%Y-%m-%d %H:%M:%S").to_string(),
             pid: self.pid,
         };
-        let text = ron::ser::to_string_pretty(&info, ron::ser::PrettyConfig::default())?;
+        let text = info.to_text()?;
         let path = info_file(&self.dir, self.pid);
         write_atomic(&path, text.as_bytes()).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
     }
@@ -209,7 +200,7 @@ mod tests {
             saved_at: saved_at.into(),
             pid,
         };
-        std::fs::write(info_file(dir, pid), ron::to_string(&info).unwrap()).unwrap();
+        std::fs::write(info_file(dir, pid), info.to_text().unwrap()).unwrap();
     }
 
     /// Pids beyond Linux's pid_max (2^22): no such process.

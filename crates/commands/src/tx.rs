@@ -7,17 +7,13 @@
 use crate::render::parse_size;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::Vec3;
 use marbre_core::capped_read::{self, read_capped_to_string};
 use marbre_core::image_io;
-use marbre_core::scene::{
-    Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere, Texture,
-};
 use marbre_core::tx;
+use marbre_core::tx_preview::{self, preview_scene};
 use marbre_render::final_render::refuse_substitutes;
 use marbre_render::gpu::{GpuContext, Kernel};
 use marbre_render::session::{accumulate, prepare_scene, renderer_with};
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -90,82 +86,6 @@ fn read(file: &Path) -> Result<tx::Document> {
     tx::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))
 }
 
-/// The neutral material the text is applied onto: a light grey, slightly
-/// glossy dielectric.
-pub fn neutral_material() -> Material {
-    Material {
-        diffuse: Texture::color(Vec3::splat(0.6)),
-        specular: Texture::color(Vec3::splat(0.04)),
-        roughness: Texture::scalar(0.45),
-        ..Material::default()
-    }
-}
-
-/// The report's preview: a square polygon standing behind (its default
-/// frame: (u, v) spanning it from its first vertex), a sphere and a
-/// cylinder in front, on a grey ground, all wearing the lowered material
-/// (the ground too when the text gives a plane frame, APTX: without one
-/// N3D ignores a plane's texture). Images resolve against `base_dir`.
-pub fn preview_scene(doc: &tx::Document, base_dir: &Path) -> Result<Scene, tx::TxError> {
-    let lowered = tx::lower_document(doc, &neutral_material(), base_dir)?;
-    let m = lowered.material;
-    let mut scene = Scene {
-        camera: OrbitCamera {
-            target: Vec3::new(0.0, 1.0, 0.0),
-            distance: 6.2,
-            yaw_degrees: 0.0,
-            pitch_degrees: 12.0,
-            fov_degrees: 40.0,
-        },
-        spheres: vec![Sphere {
-            name: "sphere".into(),
-            center: Vec3::new(-1.05, 0.55, 0.7),
-            radius: 0.55,
-            material: m.clone(),
-        }],
-        cylinders: vec![Cylinder {
-            name: "cylinder".into(),
-            base: Vec3::new(1.05, 0.0, 0.7),
-            radius: 0.45,
-            height: 1.1,
-            material: m.clone(),
-        }],
-        polygons: vec![Polygon {
-            name: "polygon".into(),
-            vertices: vec![
-                Vec3::new(-1.4, 0.0, -1.2),
-                Vec3::new(1.4, 0.0, -1.2),
-                Vec3::new(1.4, 2.8, -1.2),
-                Vec3::new(-1.4, 2.8, -1.2),
-            ],
-            uv_frame: lowered.polygon_frame,
-            material: m.clone(),
-        }],
-        ground: Some(Ground {
-            height: 0.0,
-            uv_frame: lowered.plane_frame,
-            material: if lowered.plane_frame.is_some() {
-                m
-            } else {
-                Material {
-                    diffuse: Texture::color(Vec3::splat(0.35)),
-                    ..neutral_material()
-                }
-            },
-        }),
-        point_light: Some(PointLight {
-            position: Vec3::new(2.5, 5.0, 4.0),
-            color: Vec3::ONE,
-            intensity: 25.0,
-        }),
-        ..Scene::default()
-    };
-    scene.environment.source = EnvSource::Constant {
-        radiance: Vec3::splat(0.5),
-    };
-    Ok(scene)
-}
-
 /// How a TX text's preview is rendered.
 struct Preview {
     size: (u32, u32),
@@ -204,21 +124,12 @@ fn render(
     Ok(())
 }
 
-/// One example of a gallery: its TX file, a title, and what the report
-/// says of it.
-#[derive(Debug, Deserialize)]
-struct Entry {
-    file: String,
-    title: String,
-    description: String,
-}
-
 fn gallery(folder: &Path, out: &Path, markdown: &Path, size: (u32, u32), spp: u32) -> Result<()> {
     let index = folder.join("gallery.ron");
     let text = read_capped_to_string(&index, capped_read::TX)
         .with_context(|| format!("{}: cannot read", index.display()))?;
-    let entries: Vec<Entry> =
-        ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", index.display()))?;
+    let entries = tx_preview::parse_gallery(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", index.display()))?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let ctx = GpuContext::headless()?;
     let page_dir = markdown.parent().unwrap_or(Path::new("."));

@@ -26,6 +26,8 @@ pub mod scene;
 pub mod shown;
 pub mod texture;
 pub mod tx;
+pub mod tx_preview;
+pub mod viewer_files;
 pub mod wgsl;
 
 /// The repository's root, where the shipped presets, images and env maps
