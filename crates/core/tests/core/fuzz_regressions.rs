@@ -254,3 +254,210 @@ fn envmap_seeds_decode_to_their_size() {
     }
     assert_eq!(decoded, 12);
 }
+
+/// A RON error must point inside the text: a line between the first and
+/// just past the last, and a column.
+fn ron_error_inside(e: &ron::error::SpannedError, text: &str) -> Result<(), String> {
+    let lines = text.lines().count() + 1;
+    let at = e.span.start;
+    if (1..=lines).contains(&at.line) && at.col >= 1 {
+        Ok(())
+    } else {
+        Err(format!("the error points at {at} in {lines} lines: {e}"))
+    }
+}
+
+/// The text formats' targets skip bytes that are not UTF-8 (the app
+/// refuses them when it reads the file): so do their tests.
+fn utf8(bytes: &[u8]) -> Option<&str> {
+    std::str::from_utf8(bytes).ok()
+}
+
+#[test]
+fn tx_inputs_lower_and_print_back_or_give_a_syntax_error_inside_the_text() {
+    use marbre_core::scene::Texture;
+    use marbre_core::tx::{self, TxError};
+    check_all("tx", |bytes| {
+        let Some(text) = utf8(bytes) else {
+            return Ok(());
+        };
+        for channel in tx::Channel::ALL {
+            // Whatever it returns, the preset's reader must not panic.
+            let _ = tx::read_preset_property(channel.name(), text);
+        }
+        let doc = match tx::parse(text) {
+            Err(TxError::Syntax { line, column, .. }) => {
+                let lines = text.lines().count().max(1);
+                return if (1..=lines).contains(&line) && column >= 1 {
+                    Ok(())
+                } else {
+                    Err(format!("syntax error at {line}:{column} of {lines} lines"))
+                };
+            }
+            Err(e) => return Err(format!("parsing gave a non-syntax error: {e}")),
+            Ok(doc) => doc,
+        };
+        let printed = tx::print(&doc);
+        if tx::parse(&printed).as_ref() != Ok(&doc) {
+            return Err(format!("printed as {printed:?}, which reads otherwise"));
+        }
+        let mut scene = match marbre_core::tx_preview::preview_scene(&doc, Path::new("/fuzz/tx")) {
+            Err(TxError::Lower(_)) => return Ok(()),
+            Err(e) => return Err(format!("lowering gave a non-lowering error: {e}")),
+            Ok(scene) => scene,
+        };
+        let material = &scene.spheres[0].material;
+        let deepest = [
+            &material.diffuse,
+            &material.specular,
+            &material.mirror,
+            &material.opacity,
+            &material.transmission,
+            &material.diffuse_transmission,
+            &material.bump,
+        ]
+        .iter()
+        .map(|t| t.depth())
+        .max()
+        .unwrap();
+        if deepest > Texture::MAX_DEPTH {
+            return Err(format!("a texture nests {deepest} deep"));
+        }
+        scene.sanitize();
+        Ok(())
+    });
+}
+
+#[test]
+fn gallery_inputs_list_files_inside_the_folder_or_say_what_is_wrong() {
+    use marbre_core::tx_preview::{GalleryError, parse_gallery};
+    use std::path::Component;
+    // Inside: a relative path naming a file, that never climbs out.
+    let inside = |file: &str| {
+        let path = Path::new(file);
+        !path.is_absolute()
+            && path.file_name().is_some()
+            && !path.components().any(|c| c == Component::ParentDir)
+    };
+    check_all("gallery", |bytes| {
+        let Some(text) = utf8(bytes) else {
+            return Ok(());
+        };
+        match parse_gallery(text) {
+            Ok(entries) => match entries.iter().find(|e| !inside(&e.file)) {
+                Some(e) => Err(format!("`{}` was accepted", e.file)),
+                None => Ok(()),
+            },
+            Err(GalleryError::Syntax(e)) => ron_error_inside(&e, text),
+            Err(GalleryError::OutsideFolder { file, .. }) if inside(&file) => {
+                Err(format!("`{file}` was refused"))
+            }
+            Err(GalleryError::OutsideFolder { .. }) => Ok(()),
+        }
+    });
+}
+
+#[test]
+fn noise_inputs_give_each_line_in_order_as_a_finite_point_or_why_not() {
+    use marbre_core::noise::points::read_points;
+    check_all("noise", |bytes| {
+        // The lines that are neither blank nor a comment, counted apart.
+        let expected: Vec<usize> = bytes
+            .split(|&b| b == b'\n')
+            .enumerate()
+            .filter(|(_, line)| {
+                let t = String::from_utf8_lossy(line);
+                let t = t.trim();
+                !t.is_empty() && !t.starts_with('#')
+            })
+            .map(|(i, _)| i + 1)
+            .collect();
+        let mut numbers = Vec::new();
+        for line in read_points(bytes) {
+            let line = line.map_err(|e| format!("reading memory failed: {e}"))?;
+            if let Ok(p) = line.point
+                && !p.is_finite()
+            {
+                return Err(format!("line {}: {p} was accepted", line.number));
+            }
+            numbers.push(line.number);
+        }
+        if numbers == expected {
+            Ok(())
+        } else {
+            Err(format!("lines {numbers:?}, expected {expected:?}"))
+        }
+    });
+}
+
+/// The seeds of `noise` hold Perlin's 80 reference points and a file of
+/// good and bad lines, each bad line reported as what it is.
+#[test]
+fn the_noise_seeds_read_as_written() {
+    use marbre_core::noise::points::{BadPoint, read_points};
+    let (_, bytes) = inputs("noise")
+        .into_iter()
+        .find(|(file, _)| file.ends_with("good_and_bad_lines.txt"))
+        .unwrap();
+    let lines: Vec<(usize, Result<glam::DVec3, BadPoint>)> = read_points(&bytes[..])
+        .map(|l| l.unwrap())
+        .map(|l| (l.number, l.point))
+        .collect();
+    let bad = |number, why| (number, Err(why));
+    assert_eq!(
+        lines,
+        vec![
+            (2, Ok(glam::DVec3::splat(0.5))),
+            (4, Ok(glam::DVec3::new(1.0, 2.0, 3.0))),
+            bad(5, BadPoint::Count(2)),
+            bad(6, BadPoint::Count(4)),
+            bad(7, BadPoint::NotANumber("x".into())),
+            bad(8, BadPoint::NotFinite),
+            bad(9, BadPoint::NotFinite),
+            (10, Ok(glam::DVec3::new(-0.25, 7e-3, 42.0))),
+        ]
+    );
+}
+
+#[test]
+fn settings_inputs_read_back_from_what_is_written_or_say_where_they_fail() {
+    use marbre_core::viewer_files::{MAX_RECENT_FILES, Settings};
+    check_all("settings", |bytes| {
+        let Some(text) = utf8(bytes) else {
+            return Ok(());
+        };
+        let settings = match Settings::parse(text) {
+            Err(e) => return ron_error_inside(&e, text),
+            Ok(settings) => settings,
+        };
+        if settings.recent_files.len() > MAX_RECENT_FILES {
+            return Err(format!("{} recent files", settings.recent_files.len()));
+        }
+        let written = settings
+            .to_text()
+            .map_err(|e| format!("cannot write: {e}"))?;
+        match Settings::parse(&written) {
+            Ok(back) if back == settings => Ok(()),
+            other => Err(format!("written as {written:?}, read back as {other:?}")),
+        }
+    });
+}
+
+#[test]
+fn recovery_inputs_read_back_from_what_is_written_or_say_where_they_fail() {
+    use marbre_core::viewer_files::RecoveryInfo;
+    check_all("recovery", |bytes| {
+        let Some(text) = utf8(bytes) else {
+            return Ok(());
+        };
+        let info = match RecoveryInfo::parse(text) {
+            Err(e) => return ron_error_inside(&e, text),
+            Ok(info) => info,
+        };
+        let written = info.to_text().map_err(|e| format!("cannot write: {e}"))?;
+        match RecoveryInfo::parse(&written) {
+            Ok(back) if back == info => Ok(()),
+            other => Err(format!("written as {written:?}, read back as {other:?}")),
+        }
+    });
+}
