@@ -1,7 +1,8 @@
 //! The questions the viewer asks before it could lose work: unsaved edits
 //! before another preset replaces them or the app quits, an outside change
-//! to the preset file while there are unsaved edits, and a recovery file
-//! left by a run that did not end cleanly. Each is a modal dialog; Esc or
+//! to the preset file while there are unsaved edits, a file that a typed
+//! Save as would replace, and a recovery file left by a run that did not
+//! end cleanly. Each is a modal dialog; Esc or
 //! a click outside it is the cautious answer (cancel, keep my edits, decide
 //! later).
 
@@ -19,6 +20,8 @@ pub enum Prompt {
     ReloadFromDisk,
     /// Recover the scene a previous run autosaved.
     Recover(RecoveryOffer),
+    /// Save as to a typed path where a file already is.
+    Replace(PathBuf),
 }
 
 /// The user's answer.
@@ -26,7 +29,8 @@ pub enum Prompt {
 pub enum Answer {
     /// Save the edits, then go on (load or quit).
     SaveFirst,
-    /// Go on and lose the edits (load, quit, reload from disk, recover).
+    /// Go on and lose the edits (load, quit, reload from disk, recover),
+    /// or the file there (replace).
     Proceed,
     /// Do nothing: keep the scene as it is (and an offered recovery for
     /// the next start).
@@ -77,8 +81,9 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
         Prompt::Recover(offer) => (
             "Recover unsaved changes",
             format!(
-                "marbre did not close cleanly last time. Unsaved changes to {} were autosaved \
-                 at {}. Recover them? (Later keeps them for the next start.)",
+                "marbre did not close cleanly while {} had unsaved changes; they were \
+                 autosaved at {}. Recover them, as unsaved changes of that preset? (Later \
+                 keeps them: they are offered again when it is next opened.)",
                 offer.source.display(),
                 offer.saved_at
             ),
@@ -88,35 +93,50 @@ pub fn show(ctx: &egui::Context, prompt: &Prompt, preset_name: &str) -> Option<A
                 ("Discard", Answer::Discard),
             ],
         ),
+        // Cancel first, the default: Enter must not replace a file.
+        Prompt::Replace(path) => (
+            "Replace file?",
+            format!(
+                "{} already exists. Replace it with this scene? What it holds now is lost.",
+                path.display()
+            ),
+            &[("Cancel", Answer::Cancel), ("Replace", Answer::Proceed)],
+        ),
     };
     let mut answer = None;
-    let response = egui::Modal::new(egui::Id::unique("marbre prompt")).show(ctx, |ui| {
-        // A fixed width: egui centres the dialog by the size it measured
-        // the frame before, and a width that followed the content moved
-        // it once measured (by about 35 px after the first frame).
-        ui.set_width(PROMPT_WIDTH);
-        ui.heading(title);
-        ui.label(text);
-        ui.separator();
-        ui.horizontal(|ui| {
-            let responses: Vec<egui::Response> = buttons
-                .iter()
-                .map(|(label, choice)| {
-                    let response = ui.button(*label);
-                    if response.clicked() {
-                        answer = Some(*choice);
-                    }
-                    response
-                })
-                .collect();
-            // The first button is the default, as in a native dialog: it
-            // has the keyboard focus, so Enter chooses it (Esc cancels),
-            // whatever had the focus when the prompt opened.
-            if !responses.iter().any(egui::Response::has_focus) {
-                responses[0].request_focus();
-            }
+    // No backdrop: it would cover the whole window, and the kept panel
+    // layer would then be blended over all the image every frame rather
+    // than over the box alone (`app/ui_layer.rs`). It still blocks the
+    // widgets behind it.
+    let response = egui::Modal::new(egui::Id::unique("marbre prompt"))
+        .backdrop_color(egui::Color32::TRANSPARENT)
+        .show(ctx, |ui| {
+            // A fixed width: egui centres the dialog by the size it measured
+            // the frame before, and a width that followed the content moved
+            // it once measured (by about 35 px after the first frame).
+            ui.set_width(PROMPT_WIDTH);
+            ui.heading(title);
+            ui.label(text);
+            ui.separator();
+            ui.horizontal(|ui| {
+                let responses: Vec<egui::Response> = buttons
+                    .iter()
+                    .map(|(label, choice)| {
+                        let response = ui.button(*label);
+                        if response.clicked() {
+                            answer = Some(*choice);
+                        }
+                        response
+                    })
+                    .collect();
+                // The first button is the default, as in a native dialog: it
+                // has the keyboard focus, so Enter chooses it (Esc cancels),
+                // whatever had the focus when the prompt opened.
+                if !responses.iter().any(egui::Response::has_focus) {
+                    responses[0].request_focus();
+                }
+            });
         });
-    });
     if answer.is_none() && response.should_close() {
         answer = Some(Answer::Cancel);
     }
@@ -154,6 +174,26 @@ mod tests {
                 title
             })
             .collect()
+    }
+
+    /// A prompt draws its box and nothing beyond it (no backdrop): the
+    /// panel's kept layer is then blended over the image only there, and
+    /// the scene keeps rendering under the prompt at its frame rate. A
+    /// backdrop over the whole window made that blend, and egui's pass,
+    /// cover the window (issue 28).
+    #[test]
+    fn a_prompt_covers_its_box_only() {
+        // Every prompt is the same modal; the recovery offer's text is
+        // the longest.
+        for prompt in [Prompt::Quit, Prompt::Replace("copy.ron".into())] {
+            let drawn = crate::panel::save_as::tests::modal_drawn(|ctx| {
+                show(ctx, &prompt, "mine.ron");
+            });
+            assert!(
+                drawn.width() < PROMPT_WIDTH + 60.0 && drawn.height() < 250.0,
+                "{prompt:?} draws over {drawn:?}"
+            );
+        }
     }
 
     /// The prompt is drawn where it stays from its first frame on: it

@@ -1,8 +1,8 @@
 //! Autosave: while the scene has unsaved edits, a copy goes to a recovery
 //! file every [`AUTOSAVE_INTERVAL`]; a clean exit, a save or a discard
-//! removes it. A recovery file found at start-up means the run that wrote
-//! it ended without that (a crash, a kill, a power cut), and the viewer
-//! offers it.
+//! removes it. A recovery file found later means the run that wrote it
+//! ended without that (a crash, a kill, a power cut), and the viewer
+//! offers it when the preset it was edited from is opened ([`offer_for`]).
 //!
 //! The copy is a preset (written by `preset::save`, so its paths are made
 //! relative to the recovery folder and it loads like any other), beside a
@@ -94,11 +94,13 @@ fn has_ended(pid: u32) -> bool {
     matches!(state, Some("Z" | "X") | None)
 }
 
-/// The newest recovery file in `dir` whose writer has ended, if any (the
-/// others are offered at later starts, one at a time).
-pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
-    std::fs::read_dir(dir)
-        .ok()?
+/// The recovery files in `dir` whose writers have ended, newest first:
+/// each is offered when the preset it was edited from is opened.
+pub fn pending_offers(dir: &Path) -> Vec<RecoveryOffer> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut offers: Vec<RecoveryOffer> = entries
         .filter_map(|entry| info_file_pid(entry.ok()?.file_name().to_str()?))
         .filter(|&pid| !process_alive(pid))
         .filter_map(|pid| {
@@ -113,7 +115,19 @@ pub fn pending_offer(dir: &Path) -> Option<RecoveryOffer> {
                 pid,
             })
         })
-        .max_by(|a, b| a.saved_at.cmp(&b.saved_at))
+        .collect();
+    offers.sort_by(|a, b| b.saved_at.cmp(&a.saved_at));
+    offers
+}
+
+/// The newest recovery file in `dir` of the preset (or OBJ file) at
+/// `document`, however the path is written (relative, through a link):
+/// what opening `document` offers. Another preset's autosave is not
+/// offered over the one the user asked for (issue 28).
+pub fn offer_for(dir: &Path, document: &Path) -> Option<RecoveryOffer> {
+    pending_offers(dir)
+        .into_iter()
+        .find(|offer| crate::app::file_watch::is_same_file(&offer.source, document))
 }
 
 /// Removes a recovery file once it was recovered or declined.
@@ -206,6 +220,10 @@ mod tests {
     /// Pids beyond Linux's pid_max (2^22): no such process.
     const GONE: u32 = 1 << 23;
 
+    fn newest(dir: &Path) -> Option<RecoveryOffer> {
+        pending_offers(dir).into_iter().next()
+    }
+
     /// A marbre killed a moment ago whose parent has not reaped it yet: a
     /// real zombie with this program's name (this test binary run again,
     /// listing its tests and exiting), left unreaped while it is judged.
@@ -248,7 +266,7 @@ mod tests {
             .tempdir()
             .unwrap();
         left_by(dir.path(), pid, "2026-11-22 19:00:00", 2.0);
-        assert_eq!(pending_offer(dir.path()).map(|o| o.pid), Some(pid));
+        assert_eq!(newest(dir.path()).map(|o| o.pid), Some(pid));
         child.wait().unwrap();
     }
 
@@ -259,14 +277,14 @@ mod tests {
             .tempdir()
             .unwrap();
         left_by(dir.path(), std::process::id(), "2026-11-22 19:00:00", 2.0);
-        assert_eq!(pending_offer(dir.path()), None, "this process is alive");
+        assert_eq!(newest(dir.path()), None, "this process is alive");
         left_by(dir.path(), GONE, "2026-11-22 18:00:00", 3.0);
-        let offer = pending_offer(dir.path()).expect("an offer");
+        let offer = newest(dir.path()).expect("an offer");
         assert_eq!(offer.source, Path::new(&format!("/presets/{GONE}.ron")));
         let recovered = preset::load(&offer.preset).unwrap().preset;
         assert_eq!(recovered.scene.render.display.exposure, 3.0);
         discard(&offer);
-        assert_eq!(pending_offer(dir.path()), None);
+        assert_eq!(newest(dir.path()), None);
         assert!(
             preset_file(dir.path(), std::process::id()).exists(),
             "the live writer's file is left alone"
@@ -274,20 +292,59 @@ mod tests {
     }
 
     #[test]
-    fn the_newest_of_several_is_offered_first_and_the_rest_later() {
+    fn several_are_listed_newest_first() {
         let dir = tempfile::Builder::new()
             .prefix("recovery-several")
             .tempdir()
             .unwrap();
         left_by(dir.path(), GONE, "2026-11-22 18:00:00", 3.0);
+        left_by(dir.path(), GONE + 2, "2026-11-22 17:00:00", 5.0);
         left_by(dir.path(), GONE + 1, "2026-11-22 18:30:00", 4.0);
-        let newest = pending_offer(dir.path()).unwrap();
-        assert_eq!(newest.saved_at, "2026-11-22 18:30:00");
-        discard(&newest);
+        let times: Vec<String> = pending_offers(dir.path())
+            .into_iter()
+            .map(|o| o.saved_at)
+            .collect();
         assert_eq!(
-            pending_offer(dir.path()).unwrap().saved_at,
-            "2026-11-22 18:00:00"
+            times,
+            [
+                "2026-11-22 18:30:00",
+                "2026-11-22 18:00:00",
+                "2026-11-22 17:00:00"
+            ]
         );
+    }
+
+    /// Opening a preset offers its own autosave, however its path is
+    /// written, and never another preset's; of two of its own, the newer.
+    #[test]
+    fn opening_a_preset_offers_its_own_autosave_only() {
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-for")
+            .tempdir()
+            .unwrap();
+        let presets = dir.path().join("presets");
+        std::fs::create_dir(&presets).unwrap();
+        let (mine, cornell) = (presets.join("mine.ron"), presets.join("cornell.ron"));
+        for path in [&mine, &cornell] {
+            preset::save(&Preset::default(), path).unwrap();
+        }
+        let config = dir.path().join("config");
+        std::fs::create_dir(&config).unwrap();
+        for (pid, saved_at) in [
+            (GONE, "2026-11-22 18:00:00"),
+            (GONE + 1, "2026-11-22 19:00:00"),
+        ] {
+            left_by(&config, pid, saved_at, 3.0);
+            let info = RecoveryInfo {
+                source: mine.clone(),
+                saved_at: saved_at.into(),
+                pid,
+            };
+            std::fs::write(info_file(&config, pid), ron::to_string(&info).unwrap()).unwrap();
+        }
+        assert_eq!(offer_for(&config, &cornell), None);
+        let offer = offer_for(&config, &presets.join("../presets/./mine.ron"));
+        assert_eq!(offer.map(|o| o.pid), Some(GONE + 1));
     }
 
     /// After a reboot a dead marbre's pid may be another program's.
@@ -303,7 +360,7 @@ mod tests {
             .spawn()
             .expect("spawn sleep");
         left_by(dir.path(), other.id(), "2026-11-22 18:00:00", 3.0);
-        let offer = pending_offer(dir.path());
+        let offer = newest(dir.path());
         other.kill().unwrap();
         other.wait().unwrap();
         assert!(offer.is_some(), "sleep is not marbre: the file is offered");

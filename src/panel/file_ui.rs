@@ -4,7 +4,8 @@
 //!
 //! The typed path stays for systems with no file dialog (no desktop
 //! portal, no zenity): Ctrl+O there focuses this field instead, and Enter
-//! in it loads the preset.
+//! in it loads the preset. Save as… there asks for its path in a dialog of
+//! its own (`save_as`), never in this field, whose Enter opens.
 
 use super::widgets::{enter_pressed, typed_path};
 use super::{PanelAction, PanelState, SHOWN_MESSAGES};
@@ -57,14 +58,16 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         }
         if ui
             .button("Save as")
-            .on_hover_text("Write the scene to the path above")
+            .on_hover_text("Write the scene to the path above (a file already there is replaced only once you confirm)")
             .clicked()
         {
             actions.push(PanelAction::SavePresetAs(path));
         }
         if ui
             .button("Save as…")
-            .on_hover_text("Pick where to save in a file dialog (Ctrl+Shift+S)")
+            .on_hover_text(
+                "Pick where to save in a file dialog, or type it where none can open (Ctrl+Shift+S)",
+            )
             .clicked()
         {
             actions.push(PanelAction::BrowseSavePresetAs);

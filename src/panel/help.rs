@@ -28,7 +28,7 @@ pub const SHORTCUTS: &[Shortcut] = &[
     },
     Shortcut {
         keys: "H",
-        action: "Hide or show the UI panels",
+        action: "Hide or show the UI panels (with the pointer over the image)",
     },
     Shortcut {
         keys: "F12",
@@ -59,18 +59,22 @@ pub const SHORTCUTS: &[Shortcut] = &[
         action: "Open a preset",
     },
     Shortcut {
-        keys: "1–9",
+        keys: "Ctrl+1–9",
         action: "Go to saved view 1 to 9 (Camera section)",
     },
     Shortcut {
         keys: "Esc",
-        action: "Close dialogs and this help",
+        action: "Close this help, Save as, or a question (its cautious answer)",
     },
 ];
 
 /// What the mouse does over the image (see `app::camera_input`).
 const MOUSE_CONTROLS: &str =
     "Mouse over the image: left drag orbits, right or middle drag pans, the wheel zooms.";
+
+/// Why some keys do nothing at times (see `app::shortcuts`).
+const TYPING_NOTE: &str = "While a text field has the keyboard, only the F keys, Esc and the \
+     saves act: the other keys are typing.";
 
 /// The window's title.
 const TITLE: &str = "Keyboard shortcuts (F1)";
@@ -103,6 +107,7 @@ pub fn draw_help_overlay(ctx: &egui::Context, open: &mut bool) {
                 });
             ui.separator();
             ui.label(MOUSE_CONTROLS);
+            ui.label(TYPING_NOTE);
         });
 }
 
@@ -166,11 +171,11 @@ mod tests {
         let mut open = true;
         let texts = run_frames(&ctx, &mut open);
         assert!(open, "nothing asked the overlay to close");
-        for wanted in SHORTCUTS
-            .iter()
-            .flat_map(|s| [s.keys, s.action])
-            .chain([TITLE, MOUSE_CONTROLS])
-        {
+        for wanted in SHORTCUTS.iter().flat_map(|s| [s.keys, s.action]).chain([
+            TITLE,
+            MOUSE_CONTROLS,
+            TYPING_NOTE,
+        ]) {
             assert!(
                 texts.iter().any(|t| t == wanted),
                 "{wanted:?} not drawn; drawn: {texts:?}"

@@ -15,6 +15,7 @@ pub mod node_graph;
 mod quality;
 pub mod render_dialog;
 mod render_ui;
+pub mod save_as;
 mod scene_ui;
 mod stats;
 pub mod swatches;
@@ -94,6 +95,8 @@ pub struct PanelState {
     pub progress: Option<(String, f32)>,
     /// The Render dialog's fields and the render under way.
     pub render_dialog: render_dialog::RenderDialog,
+    /// Save as asking for a path, where no file dialog can open.
+    pub save_as: Option<save_as::SaveAs>,
     /// The material whose node-graph window is open.
     pub node_graph: Option<MaterialKey>,
 }
@@ -118,6 +121,7 @@ impl PanelState {
             focus_env_path: false,
             progress: None,
             render_dialog: Default::default(),
+            save_as: None,
             node_graph: None,
         }
     }
@@ -197,6 +201,8 @@ pub enum PanelAction {
     LoadPreset(PathBuf),
     /// Save to the preset file the scene came from.
     SavePreset,
+    /// Save to a typed path (the Preset field's Save as, or the Save as
+    /// dialog); a file already there is replaced only once confirmed.
     SavePresetAs(PathBuf),
     LoadEnvironment(PathBuf),
     Screenshot,

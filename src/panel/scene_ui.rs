@@ -221,7 +221,7 @@ pub(super) fn camera_ui(ui: &mut Ui, scene: &mut Scene, actions: &mut Vec<PanelA
     views_ui(ui, scene);
 }
 
-/// The preset's saved views: recall (or keys 1–9), rename, delete, and
+/// The preset's saved views: recall (or Ctrl+1–9), rename, delete, and
 /// save the current camera as a new one.
 pub(super) fn views_ui(ui: &mut Ui, scene: &mut Scene) {
     let mut recall = None;
@@ -261,7 +261,7 @@ pub(super) fn views_ui(ui: &mut Ui, scene: &mut Scene) {
     }
     if ui
         .button("Save view")
-        .on_hover_text("Keep the current camera in the preset; keys 1–9 recall the first nine")
+        .on_hover_text("Keep the current camera in the preset; Ctrl+1–9 recall the first nine")
         .clicked()
     {
         scene.save_view();

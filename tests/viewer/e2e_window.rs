@@ -12,8 +12,8 @@
 //! 4. Ctrl+Z: the light is back, the ball white again.
 //!
 //! Also: closing the window with an unsaved edit (asked, Esc, then Save);
-//! a crashed run's autosave offered, kept for later by Esc, and
-//! recovered; a window shrunk to a pixel and back; and a preset that takes
+//! a crashed run's autosave offered when its preset opens, kept for later
+//! by Esc, and recovered; a window shrunk to a pixel and back; and a preset that takes
 //! seconds to load at start-up (its progress shown, a key pressed meanwhile
 //! kept for the scene).
 //!
@@ -36,7 +36,7 @@ use std::time::{Duration, Instant};
 use crate::REPO;
 
 /// The side panel's left edge at the default window size.
-const PANEL_LEFT: i32 = 900;
+pub(crate) const PANEL_LEFT: i32 = 900;
 /// Height of a folded section header, in pixels.
 const HEADER_STEP: i32 = 23;
 /// How long one step may take to show: a preset load builds a shader
@@ -44,12 +44,14 @@ const HEADER_STEP: i32 = 23;
 pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// Mean luma (0..1) and mean blue-minus-red of the image's central
-/// quarter, and the luma of its top-left corner (background).
+/// quarter, the luma of its top-left corner (background), and the mean
+/// luma of its top sixth (which view of a scene is shown).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Look {
     pub(crate) centre_luma: f64,
     pub(crate) centre_blue_excess: f64,
     pub(crate) corner_luma: f64,
+    pub(crate) top_luma: f64,
 }
 
 fn look(path: &Path) -> Look {
@@ -73,10 +75,12 @@ fn look(path: &Path) -> Look {
     let luma = |rgb: [f64; 3]| 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
     let centre = mean(w * 3 / 8..w * 5 / 8, h * 3 / 8..h * 5 / 8);
     let corner = mean(0..w / 10, 0..h / 10);
+    let top = mean(0..w, 0..h / 6);
     Look {
         centre_luma: luma(centre),
         centre_blue_excess: centre[2] - centre[0],
         corner_luma: luma(corner),
+        top_luma: luma(top),
     }
 }
 
@@ -94,7 +98,7 @@ fn pngs(folder: &Path) -> Vec<PathBuf> {
 }
 
 pub(crate) struct Session<'a> {
-    x: &'a xvfb::Xvfb,
+    pub(crate) x: &'a xvfb::Xvfb,
     pub(crate) window: String,
     screenshots: PathBuf,
     dir: &'a TempDir,
@@ -124,7 +128,7 @@ impl Session<'_> {
     /// fourth row of the section) from its knob to the far left. Each step
     /// waits a second: egui reads the pointer once per frame, and a press,
     /// moves and release within one slow frame would be a click on the knob.
-    fn drag_light_intensity_to_zero(&self) {
+    pub(crate) fn drag_light_intensity_to_zero(&self) {
         for header in 0..4 {
             self.click(PANEL_LEFT + 50, 12 + header * HEADER_STEP);
         }
@@ -318,9 +322,10 @@ fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
 
 /// A run that crashed with unsaved edits left its autosave (written here
 /// as the viewer writes it: a preset and an info file named by the dead
-/// process's pid). The next start offers it; Esc closes the offer and keeps
-/// the files for later; the start after that offers it again, and Recover
-/// (the default button: Enter) brings the edits back and removes the files.
+/// process's pid). The next start on its preset offers it once the preset
+/// is in; Esc closes the offer and keeps the files for later; the start
+/// after that offers it again, and Recover (the default button: Enter)
+/// brings the edits back and removes the files.
 #[test]
 fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
     const TEST: &str = "a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered";
@@ -470,8 +475,8 @@ fn progress_bar_shown(window: &image::RgbImage) -> bool {
 /// A preset that is slow to load at start-up (its OBJ is a named pipe the
 /// test writes only when it chooses, as a slow disk or a network share
 /// would deliver it): the window draws at once, the panel showing the
-/// load's progress, and a key pressed meanwhile (2: the preset's second
-/// saved view) and F12 after it act on the scene once it is drawn, rather
+/// load's progress, and keys pressed meanwhile (Ctrl+2: the preset's second
+/// saved view) and F12 after them act on the scene once it is drawn, rather
 /// than on the empty placeholder shown until then.
 #[test]
 fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() {
@@ -507,7 +512,7 @@ fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() 
     // The loader waits on the pipe: the bar stays until the test writes.
     wait_while("the progress bar while the preset loads", &|| !loading());
     session.focus();
-    session.run(&["key", "2"]);
+    session.run(&["key", "ctrl+2"]);
     session.run(&["key", "F12"]);
     std::thread::sleep(Duration::from_secs(2));
     assert!(loading(), "the load cannot end before the pipe is written");
@@ -522,7 +527,7 @@ fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() 
     wait_while("the screenshot F12 asked for during the load", &|| {
         pngs(&session.screenshots).is_empty()
     });
-    // The held keys in order: 2 recalled the sky view, then F12 saved it
+    // The held keys in order: Ctrl+2 recalled the sky view, then F12 saved it
     // (not the placeholder, black, nor the preset's own view of the grid).
     let first = look(&pngs(&session.screenshots)[0]);
     assert!(

@@ -1,6 +1,7 @@
 //! The viewer's tests under Xvfb: the window (`window`), a user's session
 //! driven end to end (`e2e_window`), OBJ files opened as scenes
-//! (`obj_window`) and the soak (`soak`), each running the `marbre` binary
+//! (`obj_window`), the guards on the user's work (`work_at_risk`) and the
+//! soak (`soak`), each running the `marbre` binary
 //! on lavapipe. `xvfb` starts the display and drives it. `render_cli` runs
 //! `marbre render` (no window) for what it says on stderr.
 
@@ -13,4 +14,5 @@ mod render_cli;
 mod render_window;
 mod soak;
 mod window;
+mod work_at_risk;
 mod xvfb;

@@ -44,6 +44,7 @@ impl Viewer {
         self.renderer = renderer_with(&ctx, &loaded, size, self.renderer.kernel())?;
         self.meters.timer = PassTimer::new(&ctx);
         self.ui_layer = None;
+        self.ui_compositor = None;
         self.egui_renderer =
             egui_wgpu::Renderer::new(&ctx.device, self.config.format, Default::default());
         // The new egui renderer has no textures, and egui only sends what

@@ -15,6 +15,7 @@ use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
 use crate::app::scene_loader::{FileKind, ReadyScene, SceneKind, SceneLoad};
+use crate::panel::save_as::SaveAs;
 use anyhow::{Context as _, Result};
 use marbre_core::envmap;
 use marbre_core::preset::{self, Header};
@@ -92,7 +93,12 @@ impl Viewer {
         };
         let (load, keep_view) = self.incoming.loading.take().expect("a load is under way");
         self.panel.progress = None;
+        // A reload after an outside edit is the same document, not an open.
+        let opened = keep_view.is_none();
         let installed = result.and_then(|ready| self.install_loaded(load.path(), ready, keep_view));
+        if installed.is_ok() && opened {
+            self.offer_recovery();
+        }
         match (installed, self.incoming.startup.as_ref()) {
             (Ok(()), None) => Ok(()),
             // Undo starts at the loaded scene, not at the placeholder.
@@ -300,10 +306,26 @@ impl Viewer {
         false
     }
 
+    /// Save as to a path the user typed: a file already there (another
+    /// preset, or the original) is replaced only once the user confirms,
+    /// as a native dialog asks.
+    pub(super) fn request_save_as(&mut self, path: &Path) {
+        if path.as_os_str().is_empty() {
+            self.panel.error("Save as: type the path to save to first");
+        } else if path.is_file() {
+            self.edits.prompt = Some(Prompt::Replace(path.to_owned()));
+        } else {
+            self.save_preset(path);
+        }
+    }
+
     /// Saves the scene to `path` (atomically); returns whether it saved.
+    /// The document is that file from then on, and a Save as dialog
+    /// waiting for its path is done.
     pub(super) fn save_preset(&mut self, path: &Path) -> bool {
         match self.edits.document.save(&self.scene, path) {
             Ok(()) => {
+                self.panel.save_as = None;
                 self.panel.preset_path = path.display().to_string();
                 self.panel.info(format!("saved {}", path.display()));
                 self.opened(path);
@@ -318,19 +340,34 @@ impl Viewer {
     }
 
     /// Opens a native file dialog; where none can open, points the user
-    /// to the typed path and to drag and drop instead.
+    /// to the typed path and to drag and drop instead, and Save as asks
+    /// for its path in a dialog of its own (`panel::save_as`): the path
+    /// fields' Enter opens what they name, which is no way to save.
     pub(super) fn open_dialog(&mut self, purpose: DialogPurpose) {
         if self.incoming.dialog.is_some() {
             return;
         }
         if !dialogs_available() {
-            self.panel.info(
-                "no file dialog here (no desktop portal, no zenity): type the path in the \
-                 field and press Enter, or drop the file on the window",
-            );
+            let suggestion = self.edits.document.save_as_suggestion();
             match purpose {
-                DialogPurpose::OpenEnvironment => self.panel.focus_env_path = true,
-                _ => self.panel.focus_preset_path = true,
+                DialogPurpose::SavePresetAs => {
+                    self.panel.info(
+                        "no file dialog here (no desktop portal, no zenity): type where to \
+                         save in Save as and press Enter",
+                    );
+                    self.panel.save_as = Some(SaveAs::new(suggestion.display().to_string()));
+                }
+                DialogPurpose::OpenPreset | DialogPurpose::OpenEnvironment => {
+                    self.panel.info(
+                        "no file dialog here (no desktop portal, no zenity): type the path in \
+                         the field and press Enter, or drop the file on the window",
+                    );
+                    if purpose == DialogPurpose::OpenEnvironment {
+                        self.panel.focus_env_path = true;
+                    } else {
+                        self.panel.focus_preset_path = true;
+                    }
+                }
             }
             return;
         }
@@ -381,6 +418,9 @@ impl Viewer {
             }
             (Prompt::Quit, Answer::Proceed) => self.quit(),
             (Prompt::ReloadFromDisk, Answer::Proceed) => self.reload_from_disk(),
+            (Prompt::Replace(path), Answer::Proceed) => {
+                self.save_preset(&path);
+            }
             // Once the scene is back it is autosaved again, to this
             // process's own file, while it stays unsaved.
             (Prompt::Recover(offer), Answer::Proceed) => {
@@ -389,8 +429,23 @@ impl Viewer {
                 }
             }
             (Prompt::Recover(offer), Answer::Discard) => recovery::discard(&offer),
-            (Prompt::Recover(_), Answer::SaveFirst) => {}
+            (Prompt::Recover(_) | Prompt::Replace(_), Answer::SaveFirst) => {}
             (_, Answer::Discard) => {}
+        }
+    }
+
+    /// Offers the autosave that a run which did not end cleanly left of
+    /// the document just opened, if there is one (the newest), unless
+    /// another question is waiting: it is offered again at the next open.
+    fn offer_recovery(&mut self) {
+        if self.edits.prompt.is_some() {
+            return;
+        }
+        let Some(dir) = &self.config_dir else {
+            return;
+        };
+        if let Some(offer) = recovery::offer_for(dir, &self.edits.document.path) {
+            self.edits.prompt = Some(Prompt::Recover(offer));
         }
     }
 
@@ -523,6 +578,25 @@ impl Viewer {
             }
             Err(e) => self.panel.error(format!("cannot reload shaders: {e:#}")),
         }
+    }
+}
+
+/// The message naming an autosave of a preset other than the one opened
+/// at start-up: where it will be offered, or, its preset gone, the
+/// autosave itself to open.
+pub(super) fn recovery_note(offer: &recovery::RecoveryOffer) -> String {
+    let left = format!(
+        "a run that did not close cleanly left unsaved changes to {}, autosaved at {}",
+        offer.source.display(),
+        offer.saved_at
+    );
+    if offer.source.exists() {
+        format!("{left}: open it to recover them")
+    } else {
+        format!(
+            "{left}; that file is gone: open {} to see them",
+            offer.preset.display()
+        )
     }
 }
 

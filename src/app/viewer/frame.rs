@@ -4,7 +4,7 @@
 
 use super::Viewer;
 use crate::app::screenshots;
-use crate::app::ui_layer::{self, UiLayer};
+use crate::app::ui_layer::{self, Compositor, Mode, UiLayer};
 use crate::panel::{QualityStats, Stats};
 use anyhow::{Context as _, Result};
 use marbre_core::scene::Change;
@@ -271,13 +271,15 @@ impl Viewer {
             egui::pos2(viewport.x, viewport.y),
             egui::vec2(viewport.width, viewport.height),
         );
-        let layered = self.config.usage.contains(wgpu::TextureUsages::COPY_DST)
-            && !ui_layer::reaches_into(&paint_jobs, ppp, image);
-        let extra = if layered {
-            self.draw_layered(&mut encoder, &targets, viewport, &paint_jobs, &screen)?
-        } else {
-            self.draw_on_top(&mut encoder, &targets, viewport, &paint_jobs, &screen)?
-        };
+        let inside = ui_layer::drawn_inside(&paint_jobs, ppp, image);
+        let extra = self.draw_layered(
+            &mut encoder,
+            &targets,
+            viewport,
+            &paint_jobs,
+            &screen,
+            inside,
+        )?;
         if let Some(t) = &mut self.meters.timer {
             t.resolve(&mut encoder);
         }
@@ -308,28 +310,7 @@ impl Viewer {
         {
             self.save_window_capture(&texture, &path)?;
         }
-        if is_last {
-            self.report_quality();
-        }
         Ok(!is_last && script_goes_on)
-    }
-
-    /// The image, then egui over it, on each target: for frames whose
-    /// egui output reaches into the image (a popup, a prompt).
-    fn draw_on_top(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        targets: &[(&wgpu::Texture, &wgpu::TextureView)],
-        viewport: Viewport,
-        paint_jobs: &[egui::ClippedPrimitive],
-        screen: &egui_wgpu::ScreenDescriptor,
-    ) -> Result<Vec<wgpu::CommandBuffer>> {
-        let extra = self.update_egui_buffers(encoder, paint_jobs, screen);
-        for &(_, view) in targets {
-            self.display_on(encoder, view, viewport, wgpu::LoadOp::Clear(BACKGROUND))?;
-            self.draw_egui(encoder, view, wgpu::LoadOp::Load, paint_jobs, screen);
-        }
-        Ok(extra)
     }
 
     /// Uploads egui's meshes for a pass that draws them.
@@ -367,8 +348,11 @@ impl Viewer {
     }
 
     /// The kept panel layer (egui drawn into it again only if its output
-    /// changed, `app/ui_layer.rs`), copied onto each target, then the image
-    /// over it.
+    /// changed, `app/ui_layer.rs`) on each target with the image: copied
+    /// under the image (where the window's image allows copies), and
+    /// blended over it within `inside`, the pixels where egui draws inside
+    /// the image (a prompt), if any; without copies, the image is drawn
+    /// first and the whole layer blended over it.
     fn draw_layered(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -376,29 +360,60 @@ impl Viewer {
         viewport: Viewport,
         paint_jobs: &[egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
+        inside: Option<egui::Rect>,
     ) -> Result<Vec<wgpu::CommandBuffer>> {
+        let copies = self.config.usage.contains(wgpu::TextureUsages::COPY_DST);
+        let mode = if copies && inside.is_none() {
+            Mode::Copied
+        } else {
+            Mode::Blended
+        };
+        let format = self.config.format;
+        let compositor = match self.ui_compositor.take() {
+            Some(c) if c.format() == format => c,
+            _ => {
+                self.ui_layer = None;
+                Compositor::new(&self.ctx.device, format)
+            }
+        };
         if !self.ui_layer.as_ref().is_some_and(|l| l.fits(&self.config)) {
-            self.ui_layer = Some(UiLayer::new(&self.ctx.device, &self.config));
+            self.ui_layer = Some(UiLayer::new(&self.ctx.device, &self.config, &compositor));
         }
         let key = ui_layer::output_key(paint_jobs, screen);
         let mut layer = self.ui_layer.take().expect("made above");
         let mut extra = Vec::new();
-        if let Some(view) = layer.view_to_redraw(key) {
+        if let Some(view) = layer.view_to_redraw(key, mode) {
             extra = self.update_egui_buffers(encoder, paint_jobs, screen);
+            let clear = match mode {
+                Mode::Copied => BACKGROUND,
+                Mode::Blended => wgpu::Color::TRANSPARENT,
+            };
             self.draw_egui(
                 encoder,
                 view,
-                wgpu::LoadOp::Clear(BACKGROUND),
+                wgpu::LoadOp::Clear(clear),
                 paint_jobs,
                 screen,
             );
         }
+        let mut drawn = Ok(());
         for &(texture, view) in targets {
-            layer.copy_to(encoder, texture);
-            self.display_on(encoder, view, viewport, wgpu::LoadOp::Load)?;
+            drawn = if copies {
+                layer.copy_to(encoder, texture);
+                self.display_on(encoder, view, viewport, wgpu::LoadOp::Load)
+            } else {
+                self.display_on(encoder, view, viewport, wgpu::LoadOp::Clear(BACKGROUND))
+            };
+            if drawn.is_err() {
+                break;
+            }
+            if mode == Mode::Blended {
+                compositor.blend(encoder, view, &layer, inside.filter(|_| copies));
+            }
         }
         self.ui_layer = Some(layer);
-        Ok(extra)
+        self.ui_compositor = Some(compositor);
+        drawn.map(|()| extra)
     }
 
     /// Records egui's pass onto `view`.
@@ -447,9 +462,10 @@ impl Viewer {
         }
     }
 
-    /// One line on stderr when a scripted run (`--exit-after-frames`) ends:
-    /// what the Quality strip showed, for scripts and tests.
-    fn report_quality(&self) {
+    /// One line on stderr when the viewer ends cleanly (closed, or a
+    /// scripted run's last frame): what the Quality strip showed, and the
+    /// frames drawn since the start, for scripts and tests.
+    pub(super) fn report_quality(&self) {
         let spp = self.renderer.accumulated_samples();
         let error = self
             .meters

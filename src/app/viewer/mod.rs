@@ -15,7 +15,7 @@ use super::device_watch::DeviceWatch;
 use super::document::Document;
 use super::feature_costs::FeatureCosts;
 use super::file_dialogs::OpenDialog;
-use super::file_watch::FileWatch;
+use super::file_watch::{FileWatch, is_same_file};
 use super::frame_budget::FrameBudget;
 use super::frame_script::{FrameScript, Presented, ScriptAction};
 use super::history::History;
@@ -25,10 +25,10 @@ use super::recovery::{self, Autosave};
 use super::render_job::{RenderJob, Update};
 use super::scene_loader::{FileKind, SceneKind, SceneLoad, load_reporting};
 use super::settings::Settings;
-use super::shortcuts::{self, Shortcut};
+use super::shortcuts::{Keys, Shortcut};
 use super::soak::SoakDriver;
 use super::swatches::Swatches;
-use super::ui_layer::{STATS_REFRESH, UiLayer};
+use super::ui_layer::{Compositor, STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
 use crate::panel::{self, PanelAction, PanelState};
 use anyhow::Result;
@@ -41,8 +41,7 @@ use marbre_render::session::{
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
-use winit::event::{ElementState, KeyEvent, WindowEvent};
-use winit::keyboard::Key;
+use winit::event::WindowEvent;
 use winit::window::{Fullscreen, Window};
 
 /// Width of the side panel, in points, when the window opens.
@@ -83,8 +82,10 @@ pub struct Viewer {
     renderer: Renderer,
     /// What the Quality strip and the Stats panel report.
     meters: Meters,
-    /// The panel's pixels kept between frames (`app/ui_layer.rs`).
+    /// The panel's pixels kept between frames (`app/ui_layer.rs`), and
+    /// what blends them over the image when they reach into it.
     ui_layer: Option<UiLayer>,
+    ui_compositor: Option<Compositor>,
     egui_renderer: egui_wgpu::Renderer,
     egui_state: egui_winit::State,
     egui_ctx: egui::Context,
@@ -353,11 +354,18 @@ impl Viewer {
         // is the one their own last session left.
         let persists = !scripted && options.window_screenshot.is_none();
         let config_dir = config_dir.filter(|_| persists);
-        // A run that crashed left its unsaved edits: offer them first.
-        let prompt = config_dir
+        // A run that crashed left unsaved edits: those of the preset opening
+        // now are offered once it is in (`Viewer::offer_recovery`); those
+        // of any other are named, and offered when it is opened.
+        for offer in config_dir
             .as_deref()
-            .and_then(recovery::pending_offer)
-            .map(Prompt::Recover);
+            .map(recovery::pending_offers)
+            .unwrap_or_default()
+        {
+            if !is_same_file(&offer.source, &preset_path) {
+                panel.info(files::recovery_note(&offer));
+            }
+        }
         let autosave = config_dir.clone().map(Autosave::new);
         let script = options
             .soak
@@ -378,6 +386,7 @@ impl Viewer {
                 non_finite: (0, NonFiniteCounts::default()),
             },
             ui_layer: None,
+            ui_compositor: None,
             window,
             surface,
             config,
@@ -393,7 +402,7 @@ impl Viewer {
                 preset_camera,
                 history,
                 autosave,
-                prompt,
+                prompt: None,
             },
             panel,
             options,
@@ -435,10 +444,9 @@ impl Viewer {
             startup.held_events.push(event.clone());
             return Ok(true);
         }
-        let consumed = self
-            .egui_state
-            .on_window_event(&self.window, event)
-            .consumed;
+        // Keys reach the viewer through egui's input only, read where the
+        // frame knows which widget has the keyboard (`app/shortcuts.rs`).
+        let _ = self.egui_state.on_window_event(&self.window, event);
         match event {
             WindowEvent::CloseRequested => self.request_quit(),
             // A minimised window has zero size: keep the last valid
@@ -449,20 +457,6 @@ impl Viewer {
                 self.surface.configure(&self.ctx.device, &self.config);
             }
             WindowEvent::DroppedFile(path) => self.load_dropped(path),
-            WindowEvent::KeyboardInput {
-                event:
-                    KeyEvent {
-                        logical_key: Key::Character(text),
-                        state: ElementState::Pressed,
-                        ..
-                    },
-                ..
-            } if !consumed => {
-                // Keys 1–9 recall the preset's saved views.
-                if let Ok(digit @ 1..=9) = text.parse::<usize>() {
-                    self.scene.recall_view(digit - 1);
-                }
-            }
             WindowEvent::RedrawRequested => return self.redraw(),
             _ => {}
         }
@@ -497,6 +491,7 @@ impl Viewer {
                 .unwrap_or_else(|_| self.edits.document.path.clone()),
         );
         self.save_settings();
+        self.report_quality();
         self.quitting = true;
     }
 
@@ -689,9 +684,7 @@ impl Viewer {
                 PanelAction::SavePreset => {
                     self.save_document();
                 }
-                PanelAction::SavePresetAs(p) => {
-                    self.save_preset(&p);
-                }
+                PanelAction::SavePresetAs(p) => self.request_save_as(&p),
                 PanelAction::BrowsePreset => {
                     self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset)
                 }
@@ -734,22 +727,28 @@ impl Viewer {
         use super::file_dialogs::DialogPurpose;
         for shortcut in pressed {
             // A prompt waits for its answer: Esc is Cancel (which keeps an
-            // offered recovery for later), and shortcuts that would change
-            // the scene or open files behind it wait too.
-            if self.edits.prompt.is_some() {
-                match shortcut {
-                    Shortcut::Close if !self.show_help => {
-                        self.answer_prompt(prompts::Answer::Cancel);
-                        continue;
-                    }
+            // offered recovery for later). While it, or Save as, waits, the
+            // shortcuts that would change the scene or write or open files
+            // behind it wait too: Ctrl+S in Save as's field would otherwise
+            // save over the preset that Save as is keeping.
+            if self.edits.prompt.is_some() && shortcut == Shortcut::Close && !self.show_help {
+                self.answer_prompt(prompts::Answer::Cancel);
+                continue;
+            }
+            let waiting = self.edits.prompt.is_some() || self.panel.save_as.is_some();
+            if waiting
+                && matches!(
+                    shortcut,
                     Shortcut::Undo
-                    | Shortcut::Redo
-                    | Shortcut::Save
-                    | Shortcut::SaveAs
-                    | Shortcut::Open
-                    | Shortcut::HideUi => continue,
-                    _ => {}
-                }
+                        | Shortcut::Redo
+                        | Shortcut::Save
+                        | Shortcut::SaveAs
+                        | Shortcut::Open
+                        | Shortcut::HideUi
+                        | Shortcut::RecallView(_)
+                )
+            {
+                continue;
             }
             match shortcut {
                 Shortcut::Undo => self.step_history(true),
@@ -760,8 +759,13 @@ impl Viewer {
                 Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
                 Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
                 Shortcut::Help => self.show_help = !self.show_help,
-                Shortcut::Close => self.show_help = false,
+                // The help first: it is drawn over Save as.
+                Shortcut::Close if self.show_help => self.show_help = false,
+                Shortcut::Close => self.panel.save_as = None,
                 Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
+                Shortcut::RecallView(index) => {
+                    self.scene.recall_view(index);
+                }
                 Shortcut::Screenshot => self.screenshot_requested = true,
                 Shortcut::RenderDialog => self.panel.render_dialog.toggle(),
                 Shortcut::Fullscreen => {
@@ -817,7 +821,7 @@ impl Viewer {
         let mut pressed = Vec::new();
         let mut answer = None;
         let output = self.egui_ctx.run_ui(raw_input, |ui| {
-            pressed = shortcuts::pressed(ui.ctx());
+            let keys = Keys::before_widgets(ui.ctx());
             // Too small a window for the panels (egui's layouts need room):
             // show the image alone until it grows again.
             let room = ui.max_rect().size();
@@ -855,9 +859,27 @@ impl Viewer {
             if !ui_hidden {
                 panel::render_dialog::show(ui.ctx(), &mut panel_state.render_dialog, &mut actions);
             }
+            // Save as under a question it asked (a file to replace): the
+            // question has the keyboard.
+            panel::save_as::show(
+                ui.ctx(),
+                &mut panel_state.save_as,
+                prompt.is_none(),
+                &mut actions,
+            );
             if let Some(prompt) = prompt {
                 answer = prompts::show(ui.ctx(), prompt, &preset_name);
             }
+            // A window over the image (help, a prompt, the Render dialog)
+            // is not the image.
+            let pointer_on_image = ui.ctx().pointer_hover_pos().is_none_or(|p| {
+                image_rect.contains(p)
+                    && ui
+                        .ctx()
+                        .layer_id_at(p)
+                        .is_none_or(|layer| layer.order == egui::Order::Background)
+            });
+            pressed = keys.after_widgets(ui.ctx(), pointer_on_image);
         });
         self.show_help = show_help;
         self.handle_actions(actions);
@@ -1004,7 +1026,7 @@ fn surface_config(
         .find(|f| !f.is_srgb())
         .unwrap_or(caps.formats[0]);
     // The kept panel layer is copied onto the window's image, where the
-    // surface allows copies (app/ui_layer.rs); else egui draws every frame.
+    // surface allows copies (app/ui_layer.rs); else it is blended over it.
     let copy = caps.usages & wgpu::TextureUsages::COPY_DST;
     wgpu::SurfaceConfiguration {
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | copy,
