@@ -56,6 +56,20 @@ pub fn load_reporting(
     }
 }
 
+/// The test hook of a slow load: while the file `MARBRE_TEST_HOLD_LOADS`
+/// names exists, a load waits before reading its meshes, as on a slow disk
+/// or network share. The window test of a slow start-up holds a load so;
+/// it once used a FIFO as the OBJ, which inputs now refuse (only regular
+/// files are read, so that a FIFO can never hang a load).
+fn hold_while_asked() {
+    let Some(hold) = std::env::var_os("MARBRE_TEST_HOLD_LOADS") else {
+        return;
+    };
+    while Path::new(&hold).exists() {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
 /// A loaded scene with its BVH already built.
 pub struct ReadyScene {
     pub loaded: LoadedScene,
@@ -84,6 +98,9 @@ impl SceneLoad {
         std::thread::spawn(move || {
             let result = load_reporting(&worker_path, kind, worker_env.as_deref(), &mut |s| {
                 worker_stage.store(s.index(), Ordering::Relaxed);
+                if s == LoadStage::Meshes {
+                    hold_while_asked();
+                }
             })
             .map(|loaded| {
                 let loaded = loaded.fit_environment(max_side);

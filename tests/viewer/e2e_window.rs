@@ -472,9 +472,10 @@ fn progress_bar_shown(window: &image::RgbImage) -> bool {
     filled >= 500
 }
 
-/// A preset that is slow to load at start-up (its OBJ is a named pipe the
-/// test writes only when it chooses, as a slow disk or a network share
-/// would deliver it): the window draws at once, the panel showing the
+/// A preset that is slow to load at start-up (held before its meshes are
+/// read while the file `MARBRE_TEST_HOLD_LOADS` names exists, which the
+/// test removes when it chooses, as a slow disk or a network share would
+/// deliver the OBJ): the window draws at once, the panel showing the
 /// load's progress, and keys pressed meanwhile (Ctrl+2: the preset's second
 /// saved view) and F12 after them act on the scene once it is drawn, rather
 /// than on the empty placeholder shown until then.
@@ -483,16 +484,13 @@ fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() 
     const TEST: &str = "a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile";
     let _serial = serial();
     let dir = TempDir::new("e2e-slow-start");
-    let Some(x) = display_or_skip(TEST, &dir, &["xdotool", "mkfifo"]) else {
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
         return;
     };
     let folder = dir.subdir("slow");
-    let pipe = folder.join("grid.obj");
-    let made = std::process::Command::new("mkfifo")
-        .arg(&pipe)
-        .status()
-        .unwrap();
-    assert!(made.success(), "mkfifo {}", pipe.display());
+    write_grid_obj(&folder.join("grid.obj"), GRID_QUADS);
+    let hold = xvfb::hold_loads(&dir);
+    std::fs::write(&hold, "").unwrap();
     let preset = folder.join("slow.ron");
     std::fs::write(&preset, SLOW_PRESET).unwrap();
     let (_child, session) = open(&x, &dir, &preset);
@@ -509,20 +507,18 @@ fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() 
         }
     };
 
-    // The loader waits on the pipe: the bar stays until the test writes.
+    // The loader is held: the bar stays until the test lets it go.
     wait_while("the progress bar while the preset loads", &|| !loading());
     session.focus();
     session.run(&["key", "ctrl+2"]);
     session.run(&["key", "F12"]);
     std::thread::sleep(Duration::from_secs(2));
-    assert!(loading(), "the load cannot end before the pipe is written");
+    assert!(loading(), "the load cannot end while it is held");
     assert!(
         pngs(&session.screenshots).is_empty(),
         "F12 waits for the scene"
     );
-    // Opening the pipe waits for its reader, the loader: on a thread, so
-    // that a viewer that died fails the wait below rather than hanging.
-    std::thread::spawn(move || write_grid_obj(&pipe, GRID_QUADS));
+    std::fs::remove_file(&hold).unwrap();
     wait_while("the end of the load (the progress bar gone)", &loading);
     wait_while("the screenshot F12 asked for during the load", &|| {
         pngs(&session.screenshots).is_empty()

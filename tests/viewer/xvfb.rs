@@ -196,6 +196,9 @@ pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> G
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", dir.subdir("runtime"))
         .env("MARBRE_CONFIG_DIR", dir.subdir("config"))
+        // Loads wait while this file exists (`hold_loads`); none does
+        // unless a test makes it.
+        .env("MARBRE_TEST_HOLD_LOADS", hold_loads(dir))
         // winit would prefer Wayland if the test itself runs in a Wayland session.
         .env_remove("WAYLAND_DISPLAY")
         .stdin(Stdio::null())
@@ -204,6 +207,12 @@ pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> G
         .spawn()
         .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"));
     Guard(child)
+}
+
+/// The file whose existence holds the viewer's scene loads before their
+/// meshes are read (`MARBRE_TEST_HOLD_LOADS`): a slow disk, on demand.
+pub fn hold_loads(dir: &TempDir) -> std::path::PathBuf {
+    dir.path().join("hold-loads")
 }
 
 pub fn marbre_log(dir: &TempDir) -> String {
