@@ -26,11 +26,12 @@ pub enum ObjError {
         path: PathBuf,
         cause: std::io::Error,
     },
-    #[error("{path}:{line}: not a valid OBJ statement: `{statement}`")]
+    #[error("{path}:{line}: {why}: `{statement}`")]
     Syntax {
         path: PathBuf,
         line: usize,
         statement: String,
+        why: String,
     },
     #[error("{path}: not a valid OBJ file: {cause}")]
     Parse {
@@ -88,11 +89,12 @@ pub fn parse_bytes(
     let text = String::from_utf8_lossy(bytes);
     // tobj says what is wrong but not where, and panics on some malformed
     // statements: the syntax check runs first and names the line.
-    if let Some((line, statement)) = obj_syntax::first_bad_obj_line(&text) {
+    if let Some(bad) = obj_syntax::first_bad_obj_line(&text) {
         return Err(ObjError::Syntax {
             path: path.to_owned(),
-            line,
-            statement: shown(&statement),
+            line: bad.line,
+            statement: shown(&bad.statement),
+            why: bad.why,
         });
     }
     let options = tobj::LoadOptions {

@@ -137,7 +137,7 @@ fn the_tobj_overflow_is_refused_with_its_line() {
     .unwrap_err()
     .to_string();
     assert!(
-        e.contains("input.obj:4: not a valid OBJ statement: `f 1/-2 2/-2 3/-2`"),
+        e.contains("input.obj:4: corner `1/-2` names texture coordinate -2, but 0 texture coordinates are declared above this line: `f 1/-2 2/-2 3/-2`"),
         "{}: {e}",
         file.display()
     );
