@@ -3,6 +3,7 @@
 //! sampling. No GPU: every function here is what the shaders must match.
 
 pub mod aa_scenes;
+pub mod animation;
 pub mod accel;
 pub mod atomic_write;
 pub mod bake;

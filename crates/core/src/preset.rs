@@ -101,6 +101,8 @@ pub enum PresetError {
         /// would print it twice.
         cause: std::io::Error,
     },
+    #[error("{path}: {}", problems.join("; "))]
+    Animation { path: PathBuf, problems: Vec<String> },
     #[error("cannot serialise the scene: {0}")]
     Serialise(#[from] ron::Error),
 }
@@ -188,6 +190,15 @@ pub fn parse(text: &str, path: &Path) -> Result<Loaded, PresetError> {
         })
         .collect();
     notes.extend(preset.scene.sanitize());
+    if let Some(animation) = &preset.scene.animation {
+        let problems = animation.problems(&preset.scene);
+        if !problems.is_empty() {
+            return Err(PresetError::Animation {
+                path: path.to_owned(),
+                problems,
+            });
+        }
+    }
     Ok(Loaded { preset, notes })
 }
 

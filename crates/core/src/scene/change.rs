@@ -42,6 +42,10 @@ bitflags::bitflags! {
         /// Saved but not traced: names, saved views, the node editor's
         /// layout.
         const ANNOTATIONS = 1 << 8;
+        /// The animation: its length, rate, loop or keys. Saved and
+        /// undone; what it changes in the traced scene at the current
+        /// time is compared there (`Scene::at_time`).
+        const ANIMATION = 1 << 9;
     }
 }
 
@@ -88,6 +92,7 @@ impl Scene {
             environment,
             render,
             graph_layout,
+            animation,
         } = self;
         let mut change = Change::empty();
         change.set(Change::CAMERA, *camera != old.camera);
@@ -95,6 +100,7 @@ impl Scene {
             Change::ANNOTATIONS,
             *views != old.views || *graph_layout != old.graph_layout,
         );
+        change.set(Change::ANIMATION, *animation != old.animation);
         change.set(Change::LIGHTS, *point_light != old.point_light);
         change.set(Change::ENVIRONMENT, *environment != old.environment);
         change.set(Change::DISPLAY, render.display != old.render.display);

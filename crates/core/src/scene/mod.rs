@@ -163,6 +163,11 @@ pub struct Scene {
     /// traced, but saved (see `graph_layout`).
     #[serde(skip_serializing_if = "GraphLayout::is_empty")]
     pub graph_layout: GraphLayout,
+    /// Time: the length, frame rate and keyframe tracks (`animation`);
+    /// a still scene has none. What is traced at a time is
+    /// [`Scene::at_time`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub animation: Option<crate::animation::Animation>,
 }
 
 impl Scene {

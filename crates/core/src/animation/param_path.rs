@@ -1,0 +1,489 @@
+//! The name of an animatable number: the path of its field in the preset,
+//! as the preset's own error messages write it (`camera.fov_degrees`,
+//! `spheres["marble"].material.diffuse.pattern.noise.fractal.frequency`,
+//! `point_light.position[1]`). The panel's key buttons, the preset's
+//! tracks and the command line all name a parameter so.
+//!
+//! A path starts at one of the scene's parts ([`Part`], the one list of
+//! what can be keyed) and goes down the part's fields as serde writes
+//! them, through `serde_json`'s value tree rather than a visitor written
+//! per struct: every field a preset can hold is reachable without code
+//! per field, and a new field is animatable the day it is added. An enum
+//! variant's name is not part of a path (`pattern.noise`, not
+//! `pattern.Fbm.noise`): the variant is the structure, which keys do not
+//! change. A list's element is named by its `name` when it has one
+//! (`spheres["marble"]`, stable when spheres are added or reordered), by
+//! its index otherwise (`ramp[2]`).
+
+use crate::scene::Scene;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use serde_json::Value;
+use std::fmt;
+
+/// One step of a path.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Step {
+    Field(String),
+    Index(usize),
+    /// The element of a list whose `name` is this.
+    Name(String),
+}
+
+/// A parsed parameter path.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ParamPath(pub Vec<Step>);
+
+impl ParamPath {
+    /// Reads `camera.target[1]`, `spheres["marble"].radius`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut steps = Vec::new();
+        let mut rest = text.trim();
+        if rest.is_empty() {
+            return Err("the path is empty".into());
+        }
+        if rest.starts_with('[') {
+            return Err(format!("`{text}`: a path starts with a field name"));
+        }
+        let mut expect_field = true;
+        while !rest.is_empty() {
+            if let Some(after) = rest.strip_prefix('[') {
+                let close = after
+                    .find(']')
+                    .ok_or_else(|| format!("`{text}`: a `[` without its `]`"))?;
+                let inside = &after[..close];
+                steps.push(if let Some(name) = inside
+                    .strip_prefix('"')
+                    .and_then(|n| n.strip_suffix('"'))
+                {
+                    Step::Name(name.to_owned())
+                } else {
+                    Step::Index(inside.parse().map_err(|_| {
+                        format!("`{text}`: `[{inside}]` is neither an index nor a \"name\"")
+                    })?)
+                });
+                rest = &after[close + 1..];
+                expect_field = false;
+                continue;
+            }
+            if !expect_field {
+                rest = rest
+                    .strip_prefix('.')
+                    .ok_or_else(|| format!("`{text}`: expected `.` or `[` before `{rest}`"))?;
+            }
+            let end = rest
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            if end == 0 {
+                return Err(format!("`{text}`: expected a field name at `{rest}`"));
+            }
+            steps.push(Step::Field(rest[..end].to_owned()));
+            rest = &rest[end..];
+            expect_field = false;
+        }
+        Ok(Self(steps))
+    }
+
+    /// The path one field further down.
+    pub fn field(&self, name: &str) -> Self {
+        let mut steps = self.0.clone();
+        steps.push(Step::Field(name.to_owned()));
+        Self(steps)
+    }
+
+    /// The path one list element further down.
+    pub fn index(&self, i: usize) -> Self {
+        let mut steps = self.0.clone();
+        steps.push(Step::Index(i));
+        Self(steps)
+    }
+
+    /// The path of the element named `name` of the list here.
+    pub fn named(&self, name: &str) -> Self {
+        let mut steps = self.0.clone();
+        steps.push(Step::Name(name.to_owned()));
+        Self(steps)
+    }
+
+    /// The path of a dotted tail (`diffuse.a.factor`, a node path) below
+    /// this one.
+    pub fn join(&self, tail: &str) -> Result<Self, String> {
+        let mut steps = self.0.clone();
+        steps.extend(Self::parse(tail)?.0);
+        Ok(Self(steps))
+    }
+}
+
+impl fmt::Display for ParamPath {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, step) in self.0.iter().enumerate() {
+            match step {
+                Step::Field(name) if i == 0 => write!(f, "{name}")?,
+                Step::Field(name) => write!(f, ".{name}")?,
+                Step::Index(n) => write!(f, "[{n}]")?,
+                Step::Name(n) => write!(f, "[\"{n}\"]")?,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A part of the scene that keys can reach, each read and written whole:
+/// the one list of what is animatable. Names, saved views, the node
+/// editor's layout and the mesh files are not parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    Camera,
+    Sphere(usize),
+    Cylinder(usize),
+    Polygon(usize),
+    Ground,
+    MeshPlacement(usize),
+    /// Mesh `.0`'s material `.1`.
+    MeshMaterial(usize, usize),
+    PointLight,
+    Environment,
+    Render,
+}
+
+/// The element of a list a step names, or why none.
+fn element(
+    step: Option<&Step>,
+    names: &[&str],
+    what: &str,
+    list: &str,
+) -> Result<usize, String> {
+    match step {
+        Some(Step::Index(i)) if *i < names.len() => Ok(*i),
+        Some(Step::Index(i)) => Err(format!(
+            "no {what} {i}: the scene has {} {list}",
+            names.len()
+        )),
+        Some(Step::Name(n)) => names.iter().position(|m| m == n).ok_or_else(|| {
+            format!(
+                "no {what} named \"{n}\" (the scene's {list}: {})",
+                if names.is_empty() {
+                    "none".to_owned()
+                } else {
+                    names.join(", ")
+                }
+            )
+        }),
+        _ => Err(format!("`{list}` needs an element: `{list}[0]` or `{list}[\"name\"]`")),
+    }
+}
+
+/// The part a path starts in and the steps left inside it.
+fn locate<'p>(scene: &Scene, path: &'p ParamPath) -> Result<(Part, &'p [Step]), String> {
+    let steps = &path.0;
+    let Some(Step::Field(first)) = steps.first() else {
+        return Err("a path starts with a part of the scene, such as `camera`".into());
+    };
+    Ok(match first.as_str() {
+        "camera" => (Part::Camera, &steps[1..]),
+        "ground" if scene.ground.is_some() => (Part::Ground, &steps[1..]),
+        "ground" => return Err("the scene has no ground".into()),
+        "point_light" if scene.point_light.is_some() => (Part::PointLight, &steps[1..]),
+        "point_light" => return Err("the scene has no point light".into()),
+        "environment" => (Part::Environment, &steps[1..]),
+        "render" => (Part::Render, &steps[1..]),
+        "spheres" => {
+            let list: Vec<&str> = scene.spheres.iter().map(|s| s.name.as_str()).collect::<Vec<&str>>();
+            let i = element(steps.get(1), &list, "sphere", "spheres")?;
+            (Part::Sphere(i), &steps[2..])
+        }
+        "cylinders" => {
+            let list: Vec<&str> = scene.cylinders.iter().map(|c| c.name.as_str()).collect::<Vec<&str>>();
+            let i = element(steps.get(1), &list, "cylinder", "cylinders")?;
+            (Part::Cylinder(i), &steps[2..])
+        }
+        "polygons" => {
+            let list: Vec<&str> = scene.polygons.iter().map(|p| p.name.as_str()).collect::<Vec<&str>>();
+            let i = element(steps.get(1), &list, "polygon", "polygons")?;
+            (Part::Polygon(i), &steps[2..])
+        }
+        "meshes" => {
+            let list: Vec<&str> = scene.meshes.iter().map(|m| m.name.as_str()).collect::<Vec<&str>>();
+            let i = element(steps.get(1), &list, "mesh", "meshes")?;
+            let mesh = &scene.meshes[i];
+            match steps.get(2) {
+                Some(Step::Field(f)) if f == "placement" => (Part::MeshPlacement(i), &steps[3..]),
+                Some(Step::Field(f)) if f == "materials" => {
+                    let list: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect::<Vec<&str>>();
+                    let j = element(steps.get(3), &list, "material", "materials")?;
+                    match steps.get(4) {
+                        Some(Step::Field(f)) if f == "material" => {
+                            (Part::MeshMaterial(i, j), &steps[5..])
+                        }
+                        _ => return Err("a mesh material's numbers are under `.material`".into()),
+                    }
+                }
+                _ => return Err("a mesh's numbers are under `.placement` or `.materials`".into()),
+            }
+        }
+        other => {
+            return Err(format!(
+                "`{other}` is not an animatable part of the scene (camera, spheres, cylinders, \
+                 polygons, ground, meshes, point_light, environment, render)"
+            ));
+        }
+    })
+}
+
+/// What a step does to a value tree, read-only or not.
+fn child<'v>(value: &'v mut Value, step: &Step) -> Result<&'v mut Value, String> {
+    let value = through_variant(value, step);
+    match (step, value) {
+        (Step::Field(name), Value::Object(map)) => {
+            if !map.contains_key(name.as_str()) {
+                return Err(format!(
+                    "no field `{name}` here (it has {})",
+                    known_fields(map)
+                ));
+            }
+            Ok(map.get_mut(name.as_str()).expect("checked"))
+        }
+        (Step::Index(i), Value::Array(list)) => {
+            let len = list.len();
+            list.get_mut(*i)
+                .ok_or_else(|| format!("no element [{i}]: the list has {len}"))
+        }
+        (Step::Name(n), Value::Array(list)) => list
+            .iter_mut()
+            .find(|v| v.get("name").and_then(Value::as_str) == Some(n.as_str()))
+            .ok_or_else(|| format!("no element named \"{n}\" here")),
+        (Step::Field(name), _) => Err(format!("no field `{name}`: this is not a struct")),
+        (_, _) => Err("this is not a list".into()),
+    }
+}
+
+fn known_fields(map: &serde_json::Map<String, Value>) -> String {
+    let names: Vec<&str> = map.keys().map(String::as_str).collect();
+    names.join(", ")
+}
+
+/// An enum's value is `{"Variant": inner}` in serde's value tree; a path
+/// goes through it without naming the variant (unless it does name it).
+fn through_variant<'v>(value: &'v mut Value, step: &Step) -> &'v mut Value {
+    let is_variant = |map: &serde_json::Map<String, Value>| {
+        map.len() == 1
+            && map.keys().next().is_some_and(|k| k.starts_with(|c: char| c.is_ascii_uppercase()))
+            && !matches!(step, Step::Field(f) if map.contains_key(f.as_str()))
+    };
+    if matches!(&*value, Value::Object(map) if is_variant(map))
+        && let Value::Object(map) = value
+    {
+        return map.values_mut().next().expect("one entry");
+    }
+    value
+}
+
+/// The numbers at the end of a path: one, or a vector's components.
+fn numbers(value: &Value) -> Option<Vec<f32>> {
+    match value {
+        Value::Number(n) => Some(vec![n.as_f64()? as f32]),
+        Value::Array(items) if !items.is_empty() => items
+            .iter()
+            .map(|v| v.as_f64().map(|x| x as f32))
+            .collect(),
+        _ => None,
+    }
+}
+
+/// Writes `components` over the number(s) at `value`, keeping an integer
+/// an integer (an octave count written as `6`, a polygon's sides).
+fn write_numbers(value: &mut Value, components: &[f32]) -> Result<(), String> {
+    let count = numbers(value)
+        .ok_or("not a number or a vector of numbers")?
+        .len();
+    if count != components.len() {
+        return Err(format!(
+            "the parameter has {count} component(s), the key {}",
+            components.len()
+        ));
+    }
+    let write = |slot: &mut Value, x: f32| {
+        *slot = if slot.is_u64() {
+            Value::from(x.round().max(0.0) as u64)
+        } else if slot.is_i64() {
+            Value::from(x.round() as i64)
+        } else {
+            Value::from(f64::from(x))
+        };
+    };
+    match value {
+        Value::Array(items) => items
+            .iter_mut()
+            .zip(components)
+            .for_each(|(slot, &x)| write(slot, x)),
+        slot => write(slot, components[0]),
+    }
+    Ok(())
+}
+
+/// Reads or writes through one part, typed `T`.
+fn through<T: Serialize + DeserializeOwned>(
+    part: &mut T,
+    steps: &[Step],
+    new: Option<&[f32]>,
+) -> Result<Vec<f32>, String> {
+    let mut tree = serde_json::to_value(&*part).map_err(|e| e.to_string())?;
+    let mut at = &mut tree;
+    for step in steps {
+        at = child(at, step)?;
+    }
+    let old = numbers(at).ok_or("not a number or a vector of numbers")?;
+    if let Some(components) = new {
+        write_numbers(at, components)?;
+        *part = serde_json::from_value(tree).map_err(|e| format!("the new value: {e}"))?;
+    }
+    Ok(old)
+}
+
+/// Reads the parameter at `path` (with `new`, writes it and returns the
+/// value it had).
+fn access(scene: &mut Scene, path: &ParamPath, new: Option<&[f32]>) -> Result<Vec<f32>, String> {
+    let (part, steps) = locate(scene, path)?;
+    match part {
+        Part::Camera => through(&mut scene.camera, steps, new),
+        Part::Sphere(i) => through(&mut scene.spheres[i], steps, new),
+        Part::Cylinder(i) => through(&mut scene.cylinders[i], steps, new),
+        Part::Polygon(i) => through(&mut scene.polygons[i], steps, new),
+        Part::Ground => through(scene.ground.as_mut().expect("located"), steps, new),
+        Part::MeshPlacement(i) => through(&mut scene.meshes[i].placement, steps, new),
+        Part::MeshMaterial(i, j) => through(&mut scene.meshes[i].materials[j].material, steps, new),
+        Part::PointLight => through(scene.point_light.as_mut().expect("located"), steps, new),
+        Part::Environment => through(&mut scene.environment, steps, new),
+        Part::Render => through(&mut scene.render, steps, new),
+    }
+}
+
+impl Scene {
+    /// The number(s) at `path`, or why the path names none.
+    pub fn parameter(&self, path: &ParamPath) -> Result<Vec<f32>, String> {
+        // Reading goes through the same code as writing, on a copy of the
+        // part alone.
+        let mut part_only = self.clone();
+        access(&mut part_only, path, None)
+    }
+
+    /// Sets the number(s) at `path`.
+    pub fn set_parameter(&mut self, path: &ParamPath, components: &[f32]) -> Result<(), String> {
+        access(self, path, Some(components)).map(drop)
+    }
+
+    /// Every animatable parameter of the scene with its current value: the
+    /// list the tests check round-trips, and the CLI prints.
+    pub fn animatable_parameters(&self) -> Vec<(ParamPath, Vec<f32>)> {
+        let mut out = Vec::new();
+        let root = |name: &str| ParamPath(vec![Step::Field(name.to_owned())]);
+        let element = |list: &str, i: usize, name: &str| {
+            let path = root(list);
+            if name.is_empty() || !unique(self, list, name) {
+                path.index(i)
+            } else {
+                path.named(name)
+            }
+        };
+        leaves(&to_tree(&self.camera), root("camera"), &mut out);
+        for (i, s) in self.spheres.iter().enumerate() {
+            leaves(&to_tree(s), element("spheres", i, &s.name), &mut out);
+        }
+        for (i, c) in self.cylinders.iter().enumerate() {
+            leaves(&to_tree(c), element("cylinders", i, &c.name), &mut out);
+        }
+        for (i, p) in self.polygons.iter().enumerate() {
+            leaves(&to_tree(p), element("polygons", i, &p.name), &mut out);
+        }
+        if let Some(g) = &self.ground {
+            leaves(&to_tree(g), root("ground"), &mut out);
+        }
+        for (i, m) in self.meshes.iter().enumerate() {
+            let mesh = element("meshes", i, &m.name);
+            leaves(&to_tree(&m.placement), mesh.field("placement"), &mut out);
+            for (j, mm) in m.materials.iter().enumerate() {
+                let materials = mesh.field("materials");
+                let at = if mm.name.is_empty() {
+                    materials.index(j)
+                } else {
+                    materials.named(&mm.name)
+                };
+                leaves(&to_tree(&mm.material), at.field("material"), &mut out);
+            }
+        }
+        if let Some(l) = &self.point_light {
+            leaves(&to_tree(l), root("point_light"), &mut out);
+        }
+        leaves(&to_tree(&self.environment), root("environment"), &mut out);
+        leaves(&to_tree(&self.render), root("render"), &mut out);
+        out
+    }
+}
+
+fn unique(scene: &Scene, list: &str, name: &str) -> bool {
+    let count = match list {
+        "spheres" => scene.spheres.iter().filter(|s| s.name == name).count(),
+        "cylinders" => scene.cylinders.iter().filter(|c| c.name == name).count(),
+        "polygons" => scene.polygons.iter().filter(|p| p.name == name).count(),
+        _ => scene.meshes.iter().filter(|m| m.name == name).count(),
+    };
+    count == 1
+}
+
+fn to_tree<T: Serialize>(part: &T) -> Value {
+    serde_json::to_value(part).expect("a scene part serialises")
+}
+
+/// The numbers and vectors of numbers under `value`, each with its path.
+fn leaves(value: &Value, path: ParamPath, out: &mut Vec<(ParamPath, Vec<f32>)>) {
+    if let Some(n) = numbers(value) {
+        out.push((path, n));
+        return;
+    }
+    match value {
+        Value::Object(map) if map.len() == 1 && map.keys().all(|k| k.starts_with(|c: char| c.is_ascii_uppercase())) => {
+            leaves(map.values().next().expect("one entry"), path, out);
+        }
+        Value::Object(map) => {
+            for (name, v) in map {
+                leaves(v, path.field(name), out);
+            }
+        }
+        Value::Array(items) => {
+            let names: Vec<Option<&str>> = items
+                .iter()
+                .map(|v| v.get("name").and_then(Value::as_str))
+                .collect();
+            for (i, v) in items.iter().enumerate() {
+                let at = match names[i] {
+                    Some(n) if !n.is_empty() && names.iter().filter(|m| **m == Some(n)).count() == 1 => {
+                        path.named(n)
+                    }
+                    _ => path.index(i),
+                };
+                leaves(v, at, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_parse_and_print_alike() {
+        for text in [
+            "camera.fov_degrees",
+            "spheres[\"marble\"].material.diffuse.ramp[2].position",
+            "point_light.position[1]",
+            "meshes[0].materials[\"light\"].material.emission_strength",
+        ] {
+            assert_eq!(ParamPath::parse(text).unwrap().to_string(), text);
+        }
+        for bad in ["", "camera..fov", "spheres[x]", "spheres[0", "[0]", "camera fov"] {
+            assert!(ParamPath::parse(bad).is_err(), "`{bad}` parsed");
+        }
+    }
+}

@@ -1,0 +1,210 @@
+use super::*;
+use crate::preset::{self, Preset, PresetError};
+use crate::scene::Change;
+use std::path::{Path, PathBuf};
+
+fn shipped_presets() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 10, "{files:?}");
+    files
+}
+
+/// A value unlike `value`: each component moved (an integer by 1).
+fn moved(value: &[f32]) -> Vec<f32> {
+    value.iter().map(|v| v + 1.0).collect()
+}
+
+/// Every number a shipped preset holds (but names and layout) can be
+/// keyed: its path reads back its value, and a track on it written to a
+/// preset, read again and traced at the second key's time sets it.
+#[test]
+fn every_animatable_path_resolves_and_round_trips_through_a_preset() {
+    for file in shipped_presets() {
+        let scene = preset::load(&file).unwrap().preset.scene;
+        let params = scene.animatable_parameters();
+        assert!(params.len() > 10, "{}: {} parameters", file.display(), params.len());
+        let mut animation = Animation {
+            duration: 2.0,
+            ..Animation::default()
+        };
+        for (path, value) in &params {
+            assert_eq!(
+                scene.parameter(path).as_ref(),
+                Ok(value),
+                "{}: {path}",
+                file.display()
+            );
+            animation.insert_key(path, 0.0, value);
+            animation.insert_key(path, 1.0, &moved(value));
+        }
+        let keyed = Scene {
+            animation: Some(animation),
+            ..scene.clone()
+        };
+        let text = preset::to_text(
+            &Preset {
+                scene: keyed.clone(),
+                ..Preset::default()
+            },
+            &file,
+        )
+        .unwrap();
+        let back = preset::parse(&text, &file).unwrap().preset.scene;
+        assert_eq!(back.animation, keyed.animation, "{}", file.display());
+        let start = back.at_time(0.0);
+        let end = back.at_time(1.0);
+        for (path, value) in &params {
+            assert_eq!(start.parameter(path).as_ref(), Ok(value), "{path} at 0");
+            assert_eq!(
+                end.parameter(path).unwrap(),
+                moved(value),
+                "{}: {path} at 1",
+                file.display()
+            );
+        }
+    }
+}
+
+/// The panel's and the CLI's names for common parameters.
+#[test]
+fn parameters_are_named_as_the_preset_writes_them() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
+    let scene = preset::load(&file).unwrap().preset.scene;
+    let names: Vec<String> = scene
+        .animatable_parameters()
+        .iter()
+        .map(|(p, _)| p.to_string())
+        .collect();
+    for expected in [
+        "camera.fov_degrees",
+        "camera.target",
+        "spheres[\"marble\"].radius",
+        "spheres[\"marble\"].material.diffuse.pattern.noise.fractal.frequency",
+        "spheres[\"marble\"].material.diffuse.pattern.stripe_frequency",
+        "spheres[\"marble\"].material.diffuse.ramp[1].position",
+        "spheres[\"marble\"].material.diffuse.a",
+        "environment.intensity",
+        "render.exposure",
+    ] {
+        assert!(names.iter().any(|n| n == expected), "{expected} not in {names:#?}");
+    }
+    let path = ParamPath::parse("spheres[\"marble\"].material.diffuse.pattern.noise.fractal.octaves")
+        .unwrap();
+    assert_eq!(scene.parameter(&path), Ok(vec![6.0]));
+    let by_index = ParamPath::parse("spheres[0].radius").unwrap();
+    assert_eq!(scene.parameter(&by_index), Ok(vec![0.9]));
+}
+
+fn keyed(path: &str, keys: &[(f32, f32)]) -> Scene {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
+    let mut scene = preset::load(&file).unwrap().preset.scene;
+    let mut animation = Animation::default();
+    for &(t, v) in keys {
+        animation.insert_key(&ParamPath::parse(path).unwrap(), t, &[v]);
+    }
+    scene.animation = Some(animation);
+    scene
+}
+
+/// A keyed noise number changes the traced scene's parameters only (no
+/// code is generated again); a keyed camera moves the camera only; the
+/// keys themselves are an animation edit.
+#[test]
+fn moments_of_a_scene_differ_in_numbers_only() {
+    let noise = keyed(
+        "spheres[\"marble\"].material.diffuse.pattern.noise.fractal.frequency",
+        &[(0.0, 1.0), (2.0, 3.0)],
+    );
+    assert_eq!(
+        noise.at_time(1.5).changes_from(&noise.at_time(0.5)),
+        Change::MATERIAL_PARAMETERS
+    );
+    let camera = keyed("camera.yaw_degrees", &[(0.0, 0.0), (4.0, 360.0)]);
+    assert_eq!(
+        camera.at_time(1.0).changes_from(&camera.at_time(0.0)),
+        Change::CAMERA
+    );
+    // Smooth: a quarter of the way in time is 0.156 25 of the turn.
+    assert_eq!(camera.at_time(1.0).camera.yaw_degrees, 360.0 * 0.156_25);
+    let mut edited = camera.clone();
+    edited
+        .animation
+        .as_mut()
+        .unwrap()
+        .insert_key(&ParamPath::parse("camera.yaw_degrees").unwrap(), 1.0, &[10.0]);
+    assert_eq!(edited.changes_from(&camera), Change::ANIMATION);
+}
+
+fn parse_error(animation: &str) -> String {
+    let text = format!(
+        "(format_version: 2, scene: (spheres: [(name: \"ball\", center: (0.0, 1.0, 0.0), radius: 1.0)], animation: Some({animation})))"
+    );
+    match preset::parse(&text, Path::new("bad.ron")) {
+        Err(e @ PresetError::Animation { .. }) => e.to_string(),
+        other => panic!("{animation}: {other:?}"),
+    }
+}
+
+/// Each bad animation is refused naming the file, the field and why.
+#[test]
+fn bad_animations_are_refused_naming_the_field() {
+    for (animation, expected) in [
+        (
+            "(tracks: [(path: \"spheres[\\\"bal\\\"].radius\", keys: [(time: 0.0, value: 1.0)])])",
+            "animation.tracks[0] (`spheres[\"bal\"].radius`): no sphere named \"bal\" (the scene's spheres: ball)",
+        ),
+        (
+            "(tracks: [(path: \"spheres[0].radius\", keys: [(time: 1.0, value: 1.0), (time: 1.0, value: 2.0)])])",
+            "keys[1].time: 1 does not come after the key before it (1)",
+        ),
+        (
+            "(tracks: [(path: \"spheres[0].radius\", keys: [(time: 0.0, value: NaN)])])",
+            "keys[0].value: NaN is not a finite number",
+        ),
+        (
+            "(tracks: [(path: \"spheres[0].center\", keys: [(time: 0.0, value: 1.0)])])",
+            "keys[0].value: 1 component(s) for a parameter of 3",
+        ),
+        (
+            "(tracks: [(path: \"spheres[0].colour\", keys: [(time: 0.0, value: 1.0)])])",
+            "no field `colour` here",
+        ),
+        ("(fps: 0.0)", "animation.fps: 0 is not a frame rate"),
+        ("(duration: 0.0)", "animation.duration: 0 is not a length"),
+    ] {
+        let message = parse_error(animation);
+        assert!(message.starts_with("bad.ron: "), "{message}");
+        assert!(message.contains(expected), "{message}\nexpected: {expected}");
+    }
+}
+
+/// A preset without an animation writes none, and one written reads back
+/// equal, its keys' interpolation and extrapolation included.
+#[test]
+fn presets_without_an_animation_read_and_write_as_before() {
+    let text = preset::to_text(&Preset::default(), Path::new("a.ron")).unwrap();
+    assert!(!text.contains("animation"), "{text}");
+    let mut scene = keyed("camera.distance", &[(0.0, 5.0), (1.0, 6.0)]);
+    let animation = scene.animation.as_mut().unwrap();
+    animation.looping = true;
+    animation.tracks[0].extrapolation = Extrapolation::Cycle;
+    animation.tracks[0].keys[0].interpolation = Interpolation::Constant;
+    animation.insert_key(&ParamPath::parse("camera.target").unwrap(), 0.5, &[1.0, 2.0, 3.0]);
+    let text = preset::to_text(
+        &Preset {
+            scene: scene.clone(),
+            ..Preset::default()
+        },
+        Path::new("a.ron"),
+    )
+    .unwrap();
+    assert!(text.contains("loop: true"), "{text}");
+    let back = preset::parse(&text, Path::new("a.ron")).unwrap().preset.scene;
+    assert_eq!(back.animation, scene.animation);
+}
