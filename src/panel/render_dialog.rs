@@ -100,6 +100,7 @@ impl RenderDialog {
             // The viewer shows the placeholder and its note: it renders
             // what it shows.
             allow_placeholders: true,
+            timing: Default::default(),
         })
     }
 

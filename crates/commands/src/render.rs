@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use marbre_core::scene::{LightPoints, Metering, Strategy, View};
 pub use marbre_render::final_render::parse_size;
 use marbre_render::final_render::{FinalRender, Progress, RenderObserver, Stop, render_to_file};
+use marbre_render::frame_sequence::Timing;
 use marbre_render::gpu::{GpuContext, KernelChoice};
 use marbre_render::session::load_scene;
 use std::ops::ControlFlow;
@@ -79,6 +80,30 @@ pub struct RenderArgs {
     /// without it such a render fails before tracing, naming the files.
     #[arg(long)]
     pub allow_placeholders: bool,
+    /// Render the frames FIRST..LAST (both included, as Blender's range;
+    /// `0..119` is 120 frames) of the preset's animation, each at its time
+    /// frame/fps, to the output with its run of # replaced by the frame
+    /// number (`-o out/frame_####.png`). Frames whose file exists are
+    /// skipped (a stopped sequence resumes) unless --overwrite. Each
+    /// frame's samples are its own, seeded by its number.
+    #[arg(long, value_parser = marbre_render::frame_sequence::parse_frame_range, conflicts_with = "time")]
+    pub frames: Option<std::ops::RangeInclusive<u32>>,
+    /// Frames a second for --frames and --time (default: the preset's
+    /// animation's, else 24).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fps: Option<f32>,
+    /// Render one moment of the preset's time, in seconds (its samples
+    /// those of the frame nearest it).
+    #[arg(long, allow_negative_numbers = true)]
+    pub time: Option<f32>,
+    /// With --frames, trace again frames whose file exists.
+    #[arg(long, requires = "frames")]
+    pub overwrite: bool,
+    /// With --frames, also assemble the frames (PNG) into one animated
+    /// file: .gif or .apng (written by marbre), .webp or .mp4 (through
+    /// ffmpeg, which must be installed).
+    #[arg(long, requires = "frames", value_name = "FILE")]
+    pub animation: Option<PathBuf>,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -127,6 +152,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--target-error must be a positive number, like 0.01 for 1 %");
     }
     let mut loaded = load_scene(&args.preset, args.env.as_deref())?;
+    let timing = timing(args, loaded.scene.animation.as_ref().map(|a| a.fps))?;
     let render = &mut loaded.scene.render;
     render.view = args.view.unwrap_or(render.view);
     if args.denoise {
@@ -157,39 +183,89 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         output: args.output.clone(),
         denoise_exr: args.denoise_exr,
         allow_placeholders: args.allow_placeholders,
+        timing,
     };
+    let frames = match &job.timing {
+        Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,
+        Timing::Still { .. } => 1,
+    };
+    marbre_render::final_render::check_job(&job)?;
     let ctx = GpuContext::headless()?;
-    let mut bar = Bar::new(spp, ctx.describe());
+    let mut bar = Bar::new(spp, frames, ctx.describe());
     render_to_file(&ctx, loaded, &job, &mut bar)?;
     Ok(())
 }
 
-/// The terminal's progress bar, and the render's lines on stderr.
-struct Bar(indicatif::ProgressBar);
+/// `--frames`, `--time` and `--fps` as the render's timing, refused
+/// before any loading of the GPU.
+fn timing(args: &RenderArgs, preset_fps: Option<f32>) -> Result<Timing> {
+    let fps = args.fps.or(preset_fps).unwrap_or(24.0);
+    if !(fps.is_finite() && fps > 0.0) {
+        bail!("--fps must be a positive number of frames a second, such as 24 (got {fps})");
+    }
+    if let Some(time) = args.time
+        && !time.is_finite()
+    {
+        bail!("--time must be a number of seconds (got {time})");
+    }
+    Ok(match &args.frames {
+        Some(frames) => Timing::Sequence {
+            frames: frames.clone(),
+            fps,
+            overwrite: args.overwrite,
+            animation: args.animation.clone(),
+        },
+        None => {
+            let time = args.time.unwrap_or(0.0);
+            Timing::Still {
+                time,
+                frame: (f64::from(time) * f64::from(fps)).round().max(0.0) as u32,
+            }
+        }
+    })
+}
+
+/// The terminal's progress bar (over every frame's samples), and the
+/// render's lines on stderr.
+struct Bar {
+    bar: indicatif::ProgressBar,
+    frames: u32,
+}
 
 impl Bar {
-    fn new(spp: u32, device: String) -> Self {
-        let bar = indicatif::ProgressBar::new(u64::from(spp));
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})",
-            )
-            .expect("a valid template"),
-        );
+    fn new(spp: u32, frames: u32, device: String) -> Self {
+        let bar = indicatif::ProgressBar::new(u64::from(spp) * u64::from(frames));
+        let template = if frames > 1 {
+            "{msg} [{bar:40}] {prefix} {elapsed} (eta {eta})"
+        } else {
+            "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})"
+        };
+        bar.set_style(indicatif::ProgressStyle::with_template(template).expect("a valid template"));
         bar.set_message(device);
-        Self(bar)
+        Self { bar, frames }
     }
 }
 
 impl RenderObserver for Bar {
     fn note(&mut self, line: &str) {
-        self.0.suspend(|| eprintln!("{line}"));
+        self.bar.suspend(|| eprintln!("{line}"));
     }
 
     fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {
-        self.0.set_position(u64::from(progress.samples));
+        let per_frame = u64::from(progress.max_samples);
+        self.bar
+            .set_position(u64::from(progress.frame) * per_frame + u64::from(progress.samples));
+        if self.frames > 1 {
+            self.bar.set_prefix(format!(
+                "frame {}/{}, {}/{} spp,",
+                progress.frame + 1,
+                progress.frames,
+                progress.samples,
+                progress.max_samples
+            ));
+        }
         if let Some(e) = progress.relative_error {
-            self.0.set_message(format!("error {:.2} %", 100.0 * e));
+            self.bar.set_message(format!("error {:.2} %", 100.0 * e));
         }
         ControlFlow::Continue(())
     }

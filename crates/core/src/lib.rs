@@ -3,8 +3,9 @@
 //! sampling. No GPU: every function here is what the shaders must match.
 
 pub mod aa_scenes;
-pub mod animation;
 pub mod accel;
+pub mod animated_image;
+pub mod animation;
 pub mod atomic_write;
 pub mod bake;
 pub mod bsdf;

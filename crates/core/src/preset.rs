@@ -102,7 +102,10 @@ pub enum PresetError {
         cause: std::io::Error,
     },
     #[error("{path}: {}", problems.join("; "))]
-    Animation { path: PathBuf, problems: Vec<String> },
+    Animation {
+        path: PathBuf,
+        problems: Vec<String>,
+    },
     #[error("cannot serialise the scene: {0}")]
     Serialise(#[from] ron::Error),
 }

@@ -4,6 +4,7 @@
 //! that the dialog's image is the command's, byte for byte; each caller
 //! only says how progress is shown and whether to stop early.
 
+use crate::frame_sequence::{self, PlannedFrame, Timing};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::{GpuContext, KernelChoice, Renderer};
@@ -12,6 +13,7 @@ use crate::session::{
     trace_frame,
 };
 use anyhow::{Context, Result, bail};
+use marbre_core::animated_image;
 use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::scene::{Metering, Scene};
 use marbre_core::texture::ImageSet;
@@ -75,22 +77,30 @@ pub struct FinalRender {
     /// only with `--allow-placeholders`, so that a script or a farm never
     /// takes such an image as good.
     pub allow_placeholders: bool,
+    /// The moment traced, or the frames of a sequence.
+    pub timing: Timing,
 }
 
-/// How far a render has come, after each frame.
+/// How far a render has come, after each round of samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress {
     pub samples: u32,
     pub max_samples: u32,
     /// The last estimated relative error, when rendering to a target.
     pub relative_error: Option<f64>,
+    /// Which of the frames to trace this is (0 for a still), and how many
+    /// there are (1 for a still).
+    pub frame: u32,
+    pub frames: u32,
 }
 
 impl Progress {
-    /// The fraction done, 0 to 1: samples against the cap (a render to an
-    /// error target may end well before it).
+    /// The fraction done, 0 to 1: frames done, and samples against the cap
+    /// in the frame under way (a render to an error target may end well
+    /// before it).
     pub fn fraction(&self) -> f32 {
-        (f64::from(self.samples) / f64::from(self.max_samples.max(1))).min(1.0) as f32
+        let in_frame = (f64::from(self.samples) / f64::from(self.max_samples.max(1))).min(1.0);
+        ((f64::from(self.frame) + in_frame) / f64::from(self.frames.max(1))).min(1.0) as f32
     }
 }
 
@@ -190,15 +200,10 @@ pub fn refuse_substitutes(loaded: &LoadedScene) -> Result<()> {
     )
 }
 
-/// Renders `loaded` as `job` says on `ctx` and writes the image to
-/// `job.output` atomically (a sibling file renamed over it: a cancelled or
-/// failed render leaves no partial file). Errors name the output file.
-pub fn render_to_file(
-    ctx: &GpuContext,
-    mut loaded: LoadedScene,
-    job: &FinalRender,
-    observer: &mut dyn RenderObserver,
-) -> Result<Outcome> {
+/// What a job writes, checked before any loading or tracing: the output's
+/// format, its folder, the samples, the target, and a sequence's
+/// animated file; the latter is returned with the format.
+pub fn check_job(job: &FinalRender) -> Result<(ImageFormat, Option<&PathBuf>)> {
     let format = ImageFormat::from_path(&job.output)?;
     // Found before the render, not after it, and never created by
     // surprise; a file in the way is named.
@@ -211,11 +216,66 @@ pub fn render_to_file(
     {
         bail!("the target error must be a positive number, like 0.01 for 1 %");
     }
+    let animation = match &job.timing {
+        Timing::Sequence {
+            animation: Some(path),
+            ..
+        } => {
+            if format != ImageFormat::Png {
+                bail!(
+                    "{}: an animation is assembled from PNG frames; write the frames as .png",
+                    path.display()
+                );
+            }
+            image_io::check_output(path)?;
+            animated_image::check_writable(path)?;
+            Some(path)
+        }
+        _ => None,
+    };
+    frame_sequence::plan(&job.timing, &job.output)?;
+    Ok((format, animation))
+}
+
+/// Renders `loaded` as `job` says on `ctx` and writes the image to
+/// `job.output` atomically (a sibling file renamed over it: a cancelled or
+/// failed render leaves no partial file), or, for a sequence, each frame
+/// to its file, the scene at each frame's time traced by one renderer (a
+/// moment differs from the next in numbers only: no pipeline is built
+/// again). Errors name the output file.
+pub fn render_to_file(
+    ctx: &GpuContext,
+    mut loaded: LoadedScene,
+    job: &FinalRender,
+    observer: &mut dyn RenderObserver,
+) -> Result<Outcome> {
+    let (format, animation) = check_job(job)?;
+    let (frames, written) = frame_sequence::plan(&job.timing, &job.output)?;
+    if !written.is_empty() {
+        observer.note(&format!(
+            "{} of the frames are written already and skipped (--overwrite traces them again): {} …",
+            written.len(),
+            written[0].output.display()
+        ));
+    }
     if let Some(metering) = job.auto_exposure {
         let display = &mut loaded.scene.render.display;
         display.auto_exposure = true;
         display.metering = metering;
     }
+    if let Some(problem) = loaded
+        .scene
+        .animation
+        .as_ref()
+        .and_then(|a| a.problems(&loaded.scene).into_iter().next())
+    {
+        bail!("the scene's animation cannot be traced: {problem}");
+    }
+    let base = std::mem::take(&mut loaded.scene);
+    let Some(first) = frames.first() else {
+        return assemble(animation, &written, job, observer);
+    };
+    loaded.scene = base.at_time(first.time);
     let loaded = loaded.fit_environment(max_texture_side(ctx));
     for note in &loaded.notes {
         observer.note(&format!("note: {note}"));
@@ -226,52 +286,141 @@ pub fn render_to_file(
     let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
     let mut renderer = renderer_fitting(ctx, &loaded, job.size, kernel)?;
-    let flow = match job.stop {
-        Stop::Samples(spp) => accumulate(ctx, &mut renderer, spp, observer)?,
+    for (index, planned) in frames.iter().enumerate() {
+        if index > 0 {
+            renderer.set_scene(ctx, &base.at_time(planned.time))?;
+        }
+        renderer.restart_at_frame(planned.frame);
+        let mut in_sequence = InSequence {
+            observer: &mut *observer,
+            frame: index as u32,
+            frames: frames.len() as u32,
+        };
+        if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
+            return Ok(Outcome::Cancelled);
+        }
+        write_image(ctx, &mut renderer, job, format, planned, observer)?;
+    }
+    let mut all: Vec<PlannedFrame> = frames.into_iter().chain(written).collect();
+    all.sort_by_key(|f| f.frame);
+    assemble(animation, &all, job, observer)
+}
+
+/// The observer of one frame of a sequence: its progress counts the
+/// frames before it.
+struct InSequence<'a> {
+    observer: &'a mut dyn RenderObserver,
+    frame: u32,
+    frames: u32,
+}
+
+impl RenderObserver for InSequence<'_> {
+    fn note(&mut self, line: &str) {
+        self.observer.note(line);
+    }
+
+    fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {
+        self.observer.progress(&Progress {
+            frame: self.frame,
+            frames: self.frames,
+            ..*progress
+        })
+    }
+}
+
+/// Traces the frame under way until `stop`; `Break` if cancelled.
+fn trace_to_stop(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    stop: Stop,
+    observer: &mut dyn RenderObserver,
+) -> Result<ControlFlow<()>> {
+    Ok(match stop {
+        Stop::Samples(spp) => accumulate(ctx, renderer, spp, observer)?,
         Stop::TargetError { target, max_spp } => {
-            let (flow, reached) =
-                accumulate_to_error(ctx, &mut renderer, target, max_spp, observer)?;
+            let (flow, reached) = accumulate_to_error(ctx, renderer, target, max_spp, observer)?;
             if flow.is_continue() {
-                observer.note(&describe_error(&renderer, target, reached));
+                observer.note(&describe_error(renderer, target, reached));
             }
             flow
         }
-    };
-    if flow.is_break() {
-        return Ok(Outcome::Cancelled);
-    }
+    })
+}
+
+/// Writes the frame traced to its file.
+fn write_image(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    job: &FinalRender,
+    format: ImageFormat,
+    planned: &PlannedFrame,
+    observer: &mut dyn RenderObserver,
+) -> Result<()> {
+    let output = &planned.output;
     // EXR output is the radiance, unscaled (as Blender and Mitsuba write
     // it): only a PNG is exposed. The exposure is reported either way, and
     // for an EXR the note says it was not applied.
-    if loaded.scene.render.shown_display().auto_exposure {
+    if renderer.scene().render.shown_display().auto_exposure {
         if format == ImageFormat::Exr {
             observer.note(&format!(
                 "note: auto exposure does not scale {}: an EXR holds the unscaled radiance; \
                  the exposure below is for a viewer or compositor to apply",
-                job.output.display()
+                output.display()
             ));
         }
-        observer.note(&describe_auto_exposure(ctx, &mut renderer)?);
+        observer.note(&describe_auto_exposure(ctx, renderer)?);
     }
     match format {
         ImageFormat::Png => {
             let image = renderer.read_display(ctx)?;
-            image_io::save_png(&image, &job.output)
+            image_io::save_png(&image, output)
         }
         ImageFormat::Exr => {
             let (w, h, pixels) = if job.denoise_exr {
                 renderer.read_denoised(ctx)?
             } else {
-                if loaded.scene.render.display.denoise {
+                if renderer.scene().render.display.denoise {
                     observer.note("note: the EXR is the raw accumulation, not denoised");
                 }
                 renderer.read_radiance(ctx)?
             };
-            image_io::save_exr(w, h, &pixels, &job.output)
+            image_io::save_exr(w, h, &pixels, output)
         }
     }
-    .with_context(|| format!("saving {}", job.output.display()))?;
-    observer.note(&format!("wrote {}", job.output.display()));
+    .with_context(|| format!("saving {}", output.display()))?;
+    observer.note(&format!("wrote {}", output.display()));
+    Ok(())
+}
+
+/// The animated file of a sequence, from its frames' PNG files, if asked.
+fn assemble(
+    animation: Option<&PathBuf>,
+    frames: &[PlannedFrame],
+    job: &FinalRender,
+    observer: &mut dyn RenderObserver,
+) -> Result<Outcome> {
+    let (Some(path), Timing::Sequence { fps, .. }) = (animation, &job.timing) else {
+        return Ok(Outcome::Written);
+    };
+    let images = frames
+        .iter()
+        .map(|f| {
+            let bytes =
+                marbre_core::capped_read::read_capped(&f.output, marbre_core::capped_read::IMAGE)
+                    .with_context(|| format!("reading the frame {}", f.output.display()))?;
+            Ok(
+                image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+                    .with_context(|| format!("decoding the frame {}", f.output.display()))?
+                    .to_rgba8(),
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    animated_image::save_animation(&images, *fps, path)?;
+    observer.note(&format!(
+        "wrote {} ({} frames at {fps} fps)",
+        path.display(),
+        images.len()
+    ));
     Ok(Outcome::Written)
 }
 
@@ -289,6 +438,8 @@ fn accumulate(
             samples: renderer.accumulated_samples(),
             max_samples: spp,
             relative_error: None,
+            frame: 0,
+            frames: 1,
         };
         if observer.progress(&progress).is_break() {
             return Ok(ControlFlow::Break(()));
@@ -331,6 +482,8 @@ fn accumulate_to_error(
             samples: renderer.accumulated_samples(),
             max_samples: max_spp,
             relative_error,
+            frame: 0,
+            frames: 1,
         };
         if observer.progress(&progress).is_break() {
             return Ok((ControlFlow::Break(()), None));

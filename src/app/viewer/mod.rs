@@ -970,6 +970,7 @@ impl Viewer {
                     output,
                     denoise_exr: false,
                     allow_placeholders: true,
+                    timing: Default::default(),
                 })
             }
         }

@@ -86,6 +86,11 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         denoise: false,
         denoise_exr: false,
         allow_placeholders: false,
+        frames: None,
+        fps: None,
+        time: None,
+        overwrite: false,
+        animation: None,
     }
 }
 
@@ -98,6 +103,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         output,
         denoise_exr: false,
         allow_placeholders: false,
+        timing: Default::default(),
     }
 }
 

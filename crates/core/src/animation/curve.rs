@@ -212,7 +212,13 @@ mod tests {
         ];
         assert_eq!(at(&keys, Extrapolation::Hold, -4.0), 10.0);
         assert_eq!(at(&keys, Extrapolation::Hold, 9.0), 30.0);
-        for (t, expected) in [(1.5, 20.0), (3.5, 20.0), (5.5, 20.0), (-0.5, 20.0), (4.5, 10.0)] {
+        for (t, expected) in [
+            (1.5, 20.0),
+            (3.5, 20.0),
+            (5.5, 20.0),
+            (-0.5, 20.0),
+            (4.5, 10.0),
+        ] {
             assert_eq!(at(&keys, Extrapolation::Cycle, t), expected, "cycle at {t}");
         }
         // One key: its value everywhere, cycle or not.

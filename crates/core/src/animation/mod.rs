@@ -65,7 +65,9 @@ impl Animation {
 
     /// The track on `path`, if any.
     pub fn track(&self, path: &ParamPath) -> Option<&Track> {
-        self.tracks.iter().find(|t| t.parsed_path().as_ref() == Ok(path))
+        self.tracks
+            .iter()
+            .find(|t| t.parsed_path().as_ref() == Ok(path))
     }
 
     /// Inserts (or replaces) the key at `time` on `path`'s track, made if

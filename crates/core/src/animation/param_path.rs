@@ -52,16 +52,15 @@ impl ParamPath {
                     .find(']')
                     .ok_or_else(|| format!("`{text}`: a `[` without its `]`"))?;
                 let inside = &after[..close];
-                steps.push(if let Some(name) = inside
-                    .strip_prefix('"')
-                    .and_then(|n| n.strip_suffix('"'))
-                {
-                    Step::Name(name.to_owned())
-                } else {
-                    Step::Index(inside.parse().map_err(|_| {
-                        format!("`{text}`: `[{inside}]` is neither an index nor a \"name\"")
-                    })?)
-                });
+                steps.push(
+                    if let Some(name) = inside.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+                        Step::Name(name.to_owned())
+                    } else {
+                        Step::Index(inside.parse().map_err(|_| {
+                            format!("`{text}`: `[{inside}]` is neither an index nor a \"name\"")
+                        })?)
+                    },
+                );
                 rest = &after[close + 1..];
                 expect_field = false;
                 continue;
@@ -147,12 +146,7 @@ enum Part {
 }
 
 /// The element of a list a step names, or why none.
-fn element(
-    step: Option<&Step>,
-    names: &[&str],
-    what: &str,
-    list: &str,
-) -> Result<usize, String> {
+fn element(step: Option<&Step>, names: &[&str], what: &str, list: &str) -> Result<usize, String> {
     match step {
         Some(Step::Index(i)) if *i < names.len() => Ok(*i),
         Some(Step::Index(i)) => Err(format!(
@@ -169,7 +163,9 @@ fn element(
                 }
             )
         }),
-        _ => Err(format!("`{list}` needs an element: `{list}[0]` or `{list}[\"name\"]`")),
+        _ => Err(format!(
+            "`{list}` needs an element: `{list}[0]` or `{list}[\"name\"]`"
+        )),
     }
 }
 
@@ -188,28 +184,48 @@ fn locate<'p>(scene: &Scene, path: &'p ParamPath) -> Result<(Part, &'p [Step]), 
         "environment" => (Part::Environment, &steps[1..]),
         "render" => (Part::Render, &steps[1..]),
         "spheres" => {
-            let list: Vec<&str> = scene.spheres.iter().map(|s| s.name.as_str()).collect::<Vec<&str>>();
+            let list: Vec<&str> = scene
+                .spheres
+                .iter()
+                .map(|s| s.name.as_str())
+                .collect::<Vec<&str>>();
             let i = element(steps.get(1), &list, "sphere", "spheres")?;
             (Part::Sphere(i), &steps[2..])
         }
         "cylinders" => {
-            let list: Vec<&str> = scene.cylinders.iter().map(|c| c.name.as_str()).collect::<Vec<&str>>();
+            let list: Vec<&str> = scene
+                .cylinders
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<&str>>();
             let i = element(steps.get(1), &list, "cylinder", "cylinders")?;
             (Part::Cylinder(i), &steps[2..])
         }
         "polygons" => {
-            let list: Vec<&str> = scene.polygons.iter().map(|p| p.name.as_str()).collect::<Vec<&str>>();
+            let list: Vec<&str> = scene
+                .polygons
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<&str>>();
             let i = element(steps.get(1), &list, "polygon", "polygons")?;
             (Part::Polygon(i), &steps[2..])
         }
         "meshes" => {
-            let list: Vec<&str> = scene.meshes.iter().map(|m| m.name.as_str()).collect::<Vec<&str>>();
+            let list: Vec<&str> = scene
+                .meshes
+                .iter()
+                .map(|m| m.name.as_str())
+                .collect::<Vec<&str>>();
             let i = element(steps.get(1), &list, "mesh", "meshes")?;
             let mesh = &scene.meshes[i];
             match steps.get(2) {
                 Some(Step::Field(f)) if f == "placement" => (Part::MeshPlacement(i), &steps[3..]),
                 Some(Step::Field(f)) if f == "materials" => {
-                    let list: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect::<Vec<&str>>();
+                    let list: Vec<&str> = mesh
+                        .materials
+                        .iter()
+                        .map(|m| m.name.as_str())
+                        .collect::<Vec<&str>>();
                     let j = element(steps.get(3), &list, "material", "materials")?;
                     match steps.get(4) {
                         Some(Step::Field(f)) if f == "material" => {
@@ -267,7 +283,10 @@ fn known_fields(map: &serde_json::Map<String, Value>) -> String {
 fn through_variant<'v>(value: &'v mut Value, step: &Step) -> &'v mut Value {
     let is_variant = |map: &serde_json::Map<String, Value>| {
         map.len() == 1
-            && map.keys().next().is_some_and(|k| k.starts_with(|c: char| c.is_ascii_uppercase()))
+            && map
+                .keys()
+                .next()
+                .is_some_and(|k| k.starts_with(|c: char| c.is_ascii_uppercase()))
             && !matches!(step, Step::Field(f) if map.contains_key(f.as_str()))
     };
     if matches!(&*value, Value::Object(map) if is_variant(map))
@@ -282,10 +301,9 @@ fn through_variant<'v>(value: &'v mut Value, step: &Step) -> &'v mut Value {
 fn numbers(value: &Value) -> Option<Vec<f32>> {
     match value {
         Value::Number(n) => Some(vec![n.as_f64()? as f32]),
-        Value::Array(items) if !items.is_empty() => items
-            .iter()
-            .map(|v| v.as_f64().map(|x| x as f32))
-            .collect(),
+        Value::Array(items) if !items.is_empty() => {
+            items.iter().map(|v| v.as_f64().map(|x| x as f32)).collect()
+        }
         _ => None,
     }
 }
@@ -441,7 +459,12 @@ fn leaves(value: &Value, path: ParamPath, out: &mut Vec<(ParamPath, Vec<f32>)>) 
         return;
     }
     match value {
-        Value::Object(map) if map.len() == 1 && map.keys().all(|k| k.starts_with(|c: char| c.is_ascii_uppercase())) => {
+        Value::Object(map)
+            if map.len() == 1
+                && map
+                    .keys()
+                    .all(|k| k.starts_with(|c: char| c.is_ascii_uppercase())) =>
+        {
             leaves(map.values().next().expect("one entry"), path, out);
         }
         Value::Object(map) => {
@@ -456,7 +479,10 @@ fn leaves(value: &Value, path: ParamPath, out: &mut Vec<(ParamPath, Vec<f32>)>) 
                 .collect();
             for (i, v) in items.iter().enumerate() {
                 let at = match names[i] {
-                    Some(n) if !n.is_empty() && names.iter().filter(|m| **m == Some(n)).count() == 1 => {
+                    Some(n)
+                        if !n.is_empty()
+                            && names.iter().filter(|m| **m == Some(n)).count() == 1 =>
+                    {
                         path.named(n)
                     }
                     _ => path.index(i),
@@ -482,7 +508,14 @@ mod tests {
         ] {
             assert_eq!(ParamPath::parse(text).unwrap().to_string(), text);
         }
-        for bad in ["", "camera..fov", "spheres[x]", "spheres[0", "[0]", "camera fov"] {
+        for bad in [
+            "",
+            "camera..fov",
+            "spheres[x]",
+            "spheres[0",
+            "[0]",
+            "camera fov",
+        ] {
             assert!(ParamPath::parse(bad).is_err(), "`{bad}` parsed");
         }
     }

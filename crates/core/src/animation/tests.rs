@@ -28,7 +28,12 @@ fn every_animatable_path_resolves_and_round_trips_through_a_preset() {
     for file in shipped_presets() {
         let scene = preset::load(&file).unwrap().preset.scene;
         let params = scene.animatable_parameters();
-        assert!(params.len() > 10, "{}: {} parameters", file.display(), params.len());
+        assert!(
+            params.len() > 10,
+            "{}: {} parameters",
+            file.display(),
+            params.len()
+        );
         let mut animation = Animation {
             duration: 2.0,
             ..Animation::default()
@@ -92,10 +97,14 @@ fn parameters_are_named_as_the_preset_writes_them() {
         "environment.intensity",
         "render.exposure",
     ] {
-        assert!(names.iter().any(|n| n == expected), "{expected} not in {names:#?}");
+        assert!(
+            names.iter().any(|n| n == expected),
+            "{expected} not in {names:#?}"
+        );
     }
-    let path = ParamPath::parse("spheres[\"marble\"].material.diffuse.pattern.noise.fractal.octaves")
-        .unwrap();
+    let path =
+        ParamPath::parse("spheres[\"marble\"].material.diffuse.pattern.noise.fractal.octaves")
+            .unwrap();
     assert_eq!(scene.parameter(&path), Ok(vec![6.0]));
     let by_index = ParamPath::parse("spheres[0].radius").unwrap();
     assert_eq!(scene.parameter(&by_index), Ok(vec![0.9]));
@@ -133,11 +142,11 @@ fn moments_of_a_scene_differ_in_numbers_only() {
     // Smooth: a quarter of the way in time is 0.156 25 of the turn.
     assert_eq!(camera.at_time(1.0).camera.yaw_degrees, 360.0 * 0.156_25);
     let mut edited = camera.clone();
-    edited
-        .animation
-        .as_mut()
-        .unwrap()
-        .insert_key(&ParamPath::parse("camera.yaw_degrees").unwrap(), 1.0, &[10.0]);
+    edited.animation.as_mut().unwrap().insert_key(
+        &ParamPath::parse("camera.yaw_degrees").unwrap(),
+        1.0,
+        &[10.0],
+    );
     assert_eq!(edited.changes_from(&camera), Change::ANIMATION);
 }
 
@@ -180,7 +189,10 @@ fn bad_animations_are_refused_naming_the_field() {
     ] {
         let message = parse_error(animation);
         assert!(message.starts_with("bad.ron: "), "{message}");
-        assert!(message.contains(expected), "{message}\nexpected: {expected}");
+        assert!(
+            message.contains(expected),
+            "{message}\nexpected: {expected}"
+        );
     }
 }
 
@@ -195,7 +207,11 @@ fn presets_without_an_animation_read_and_write_as_before() {
     animation.looping = true;
     animation.tracks[0].extrapolation = Extrapolation::Cycle;
     animation.tracks[0].keys[0].interpolation = Interpolation::Constant;
-    animation.insert_key(&ParamPath::parse("camera.target").unwrap(), 0.5, &[1.0, 2.0, 3.0]);
+    animation.insert_key(
+        &ParamPath::parse("camera.target").unwrap(),
+        0.5,
+        &[1.0, 2.0, 3.0],
+    );
     let text = preset::to_text(
         &Preset {
             scene: scene.clone(),
@@ -205,6 +221,9 @@ fn presets_without_an_animation_read_and_write_as_before() {
     )
     .unwrap();
     assert!(text.contains("loop: true"), "{text}");
-    let back = preset::parse(&text, Path::new("a.ron")).unwrap().preset.scene;
+    let back = preset::parse(&text, Path::new("a.ron"))
+        .unwrap()
+        .preset
+        .scene;
     assert_eq!(back.animation, scene.animation);
 }

@@ -60,6 +60,15 @@ impl Renderer {
         self.accumulation.reset();
     }
 
+    /// Starts the accumulation again with the samples of animation frame
+    /// `frame` (`frame_sequence::FRAME_SEED_STRIDE` apart): a sequence's
+    /// frames each trace their own, and a frame traced again traces the
+    /// same ones.
+    pub fn restart_at_frame(&mut self, frame: u32) {
+        self.reset_accumulation();
+        self.frame_index = frame.wrapping_mul(crate::frame_sequence::FRAME_SEED_STRIDE);
+    }
+
     /// Records one whole round: `samples_per_frame` more samples per pixel
     /// (or the rest of the round under way), timed by `timestamps` if
     /// given (the viewer's [`PassTimer`], the benchmarks' own query sets).

@@ -1,0 +1,258 @@
+//! One file holding a sequence's frames: an animated GIF (the image
+//! crate's encoder) or APNG (the png crate's, which the image crate
+//! decodes but does not write), or, through ffmpeg when it is installed,
+//! an animated WebP or an MP4 (H.264). Written atomically, as every
+//! output.
+
+use crate::atomic_write::write_atomic;
+use anyhow::{Context, Result, bail};
+use image::RgbaImage;
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// The kinds of animated file, by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AnimatedFormat {
+    Gif,
+    Apng,
+    Webp,
+    Mp4,
+}
+
+impl AnimatedFormat {
+    pub fn from_path(path: &Path) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        Ok(match ext.as_deref() {
+            Some("gif") => AnimatedFormat::Gif,
+            Some("apng") => AnimatedFormat::Apng,
+            Some("webp") => AnimatedFormat::Webp,
+            Some("mp4") => AnimatedFormat::Mp4,
+            _ => bail!(
+                "{}: an animation is written as .gif, .apng, .webp or .mp4",
+                path.display()
+            ),
+        })
+    }
+
+    /// Whether writing it needs ffmpeg.
+    pub fn needs_ffmpeg(self) -> bool {
+        matches!(self, AnimatedFormat::Webp | AnimatedFormat::Mp4)
+    }
+}
+
+/// Refuses, before any tracing, an animation that cannot be written: an
+/// unknown extension, or ffmpeg missing for WebP and MP4.
+pub fn check_writable(path: &Path) -> Result<AnimatedFormat> {
+    let format = AnimatedFormat::from_path(path)?;
+    if format.needs_ffmpeg() && !ffmpeg_available() {
+        bail!(
+            "{}: writing .webp and .mp4 animations needs ffmpeg (the Debian package `ffmpeg`), \
+             which is not on PATH; .gif and .apng are written without it",
+            path.display()
+        );
+    }
+    Ok(format)
+}
+
+fn ffmpeg_available() -> bool {
+    Command::new("ffmpeg")
+        .arg("-version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Writes `frames` (all one size) shown `fps` a second, looping forever.
+pub fn save_animation(frames: &[RgbaImage], fps: f32, path: &Path) -> Result<()> {
+    let format = check_writable(path)?;
+    let Some(first) = frames.first() else {
+        bail!("{}: no frames to write", path.display());
+    };
+    if let Some(odd) = frames.iter().find(|f| f.dimensions() != first.dimensions()) {
+        bail!(
+            "{}: the frames are not all one size ({:?} and {:?})",
+            path.display(),
+            first.dimensions(),
+            odd.dimensions()
+        );
+    }
+    let bytes = match format {
+        AnimatedFormat::Gif => encode_gif(frames, fps)?,
+        AnimatedFormat::Apng => encode_apng(frames, fps)?,
+        AnimatedFormat::Webp | AnimatedFormat::Mp4 => encode_with_ffmpeg(frames, fps, format)?,
+    };
+    write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// A frame's delay as a fraction of a second: `1/fps` as a ratio of
+/// integers, in hundredths for GIF (its unit).
+fn delay_ms(fps: f32) -> (u32, u32) {
+    let ms = (1000.0 / f64::from(fps)).round().max(10.0) as u32;
+    (ms, 1)
+}
+
+fn encode_gif(frames: &[RgbaImage], fps: f32) -> Result<Vec<u8>> {
+    use image::codecs::gif::{GifEncoder, Repeat};
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
+        encoder.set_repeat(Repeat::Infinite)?;
+        let (numer, denom) = delay_ms(fps);
+        let delay = image::Delay::from_numer_denom_ms(numer, denom);
+        for frame in frames {
+            encoder.encode_frame(image::Frame::from_parts(frame.clone(), 0, 0, delay))?;
+        }
+    }
+    Ok(bytes)
+}
+
+fn encode_apng(frames: &[RgbaImage], fps: f32) -> Result<Vec<u8>> {
+    let (width, height) = frames[0].dimensions();
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut bytes, width, height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_animated(frames.len() as u32, 0)?;
+        // The delay as fps's ratio: 1/24 s is 1000/24000 exactly.
+        encoder.set_frame_delay(1000, (f64::from(fps) * 1000.0).round() as u16)?;
+        let mut writer = encoder.write_header()?;
+        for frame in frames {
+            writer.write_image_data(frame.as_raw())?;
+        }
+        writer.finish()?;
+    }
+    Ok(bytes)
+}
+
+/// WebP and MP4 through ffmpeg, the frames piped in as PNGs: the image
+/// crate writes neither an animated WebP nor video, and ffmpeg is what
+/// Blender and every farm use for both.
+fn encode_with_ffmpeg(frames: &[RgbaImage], fps: f32, format: AnimatedFormat) -> Result<Vec<u8>> {
+    let dir = tempfile::tempdir()?;
+    let out = dir.path().join(match format {
+        AnimatedFormat::Mp4 => "out.mp4",
+        _ => "out.webp",
+    });
+    let codec: &[&str] = match format {
+        // yuv420p plays everywhere; it needs even sides, hence the pad.
+        AnimatedFormat::Mp4 => &[
+            "-c:v",
+            "libx264",
+            "-pix_fmt",
+            "yuv420p",
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+        ],
+        _ => &["-c:v", "libwebp_anim", "-lossless", "1", "-loop", "0"],
+    };
+    let mut child = Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-f", "image2pipe", "-framerate"])
+        .arg(fps.to_string())
+        .args(["-i", "-"])
+        .args(codec)
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting ffmpeg")?;
+    {
+        let mut stdin = child.stdin.take().expect("piped");
+        for frame in frames {
+            stdin.write_all(&crate::image_io::encode_png(frame)?)?;
+        }
+    }
+    let output = child.wait_with_output()?;
+    if !output.status.success() {
+        bail!(
+            "ffmpeg failed ({}): {}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr).trim()
+        );
+    }
+    Ok(std::fs::read(&out)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::AnimationDecoder;
+
+    fn frames(n: u8) -> Vec<RgbaImage> {
+        (0..n)
+            .map(|i| RgbaImage::from_fn(8, 6, |x, _| image::Rgba([i * 40, x as u8 * 30, 0, 255])))
+            .collect()
+    }
+
+    /// GIF and APNG decode (with the image crate's decoders) to the
+    /// frames written, in order, at 1/fps each.
+    #[test]
+    fn gif_and_apng_decode_with_their_frames() {
+        let dir = tempfile::tempdir().unwrap();
+        let written = frames(5);
+        let gif = dir.path().join("a.gif");
+        save_animation(&written, 25.0, &gif).unwrap();
+        let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+            std::fs::File::open(&gif).unwrap(),
+        ))
+        .unwrap();
+        let read: Vec<image::Frame> = decoder.into_frames().collect::<Result<_, _>>().unwrap();
+        assert_eq!(read.len(), 5);
+        assert_eq!(read[0].delay().numer_denom_ms(), (40, 1));
+        // GIF's palette keeps these few colours exactly.
+        assert_eq!(read[3].buffer().get_pixel(2, 1), written[3].get_pixel(2, 1));
+
+        let apng = dir.path().join("a.apng");
+        save_animation(&written, 24.0, &apng).unwrap();
+        let decoder = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
+            std::fs::File::open(&apng).unwrap(),
+        ))
+        .unwrap();
+        assert!(decoder.is_apng().unwrap());
+        let read: Vec<image::Frame> = decoder
+            .apng()
+            .unwrap()
+            .into_frames()
+            .collect::<Result<_, _>>()
+            .unwrap();
+        assert_eq!(read.len(), 5);
+        for (r, w) in read.iter().zip(&written) {
+            assert_eq!(r.buffer(), w);
+        }
+        let (n, d) = read[1].delay().numer_denom_ms();
+        assert!(
+            (f64::from(n) / f64::from(d) - 1000.0 / 24.0).abs() < 1e-9,
+            "{n}/{d}"
+        );
+    }
+
+    /// An unknown extension, and WebP or MP4 without ffmpeg, are refused
+    /// naming the file (and the package), nothing written.
+    #[test]
+    fn unwritable_animations_are_refused_before_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let avi = dir.path().join("a.avi");
+        let e = check_writable(&avi).unwrap_err().to_string();
+        assert!(
+            e.contains("a.avi") && e.contains(".gif, .apng, .webp or .mp4"),
+            "{e}"
+        );
+        if !ffmpeg_available() {
+            let mp4 = dir.path().join("a.mp4");
+            let e = save_animation(&frames(2), 24.0, &mp4)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("a.mp4") && e.contains("Debian package `ffmpeg`"),
+                "{e}"
+            );
+            assert!(!mp4.exists());
+        }
+    }
+}
