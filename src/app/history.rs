@@ -77,6 +77,12 @@ impl History {
         Some(self.restore(next, current))
     }
 
+    /// The scene as of the last edit seen: what a frame's edits are
+    /// measured from when the traced scene moves on its own (time).
+    pub fn last(&self) -> &Scene {
+        &self.last
+    }
+
     pub fn can_undo(&self) -> bool {
         !self.undo.is_empty()
     }

@@ -34,6 +34,8 @@ pub enum Shortcut {
     RenderDialog,
     /// Ctrl+1 to Ctrl+9: go to the preset's saved view (0-based here).
     RecallView(usize),
+    /// Space: play or pause the scene's time.
+    PlayPause,
 }
 
 /// The digit keys of the saved views, in order.
@@ -107,6 +109,7 @@ impl Keys {
             (Modifiers::COMMAND, Key::Z, Shortcut::Undo),
             (Modifiers::COMMAND, Key::O, Shortcut::Open),
             (Modifiers::COMMAND, Key::R, Shortcut::RenderDialog),
+            (Modifiers::NONE, Key::Space, Shortcut::PlayPause),
         ];
         combos.extend(
             VIEW_KEYS

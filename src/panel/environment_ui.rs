@@ -1,9 +1,11 @@
 //! The Environment section: the source (none, constant, lat-long map, cube
 //! faces or cross), its fields and its rotation.
 
+use super::keying;
 use super::widgets::{enter_pressed, labelled_color, slider, typed_path};
 use super::{PanelAction, PanelState};
 use egui::{ComboBox, TextEdit, Ui};
+use marbre_core::animation::ParamPath;
 use marbre_core::scene::{EnvSource, Environment, LdrImages};
 
 /// The environment sources in the order of the source dropdown.
@@ -30,10 +32,22 @@ pub(super) fn environment_ui(
     if env.source.is_map() {
         ldr_images_ui(ui, &mut env.ldr_images);
     }
-    ui.add(slider(&mut env.rotation_degrees, -180.0..=180.0, "rotation").suffix("°"))
-        .on_hover_text("Turns the environment about the vertical axis");
-    ui.add(slider(&mut env.intensity, 0.01..=100.0, "intensity").logarithmic(true))
-        .on_hover_text("Multiplies the environment's radiance");
+    let at = |field: &str| {
+        ParamPath::parse("environment")
+            .expect("a path")
+            .field(field)
+    };
+    keying::number(
+        ui,
+        &at("rotation_degrees"),
+        &mut env.rotation_degrees,
+        |ui, v| ui.add(slider(v, -180.0..=180.0, "rotation").suffix("°")),
+    )
+    .on_hover_text("Turns the environment about the vertical axis");
+    keying::number(ui, &at("intensity"), &mut env.intensity, |ui, v| {
+        ui.add(slider(v, 0.01..=100.0, "intensity").logarithmic(true))
+    })
+    .on_hover_text("Multiplies the environment's radiance");
     ui.checkbox(&mut env.background_visible, "background visible")
         .on_hover_text("Show the environment behind the scene; it lights the scene either way");
 }

@@ -1,12 +1,14 @@
 //! The material editor: each property's texture tree, its layers, and the
 //! tree operations (nest, unnest, copy a subtree, paste it over another).
 
+use super::keying::number as keyed;
 use super::swatches::{self, SwatchPlace};
 use super::tx_ui::{has_tx_section, tx_ui};
 use super::widgets::uv_frame_ui;
 use super::{color_button, labelled_color, slider, vec3_ui};
 use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
+use marbre_core::animation::ParamPath;
 use marbre_core::bake::BakeProperty;
 use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
 use marbre_core::scene::MaterialKey;
@@ -235,7 +237,8 @@ fn texture_ui(
             .default_open(place.path.steps.is_empty())
             .show(ui, |ui| {
                 swatch_ui(ui, texture, place);
-                pattern_ui(ui, texture);
+                let node = node_param_path(place);
+                pattern_ui(ui, texture, &node.field("pattern"));
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
                 }
@@ -317,6 +320,13 @@ fn texture_ui(
                 }
             });
     });
+}
+
+/// The parameter path of the node at `place` (`spheres[0].material.diffuse.a`):
+/// its numbers' key buttons name them under it.
+fn node_param_path(place: &SwatchPlace) -> ParamPath {
+    ParamPath::parse(&format!("{}.material.{}", place.key, place.path))
+        .expect("a material key and a node path print as a parameter path")
 }
 
 /// Side of a node's preview swatch in the panel, in points.
@@ -633,7 +643,9 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, place:
 }
 
 /// The pattern dropdown and the chosen pattern's parameters.
-pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
+/// `path`: the pattern's parameter path (`….diffuse.pattern`), for the
+/// key buttons.
+pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture, path: &ParamPath) {
     let kind = texture.pattern.kind();
     let mut index = kind as usize;
     ComboBox::new("pattern", "pattern")
@@ -655,11 +667,13 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
     match &mut texture.pattern {
         Pattern::Constant | Pattern::Diagonal => {}
         Pattern::Checker { size } => {
-            ui.add(slider(size, 0.01..=10.0, "cube size").logarithmic(true))
-                .on_hover_text("Side of the checkerboard's cubes, in scene units");
+            keyed(ui, &path.field("size"), size, |ui, v| {
+                ui.add(slider(v, 0.01..=10.0, "cube size").logarithmic(true))
+            })
+            .on_hover_text("Side of the checkerboard's cubes, in scene units");
         }
         Pattern::Fbm { noise } | Pattern::Turbulence { noise } | Pattern::Ridged { noise } => {
-            noise_ui(ui, noise)
+            noise_ui(ui, noise, &path.field("noise"))
         }
         Pattern::Mix => {}
         Pattern::Image { filter, wrap } => {
@@ -693,46 +707,71 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
             noise,
             stripe_frequency,
         } => {
-            noise_ui(ui, noise);
-            ui.add(slider(stripe_frequency, 0.0..=32.0, "stripe frequency"))
-                .on_hover_text(
-                    "t = 0.5 + 0.5·sin(x · stripe frequency + fBm): veins per 2π units along x",
-                );
+            noise_ui(ui, noise, &path.field("noise"));
+            keyed(
+                ui,
+                &path.field("stripe_frequency"),
+                stripe_frequency,
+                |ui, v| ui.add(slider(v, 0.0..=32.0, "stripe frequency")),
+            )
+            .on_hover_text(
+                "t = 0.5 + 0.5·sin(x · stripe frequency + fBm): veins per 2π units along x",
+            );
         }
         Pattern::Checker2d { size, phase } => {
-            ui.add(slider(&mut size.x, 0.01..=4.0, "cell width (u)").logarithmic(true))
-                .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
-            ui.add(slider(&mut size.y, 0.01..=4.0, "cell height (v)").logarithmic(true))
-                .on_hover_text("Height of a cell in (u, v)");
-            ui.add(slider(phase, 0.0..=1.0, "row phase"))
-                .on_hover_text("Shift of every other row, in cells: 0.5 lays them like bricks");
+            keyed(ui, &path.field("size").index(0), &mut size.x, |ui, v| {
+                ui.add(slider(v, 0.01..=4.0, "cell width (u)").logarithmic(true))
+            })
+            .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
+            keyed(ui, &path.field("size").index(1), &mut size.y, |ui, v| {
+                ui.add(slider(v, 0.01..=4.0, "cell height (v)").logarithmic(true))
+            })
+            .on_hover_text("Height of a cell in (u, v)");
+            keyed(ui, &path.field("phase"), phase, |ui, v| {
+                ui.add(slider(v, 0.0..=1.0, "row phase"))
+            })
+            .on_hover_text("Shift of every other row, in cells: 0.5 lays them like bricks");
         }
         Pattern::Brick {
             size,
             mortar,
             row_offset,
         } => {
-            ui.add(slider(&mut size.x, 0.01..=4.0, "brick width (u)").logarithmic(true))
-                .on_hover_text("Width of a brick and its joint, in (u, v) units");
-            ui.add(slider(&mut size.y, 0.01..=4.0, "brick height (v)").logarithmic(true))
-                .on_hover_text("Height of a brick and its joint, in (u, v) units");
-            ui.add(slider(mortar, 0.0..=0.2, "mortar width"))
-                .on_hover_text(
-                    "Width of the joints, in (u, v) units; a is the mortar, b the bricks",
-                );
-            ui.add(slider(row_offset, 0.0..=1.0, "row offset"))
-                .on_hover_text("Shift of every other row, in bricks: 0.5 is the running bond");
+            keyed(ui, &path.field("size").index(0), &mut size.x, |ui, v| {
+                ui.add(slider(v, 0.01..=4.0, "brick width (u)").logarithmic(true))
+            })
+            .on_hover_text("Width of a brick and its joint, in (u, v) units");
+            keyed(ui, &path.field("size").index(1), &mut size.y, |ui, v| {
+                ui.add(slider(v, 0.01..=4.0, "brick height (v)").logarithmic(true))
+            })
+            .on_hover_text("Height of a brick and its joint, in (u, v) units");
+            keyed(ui, &path.field("mortar"), mortar, |ui, v| {
+                ui.add(slider(v, 0.0..=0.2, "mortar width"))
+            })
+            .on_hover_text("Width of the joints, in (u, v) units; a is the mortar, b the bricks");
+            keyed(ui, &path.field("row_offset"), row_offset, |ui, v| {
+                ui.add(slider(v, 0.0..=1.0, "row offset"))
+            })
+            .on_hover_text("Shift of every other row, in bricks: 0.5 is the running bond");
         }
         Pattern::Tile {
             mortar_half_width,
             bevel,
         } => {
-            ui.add(slider(mortar_half_width, 0.0..=0.5, "mortar half-width"))
-                .on_hover_text(
-                    "Half the joint width, in (u, v) units; one tile per unit square, so lay it \
+            keyed(
+                ui,
+                &path.field("mortar_half_width"),
+                mortar_half_width,
+                |ui, v| ui.add(slider(v, 0.0..=0.5, "mortar half-width")),
+            )
+            .on_hover_text(
+                "Half the joint width, in (u, v) units; one tile per unit square, so lay it \
                      in a checker cell",
-                );
-            ui.add(slider(bevel, 0.0..=0.5, "bevel")).on_hover_text(
+            );
+            keyed(ui, &path.field("bevel"), bevel, |ui, v| {
+                ui.add(slider(v, 0.0..=0.5, "bevel"))
+            })
+            .on_hover_text(
                 "Width over which the tile rises from the mortar: bump it to raise the tiles",
             );
         }
@@ -740,8 +779,10 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
             frequency,
             direction,
         } => {
-            ui.add(slider(frequency, 0.0..=64.0, "frequency"))
-                .on_hover_text("Crests per unit of (u, v) along the direction");
+            keyed(ui, &path.field("frequency"), frequency, |ui, v| {
+                ui.add(slider(v, 0.0..=64.0, "frequency"))
+            })
+            .on_hover_text("Crests per unit of (u, v) along the direction");
             let mut angle = direction.y.atan2(direction.x).to_degrees();
             if ui
                 .add(slider(&mut angle, -180.0..=180.0, "direction (°)"))
@@ -755,7 +796,10 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
         Pattern::Cutout { sides, radius } => {
             ui.add(Slider::new(sides, 0..=12).text("sides"))
                 .on_hover_text("A regular polygon; below 3, a disc. a is outside, b inside");
-            ui.add(slider(radius, 0.0..=0.71, "radius")).on_hover_text(
+            keyed(ui, &path.field("radius"), radius, |ui, v| {
+                ui.add(slider(v, 0.0..=0.71, "radius"))
+            })
+            .on_hover_text(
                 "From the cell's centre to the polygon's corners (the disc's radius), in (u, v) \
                  units; 0.71 reaches the cell's corners",
             );
@@ -765,41 +809,60 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture) {
             ring_width,
             turbulence_amount,
         } => {
-            ui.add(slider(ring_width, 0.01..=1.0, "ring width").logarithmic(true))
-                .on_hover_text("Width of each ring, in scene units: dark and pale alternate");
-            ui.add(slider(turbulence_amount, 0.0..=2.0, "turbulence"))
-                .on_hover_text("How far turbulence moves the rings; a dark, b pale");
-            noise_ui(ui, noise);
+            keyed(ui, &path.field("ring_width"), ring_width, |ui, v| {
+                ui.add(slider(v, 0.01..=1.0, "ring width").logarithmic(true))
+            })
+            .on_hover_text("Width of each ring, in scene units: dark and pale alternate");
+            keyed(
+                ui,
+                &path.field("turbulence_amount"),
+                turbulence_amount,
+                |ui, v| ui.add(slider(v, 0.0..=2.0, "turbulence")),
+            )
+            .on_hover_text("How far turbulence moves the rings; a dark, b pale");
+            noise_ui(ui, noise, &path.field("noise"));
         }
         Pattern::Veins {
             noise,
             frequency,
             turbulence_amount,
         } => {
-            ui.add(slider(frequency, 0.0..=32.0, "frequency"))
-                .on_hover_text(
-                    "t = max(0, sin(frequency · x + turbulence · T(p))): a dominant, b veins",
-                );
-            ui.add(slider(turbulence_amount, 0.0..=40.0, "turbulence"))
-                .on_hover_text("How far turbulence bends the veins (times the fractal sum)");
-            noise_ui(ui, noise);
+            keyed(ui, &path.field("frequency"), frequency, |ui, v| {
+                ui.add(slider(v, 0.0..=32.0, "frequency"))
+            })
+            .on_hover_text(
+                "t = max(0, sin(frequency · x + turbulence · T(p))): a dominant, b veins",
+            );
+            keyed(
+                ui,
+                &path.field("turbulence_amount"),
+                turbulence_amount,
+                |ui, v| ui.add(slider(v, 0.0..=40.0, "turbulence")),
+            )
+            .on_hover_text("How far turbulence bends the veins (times the fractal sum)");
+            noise_ui(ui, noise, &path.field("noise"));
         }
         Pattern::MassalMarble {
             noise,
             stripe_frequency,
         } => {
-            ui.add(slider(stripe_frequency, 0.0..=32.0, "stripe frequency"))
-                .on_hover_text(
-                    "t = 0.5 + 0.5·sin((x + y) · stripe frequency + turbulence): Massal's \
+            keyed(
+                ui,
+                &path.field("stripe_frequency"),
+                stripe_frequency,
+                |ui, v| ui.add(slider(v, 0.0..=32.0, "stripe frequency")),
+            )
+            .on_hover_text(
+                "t = 0.5 + 0.5·sin((x + y) · stripe frequency + turbulence): Massal's \
                      marble, his stripe frequency equal to the noise's",
-                );
-            noise_ui(ui, noise);
+            );
+            noise_ui(ui, noise, &path.field("noise"));
         }
     }
 }
 
 /// The lattice noise, its hash and the fractal sum of a noise pattern.
-fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
+fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings, path: &ParamPath) {
     ComboBox::new("noise kind", "noise")
         .selected_text(noise.kind.label())
         .show_ui(ui, |ui| {
@@ -842,17 +905,31 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
             .on_disabled_hover_text("Unused: Perlin noise hashes with its permutation table");
     });
     let f = &mut noise.fractal;
-    octaves_slider(ui, &mut f.octaves);
-    ui.add(typed_beyond(
-        slider(&mut f.frequency, 0.01..=100.0, "frequency").logarithmic(true),
-    ))
+    let fractal = path.field("fractal");
+    keyed(
+        ui,
+        &fractal.field("octaves"),
+        &mut f.octaves,
+        octaves_slider,
+    );
+    keyed(
+        ui,
+        &fractal.field("frequency"),
+        &mut f.frequency,
+        |ui, v| {
+            ui.add(typed_beyond(
+                slider(v, 0.01..=100.0, "frequency").logarithmic(true),
+            ))
+        },
+    )
     .on_hover_text("Frequency of the first octave, in cycles per scene unit (type up to 1e6)");
     limit(&mut f.frequency, FractalParams::FREQUENCY);
-    ui.add(typed_beyond(slider(
+    keyed(
+        ui,
+        &fractal.field("amplitude"),
         &mut f.amplitude,
-        0.0..=2.0,
-        "amplitude",
-    )))
+        |ui, v| ui.add(typed_beyond(slider(v, 0.0..=2.0, "amplitude"))),
+    )
     .on_hover_text("Amplitude of the first octave (type any value in ±100)");
     limit(&mut f.amplitude, FractalParams::AMPLITUDE);
     ComboBox::new("progression", "octaves progress")
@@ -876,32 +953,35 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings) {
         .on_hover_text("How each octave's frequency and weight follow from the first's");
     let geometric = f.progression == Progression::Geometric;
     ui.add_enabled_ui(geometric, |ui| {
-        ui.add(slider(
+        keyed(
+            ui,
+            &fractal.field("persistence"),
             &mut f.persistence,
-            FractalParams::PERSISTENCE,
-            "persistence",
-        ))
+            |ui, v| ui.add(slider(v, FractalParams::PERSISTENCE, "persistence")),
+        )
         .on_hover_text(
             "Amplitude ratio between successive octaves (0.5: each half as strong; \
              above 1 the finest octaves dominate)",
         )
         .on_disabled_hover_text("Unused: linear levels are weighted 1/k");
-        ui.add(typed_beyond(slider(
+        keyed(
+            ui,
+            &fractal.field("lacunarity"),
             &mut f.lacunarity,
-            1.0..=4.0,
-            "lacunarity",
-        )))
+            |ui, v| ui.add(typed_beyond(slider(v, 1.0..=4.0, "lacunarity"))),
+        )
         .on_hover_text(
             "Frequency ratio between successive octaves (2: each twice as fine; type up to 8)",
         )
         .on_disabled_hover_text("Unused: linear level k is at frequency · k");
     });
     limit(&mut f.lacunarity, FractalParams::LACUNARITY);
-    ui.add(typed_beyond(slider(
+    keyed(
+        ui,
+        &fractal.field("distortion"),
         &mut f.distortion,
-        0.0..=4.0,
-        "distortion",
-    )))
+        |ui, v| ui.add(typed_beyond(slider(v, 0.0..=4.0, "distortion"))),
+    )
     .on_hover_text(
         "Domain warp: moves the point by noise before summing, three more noise evaluations \
          (0: none and free; type any value in ±100)",

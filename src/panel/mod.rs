@@ -10,6 +10,7 @@
 mod environment_ui;
 mod file_ui;
 pub mod help;
+pub mod keying;
 mod material_editor;
 pub mod node_graph;
 mod quality;
@@ -19,6 +20,7 @@ pub mod save_as;
 mod scene_ui;
 mod stats;
 pub mod swatches;
+pub mod timeline;
 mod transport;
 mod tx_ui;
 mod widgets;
@@ -238,6 +240,7 @@ pub fn draw(
     scene: &mut Scene,
     state: &mut PanelState,
     stats: &Stats,
+    timeline: &mut timeline::Timeline,
 ) -> Vec<PanelAction> {
     let mut actions = Vec::new();
     ScrollArea::vertical()
@@ -247,6 +250,9 @@ pub fn draw(
             let header = format!("Preset      {}", headline(stats));
             section_headed(ui, "Preset", header, true, |ui| {
                 file_ui::preset_ui(ui, state, &mut actions);
+            });
+            section(ui, "Time", scene.animation.is_some(), |ui| {
+                timeline::timeline_ui(ui, scene, timeline);
             });
             section(ui, "Materials", true, |ui| {
                 if let Some((object, property)) = materials_ui(ui, scene, &mut state.node_graph) {

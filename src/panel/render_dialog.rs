@@ -21,6 +21,9 @@ pub struct RenderDialog {
     pub size: String,
     /// Stop at a target error rather than at a number of samples.
     pub by_error: bool,
+    /// Render every frame of the scene's animation (the output's name
+    /// numbered with #), not the moment under the play head.
+    pub all_frames: bool,
     pub spp: u32,
     /// The target relative error, in percent.
     pub target_percent: f64,
@@ -57,6 +60,7 @@ impl Default for RenderDialog {
             output: "render.png".to_owned(),
             size: DEFAULT_SIZE.to_owned(),
             by_error: false,
+            all_frames: false,
             spp: DEFAULT_SPP,
             target_percent: DEFAULT_TARGET_PERCENT,
             max_spp: DEFAULT_MAX_SPP,
@@ -228,6 +232,13 @@ fn dialog_ui(ui: &mut Ui, dialog: &mut RenderDialog, actions: &mut Vec<PanelActi
                             .suffix(" spp"),
                     );
                 }
+                ui.end_row();
+                ui.label("time");
+                ui.checkbox(&mut dialog.all_frames, "every frame of the animation")
+                    .on_hover_text(
+                        "As `render --frames`: each frame to the output with its # replaced by \
+                         the frame number (out/frame_####.png); off, the moment under the play head",
+                    );
                 ui.end_row();
                 ui.label("auto exposure");
                 ComboBox::new("render auto exposure", "")

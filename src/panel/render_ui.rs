@@ -1,9 +1,11 @@
 //! The Render section: the view, samples, bounces, exposure and tone map,
 //! the anti-aliasing switches and the kernel.
 
+use super::keying;
 use super::widgets::slider;
 use super::{PanelAction, Stats};
 use egui::{ComboBox, Ui};
+use marbre_core::animation::ParamPath;
 use marbre_core::scene::{Metering, RenderSettings, ToneMap, View};
 
 pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
@@ -69,8 +71,11 @@ pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut 
         )
     };
     let stops = RenderSettings::MAX_EXPOSURE_STOPS;
-    ui.add(slider(&mut render.display.exposure, -stops..=stops, label).suffix(" stops"))
-        .on_hover_text(hint);
+    let exposure = ParamPath::parse("render.exposure").expect("a path");
+    keying::number(ui, &exposure, &mut render.display.exposure, |ui, v| {
+        ui.add(slider(v, -stops..=stops, label).suffix(" stops"))
+    })
+    .on_hover_text(hint);
     ComboBox::new("tone map", "tone map")
         .selected_text(render.display.tone_map.label())
         .show_ui(ui, |ui| {

@@ -2,10 +2,12 @@
 //! its saved views.
 
 use super::PanelAction;
+use super::keying;
 use super::material_editor::material_ui;
 use super::node_graph;
-use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_ui};
+use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_field, vec3_ui};
 use egui::{CollapsingHeader, Ui};
+use marbre_core::animation::ParamPath;
 use marbre_core::bake::{BakeProperty, ObjectRef};
 use marbre_core::scene::{Ground, MaterialKey, OrbitCamera, PointLight, Scene};
 
@@ -169,47 +171,65 @@ pub(super) fn point_light_ui(ui: &mut Ui, light: &mut Option<PointLight>) {
         *light = enabled.then(PointLight::default);
     }
     if let Some(l) = light {
-        vec3_ui(
-            ui,
-            "position",
-            &mut l.position,
-            0.05,
-            "Where the light is, in scene units",
-        );
-        labelled_color(ui, &mut l.color, "colour").on_hover_text("The light's colour");
-        ui.add(
-            slider(&mut l.intensity, 0.0..=10_000.0, "intensity")
-                .logarithmic(true)
-                .smallest_positive(0.1),
-        )
+        let at = |field: &str| {
+            ParamPath::parse("point_light")
+                .expect("a path")
+                .field(field)
+        };
+        keying::vector(ui, &at("position"), &mut l.position, |ui, v| {
+            vec3_field(
+                ui,
+                "position",
+                v,
+                0.05,
+                "Where the light is, in scene units",
+            )
+        });
+        keying::vector(ui, &at("color"), &mut l.color, |ui, c| {
+            labelled_color(ui, c, "colour").on_hover_text("The light's colour")
+        });
+        keying::number(ui, &at("intensity"), &mut l.intensity, |ui, v| {
+            ui.add(
+                slider(v, 0.0..=10_000.0, "intensity")
+                    .logarithmic(true)
+                    .smallest_positive(0.1),
+            )
+        })
         .on_hover_text("Radiant intensity in watts per steradian (times the colour)");
     }
 }
 
 pub(super) fn camera_ui(ui: &mut Ui, scene: &mut Scene, actions: &mut Vec<PanelAction>) {
     let camera = &mut scene.camera;
-    vec3_ui(
-        ui,
-        "target",
-        &mut camera.target,
-        0.05,
-        "The point the camera orbits and looks at",
-    );
-    ui.add(
-        slider(
-            &mut camera.distance,
-            OrbitCamera::MIN_DISTANCE..=1000.0,
-            "distance",
+    let at = |field: &str| ParamPath::parse("camera").expect("a path").field(field);
+    keying::vector(ui, &at("target"), &mut camera.target, |ui, v| {
+        vec3_field(
+            ui,
+            "target",
+            v,
+            0.05,
+            "The point the camera orbits and looks at",
         )
-        .logarithmic(true),
-    )
+    });
+    keying::number(ui, &at("distance"), &mut camera.distance, |ui, v| {
+        ui.add(slider(v, OrbitCamera::MIN_DISTANCE..=1000.0, "distance").logarithmic(true))
+    })
     .on_hover_text("Distance from the target");
-    ui.add(slider(&mut camera.yaw_degrees, 0.0..=360.0, "yaw").suffix("°"))
-        .on_hover_text("Rotation about the vertical axis");
-    ui.add(slider(&mut camera.pitch_degrees, -89.0..=89.0, "pitch").suffix("°"))
-        .on_hover_text("Elevation above the horizontal");
-    ui.add(slider(&mut camera.fov_degrees, 10.0..=120.0, "field of view").suffix("°"))
-        .on_hover_text("Vertical field of view");
+    keying::number(ui, &at("yaw_degrees"), &mut camera.yaw_degrees, |ui, v| {
+        ui.add(slider(v, 0.0..=360.0, "yaw").suffix("°"))
+    })
+    .on_hover_text("Rotation about the vertical axis");
+    keying::number(
+        ui,
+        &at("pitch_degrees"),
+        &mut camera.pitch_degrees,
+        |ui, v| ui.add(slider(v, -89.0..=89.0, "pitch").suffix("°")),
+    )
+    .on_hover_text("Elevation above the horizontal");
+    keying::number(ui, &at("fov_degrees"), &mut camera.fov_degrees, |ui, v| {
+        ui.add(slider(v, 10.0..=120.0, "field of view").suffix("°"))
+    })
+    .on_hover_text("Vertical field of view");
     if ui
         .button("Reset")
         .on_hover_text("Back to the preset's camera")

@@ -112,13 +112,32 @@ pub(super) fn labelled_color(ui: &mut Ui, color: &mut Vec3, label: &str) -> Resp
 
 /// Three drag values for a point or direction, each with the same tooltip.
 pub(super) fn vec3_ui(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, hint: &str) {
+    let _ = vec3_field(ui, label, v, speed, hint);
+}
+
+/// [`vec3_ui`], its three fields' response joined (changed if any is).
+pub(super) fn vec3_field(
+    ui: &mut Ui,
+    label: &str,
+    v: &mut Vec3,
+    speed: f32,
+    hint: &str,
+) -> Response {
     ui.horizontal(|ui| {
+        let mut joined: Option<Response> = None;
         for (prefix, c) in [("x ", &mut v.x), ("y ", &mut v.y), ("z ", &mut v.z)] {
-            ui.add(DragValue::new(c).speed(speed).prefix(prefix))
+            let r = ui
+                .add(DragValue::new(c).speed(speed).prefix(prefix))
                 .on_hover_text(hint);
+            joined = Some(match joined {
+                Some(j) => j | r,
+                None => r,
+            });
         }
         ui.label(label);
-    });
+        joined.expect("three fields")
+    })
+    .inner
 }
 
 /// A texture frame (the report's ATX, APTX, ATX3D): ticked, its origin and

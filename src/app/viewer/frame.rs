@@ -129,7 +129,12 @@ impl Viewer {
         }
         // What this frame's edits changed, worked out once against the
         // scene the renderer was last asked to draw, and handed on.
-        let mut change = self.scene.changes_from(self.renderer.requested_scene());
+        // The scene as traced at the play head; for a scene whose time
+        // moves nothing, the scene itself, and its one comparison serves
+        // the renderer and the document alike.
+        let traced = self.traced(&self.scene).into_owned();
+        let moves = self.scene.moves();
+        let mut change = traced.changes_from(self.renderer.requested_scene());
         // A structural edit that changes the scene's features ends any
         // feature-cost experiment: the new shader is specialised again.
         if self
@@ -143,7 +148,7 @@ impl Viewer {
         self.poll_bakes();
         // Structural edits build their shader off this thread: the old one
         // keeps rendering until the new one is ready.
-        if let Err(e) = self.renderer.request_scene(&self.ctx, &self.scene, change) {
+        if let Err(e) = self.renderer.request_scene(&self.ctx, &traced, change) {
             // Keep what is on screen; show why the edit was refused.
             self.panel.error(format!("{e:#}"));
             self.scene = self.renderer.requested_scene().clone();
@@ -160,6 +165,11 @@ impl Viewer {
         // step of the undo history unless a drag or typing goes on.
         let gesture = self.egui_ctx.input(|i| i.pointer.any_down())
             || self.egui_ctx.egui_wants_keyboard_input();
+        // With time in the scene the traced scene moves on its own: the
+        // document's edits are its change from the last one recorded.
+        if moves {
+            change = self.scene.changes_from(self.edits.history.last());
+        }
         self.edits.history.observe(&self.scene, change, gesture);
         self.edits.document.observe(&self.scene, change);
         if let Some(error) = self

@@ -30,6 +30,7 @@ use super::soak::SoakDriver;
 use super::swatches::Swatches;
 use super::ui_layer::{Compositor, STATS_REFRESH, UiLayer};
 use super::{ViewerOptions, camera_input};
+use crate::panel::timeline::Timeline;
 use crate::panel::{self, PanelAction, PanelState};
 use anyhow::Result;
 use marbre_core::scene::{EnvSource, OrbitCamera, Scene};
@@ -110,6 +111,8 @@ pub struct Viewer {
     /// The user chose to quit: the loop exits after this frame.
     quitting: bool,
     clock: FrameClock,
+    /// The play head: the moment of the scene's time that is traced.
+    timeline: Timeline,
     screenshot_requested: bool,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
@@ -413,6 +416,7 @@ impl Viewer {
             show_help: false,
             ui_hidden: false,
             quitting: false,
+            timeline: Timeline::default(),
             clock: FrameClock {
                 frames: 0,
                 last_frame: Instant::now(),
@@ -649,6 +653,36 @@ impl Viewer {
         }
     }
 
+    /// What the Render dialog renders in time: the play head's moment, or
+    /// every frame of the animation.
+    fn render_timing(&self) -> marbre_render::frame_sequence::Timing {
+        use marbre_render::frame_sequence::Timing;
+        let animation = self.scene.animation.clone().unwrap_or_default();
+        if self.panel.render_dialog.all_frames {
+            Timing::Sequence {
+                frames: 0..=animation.frame_count() - 1,
+                fps: animation.fps,
+                overwrite: true,
+                animation: None,
+            }
+        } else {
+            Timing::Still {
+                time: self.timeline.time,
+                frame: self.timeline.frame(animation.fps),
+            }
+        }
+    }
+
+    /// What is traced of `scene` at the play head: the scene itself unless
+    /// its time moves anything ([`Scene::at_time`]).
+    fn traced<'a>(&self, scene: &'a Scene) -> std::borrow::Cow<'a, Scene> {
+        if scene.moves() {
+            std::borrow::Cow::Owned(scene.at_time(self.timeline.time))
+        } else {
+            std::borrow::Cow::Borrowed(scene)
+        }
+    }
+
     /// Undoes or redoes one step of scene edits, keeping the view.
     fn step_history(&mut self, undo: bool) {
         let restored = if undo {
@@ -660,8 +694,9 @@ impl Viewer {
             Some(scene) => {
                 // A restored scene is handed on at once, so that the next
                 // frame's change is the edits made after it, not the undo.
-                let change = scene.changes_from(self.renderer.requested_scene());
-                match self.renderer.request_scene(&self.ctx, &scene, change) {
+                let traced = self.traced(&scene);
+                let change = traced.changes_from(self.renderer.requested_scene());
+                match self.renderer.request_scene(&self.ctx, &traced, change) {
                     Ok(()) => {
                         self.scene = scene;
                         self.swatches.note(change);
@@ -713,7 +748,10 @@ impl Viewer {
                         self.panel.error(e);
                     }
                 }
-                PanelAction::StartRender(job) => self.start_render(job),
+                PanelAction::StartRender(mut job) => {
+                    job.timing = self.render_timing();
+                    self.start_render(job)
+                }
                 PanelAction::CancelRender => {
                     if let Some(job) = &self.render_job {
                         job.cancel();
@@ -763,6 +801,7 @@ impl Viewer {
                 Shortcut::Close if self.show_help => self.show_help = false,
                 Shortcut::Close => self.panel.save_as = None,
                 Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
+                Shortcut::PlayPause => self.timeline.toggle(Instant::now()),
                 Shortcut::RecallView(index) => {
                     self.scene.recall_view(index);
                 }
@@ -815,7 +854,15 @@ impl Viewer {
             .recent_files
             .clone_from(&self.settings.recent_files);
         let preset_name = self.document_name();
-        let (scene, panel_state) = (&mut self.scene, &mut self.panel);
+        if self
+            .timeline
+            .tick(Instant::now(), self.scene.animation.as_ref())
+        {
+            self.window.request_redraw();
+        }
+        let time = self.timeline.time;
+        panel::keying::begin_frame(&self.egui_ctx, time, &self.scene, &self.traced(&self.scene));
+        let (scene, panel_state, timeline) = (&mut self.scene, &mut self.panel, &mut self.timeline);
         let (prompt, ui_hidden) = (&self.edits.prompt, self.ui_hidden);
         let mut show_help = self.show_help;
         let mut pressed = Vec::new();
@@ -835,7 +882,7 @@ impl Viewer {
                         egui::ScrollArea::vertical()
                             .auto_shrink([false; 2])
                             .show(ui, |ui| {
-                                actions = panel::draw(ui, scene, panel_state, &stats);
+                                actions = panel::draw(ui, scene, panel_state, &stats, timeline);
                             });
                     });
                 // Folded, the strip is its header line: a panel of its
@@ -884,6 +931,13 @@ impl Viewer {
         self.show_help = show_help;
         self.handle_actions(actions);
         self.handle_shortcuts(pressed);
+        let keys = panel::keying::take_requests(&self.egui_ctx);
+        if !keys.is_empty() {
+            let animation = self.scene.animation.get_or_insert_with(Default::default);
+            for (path, value) in keys {
+                animation.insert_key(&path, time, &value);
+            }
+        }
         if let Some(answer) = answer {
             self.answer_prompt(answer);
         }

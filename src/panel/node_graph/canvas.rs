@@ -12,6 +12,7 @@ use egui::{
     CollapsingHeader, Color32, Frame, Id, Label, Pos2, Rect, Sense, Shape, Stroke, Ui, UiBuilder,
     Vec2, pos2, vec2,
 };
+use marbre_core::animation::ParamPath;
 use marbre_core::scene::texture_graph::{
     NodePath, Root, Socket, TextureGraph, detach, move_subtree, roots, texture_at_mut,
 };
@@ -127,6 +128,7 @@ pub(super) fn canvas(
         let top_left = origin + vec2(position.x, position.y);
         let swatch = swatches(key, &node.path, texture);
         let drawn = texture_node(
+            key,
             ui,
             rect,
             top_left,
@@ -312,6 +314,7 @@ struct DrawnNode {
 /// inputs the pattern reads, each a socket with its value inline when no
 /// texture is linked.
 fn texture_node(
+    key: MaterialKey,
     ui: &mut Ui,
     canvas: Rect,
     top_left: Pos2,
@@ -338,7 +341,9 @@ fn texture_node(
             .response
             .rect;
         ui.separator();
-        pattern_ui(ui, texture);
+        let node = ParamPath::parse(&format!("{key}.material.{path}"))
+            .expect("a material key and a node path print as a parameter path");
+        pattern_ui(ui, texture, &node.field("pattern"));
         if texture.pattern == Pattern::Mix && texture.factor.is_none() {
             // A pattern just switched to mix: the tree panel's default.
             texture.factor = Some(Box::new(Texture::scalar(0.5)));

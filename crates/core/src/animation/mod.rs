@@ -189,6 +189,13 @@ impl Track {
 }
 
 impl Scene {
+    /// Whether anything traced changes with time: an animation's tracks.
+    pub fn moves(&self) -> bool {
+        self.animation
+            .as_ref()
+            .is_some_and(|a| !a.tracks.is_empty())
+    }
+
     /// The scene as traced at `time` seconds: each track's value written
     /// in (a track that no longer fits the scene, after an edit, is left
     /// out: [`Animation::problems`] names it) and each evolving noise's
