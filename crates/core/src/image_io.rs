@@ -87,7 +87,15 @@ pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Re
     Ok(())
 }
 
-/// The EXR file (32-bit float RGBA) of `pixels`, row 0 at the top.
+/// The EXR file (32-bit float RGBA) of `pixels`, row 0 at the top: the
+/// same pixels always give the same bytes.
+///
+/// `exr` compresses the blocks (64 × 64 tiles) on a thread pool, and with
+/// its default line order, `Unspecified`, writes each one as soon as it is
+/// compressed: the tiles' order in the file, and so the file's bytes,
+/// varied from run to run with the threads' timing (often in debug builds,
+/// where compression is slower), though the pixels were the same. An
+/// increasing line order makes it write them in order.
 pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let (w, h) = (width as usize, height as usize);
@@ -95,7 +103,11 @@ pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8
         let p = pixels[y * w + x];
         (p[0], p[1], p[2], p[3])
     });
-    let image = Image::from_channels((w, h), channels);
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let image = Image::from_encoded_channels((w, h), encoding, channels);
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut bytes)?;
     Ok(bytes.into_inner())
@@ -104,6 +116,43 @@ pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Many tiles of different content, so that they take different times
+    /// to compress: encoded again and again, the bytes never change, and
+    /// the tiles are in the file in order.
+    #[test]
+    fn an_exr_is_the_same_bytes_every_time() {
+        let (w, h) = (300u32, 200u32);
+        let pixels: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                // Smooth on the left (long RLE runs), noisy on the right.
+                let v = if x < 128 {
+                    (y / 8) as f32
+                } else {
+                    (i.wrapping_mul(2_654_435_761) >> 20) as f32
+                };
+                [v, v * 0.5, 1.0 / (1.0 + v), 1.0]
+            })
+            .collect();
+        let first = encode_exr(w, h, &pixels).unwrap();
+        for _ in 0..10 {
+            assert!(encode_exr(w, h, &pixels).unwrap() == first);
+        }
+        let meta =
+            exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&first), false).unwrap();
+        assert_eq!(
+            meta.headers[0].line_order,
+            exr::meta::attribute::LineOrder::Increasing
+        );
+        let decoded = crate::image_decode::decode_bytes(
+            &first,
+            Path::new("x.exr"),
+            crate::image_decode::IntegerDecode::Linear,
+        )
+        .unwrap();
+        assert!(decoded.pixels == pixels);
+    }
 
     #[test]
     fn a_missing_folder_is_named_and_not_made() {
