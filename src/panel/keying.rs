@@ -143,12 +143,14 @@ fn components(
         let shown: Vec<f32> = keyed
             .as_ref()
             .map_or_else(|| value.to_vec(), |(v, _)| v.clone());
-        if ui
-            .small_button("🔑")
-            .on_hover_text(format!("Insert a key on {text} at {time:.2} s"))
-            .clicked()
-        {
+        let button = ui
+            .small_button("◆")
+            .on_hover_text(format!("Insert a key on {text} at {time:.2} s"));
+        if button.clicked() {
             request(shown);
+            // A key inserted is an edit to undo at once: the button keeps
+            // no keyboard focus, which would hold Ctrl+Z back.
+            button.surrender_focus();
         }
         response
     })

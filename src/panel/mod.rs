@@ -251,7 +251,7 @@ pub fn draw(
             section_headed(ui, "Preset", header, true, |ui| {
                 file_ui::preset_ui(ui, state, &mut actions);
             });
-            section(ui, "Time", scene.animation.is_some(), |ui| {
+            section(ui, "Time", true, |ui| {
                 timeline::timeline_ui(ui, scene, timeline);
             });
             section(ui, "Materials", true, |ui| {

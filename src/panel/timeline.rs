@@ -83,7 +83,7 @@ pub(super) fn timeline_ui(ui: &mut Ui, scene: &mut Scene, timeline: &mut Timelin
     let now = Instant::now();
     let Some(animation) = &mut scene.animation else {
         ui.label(
-            "A still scene: no keys yet. A key button (🔑) beside a number starts an animation.",
+            "A still scene: no keys yet. A key button (◆) beside a number starts an animation.",
         );
         if ui
             .button("Animate")
@@ -95,11 +95,7 @@ pub(super) fn timeline_ui(ui: &mut Ui, scene: &mut Scene, timeline: &mut Timelin
         return;
     };
     ui.horizontal(|ui| {
-        let label = if timeline.playing() {
-            "⏸ Pause"
-        } else {
-            "▶ Play"
-        };
+        let label = if timeline.playing() { "Pause" } else { "Play" };
         if ui.button(label).on_hover_text("Space").clicked() {
             timeline.toggle(now);
         }
@@ -112,13 +108,18 @@ pub(super) fn timeline_ui(ui: &mut Ui, scene: &mut Scene, timeline: &mut Timelin
     });
     let mut time = timeline.time;
     let end = animation.duration.max(1e-3);
-    if ui
+    let scrubbed = ui
         .add(slider(&mut time, 0.0..=end, "time").suffix(" s"))
-        .on_hover_text("Drag to scrub")
-        .changed()
-    {
+        .on_hover_text("Drag to scrub");
+    if scrubbed.changed() {
         let frame = (time * animation.fps).floor();
         timeline.scrub(frame / animation.fps, now);
+    }
+    // Scrubbing is not typing: the slider keeps no keyboard focus, which
+    // would hold Space and Ctrl+Z back (the shortcuts wait for a focused
+    // widget).
+    if scrubbed.clicked() || scrubbed.drag_stopped() {
+        scrubbed.surrender_focus();
     }
     ui.horizontal(|ui| {
         ui.add(
@@ -153,7 +154,7 @@ fn tracks_ui(ui: &mut Ui, animation: &mut Animation, now: f32) {
                             ui.push_id(k, |ui| {
                                 let on_it = (key.time - now).abs() < 1e-4;
                                 let time =
-                                    format!("{}{:.2} s", if on_it { "▶" } else { "" }, key.time);
+                                    format!("{}{:.2} s", if on_it { "at " } else { "" }, key.time);
                                 ui.label(time);
                                 let value: Vec<String> = key
                                     .value
@@ -174,7 +175,7 @@ fn tracks_ui(ui: &mut Ui, animation: &mut Animation, now: f32) {
                                         }
                                     });
                                 if ui
-                                    .small_button("🗑")
+                                    .small_button("×")
                                     .on_hover_text("Delete this key")
                                     .clicked()
                                 {

@@ -13,6 +13,7 @@ mod obj_window;
 mod render_cli;
 mod render_window;
 mod soak;
+mod timeline_window;
 mod window;
 mod work_at_risk;
 mod xvfb;

@@ -203,3 +203,91 @@ fn a_display_edit_keeps_the_samples_and_a_camera_move_restarts_them() {
     assert!(!renderer.is_building());
     assert_eq!(renderer.code_generations(), generations);
 }
+
+/// Playing an animation keyed on numbers of every kind (a noise's
+/// frequency, a stripe frequency, a ramp colour, the camera, the light,
+/// the environment, the exposure) hands the renderer one moment after
+/// another: numbers only, so no code is generated and no pipeline built.
+#[test]
+fn a_keyed_animation_plays_without_generating_code_or_building() {
+    let Some(ctx) = gpu_or_skip("a_keyed_animation_plays_without_generating_code_or_building")
+    else {
+        return;
+    };
+    use marbre_core::animation::{Animation, ParamPath};
+    let loaded = default_preset();
+    let mut animation = Animation::default();
+    let marble = "spheres[\"marble\"].material.diffuse";
+    for (path, start, end) in [
+        (
+            format!("{marble}.pattern.noise.fractal.frequency"),
+            vec![1.0],
+            vec![3.0],
+        ),
+        (
+            format!("{marble}.pattern.stripe_frequency"),
+            vec![12.0],
+            vec![4.0],
+        ),
+        (
+            format!("{marble}.ramp[1].color"),
+            vec![0.3, 0.28, 0.27],
+            vec![0.9, 0.1, 0.1],
+        ),
+        ("camera.yaw_degrees".to_owned(), vec![0.0], vec![40.0]),
+        ("point_light.intensity".to_owned(), vec![1.0], vec![50.0]),
+        (
+            "environment.rotation_degrees".to_owned(),
+            vec![0.0],
+            vec![90.0],
+        ),
+        ("render.exposure".to_owned(), vec![0.0], vec![-1.0]),
+    ] {
+        let path = ParamPath::parse(&path).unwrap();
+        animation.insert_key(&path, 0.0, &start);
+        animation.insert_key(&path, 1.0, &end);
+    }
+    let scene = Scene {
+        animation: Some(animation),
+        ..loaded.scene.clone()
+    };
+    assert!(
+        scene
+            .animation
+            .as_ref()
+            .unwrap()
+            .problems(&scene)
+            .is_empty()
+    );
+    let mut renderer = renderer_with(&ctx, &loaded, SIZE, Kernel::Fragment).unwrap();
+    request(&ctx, &mut renderer, &scene.at_time(0.0));
+    renderer.set_scene(&ctx, &scene.at_time(0.0)).unwrap();
+    let generations = renderer.code_generations();
+    let builds = renderer.last_build();
+    let numbers = Change::CAMERA
+        | Change::MATERIAL_PARAMETERS
+        | Change::LIGHTS
+        | Change::ENVIRONMENT
+        | Change::DISPLAY;
+    let mut previous = image(&ctx, &mut renderer, 1);
+    for frame in 1..=6 {
+        let change = request(&ctx, &mut renderer, &scene.at_time(frame as f32 / 6.0));
+        assert!(
+            numbers.contains(change) && !change.is_empty(),
+            "frame {frame}: {change:?}"
+        );
+        assert!(!renderer.is_building(), "frame {frame} started a build");
+        let drawn = image(&ctx, &mut renderer, 1);
+        assert!(
+            largest_difference(&drawn, &previous) > 0.0,
+            "frame {frame} drew the same image"
+        );
+        previous = drawn;
+    }
+    assert_eq!(
+        renderer.code_generations(),
+        generations,
+        "code was generated"
+    );
+    assert_eq!(renderer.last_build(), builds, "a pipeline was built");
+}

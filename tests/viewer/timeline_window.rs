@@ -1,0 +1,112 @@
+//! The Time section under Xvfb, as a person uses it, on
+//! `tests/data/e2e/timeline.ron` (a ball lit by a point light keyed on at
+//! 0 s and off from 1 s): Space plays the scene's time and the light goes
+//! out; a click at the start of the time slider scrubs back and it is on
+//! again; the environment intensity's key button adds a track, which the
+//! preset Ctrl+S writes holds, and Ctrl+Z removes it again.
+//!
+//! The panel is found by its layout, as in `e2e_window`: the Preset
+//! section folded, the Time section (open) under it, then the Materials
+//! section folded by a click, so that the Environment section's rows sit
+//! at fixed heights.
+
+use crate::e2e_window::{PANEL_LEFT, Session, assert_clean_log, open};
+use crate::xvfb::{TempDir, display_or_skip, serial};
+use marbre_core::animation::Animation;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use crate::REPO;
+
+/// The preset's animation as the file holds it now.
+fn saved_animation(preset: &Path) -> Animation {
+    marbre_core::preset::load(preset)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .preset
+        .scene
+        .animation
+        .expect("the preset keeps its animation")
+}
+
+/// Saves with Ctrl+S (the pointer over the image, where no widget takes
+/// the keys) and waits until the file holds `tracks` tracks.
+fn save_and_count(session: &Session, preset: &Path, tracks: usize) -> Animation {
+    session.run(&["mousemove", "400", "300"]);
+    session.focus();
+    session.run(&["key", "ctrl+s"]);
+    let start = Instant::now();
+    loop {
+        let animation = saved_animation(preset);
+        if animation.tracks.len() == tracks {
+            return animation;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the saved preset has {} tracks, not {tracks}: {animation:?}",
+            animation.tracks.len()
+        );
+        std::thread::sleep(Duration::from_millis(500));
+    }
+}
+
+/// A click as a slow frame sees it: the pointer rests on the spot, then
+/// the button goes down and up a frame or so apart.
+fn press(session: &Session, x: i32, y: i32) {
+    std::thread::sleep(Duration::from_secs(1));
+    session.run(&["mousemove", &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_secs(1));
+    session.run(&["mousedown", "1"]);
+    std::thread::sleep(Duration::from_millis(500));
+    session.run(&["mouseup", "1"]);
+    std::thread::sleep(Duration::from_secs(1));
+}
+
+#[test]
+fn space_plays_a_click_scrubs_and_a_key_is_undone() {
+    const TEST: &str = "space_plays_a_click_scrubs_and_a_key_is_undone";
+    let _serial = serial();
+    let dir = TempDir::new("timeline");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let preset = dir.path().join("timeline.ron");
+    std::fs::copy(Path::new(REPO).join("tests/data/e2e/timeline.ron"), &preset).unwrap();
+    let (_child, session) = open(&x, &dir, &preset);
+    session.wait_for("the light on at 0 s", |l| l.centre_luma > 0.6);
+    // Fold the Preset section: Time's rows then start at y = 58.
+    session.focus();
+    session.click(PANEL_LEFT + 50, 12);
+
+    // Space over the image plays: past 1 s the keyed light is off.
+    session.run(&["mousemove", "400", "300"]);
+    session.focus();
+    session.run(&["key", "space"]);
+    session.wait_for("playing past 1 s (the light off)", |l| l.centre_luma < 0.02);
+    // Playback stops on the last frame (1.75 s) at most 0.75 s later; a
+    // scrub during playback would play on from where it set the time.
+    std::thread::sleep(Duration::from_secs(2));
+
+    // A press at the time slider's left end scrubs back to 0 s (the
+    // pointer first rests there: egui reads it once per slow frame).
+    press(&session, PANEL_LEFT + 29, 81);
+    session.wait_for("scrubbed to 0 s (the light on)", |l| l.centre_luma > 0.6);
+
+    // Fold Materials; the Environment's intensity row is then at y = 242,
+    // its key button at the row's end.
+    session.click(PANEL_LEFT + 50, 150);
+    press(&session, PANEL_LEFT + 251, 242);
+    let keyed = save_and_count(&session, &preset, 2);
+    let track = &keyed.tracks[1];
+    assert_eq!(track.path, "environment.intensity");
+    assert_eq!(track.keys.len(), 1);
+    assert_eq!(track.keys[0].time, 0.0);
+    assert_eq!(track.keys[0].value.components(), [1.0]);
+
+    session.run(&["key", "ctrl+z"]);
+    // Not in the same frame as the Ctrl+S that follows: that frame would
+    // save (a shortcut taken before the widgets) before undoing.
+    std::thread::sleep(Duration::from_secs(2));
+    let undone = save_and_count(&session, &preset, 1);
+    assert_eq!(undone.tracks[0].path, "point_light.intensity");
+    assert_clean_log(&dir);
+}
