@@ -97,6 +97,7 @@ impl NoiseArgs {
                 },
                 ..Default::default()
             },
+            evolution: None,
         }
     }
 

@@ -61,14 +61,6 @@ impl Progression {
             Progression::Linear => "linear (Massal)",
         }
     }
-
-    /// The id the shader switches on (`NoiseParams::progression`).
-    pub fn id(self) -> u32 {
-        match self {
-            Progression::Geometric => 0,
-            Progression::Linear => 1,
-        }
-    }
 }
 
 impl FractalParams {

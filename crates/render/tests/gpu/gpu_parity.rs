@@ -34,6 +34,7 @@ fn settings(kind: NoiseKind, hash: HashKind) -> NoiseSettings {
             distortion: 0.0,
             progression: Default::default(),
         },
+        evolution: None,
     }
 }
 
