@@ -85,7 +85,8 @@ impl Evolution {
 
     /// How far the domain has moved at the moment traced: drift·t. The
     /// noise is taken at `p − offset_now()`, so its features move along
-    /// +drift.
+    /// +drift. A loop does not wrap it (the domain has no period in
+    /// general): a loop is seamless without drift.
     pub fn offset_now(&self) -> Vec3 {
         self.drift * self.time
     }

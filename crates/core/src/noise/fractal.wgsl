@@ -39,8 +39,6 @@ struct NoiseParams {
 const NOISE_LINEAR: u32 = 1u;
 // The renderer takes the signal at world coordinates, else object ones.
 const NOISE_WORLD: u32 = 2u;
-// The 4D noise at (p, w) (compiled in with NOISE_EVOLVE only).
-const NOISE_EVOLVES: u32 = 4u;
 
 fn noise_linear(n: NoiseParams) -> bool {
     return (n.flags & NOISE_LINEAR) != 0u;
@@ -49,6 +47,9 @@ fn noise_linear(n: NoiseParams) -> bool {
 const MAX_OCTAVES: f32 = 16.0;
 
 #if NOISE_EVOLVE
+// The 4D noise at (p, w).
+const NOISE_EVOLVES: u32 = 4u;
+
 // The w lattice's period of an evolving signal while looping, 0 without.
 fn noise_w_period(n: NoiseParams) -> u32 {
     return n.flags >> 8u;

@@ -121,7 +121,7 @@ pub fn gradient4_sin(cell: Vec4) -> Vec4 {
 
 /// The lattice w-coordinate of an evolving noise's corner: wrapped modulo
 /// `period` cells when looping (so the noise at w and w + period is the
-/// same), as is.
+/// same), else unchanged.
 pub fn wrap_w(cell_w: i32, period: Option<u32>) -> i32 {
     match period {
         Some(p) if p > 0 => cell_w.rem_euclid(p.min(i32::MAX as u32) as i32),
