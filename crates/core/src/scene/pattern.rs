@@ -333,19 +333,16 @@ impl Pattern {
 
     /// Whether the two patterns compile to the same code: one kind, and
     /// the same choices the code holds (an image's filter and wrap, the
-    /// noise kind and hash, which pick functions); their numbers may
-    /// differ.
+    /// noise kind and hash and whether it evolves, which pick functions);
+    /// their numbers may differ.
     pub fn same_kind(&self, other: &Pattern) -> bool {
         let choices = |p: &Pattern| match p {
-            Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8)),
+            Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8, false)),
             // An evolving noise's code is the 4D sum's (its w, period and
             // drift are numbers); a still one's is the 3D sum's.
-            _ => p.noise().map(|n| {
-                (
-                    n.kind as u8,
-                    n.hash as u8 | u8::from(n.evolution.is_some()) << 4,
-                )
-            }),
+            _ => p
+                .noise()
+                .map(|n| (n.kind as u8, n.hash as u8, n.evolution.is_some())),
         };
         self.kind() == other.kind() && choices(self) == choices(other)
     }
