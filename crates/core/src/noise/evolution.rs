@@ -63,11 +63,15 @@ impl Evolution {
     /// P = max(1, round(|speed|·D)) cells and w runs over exactly one
     /// period in D (speed snapped to P/D, its sign kept), so the frame at
     /// D is the frame at 0; without a loop w = w0 + speed·t, unbounded.
+    /// With speed 0, w stays at w0 and needs no period.
     pub fn at(&mut self, time: f32, loop_duration: Option<f32>) {
         self.time = time;
         self.loop_duration = loop_duration.filter(|d| *d > 0.0 && d.is_finite());
+        // A still w meets itself without a period, and keeps the look it
+        // has outside a loop (a period wraps the lattice's cells).
         self.w_period = self
             .loop_duration
+            .filter(|_| self.speed != 0.0)
             .map(|d| ((self.speed.abs() * d).round() as u32).clamp(1, Self::MAX_PERIOD));
     }
 
@@ -161,14 +165,14 @@ mod tests {
     }
 
     #[test]
-    fn speed_zero_in_a_loop_stays_at_w0() {
+    fn speed_zero_in_a_loop_stays_at_w0_without_a_period() {
         let mut e = Evolution {
             w: 3.0,
             speed: 0.0,
             ..Evolution::default()
         };
         e.at(1.3, Some(2.0));
-        assert_eq!(e.w_period, Some(1));
+        assert_eq!(e.w_period, None);
         assert_eq!(e.w_now(), 3.0);
     }
 
