@@ -109,7 +109,7 @@ fn signal_params(material: u32, k: u32, width: f32) -> NoiseParams {
 // Where signal k of a material is taken: its mapping of the object point p
 // or of the world point pw.
 fn signal_point(material: u32, k: u32, p: vec3f, pw: vec3f) -> vec3f {
-    let q = select(p, pw, materials[material].signals[k].world != 0u);
+    let q = select(p, pw, (materials[material].signals[k].flags & NOISE_WORLD) != 0u);
     return affine_rows(
         q,
         materials[material].signal_rows[3u * k],

@@ -8,7 +8,7 @@
 struct NoiseHarness {
     noise: NoiseParams,
     mode: u32,            // 0 noise, 1 fBm, 2 turbulence, 3 marble, 4 env_uv, 5 rotate_y, 6 ridged,
-                          // 7 footprint octaves
+                          // 7 footprint octaves, 8 the 4D noise at the signal's w
     count: u32,
     param: f32,           // marble stripe frequency, or rotation in radians
     _pad: f32,
@@ -49,6 +49,11 @@ fn cs_evaluate(@builtin(global_invocation_id) id: vec3u) {
         case 7u: {
             r.x = footprint_octaves(n, harness.param);
         }
+#if NOISE_EVOLVE
+        case 8u: {
+            r.x = lattice_noise4(p, n.w, n.kind, n.hash, noise_w_period(n));
+        }
+#endif
         default: {
             r = vec4f(rotate_y(p, harness.param), 0.0);
         }

@@ -10,7 +10,9 @@ use egui::{CollapsingHeader, ComboBox, Slider, SliderClamping, TextEdit, Ui};
 use glam::Vec3;
 use marbre_core::animation::ParamPath;
 use marbre_core::bake::BakeProperty;
-use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
+use marbre_core::noise::{
+    Evolution, FractalParams, HashKind, NoiseKind, NoiseSettings, Progression,
+};
 use marbre_core::scene::MaterialKey;
 use marbre_core::scene::texture_graph::{NodePath, Root, Socket};
 use marbre_core::scene::{
@@ -987,6 +989,43 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings, path: &ParamPath) {
          (0: none and free; type any value in ±100)",
     );
     limit(&mut f.distortion, FractalParams::DISTORTION);
+    evolution_ui(ui, &mut noise.evolution);
+}
+
+/// Evolving noise (issue 29): the 4D noise whose w moves with the scene's
+/// time, and a drift of its domain. Off is the 3D noise of before.
+fn evolution_ui(ui: &mut Ui, evolution: &mut Option<Evolution>) {
+    let mut on = evolution.is_some();
+    if ui
+        .checkbox(&mut on, "Evolve (4D)")
+        .on_hover_text(
+            "Animate the noise: the 4D noise at a w that moves with time (as Blender's 4D \
+             noise), its domain drifting. With the animation's loop on, w is periodic over \
+             the loop, so the last frame meets the first",
+        )
+        .changed()
+    {
+        *evolution = on.then(Evolution::default);
+    }
+    let Some(e) = evolution else {
+        return;
+    };
+    ui.add(typed_beyond(slider(&mut e.w, -4.0..=4.0, "w")))
+        .on_hover_text("The fourth coordinate at time 0, in cells of the first octave");
+    limit(&mut e.w, Evolution::W);
+    ui.add(typed_beyond(slider(&mut e.speed, -4.0..=4.0, "speed")))
+        .on_hover_text("Cells of w per second (a loop rounds it to whole cells over its duration)");
+    limit(&mut e.speed, Evolution::SPEED);
+    ui.horizontal(|ui| {
+        ui.label("drift").on_hover_text(
+            "How far the noise moves per second, in its own units; a loop is seamless only \
+             without drift",
+        );
+        for c in [&mut e.drift.x, &mut e.drift.y, &mut e.drift.z] {
+            ui.add(egui::DragValue::new(c).speed(0.01));
+            limit(c, Evolution::DRIFT);
+        }
+    });
 }
 
 /// A slider that drags over its useful range but keeps a typed value beyond

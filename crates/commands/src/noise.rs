@@ -8,7 +8,9 @@ use clap::{Args, ValueEnum};
 use glam::DVec3;
 use marbre_core::noise::fractal::{FractalShape, fractal_sum_f64, noise_f64};
 use marbre_core::noise::points::read_points;
-use marbre_core::noise::{FractalParams, HashKind, NoiseKind, NoiseSettings, Progression};
+use marbre_core::noise::{
+    Evolution, FractalParams, HashKind, NoiseKind, NoiseSettings, Progression, noise4_f64,
+};
 use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
 use std::io::{BufRead, Write};
@@ -62,6 +64,13 @@ pub struct NoiseArgs {
     /// Print turbulence (a sum of |noise|) instead of one octave of noise.
     #[arg(long)]
     pub turbulence: bool,
+    /// Evaluate the evolving (4D) noise at this w (issue 29): one octave is
+    /// the 4D noise at (x, y, z, w), the sums evolving ones.
+    #[arg(long)]
+    pub w: Option<f32>,
+    /// With --w, the w lattice's period in cells, as a loop makes it.
+    #[arg(long, requires = "w", value_parser = clap::value_parser!(u32).range(1..=i64::from(Evolution::MAX_PERIOD)))]
+    pub w_period: Option<u32>,
     /// Evaluate with the CPU reference (double precision) instead of the
     /// shader (single precision); both print 9 significant digits.
     #[arg(long)]
@@ -97,6 +106,12 @@ impl NoiseArgs {
                 },
                 ..Default::default()
             },
+            evolution: self.w.map(|w| Evolution {
+                w,
+                speed: 0.0,
+                w_period: self.w_period,
+                ..Evolution::default()
+            }),
         }
     }
 
@@ -105,6 +120,8 @@ impl NoiseArgs {
             Evaluate::Fbm
         } else if self.turbulence {
             Evaluate::Turbulence
+        } else if self.w.is_some() {
+            Evaluate::Noise4
         } else {
             Evaluate::Noise
         }
@@ -118,7 +135,16 @@ pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[DVec3]) 
         .map(|&p| match what {
             Evaluate::Fbm => fractal_sum_f64(p, settings, FractalShape::Signed),
             Evaluate::Turbulence => fractal_sum_f64(p, settings, FractalShape::Absolute),
-            _ => noise_f64(p, settings.kind, settings.hash),
+            _ => match settings.evolution {
+                Some(e) => noise4_f64(
+                    p,
+                    f64::from(e.w_now()),
+                    settings.kind,
+                    settings.hash,
+                    e.w_period,
+                ),
+                None => noise_f64(p, settings.kind, settings.hash),
+            },
         })
         .collect()
 }
@@ -295,6 +321,27 @@ mod tests {
             assert_eq!(n, f);
             assert_eq!(n.abs(), *t);
         }
+    }
+
+    /// `--w` evaluates the 4D noise at that w (one octave, or an evolving
+    /// sum), and `--w-period` makes it periodic in w.
+    #[test]
+    fn w_flags_give_the_4d_noise() {
+        let (points, _) = reference();
+        let evolving = args(&["--cpu", "--w", "1.25", "--w-period", "3"]);
+        assert_eq!(evolving.what(), Evaluate::Noise4);
+        let got = evaluate_cpu(&evolving.settings(), evolving.what(), &points);
+        let plus_period = args(&["--cpu", "--w", "4.25", "--w-period", "3"]);
+        assert_eq!(
+            got,
+            evaluate_cpu(&plus_period.settings(), plus_period.what(), &points)
+        );
+        for (p, v) in points.iter().zip(&got) {
+            let want = noise4_f64(*p, 1.25, NoiseKind::Gradient, HashKind::Pcg, Some(3));
+            assert_eq!(*v, want);
+        }
+        let still = args(&["--cpu"]);
+        assert_ne!(got, evaluate_cpu(&still.settings(), still.what(), &points));
     }
 
     /// `--progression linear` with Massal's knobs is his turbulence, as the

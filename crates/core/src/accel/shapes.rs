@@ -116,6 +116,7 @@ pub fn bumpy_sphere(triangles: usize) -> IndexedMesh {
             distortion: 0.0,
             progression: Default::default(),
         },
+        evolution: None,
     };
     displaced_sphere(Vec3::ZERO, 1.0, rings, 2 * rings, |d| {
         noise::fbm(d, &settings)

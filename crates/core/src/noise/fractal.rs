@@ -1,8 +1,10 @@
 //! Fractal sums of a lattice noise: fBm, turbulence and marble.
 
-use super::gradient::{gradient_noise, gradient_noise_f64};
+use super::evolution::Evolution;
+use super::gradient::{gradient_noise, gradient_noise_f64, gradient_noise4, gradient_noise4_f64};
 use super::perlin::{
     Real, improved_noise, improved_noise_f32, improved_noise_massal, improved_noise_massal_f32,
+    improved_noise4, improved_noise4_f32,
 };
 use super::{HashKind, NoiseKind};
 use glam::{DVec3, Vec3};
@@ -59,14 +61,6 @@ impl Progression {
             Progression::Linear => "linear (Massal)",
         }
     }
-
-    /// The id the shader switches on (`NoiseParams::progression`).
-    pub fn id(self) -> u32 {
-        match self {
-            Progression::Geometric => 0,
-            Progression::Linear => 1,
-        }
-    }
 }
 
 impl FractalParams {
@@ -108,6 +102,11 @@ pub struct NoiseSettings {
     pub kind: NoiseKind,
     pub hash: HashKind,
     pub fractal: FractalParams,
+    /// Evolving noise (issue 29): the 4D noise at a w that moves with time,
+    /// its domain drifting. None, as in every preset written before it, is
+    /// the 3D noise, and the renderer compiles exactly the code it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evolution: Option<Evolution>,
 }
 
 impl NoiseSettings {
@@ -125,6 +124,7 @@ impl NoiseSettings {
                 progression: Progression::Linear,
                 ..FractalParams::default()
             },
+            evolution: None,
         }
     }
 }
@@ -141,10 +141,28 @@ pub fn noise_f64(p: DVec3, kind: NoiseKind, hash: HashKind) -> f64 {
     f64::lattice_noise(p.to_array(), kind, hash)
 }
 
+/// One octave of the chosen lattice noise in 4D, at (p, w), its lattice
+/// periodic in w every `w_period` cells when given; in f32 as the shader.
+pub fn noise4(p: Vec3, w: f32, kind: NoiseKind, hash: HashKind, w_period: Option<u32>) -> f32 {
+    f32::lattice_noise4(p.to_array(), w, kind, hash, w_period)
+}
+
+/// [`noise4`] in double precision: the reference.
+pub fn noise4_f64(p: DVec3, w: f64, kind: NoiseKind, hash: HashKind, w_period: Option<u32>) -> f64 {
+    f64::lattice_noise4(p.to_array(), w, kind, hash, w_period)
+}
+
 /// A precision the noise and its fractal sums are evaluated in: f32 (the
 /// shader's twin) or f64 (the reference).
 trait NoisePrecision: Real + std::ops::Div<Output = Self> {
     fn lattice_noise(p: [Self; 3], kind: NoiseKind, hash: HashKind) -> Self;
+    fn lattice_noise4(
+        p: [Self; 3],
+        w: Self,
+        kind: NoiseKind,
+        hash: HashKind,
+        w_period: Option<u32>,
+    ) -> Self;
     fn abs(self) -> Self;
     fn min(self, other: Self) -> Self;
 }
@@ -152,13 +170,29 @@ trait NoisePrecision: Real + std::ops::Div<Output = Self> {
 /// The [`NoisePrecision`] of `$t`: its noises are `$gradient` (taking a
 /// `$vec`), `$perlin` and `$massal`.
 macro_rules! noise_precision {
-    ($t:ty, $vec:ty, $gradient:path, $perlin:path, $massal:path) => {
+    ($t:ty, $vec:ty, $gradient:path, $perlin:path, $massal:path, $gradient4:path, $perlin4:path) => {
         impl NoisePrecision for $t {
             fn lattice_noise(p: [$t; 3], kind: NoiseKind, hash: HashKind) -> $t {
                 match kind {
                     NoiseKind::Gradient => $gradient(<$vec>::from_array(p), hash),
                     NoiseKind::Perlin => $perlin(p[0], p[1], p[2]),
                     NoiseKind::PerlinMassal => $massal(p[0], p[1], p[2]),
+                }
+            }
+            fn lattice_noise4(
+                p: [$t; 3],
+                w: $t,
+                kind: NoiseKind,
+                hash: HashKind,
+                w_period: Option<u32>,
+            ) -> $t {
+                match kind {
+                    NoiseKind::Gradient => $gradient4(<$vec>::from_array(p), w, hash, w_period),
+                    // Massal's table has no 4D form: both Perlin kinds
+                    // evolve with Blender's 32 gradients.
+                    NoiseKind::Perlin | NoiseKind::PerlinMassal => {
+                        $perlin4([p[0], p[1], p[2], w], w_period)
+                    }
                 }
             }
             fn abs(self) -> $t {
@@ -175,14 +209,18 @@ noise_precision!(
     Vec3,
     gradient_noise,
     improved_noise_f32,
-    improved_noise_massal_f32
+    improved_noise_massal_f32,
+    gradient_noise4,
+    improved_noise4_f32
 );
 noise_precision!(
     f64,
     DVec3,
     gradient_noise_f64,
     improved_noise,
-    improved_noise_massal
+    improved_noise_massal,
+    gradient_noise4_f64,
+    improved_noise4
 );
 
 /// What each octave adds: the signed noise (fBm), its absolute value
@@ -221,6 +259,42 @@ const WARP_OFFSETS: [Vec3; 3] = [
     Vec3::new(8.3, 2.8, 4.9),
 ];
 
+/// The lattice noise a sum's octaves read: 3D, or with an evolution 4D at
+/// the moment's w. Without a loop octave i reads w·rᵢ, rᵢ = fᵢ/f₀ its
+/// frequency over the first's (Blender's 4D fBm scales w with each octave;
+/// measured in the first octave's cells, a frequency edit leaves the speed
+/// alone). While looping every octave reads w itself, its lattice periodic
+/// in the loop's P cells: so the sum at w + P is the sum at w for any
+/// lacunarity, where scaling w by a non-integer rᵢ would break the seam.
+struct OctaveNoise<T> {
+    kind: NoiseKind,
+    hash: HashKind,
+    /// The moment's w and the loop's period, for an evolving noise.
+    evolution: Option<(T, Option<u32>)>,
+}
+
+impl<T: NoisePrecision> OctaveNoise<T> {
+    fn new(s: &NoiseSettings) -> Self {
+        Self {
+            kind: s.kind,
+            hash: s.hash,
+            evolution: s
+                .evolution
+                .map(|e: Evolution| (T::from_f64(f64::from(e.w_now())), e.w_period)),
+        }
+    }
+
+    /// The noise at `q`, for an octave whose frequency is `ratio` times the
+    /// first's.
+    fn at(&self, q: [T; 3], ratio: T) -> T {
+        match self.evolution {
+            None => T::lattice_noise(q, self.kind, self.hash),
+            Some((w, None)) => T::lattice_noise4(q, w * ratio, self.kind, self.hash, None),
+            Some((w, period)) => T::lattice_noise4(q, w, self.kind, self.hash, period),
+        }
+    }
+}
+
 /// `p` moved by the domain warp of `s` (unchanged without distortion).
 pub fn warped(p: Vec3, s: &NoiseSettings) -> Vec3 {
     Vec3::from_array(warped_generic(p.to_array(), s))
@@ -233,9 +307,10 @@ fn warped_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings) -> [T; 3] {
     }
     let frequency = T::from_f64(f64::from(s.fractal.frequency));
     let q = p.map(|c| c * frequency);
+    let noise = OctaveNoise::new(s);
     let [a, b, c] = WARP_OFFSETS.map(|o| {
         let o = o.to_array().map(|c| T::from_f64(f64::from(c)));
-        T::lattice_noise([q[0] + o[0], q[1] + o[1], q[2] + o[2]], s.kind, s.hash)
+        noise.at([q[0] + o[0], q[1] + o[1], q[2] + o[2]], T::ONE)
     });
     [p[0] + amount * a, p[1] + amount * b, p[2] + amount * c]
 }
@@ -256,8 +331,11 @@ fn fractal_sum_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings, shape: F
     let param = |v: f32| T::from_f64(f64::from(v));
     let octaves = param(f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES));
     let whole = f.octaves.clamp(0.0, FractalParams::MAX_OCTAVES).ceil() as u32;
+    let noise = OctaveNoise::new(s);
     let mut frequency = param(f.frequency);
     let mut amplitude = param(f.amplitude);
+    // fᵢ/f₀, kept beside the frequency (not divided: f₀ may be 0).
+    let mut ratio = T::ONE;
     let mut sum = T::ZERO;
     for i in 0..whole {
         // The last octave fades in with the fractional part of `octaves`.
@@ -266,11 +344,13 @@ fn fractal_sum_generic<T: NoisePrecision>(p: [T; 3], s: &NoiseSettings, shape: F
             let k = T::from_i32(i as i32 + 1);
             frequency = param(f.frequency) * k;
             amplitude = param(f.amplitude) / k;
+            ratio = k;
         }
-        let v = T::lattice_noise(p.map(|c| c * frequency), s.kind, s.hash);
+        let v = noise.at(p.map(|c| c * frequency), ratio);
         sum = sum + weight * amplitude * shape.apply(v);
         frequency = frequency * param(f.lacunarity);
         amplitude = amplitude * param(f.persistence);
+        ratio = ratio * param(f.lacunarity);
     }
     sum
 }
@@ -332,6 +412,89 @@ mod tests {
                 amplitude,
                 ..FractalParams::default()
             },
+            evolution: None,
+        }
+    }
+
+    fn evolving(kind: NoiseKind, lacunarity: f32, distortion: f32) -> NoiseSettings {
+        NoiseSettings {
+            kind,
+            hash: HashKind::Pcg,
+            fractal: FractalParams {
+                octaves: 5.5,
+                frequency: 1.3,
+                lacunarity,
+                distortion,
+                ..FractalParams::default()
+            },
+            evolution: Some(Evolution {
+                w: 0.25,
+                speed: 0.7,
+                ..Evolution::default()
+            }),
+        }
+    }
+
+    /// A loop's last frame is its first, to the bit, for every sum and
+    /// any lacunarity (every octave's lattice periodic in the loop's
+    /// period): at t = D by the time's reduction, and just before D it
+    /// approaches the sum at w₀ + P, which the periodic lattice makes the
+    /// sum at w₀.
+    #[test]
+    fn an_evolving_sum_loops_without_a_seam() {
+        for kind in NoiseKind::ALL {
+            for lacunarity in [2.0, 1.93] {
+                for distortion in [0.0, 0.4] {
+                    let mut s = evolving(kind, lacunarity, distortion);
+                    let d = 3.0;
+                    let at = |s: &mut NoiseSettings, t: f32| {
+                        s.evolution.as_mut().expect("evolving").at(t, Some(d));
+                        *s
+                    };
+                    let first = at(&mut s, 0.0);
+                    let last = at(&mut s, d);
+                    let mut wrapped = first;
+                    let e = wrapped.evolution.as_mut().expect("evolving");
+                    e.w += e.w_period.expect("looping") as f32;
+                    for p in points() {
+                        for shape in [
+                            FractalShape::Signed,
+                            FractalShape::Absolute,
+                            FractalShape::Ridged,
+                        ] {
+                            let a = fractal_sum(p, &first, shape);
+                            assert_eq!(a, fractal_sum(p, &last, shape));
+                            assert_eq!(a, fractal_sum(p, &wrapped, shape), "{kind:?} {p}");
+                        }
+                        assert_eq!(marble(p, &first, 2.0), marble(p, &last, 2.0));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Evolving noise changes with time (its w moves), and without a loop
+    /// octave i reads w·fᵢ/f₀: one octave at w is the 4D noise at
+    /// (p·f₀, w).
+    #[test]
+    fn an_evolving_sum_moves_with_w() {
+        for kind in NoiseKind::ALL {
+            let mut s = evolving(kind, 2.0, 0.0);
+            s.fractal.octaves = 1.0;
+            let e = s.evolution.as_mut().expect("evolving");
+            e.at(2.0, None);
+            let w = e.w_now();
+            for p in points() {
+                assert_eq!(fbm(p, &s), noise4(p * 1.3, w, kind, HashKind::Pcg, None));
+            }
+            s.fractal.octaves = 4.0;
+            let before: Vec<f32> = points().map(|p| fbm(p, &s)).collect();
+            s.evolution.as_mut().expect("evolving").at(2.5, None);
+            let moved = points()
+                .zip(&before)
+                .filter(|(p, b)| fbm(*p, &s) != **b)
+                .count();
+            assert!(moved > 450, "{kind:?}: {moved}");
         }
     }
 

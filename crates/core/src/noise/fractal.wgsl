@@ -23,16 +23,70 @@ struct NoiseParams {
     shape: u32,
     // Domain warp amount (0: none); compiled in with NOISE_WARP only.
     distortion: f32,
-    // 1: the renderer takes the signal at world coordinates, 0: object ones.
-    world: u32,
+    // Bits (packed so that a material's uniform stays within 64 KiB):
+    // NOISE_LINEAR, NOISE_WORLD, NOISE_EVOLVES, and from bit 8 on the w
+    // lattice's period in cells while looping (0: none).
+    flags: u32,
     // How much the signal's mapping enlarges a footprint.
     footprint_scale: f32,
-    // 0 geometric (lacunarity, persistence), 1 linear (Massal's harmonics:
-    // level k = i + 1 at frequency · k, weighted amplitude / k).
-    progression: u32,
+    // An evolving signal's w at the moment traced (Evolution::w_now).
+    w: f32,
+}
+
+// 0 geometric progression (lacunarity, persistence), NOISE_LINEAR linear
+// (Massal's harmonics: level k = i + 1 at frequency · k, weighted
+// amplitude / k).
+const NOISE_LINEAR: u32 = 1u;
+// The renderer takes the signal at world coordinates, else object ones.
+const NOISE_WORLD: u32 = 2u;
+
+fn noise_linear(n: NoiseParams) -> bool {
+    return (n.flags & NOISE_LINEAR) != 0u;
 }
 
 const MAX_OCTAVES: f32 = 16.0;
+
+#if NOISE_EVOLVE
+// The 4D noise at (p, w).
+const NOISE_EVOLVES: u32 = 4u;
+
+// The w lattice's period of an evolving signal while looping, 0 without.
+fn noise_w_period(n: NoiseParams) -> u32 {
+    return n.flags >> 8u;
+}
+
+// The w an octave whose frequency is `ratio` times the first's reads:
+// w·ratio (Blender's 4D fBm), or while looping w itself, every octave's
+// lattice periodic in the loop's cells (fractal.rs's OctaveNoise says why).
+fn octave_w(n: NoiseParams, ratio: f32) -> f32 {
+    return select(n.w * ratio, n.w, noise_w_period(n) != 0u);
+}
+
+// The 4D noise of either kind at (p, w), for the harness.
+fn lattice_noise4(p: vec3f, w: f32, kind: u32, hash: u32, period: u32) -> f32 {
+#if NOISE_PERLIN
+    if kind == 1u {
+        return perlin_noise4(p, w, period);
+    }
+#endif
+#if NOISE_GRADIENT
+    return gradient_noise4(p, w, hash, period);
+#else
+    return 0.0;
+#endif
+}
+#endif
+
+// One octave of a signal's noise at q, the octave's frequency `ratio` times
+// the first's: 3D, or 4D for an evolving signal.
+fn signal_noise(q: vec3f, n: NoiseParams, ratio: f32) -> f32 {
+#if NOISE_EVOLVE
+    if (n.flags & NOISE_EVOLVES) != 0u {
+        return lattice_noise4(q, octave_w(n, ratio), n.kind, n.hash, noise_w_period(n));
+    }
+#endif
+    return lattice_noise(q, n.kind, n.hash);
+}
 
 fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 #if NOISE_PERLIN
@@ -52,7 +106,7 @@ fn lattice_noise(p: vec3f, kind: u32, hash: u32) -> f32 {
 // noise::footprint_octaves (pbrt's rule, any lacunarity or linear levels).
 fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
     let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
-    let linear = n.progression == 1u;
+    let linear = noise_linear(n);
     if !(width > 0.0 && (n.lacunarity > 1.0 || linear) && n.frequency > 0.0) {
         return octaves;
     }
@@ -73,7 +127,7 @@ fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
 // amplitude / k, k = i + 1.
 fn octave_scales(n: NoiseParams, i: u32, frequency: f32, amplitude: f32) -> vec2f {
     let k = f32(i + 1u);
-    return select(vec2f(frequency, amplitude), vec2f(n.frequency * k, n.amplitude / k), n.progression == 1u);
+    return select(vec2f(frequency, amplitude), vec2f(n.frequency * k, n.amplitude / k), noise_linear(n));
 }
 
 // Octave i's share of the sum, in one place for both kinds' loops: the last,
@@ -97,9 +151,9 @@ fn warped(p: vec3f, n: NoiseParams) -> vec3f {
 #if NOISE_WARP
     let q = p * n.frequency;
     let w = vec3f(
-        lattice_noise(q + WARP_OFFSET_0, n.kind, n.hash),
-        lattice_noise(q + WARP_OFFSET_1, n.kind, n.hash),
-        lattice_noise(q + WARP_OFFSET_2, n.kind, n.hash),
+        signal_noise(q + WARP_OFFSET_0, n, 1.0),
+        signal_noise(q + WARP_OFFSET_1, n, 1.0),
+        signal_noise(q + WARP_OFFSET_2, n, 1.0),
     );
     return select(p + n.distortion * w, p, n.distortion == 0.0);
 #else
@@ -119,9 +173,25 @@ fn fractal_sum_gradient(point: vec3f, n: NoiseParams) -> f32 {
     var frequency = n.frequency;
     var amplitude = n.amplitude;
     var sum = 0.0;
+#if NOISE_EVOLVE
+    // fᵢ/f₀ beside the frequency, as fractal.rs (not divided: f₀ may be 0).
+    var ratio = 1.0;
+    let evolves = (n.flags & NOISE_EVOLVES) != 0u;
+#endif
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
         let scales = octave_scales(n, i, frequency, amplitude);
+#if NOISE_EVOLVE
+        ratio = select(ratio, f32(i + 1u), noise_linear(n));
+        var v = 0.0;
+        if evolves {
+            v = gradient_noise4(p * scales.x, octave_w(n, ratio), n.hash, noise_w_period(n));
+        } else {
+            v = gradient_noise(p * scales.x, n.hash);
+        }
+        ratio = ratio * n.lacunarity;
+#else
         let v = gradient_noise(p * scales.x, n.hash);
+#endif
         sum += octave_term(v, n, octaves, i, scales.y);
         frequency = scales.x * n.lacunarity;
         amplitude = scales.y * n.persistence;
@@ -137,9 +207,25 @@ fn fractal_sum_perlin(point: vec3f, n: NoiseParams) -> f32 {
     var frequency = n.frequency;
     var amplitude = n.amplitude;
     var sum = 0.0;
+#if NOISE_EVOLVE
+    // fᵢ/f₀ beside the frequency, as fractal.rs (not divided: f₀ may be 0).
+    var ratio = 1.0;
+    let evolves = (n.flags & NOISE_EVOLVES) != 0u;
+#endif
     for (var i = 0u; i < u32(ceil(octaves)); i++) {
         let scales = octave_scales(n, i, frequency, amplitude);
+#if NOISE_EVOLVE
+        ratio = select(ratio, f32(i + 1u), noise_linear(n));
+        var v = 0.0;
+        if evolves {
+            v = perlin_noise4(p * scales.x, octave_w(n, ratio), noise_w_period(n));
+        } else {
+            v = perlin_noise(p * scales.x, n.hash == 3u);
+        }
+        ratio = ratio * n.lacunarity;
+#else
         let v = perlin_noise(p * scales.x, n.hash == 3u);
+#endif
         sum += octave_term(v, n, octaves, i, scales.y);
         frequency = scales.x * n.lacunarity;
         amplitude = scales.y * n.persistence;

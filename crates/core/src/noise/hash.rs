@@ -1,6 +1,6 @@
 //! Lattice hashes that turn an integer cell into a pseudo-random gradient.
 
-use glam::{IVec3, UVec3, Vec3};
+use glam::{IVec3, IVec4, UVec3, UVec4, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
@@ -71,6 +71,64 @@ pub fn gradient_pcg_tiled(cell: IVec3) -> Vec3 {
     gradient_pcg(cell & IVec3::splat(LATTICE_PERIOD - 1))
 }
 
+/// The pcg4d hash (Jarzynski & Olano, 2020), pcg3d's 4D form: the evolving
+/// noise's corners (x, y, z, w).
+pub fn pcg4d(v: UVec4) -> UVec4 {
+    let mut v = v
+        .wrapping_mul(UVec4::splat(1_664_525))
+        .wrapping_add(UVec4::splat(1_013_904_223));
+    v.x = v.x.wrapping_add(v.y.wrapping_mul(v.w));
+    v.y = v.y.wrapping_add(v.z.wrapping_mul(v.x));
+    v.z = v.z.wrapping_add(v.x.wrapping_mul(v.y));
+    v.w = v.w.wrapping_add(v.y.wrapping_mul(v.z));
+    v ^= v >> 16;
+    v.x = v.x.wrapping_add(v.y.wrapping_mul(v.w));
+    v.y = v.y.wrapping_add(v.z.wrapping_mul(v.x));
+    v.z = v.z.wrapping_add(v.x.wrapping_mul(v.y));
+    v.w = v.w.wrapping_add(v.y.wrapping_mul(v.z));
+    v
+}
+
+/// 4D gradient of the cell through pcg4d, each component in [-1, 1).
+pub fn gradient4_pcg(cell: IVec4) -> Vec4 {
+    let h = pcg4d(cell.as_uvec4());
+    Vec4::new(
+        unit_signed(h.x),
+        unit_signed(h.y),
+        unit_signed(h.z),
+        unit_signed(h.w),
+    )
+}
+
+/// 4D gradient of the cell modulo 256 in every axis.
+pub fn gradient4_pcg_tiled(cell: IVec4) -> Vec4 {
+    gradient4_pcg(cell & IVec4::splat(LATTICE_PERIOD - 1))
+}
+
+/// The lab's sin hash in 4D: its three rows extended by a w column, and a
+/// fourth row, constants of the same kind (chosen here; the lab has no 4D
+/// form).
+pub fn gradient4_sin(cell: Vec4) -> Vec4 {
+    let p = Vec4::new(
+        cell.dot(Vec4::new(127.1, 311.7, 74.7, 201.3)),
+        cell.dot(Vec4::new(269.5, 183.3, 246.1, 97.9)),
+        cell.dot(Vec4::new(113.5, 271.9, 124.6, 157.1)),
+        cell.dot(Vec4::new(191.3, 61.7, 233.9, 151.3)),
+    );
+    let s = Vec4::new(p.x.sin(), p.y.sin(), p.z.sin(), p.w.sin()) * 43_758.547;
+    (s - s.floor()) * 2.0 - Vec4::ONE
+}
+
+/// The lattice w-coordinate of an evolving noise's corner: wrapped modulo
+/// `period` cells when looping (so the noise at w and w + period is the
+/// same), else unchanged.
+pub fn wrap_w(cell_w: i32, period: Option<u32>) -> i32 {
+    match period {
+        Some(p) if p > 0 => cell_w.rem_euclid(p.min(i32::MAX as u32) as i32),
+        _ => cell_w,
+    }
+}
+
 /// The period, in cells, of the tiled hash and of Perlin's permutation.
 pub const LATTICE_PERIOD: i32 = 256;
 
@@ -105,6 +163,32 @@ mod tests {
         v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
         v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
         assert_eq!(pcg3d(UVec3::ZERO), UVec3::from_array(v));
+    }
+
+    #[test]
+    fn pcg4d_matches_published_algorithm_on_one_cell() {
+        // The published pcg4d on (1, 2, 3, 4), step by step in u32.
+        let mut v = [1u32, 2, 3, 4].map(|c| c.wrapping_mul(1_664_525).wrapping_add(1_013_904_223));
+        let round = |v: &mut [u32; 4]| {
+            v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
+            v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+            v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+            v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
+        };
+        round(&mut v);
+        for x in &mut v {
+            *x ^= *x >> 16;
+        }
+        round(&mut v);
+        assert_eq!(pcg4d(UVec4::new(1, 2, 3, 4)), UVec4::from_array(v));
+    }
+
+    #[test]
+    fn wrap_w_is_the_non_negative_remainder() {
+        assert_eq!(wrap_w(-1, Some(3)), 2);
+        assert_eq!(wrap_w(7, Some(3)), 1);
+        assert_eq!(wrap_w(-7, None), -7);
+        assert_eq!(wrap_w(5, Some(0)), 5);
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! can check the shader against a trusted implementation. The CPU side is
 //! the reference: when the two disagree, the shader is wrong.
 
+pub mod evolution;
 pub mod fractal;
 pub mod gradient;
 pub mod hash;
@@ -13,11 +14,12 @@ pub mod perlin;
 pub mod points;
 pub mod rebase;
 
+pub use evolution::Evolution;
 pub use fractal::{
     FractalParams, FractalShape, NoiseSettings, Progression, fbm, footprint_octaves, fractal_sum,
-    marble, noise, ridged, turbulence, warped,
+    marble, noise, noise4, noise4_f64, ridged, turbulence, warped,
 };
-pub use gradient::gradient_noise;
+pub use gradient::{gradient_noise, gradient_noise4};
 pub use hash::HashKind;
 pub use perlin::{improved_noise, improved_noise_f32};
 

@@ -180,6 +180,76 @@ pub fn improved_noise_massal_f32(x: f32, y: f32, z: f32) -> f32 {
     improved_noise_with(x, y, z, Gradients::Massal)
 }
 
+/// Blender's 4D gradient (`noise_grad` of Cycles' and its GPU noise, as in
+/// Gustavson's `Noise1234`): the low 5 bits of the hash pick one of the 32
+/// edges of the hypercube, (±1, ±1, ±1) on three axes and 0 on the fourth.
+/// Massal's tutorial has no 4D table, so both Perlin kinds evolve with this
+/// one.
+fn grad4<T: Real>(hash: i32, x: T, y: T, z: T, w: T) -> T {
+    let h = hash & 31;
+    let u = if h < 24 { x } else { y };
+    let v = if h < 16 { y } else { z };
+    let s = if h < 8 { z } else { w };
+    (if h & 1 == 0 { u } else { -u })
+        + (if h & 2 == 0 { v } else { -v })
+        + (if h & 4 == 0 { s } else { -s })
+}
+
+/// A provable bound on the 4D improved noise: |g|·|d| ≤ √3·2.
+pub const IMPROVED_NOISE4_BOUND: f64 = 3.464_101_615_137_755;
+
+/// Improved noise in 4D (evolving noise, issue 29): the permutation applied
+/// a fourth time (`perm(perm(perm(perm(x) + y) + z) + w)`, Perlin's 3D
+/// hash extended as Blender's 4D), the 32 gradients of [`grad4`] and the
+/// quintic fade, interpolated along x, y, z, then w. With `w_period` P the
+/// lattice's w wraps modulo P cells before the permutation (which then
+/// wraps it modulo 256), so the noise at w + P is the noise at w.
+pub fn improved_noise4_generic<T: Real>(p: [T; 4], w_period: Option<u32>) -> T {
+    let fl = p.map(Real::floor);
+    let xi = fl[0].to_i32() & 255;
+    let yi = fl[1].to_i32() & 255;
+    let zi = fl[2].to_i32() & 255;
+    let cell_w = fl[3].to_i32();
+    let wi = [
+        super::hash::wrap_w(cell_w, w_period) & 255,
+        super::hash::wrap_w(cell_w.wrapping_add(1), w_period) & 255,
+    ];
+    let [x, y, z, w] = [p[0] - fl[0], p[1] - fl[1], p[2] - fl[2], p[3] - fl[3]];
+    let (fx, fy, fz, fw) = (fade(x), fade(y), fade(z), fade(w));
+    let one = T::ONE;
+    let corner = |dx: i32, dy: i32, dz: i32, dw: usize| {
+        let h = perm(perm(perm(perm(xi + dx) + yi + dy) + zi + dz) + wi[dw]);
+        let d = |c: T, o: i32| if o == 0 { c } else { c - one };
+        grad4(h, d(x, dx), d(y, dy), d(z, dz), d(w, dw as i32))
+    };
+    let cube = |dw: usize| {
+        lerp(
+            fz,
+            lerp(
+                fy,
+                lerp(fx, corner(0, 0, 0, dw), corner(1, 0, 0, dw)),
+                lerp(fx, corner(0, 1, 0, dw), corner(1, 1, 0, dw)),
+            ),
+            lerp(
+                fy,
+                lerp(fx, corner(0, 0, 1, dw), corner(1, 0, 1, dw)),
+                lerp(fx, corner(0, 1, 1, dw), corner(1, 1, 1, dw)),
+            ),
+        )
+    };
+    lerp(fw, cube(0), cube(1))
+}
+
+/// The 4D improved noise, the f64 reference.
+pub fn improved_noise4(p: [f64; 4], w_period: Option<u32>) -> f64 {
+    improved_noise4_generic(p, w_period)
+}
+
+/// The 4D improved noise in f32, as the shader.
+pub fn improved_noise4_f32(p: [f32; 4], w_period: Option<u32>) -> f32 {
+    improved_noise4_generic(p, w_period)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -287,6 +357,137 @@ mod tests {
             let r = improved_noise(pf[0] as f64, pf[1] as f64, pf[2] as f64);
             let s = improved_noise_f32(pf[0], pf[1], pf[2]) as f64;
             assert!((r - s).abs() < 1e-5, "{p:?}: {r} vs {s}");
+        }
+    }
+
+    /// The 4D table is the hypercube's 32 edges: each gradient has one zero
+    /// and three ±1 components, and all 32 differ.
+    #[test]
+    fn grad4_is_the_32_hypercube_edges() {
+        let mut seen = std::collections::HashSet::new();
+        for h in 0..32 {
+            let g = [0, 1, 2, 3].map(|a| {
+                let e = [0.0f64; 4].map(|_| 0.0);
+                let mut e = e;
+                e[a] = 1.0;
+                grad4(h, e[0], e[1], e[2], e[3]) as i32
+            });
+            assert_eq!(g.iter().filter(|&&c| c == 0).count(), 1, "h {h}: {g:?}");
+            assert!(g.iter().all(|c| c.abs() <= 1));
+            assert!(seen.insert(g), "h {h} repeats {g:?}");
+        }
+    }
+
+    /// Gustavson's classic 4D noise (`Noise1234::noise(x, y, z, w)`),
+    /// re-derived: his explicit 16 corners, interpolated in his order (w
+    /// first, then z, y, x), his doubled 512-entry table read without masks,
+    /// his gradient as the table of the 32 edge vectors (three ±1 with one
+    /// axis zeroed, by the hash's bits), and the permutation composed in
+    /// Perlin's order (x outermost) as ours. Equal to rounding.
+    #[test]
+    fn noise4_matches_gustavsons_formulation() {
+        let table: Vec<usize> = (0..512)
+            .map(|i| usize::from(PERMUTATION[i % 256]))
+            .collect();
+        let edge = |h: usize| -> [f64; 4] {
+            let h = h & 31;
+            let zero = 3 - h / 8;
+            let mut g = [0.0; 4];
+            let mut bit = 0;
+            for (axis, c) in g.iter_mut().enumerate() {
+                if axis != zero {
+                    *c = if h >> bit & 1 == 1 { -1.0 } else { 1.0 };
+                    bit += 1;
+                }
+            }
+            g
+        };
+        let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+        let lerp = |t: f64, a: f64, b: f64| a + t * (b - a);
+        let gustavson = |p: [f64; 4]| {
+            let i: Vec<usize> = p
+                .iter()
+                .map(|c| (c.floor() as i64).rem_euclid(256) as usize)
+                .collect();
+            let f0: Vec<f64> = p.iter().map(|c| c - c.floor()).collect();
+            let f1: Vec<f64> = f0.iter().map(|f| f - 1.0).collect();
+            let (r, s, t, q) = (fade(f0[0]), fade(f0[1]), fade(f0[2]), fade(f0[3]));
+            let n = |dx: usize, dy: usize, dz: usize, dw: usize| {
+                let h = table[table[table[table[i[0] + dx] + i[1] + dy] + i[2] + dz] + i[3] + dw];
+                let g = edge(h);
+                let v = [
+                    if dx == 0 { f0[0] } else { f1[0] },
+                    if dy == 0 { f0[1] } else { f1[1] },
+                    if dz == 0 { f0[2] } else { f1[2] },
+                    if dw == 0 { f0[3] } else { f1[3] },
+                ];
+                g[0] * v[0] + g[1] * v[1] + g[2] * v[2] + g[3] * v[3]
+            };
+            let nxy = |dx, dy| {
+                lerp(
+                    t,
+                    lerp(q, n(dx, dy, 0, 0), n(dx, dy, 0, 1)),
+                    lerp(q, n(dx, dy, 1, 0), n(dx, dy, 1, 1)),
+                )
+            };
+            let nx = |dx| lerp(s, nxy(dx, 0), nxy(dx, 1));
+            lerp(r, nx(0), nx(1))
+        };
+        let mut spread = (f64::MAX, f64::MIN);
+        for k in 0..5000 {
+            let t = f64::from(k);
+            let p = [
+                (t * 0.754_877_666_2).fract() * 600.0 - 300.0,
+                (t * 0.569_840_291).fract() * 600.0 - 300.0,
+                (t * 0.438_579_849_3).fract() * 600.0 - 300.0,
+                (t * 0.319_472_01).fract() * 600.0 - 300.0,
+            ];
+            let got = improved_noise4(p, None);
+            let want = gustavson(p);
+            assert!((got - want).abs() < 1e-12, "{p:?}: {got} vs {want}");
+            assert!(got.abs() <= IMPROVED_NOISE4_BOUND);
+            spread = (spread.0.min(got), spread.1.max(got));
+        }
+        assert!(spread.0 < -0.6 && spread.1 > 0.6, "{spread:?}");
+    }
+
+    /// With a period P in w the 4D noise repeats every P in w, to the bit;
+    /// continuous across w's lattice planes (where the period wraps too).
+    #[test]
+    fn noise4_is_periodic_and_continuous_in_w() {
+        for k in 0..3000 {
+            let t = k as f32;
+            let xyz = [
+                (t * 0.754_877_7).fract() * 50.0,
+                (t * 0.569_840_3).fract() * 50.0,
+                (t * 0.41).fract() * 50.0,
+            ];
+            let w = (k % 512) as f32 / 32.0 - 8.0;
+            for period in [1u32, 3, 300] {
+                let at = improved_noise4_f32([xyz[0], xyz[1], xyz[2], w], Some(period));
+                let next =
+                    improved_noise4_f32([xyz[0], xyz[1], xyz[2], w + period as f32], Some(period));
+                assert_eq!(at, next, "{xyz:?} w {w} P {period}");
+                for plane in [-1.0f32, 0.0, 1.0, 3.0] {
+                    let lo =
+                        improved_noise4_f32([xyz[0], xyz[1], xyz[2], plane - 1e-5], Some(period));
+                    let hi =
+                        improved_noise4_f32([xyz[0], xyz[1], xyz[2], plane + 1e-5], Some(period));
+                    assert!((lo - hi).abs() < 1e-3, "{xyz:?} w {plane}: {lo} {hi}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn noise4_f32_twin_stays_close_to_the_reference() {
+        for k in 0..10_000 {
+            let t = k as f64;
+            let p = [0.754_877_666_2, 0.569_840_291, 0.41, 0.3271]
+                .map(|a| ((t * a).fract() * 200.0 - 100.0) as f32);
+            let r = improved_noise4(p.map(f64::from), Some(9));
+            let s = improved_noise4_f32(p, Some(9));
+            assert!((r - f64::from(s)).abs() < 1e-5, "{p:?}: {r} vs {s}");
         }
     }
 }

@@ -66,6 +66,7 @@ mod tests {
                 lacunarity,
                 ..FractalParams::default()
             },
+            evolution: None,
         }
     }
 

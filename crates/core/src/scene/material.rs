@@ -2,6 +2,7 @@
 
 use super::pattern::{MAX_SIGNALS, Pattern, Signal, SurfacePoint};
 use super::texture_tree::Texture;
+use crate::noise::NoiseSettings;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -366,6 +367,17 @@ impl Material {
         }
     }
 
+    /// Calls `f` on every noise of the material's textures (properties, bump,
+    /// layers' masks and properties, nested ones included): how the scene's
+    /// time reaches each evolving noise (`Evolution::at`).
+    pub fn for_each_noise_mut(&mut self, f: &mut dyn FnMut(&mut NoiseSettings)) {
+        self.visit_textures_mut(&mut |t| {
+            if let Some(n) = t.pattern.noise_mut() {
+                f(n);
+            }
+        });
+    }
+
     /// The material's distinct fractal sums, gradient noise first (the
     /// order `material_signals` in textures.wgsl expects), at most
     /// [`MAX_SIGNALS`] (`Scene::sanitize` keeps materials within it).
@@ -534,6 +546,42 @@ mod optional_property_serde {
 mod tests {
     use super::*;
     use crate::scene::{Child, MathOp};
+
+    /// `for_each_noise_mut` reaches every noise: a property's, a nested
+    /// child's, the bump's and a layer mask's, each once.
+    #[test]
+    fn every_noise_is_visited_once() {
+        let noisy = |frequency: f32| {
+            let mut noise = NoiseSettings::default();
+            noise.fractal.frequency = frequency;
+            Texture {
+                pattern: Pattern::Fbm { noise },
+                ..Texture::default()
+            }
+        };
+        let mut m = Material::default();
+        let mut diffuse = noisy(1.0);
+        diffuse.b = Child::Texture(Box::new(noisy(2.0)));
+        m.diffuse = diffuse;
+        m.bump = noisy(3.0);
+        m.layers.push(Layer {
+            mask: noisy(4.0),
+            ..Layer::default()
+        });
+        let mut seen = Vec::new();
+        m.for_each_noise_mut(&mut |n| {
+            seen.push(n.fractal.frequency);
+            n.fractal.octaves = 2.0;
+        });
+        seen.sort_by(f32::total_cmp);
+        assert_eq!(seen, [1.0, 2.0, 3.0, 4.0]);
+        assert!(
+            m.patterns()
+                .iter()
+                .filter_map(|p| p.noise())
+                .all(|n| n.fractal.octaves == 2.0)
+        );
+    }
 
     /// An emission the panel cannot reach is clamped at load with a note
     /// that names the field; values it can reach (any finite bump height

@@ -120,17 +120,28 @@ impl Signal {
             Some(m) => self
                 .noise_space_map()
                 .transform_point3(m.space_point(point)),
-            None => point.object,
+            None if self.drift() == Vec3::ZERO => point.object,
+            None => self.noise_space_map().transform_point3(point.object),
         };
         fractal_sum(p, &self.noise, self.shape)
     }
 
-    /// The map from surface to noise coordinates, its translation rebased by
-    /// whole periods of the noise (`noise::rebase`): the same sum in exact
-    /// arithmetic, taken near the origin where f32 resolves it.
+    /// How far an evolving noise's domain has moved at the moment traced
+    /// (`Evolution::offset_now`); zero for a still one.
+    fn drift(&self) -> Vec3 {
+        self.noise.evolution.map_or(Vec3::ZERO, |e| e.offset_now())
+    }
+
+    /// The map from surface to noise coordinates, less the evolving noise's
+    /// drift (the noise is taken at `q − drift·t`, so its features move
+    /// along +drift), its translation rebased by whole periods of the noise
+    /// (`noise::rebase`): the same sum in exact arithmetic, taken near the
+    /// origin where f32 resolves it. The rebase moves x, y and z alone:
+    /// w keeps its loop's period.
     fn noise_space_map(&self) -> Affine3A {
         let mut m = self.mapping.unwrap_or_default().point_map();
-        m.translation = rebase(m.translation.into(), &self.noise).into();
+        let translation = Vec3::from(m.translation) - self.drift();
+        m.translation = rebase(translation, &self.noise).into();
         m
     }
 
@@ -322,12 +333,16 @@ impl Pattern {
 
     /// Whether the two patterns compile to the same code: one kind, and
     /// the same choices the code holds (an image's filter and wrap, the
-    /// noise kind and hash, which pick functions); their numbers may
-    /// differ.
+    /// noise kind and hash and whether it evolves, which pick functions);
+    /// their numbers may differ.
     pub fn same_kind(&self, other: &Pattern) -> bool {
         let choices = |p: &Pattern| match p {
-            Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8)),
-            _ => p.noise().map(|n| (n.kind as u8, n.hash as u8)),
+            Pattern::Image { filter, wrap } => Some((*filter as u8, *wrap as u8, false)),
+            // An evolving noise's code is the 4D sum's (its w, period and
+            // drift are numbers); a still one's is the 3D sum's.
+            _ => p
+                .noise()
+                .map(|n| (n.kind as u8, n.hash as u8, n.evolution.is_some())),
         };
         self.kind() == other.kind() && choices(self) == choices(other)
     }
@@ -658,6 +673,15 @@ impl Pattern {
         }
         if let Some(n) = self.noise_mut() {
             sanitize_fractal(&mut n.fractal, what, notes);
+            if let Some(e) = &mut n.evolution {
+                let clean = e.sanitized();
+                if clean != *e {
+                    notes.push(format!(
+                        "{what}: noise evolution {e:?} clamped to {clean:?}"
+                    ));
+                    *e = clean;
+                }
+            }
         }
     }
 }
@@ -718,6 +742,65 @@ mod tests {
             origin: Vec3::new(0.3, -0.2, 0.1),
             u_axis: Vec3::new(0.8, 0.3, 0.0),
             v_axis: Vec3::new(0.2, 1.2, 0.4),
+        }
+    }
+
+    /// An evolving noise's drift moves its features along +drift: the
+    /// signal at q + drift·t at time t is the signal at q at time 0 (w held
+    /// still), through a mapping or none; the rows the shader reads carry
+    /// the same shift.
+    #[test]
+    fn drift_moves_the_noise_along_itself() {
+        use crate::noise::Evolution;
+        let drift = Vec3::new(0.5, -0.25, 1.0);
+        for mapping in [
+            None,
+            Some(TextureMapping {
+                frame: Some(frame()),
+                ..TextureMapping::default()
+            }),
+        ] {
+            let mut signal = Signal {
+                noise: NoiseSettings {
+                    evolution: Some(Evolution {
+                        speed: 0.0,
+                        drift,
+                        ..Evolution::default()
+                    }),
+                    ..NoiseSettings::default()
+                },
+                shape: FractalShape::Signed,
+                mapping,
+            };
+            let still = signal;
+            let t = 2.0;
+            signal
+                .noise
+                .evolution
+                .as_mut()
+                .expect("evolving")
+                .at(t, None);
+            let to_noise = |s: &Signal, p: Vec3| {
+                let [a, b, c] = s.rows();
+                Vec3::new(
+                    a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3],
+                    b[0] * p.x + b[1] * p.y + b[2] * p.z + b[3],
+                    c[0] * p.x + c[1] * p.y + c[2] * p.z + c[3],
+                )
+            };
+            for k in 0..50 {
+                let q = Vec3::new(k as f32 * 0.13, 0.4 - k as f32 * 0.07, k as f32 * 0.031);
+                let at = |p: Vec3| SurfacePoint::new(p, Vec2::ZERO);
+                // The point whose noise-space image moved by drift·t.
+                let m = mapping.unwrap_or_default().point_map();
+                let moved = m
+                    .inverse()
+                    .transform_point3(m.transform_point3(q) + drift * t);
+                let (now, then) = (signal.eval(&at(moved)), still.eval(&at(q)));
+                assert!((now - then).abs() < 1e-4, "{q}: {now} vs {then}");
+                let shift = to_noise(&signal, moved) - to_noise(&still, q);
+                assert!(shift.abs().max_element() < 1e-4, "{shift}");
+            }
         }
     }
 

@@ -69,6 +69,7 @@ fn settings(kind: NoiseKind, hash: HashKind) -> NoiseSettings {
             distortion: 0.0,
             progression: Default::default(),
         },
+        evolution: None,
     }
 }
 
@@ -716,6 +717,7 @@ fn parameter_extremes_evaluate_finite_and_to_their_closed_form_on_the_cpu() {
                 kind,
                 hash: HashKind::Pcg,
                 fractal,
+                evolution: None,
             };
             let case = Case {
                 name,
@@ -814,6 +816,7 @@ fn parameter_extremes_on_the_gpu_equal_the_cpu() {
                 kind,
                 hash: HashKind::Pcg,
                 fractal,
+                evolution: None,
             };
             for what in [Evaluate::Fbm, Evaluate::Turbulence] {
                 let case = Case {
@@ -1064,7 +1067,7 @@ mod properties {
         /// preset may hold.
         #[test]
         fn fractal_sums_are_bounded_by_their_amplitudes(p in point_within(1e4), fractal in fractal_in_range(), kind in prop::sample::select(NoiseKind::ALL.to_vec())) {
-            let s = NoiseSettings { kind, hash: HashKind::Pcg, fractal };
+            let s = NoiseSettings { kind, hash: HashKind::Pcg, fractal, evolution: None };
             let case = Case { name: "", settings: s, what: Evaluate::Fbm };
             // The f32 sum of up to 16 terms carries 16 roundings of values
             // within the bound: a relative 16 · 2⁻²⁴ slack.

@@ -156,3 +156,72 @@ fn swatches_equal_the_cpu_reference_at_their_sample_points() {
     assert!((off as f32) < 0.01 * inside as f32, "{off} of {inside}");
     assert_ne!(again[0], swatches[3]);
 }
+
+/// Evolving noise (issue 29) through the swatches' generated code: a
+/// drifting gradient marble and a looping Perlin wood equal the CPU
+/// reference at two moments, which differ from each other (the moment
+/// reaches the GPU as numbers, through the same pipeline).
+#[test]
+fn evolving_swatches_equal_the_cpu_reference_at_two_moments() {
+    use marbre_core::noise::Evolution;
+    let Some(ctx) = gpu_or_skip("evolving_swatches_equal_the_cpu_reference_at_two_moments") else {
+        return;
+    };
+    let at = |t: f32| {
+        let evolution = |looping: Option<f32>| {
+            let mut e = Evolution {
+                w: 0.3,
+                speed: 0.9,
+                drift: Vec3::new(0.25, -0.1, 0.05),
+                ..Evolution::default()
+            };
+            e.at(t, looping);
+            Some(e)
+        };
+        let marble = Texture::blend(
+            Pattern::Marble {
+                noise: NoiseSettings {
+                    evolution: evolution(None),
+                    ..NoiseSettings::default()
+                },
+                stripe_frequency: 4.0,
+            },
+            Vec3::new(0.9, 0.9, 0.85),
+            Vec3::new(0.2, 0.2, 0.3),
+        );
+        let wood = Texture::blend(
+            Pattern::Wood {
+                noise: NoiseSettings {
+                    kind: NoiseKind::Perlin,
+                    evolution: evolution(Some(3.0)),
+                    ..NoiseSettings::default()
+                },
+                ring_width: 0.12,
+                turbulence_amount: 0.3,
+            },
+            Vec3::new(0.3, 0.15, 0.05),
+            Vec3::new(0.8, 0.6, 0.4),
+        );
+        vec![marble, wood]
+    };
+    let mut renderer = SwatchRenderer::new(ctx).unwrap();
+    let mut previous: Option<Vec<Vec<[f32; 4]>>> = None;
+    for t in [0.4, 1.9] {
+        let textures = at(t);
+        let swatches = renderer.render(&textures).unwrap();
+        for (k, (texture, swatch)) in textures.iter().zip(&swatches).enumerate() {
+            let (off, inside, spread) = compare(texture, swatch);
+            assert!(
+                (off as f32) < 0.01 * inside as f32,
+                "t {t} swatch {k}: {off} of {inside} points differ from the CPU"
+            );
+            assert!(spread > 0.1, "t {t} swatch {k} is flat: {spread}");
+        }
+        if let Some(before) = &previous {
+            for k in 0..2 {
+                assert_ne!(before[k], swatches[k], "swatch {k} did not move in time");
+            }
+        }
+        previous = Some(swatches);
+    }
+}

@@ -69,6 +69,7 @@ fn turbulent() -> NoiseSettings {
             frequency: 3.0,
             ..FractalParams::default()
         },
+        evolution: None,
     }
 }
 

@@ -65,6 +65,34 @@ fn an_octave_drag_is_a_parameter_edit() {
     assert!(!change.regenerates_code());
 }
 
+/// Turning a noise's evolution on or off changes its code (the 4D sum);
+/// its w, speed, drift and the moment traced are numbers.
+#[test]
+fn evolving_noise_is_structure_and_its_moment_a_parameter() {
+    use crate::noise::Evolution;
+    let on = edited(|s| first_noise(s, |n| n.evolution = Some(Evolution::default())));
+    assert_eq!(on, Change::MATERIAL_STRUCTURE);
+    let evolving = |edit: fn(&mut Evolution)| {
+        let mut old = default_scene();
+        first_noise(&mut old, |n| n.evolution = Some(Evolution::default()));
+        let mut new = old.clone();
+        first_noise(&mut new, |n| edit(n.evolution.as_mut().expect("evolving")));
+        new.changes_from(&old)
+    };
+    let edits: [fn(&mut Evolution); 5] = [
+        |e| e.at(1.5, None),
+        |e| e.at(0.5, Some(2.0)),
+        |e| e.w += 0.25,
+        |e| e.speed = 2.0,
+        |e| e.drift = Vec3::X,
+    ];
+    for edit in edits {
+        let change = evolving(edit);
+        assert_eq!(change, Change::MATERIAL_PARAMETERS);
+        assert!(!change.regenerates_code());
+    }
+}
+
 #[test]
 fn a_colour_is_a_parameter_edit() {
     let change = edited(|s| {

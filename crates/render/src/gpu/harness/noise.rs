@@ -16,6 +16,9 @@ use marbre_core::noise::{FractalShape, NoiseSettings};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Evaluate {
     Noise,
+    /// The 4D lattice noise at the settings' evolution's w and period (an
+    /// evolving `noise` only).
+    Noise4,
     Fbm,
     Turbulence,
     Ridged,
@@ -45,6 +48,7 @@ impl Evaluate {
             Evaluate::RotateY { angle } => (5, angle),
             Evaluate::Ridged => (6, 0.0),
             Evaluate::FootprintOctaves { width } => (7, width),
+            Evaluate::Noise4 => (8, 0.0),
         }
     }
 }

@@ -27,6 +27,8 @@ pub enum Feature {
     Opacity,
     Emission,
     NoiseWarp,
+    /// Evolving noise: the 4D noises and sums (issue 29).
+    NoiseEvolve,
     NoiseGradient,
     NoisePerlin,
     HashPcg,
@@ -36,7 +38,7 @@ pub enum Feature {
 
 impl Feature {
     /// The features that are not patterns.
-    const OTHERS: [Feature; 19] = [
+    const OTHERS: [Feature; 20] = [
         Feature::Ground,
         Feature::Cylinder,
         Feature::Polygon,
@@ -51,6 +53,7 @@ impl Feature {
         Feature::Opacity,
         Feature::Emission,
         Feature::NoiseWarp,
+        Feature::NoiseEvolve,
         Feature::NoiseGradient,
         Feature::NoisePerlin,
         Feature::HashPcg,
@@ -88,6 +91,7 @@ impl Feature {
             Feature::Opacity => "OPACITY",
             Feature::Emission => "EMISSION",
             Feature::NoiseWarp => "NOISE_WARP",
+            Feature::NoiseEvolve => "NOISE_EVOLVE",
             Feature::NoiseGradient => "NOISE_GRADIENT",
             Feature::NoisePerlin => "NOISE_PERLIN",
             Feature::HashPcg => "HASH_PCG",
@@ -277,6 +281,9 @@ fn noise_features(noise: &NoiseSettings) -> Vec<Feature> {
     };
     if noise.fractal.distortion != 0.0 {
         out.push(Feature::NoiseWarp);
+    }
+    if noise.evolution.is_some() {
+        out.push(Feature::NoiseEvolve);
     }
     out
 }

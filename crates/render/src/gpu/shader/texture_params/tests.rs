@@ -133,3 +133,79 @@ fn a_plan_refuses_another_structure() {
     flat.spheres.clear();
     assert_eq!(plan.evaluate(&flat, &images), None);
 }
+
+/// Evolving noise (issue 29) on every shipped preset that reads noise:
+/// without an evolution the trace module holds none of the 4D code (the
+/// code of before, so the images are bit for bit those of before); turning
+/// evolution on adds the NOISE_EVOLVE feature and leaves the generated
+/// texture code alone; and the scene's time moving (w, the loop's period,
+/// the drift) is a parameter edit: the same code, the same pipeline's
+/// features, other numbers in the material uniform.
+#[test]
+fn evolving_noise_moves_in_time_by_its_numbers_alone() {
+    use crate::gpu::features::{Feature, FeatureSet};
+    use crate::gpu::scene_gpu;
+    use crate::gpu::shader_source::{Program, assemble};
+    use marbre_core::noise::Evolution;
+    let mut checked = 0;
+    for (name, scene, images) in shipped() {
+        if !scene.materials().any(|m| !m.signals().is_empty()) {
+            continue;
+        }
+        checked += 1;
+        let features = FeatureSet::for_scene(&scene);
+        assert!(!features.contains(Feature::NoiseEvolve), "{name}");
+        let today = generate(&scene, &images).unwrap();
+        let module = assemble(Program::Trace, &features, &today.wgsl).unwrap();
+        for four_d in ["fn pcg4d", "noise4(", "NOISE_EVOLVES: u32", "fn octave_w"] {
+            assert!(
+                !module.contains(four_d),
+                "{name}: {four_d} in a still scene's shader"
+            );
+        }
+        let at = |t: f32, looping: Option<f32>| {
+            let mut s = scene.clone();
+            for m in s.materials_mut() {
+                m.for_each_noise_mut(&mut |n| {
+                    let mut e = Evolution {
+                        w: 0.5,
+                        speed: 0.8,
+                        drift: glam::Vec3::new(0.3, 0.0, -0.2),
+                        ..Evolution::default()
+                    };
+                    e.at(t, looping);
+                    n.evolution = Some(e);
+                });
+            }
+            s
+        };
+        let start = at(0.0, None);
+        let evolving_features = FeatureSet::for_scene(&start);
+        assert!(evolving_features.contains(Feature::NoiseEvolve), "{name}");
+        let first = generate(&start, &images).unwrap();
+        assert_eq!(
+            first.wgsl, today.wgsl,
+            "{name}: evolution changed the texture code"
+        );
+        for later in [at(1.25, None), at(1.25, Some(4.0))] {
+            let change = later.changes_from(&start);
+            assert!(
+                change.contains(Change::MATERIAL_PARAMETERS) && !change.regenerates_code(),
+                "{name}: {change:?}"
+            );
+            assert_eq!(FeatureSet::for_scene(&later), evolving_features, "{name}");
+            let next = generate(&later, &images).unwrap();
+            assert_eq!(next.wgsl, first.wgsl, "{name}");
+            assert_eq!(
+                first.plan.evaluate(&later, &images).as_ref(),
+                Some(&next.params)
+            );
+            assert_ne!(
+                bytemuck::cast_slice::<_, u8>(&scene_gpu::materials(&later)),
+                bytemuck::cast_slice::<_, u8>(&scene_gpu::materials(&start)),
+                "{name}: the moment reached no number"
+            );
+        }
+    }
+    assert!(checked >= 3, "only {checked} presets read noise");
+}
