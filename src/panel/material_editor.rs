@@ -989,12 +989,12 @@ fn noise_ui(ui: &mut Ui, noise: &mut NoiseSettings, path: &ParamPath) {
          (0: none and free; type any value in ±100)",
     );
     limit(&mut f.distortion, FractalParams::DISTORTION);
-    evolution_ui(ui, &mut noise.evolution);
+    evolution_ui(ui, &mut noise.evolution, &path.field("evolution"));
 }
 
 /// Evolving noise (issue 29): the 4D noise whose w moves with the scene's
 /// time, and a drift of its domain. Off is the 3D noise of before.
-fn evolution_ui(ui: &mut Ui, evolution: &mut Option<Evolution>) {
+fn evolution_ui(ui: &mut Ui, evolution: &mut Option<Evolution>, path: &ParamPath) {
     let mut on = evolution.is_some();
     if ui
         .checkbox(&mut on, "Evolve (4D)")
@@ -1010,11 +1010,15 @@ fn evolution_ui(ui: &mut Ui, evolution: &mut Option<Evolution>) {
     let Some(e) = evolution else {
         return;
     };
-    ui.add(typed_beyond(slider(&mut e.w, -4.0..=4.0, "w")))
-        .on_hover_text("The fourth coordinate at time 0, in cells of the first octave");
+    keyed(ui, &path.field("w"), &mut e.w, |ui, v| {
+        ui.add(typed_beyond(slider(v, -4.0..=4.0, "w")))
+    })
+    .on_hover_text("The fourth coordinate at time 0, in cells of the first octave");
     limit(&mut e.w, Evolution::W);
-    ui.add(typed_beyond(slider(&mut e.speed, -4.0..=4.0, "speed")))
-        .on_hover_text("Cells of w per second (a loop rounds it to whole cells over its duration)");
+    keyed(ui, &path.field("speed"), &mut e.speed, |ui, v| {
+        ui.add(typed_beyond(slider(v, -4.0..=4.0, "speed")))
+    })
+    .on_hover_text("Cells of w per second (a loop rounds it to whole cells over its duration)");
     limit(&mut e.speed, Evolution::SPEED);
     ui.horizontal(|ui| {
         ui.label("drift").on_hover_text(

@@ -189,11 +189,15 @@ impl Track {
 }
 
 impl Scene {
-    /// Whether anything traced changes with time: an animation's tracks.
+    /// Whether anything traced changes with time: an animation's tracks,
+    /// or a noise that evolves.
     pub fn moves(&self) -> bool {
         self.animation
             .as_ref()
             .is_some_and(|a| !a.tracks.is_empty())
+            || self
+                .materials()
+                .any(|m| m.signals().iter().any(|s| s.noise.evolution.is_some()))
     }
 
     /// The scene as traced at `time` seconds: each track's value written
@@ -202,6 +206,7 @@ impl Scene {
     /// moment set. Without an animation only the noise moves.
     pub fn at_time(&self, time: f32) -> Scene {
         let mut scene = self.clone();
+        let loop_duration = self.animation.as_ref().and_then(Animation::loop_duration);
         if let Some(animation) = &self.animation {
             for track in &animation.tracks {
                 if let (Ok(path), Some(value)) = (track.parsed_path(), track.value_at(time)) {
@@ -210,6 +215,13 @@ impl Scene {
                     let _ = scene.set_parameter(&path, &value);
                 }
             }
+        }
+        for material in scene.materials_mut() {
+            material.for_each_noise_mut(&mut |noise| {
+                if let Some(evolution) = &mut noise.evolution {
+                    evolution.at(time, loop_duration);
+                }
+            });
         }
         scene
     }

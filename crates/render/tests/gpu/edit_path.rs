@@ -291,3 +291,57 @@ fn a_keyed_animation_plays_without_generating_code_or_building() {
     );
     assert_eq!(renderer.last_build(), builds, "a pipeline was built");
 }
+
+/// A looped animation's last frame meets its first: with the marble's
+/// noise evolving (w moving 1.3 cells a second, snapped to whole cells
+/// over the 2 s loop), the scene at t = 2 s traced with frame 0's samples
+/// is frame 0's image bit for bit, while half way it is another image;
+/// every moment is numbers only.
+#[test]
+fn a_looped_evolving_noise_meets_its_first_frame() {
+    let Some(ctx) = gpu_or_skip("a_looped_evolving_noise_meets_its_first_frame") else {
+        return;
+    };
+    use marbre_core::animation::Animation;
+    use marbre_core::noise::Evolution;
+    let loaded = default_preset();
+    let mut scene = loaded.scene.clone();
+    let mut evolving = false;
+    scene.spheres[0].material.for_each_noise_mut(&mut |noise| {
+        noise.evolution = Some(Evolution {
+            speed: 1.3,
+            ..Evolution::default()
+        });
+        evolving = true;
+    });
+    assert!(evolving, "the marble has a noise");
+    scene.animation = Some(Animation {
+        duration: 2.0,
+        looping: true,
+        ..Animation::default()
+    });
+    assert!(scene.moves());
+    let start = LoadedScene {
+        scene: scene.at_time(0.0),
+        ..default_preset()
+    };
+    let mut renderer = renderer_with(&ctx, &start, SIZE, Kernel::Fragment).unwrap();
+    let mut frame_zero_at = |t: f32| {
+        let change = request(&ctx, &mut renderer, &scene.at_time(t));
+        assert!(Change::MATERIAL_PARAMETERS.contains(change), "{change:?}");
+        renderer.restart_at_frame(0);
+        image(&ctx, &mut renderer, 2)
+    };
+    let first = frame_zero_at(0.0);
+    let half = frame_zero_at(1.0);
+    let last = frame_zero_at(2.0);
+    assert!(
+        largest_difference(&first, &half) > 0.01,
+        "the noise did not move"
+    );
+    assert_eq!(
+        largest_difference(&first, &last),
+        0.0,
+        "the loop has a seam"
+    );
+}
