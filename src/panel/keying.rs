@@ -98,6 +98,39 @@ pub fn vector(
     r
 }
 
+/// Blender's key button, a diamond: hollow on an unkeyed number, filled
+/// and yellow on a key, green between keys (`keyed`: whether a key sits
+/// at the play head). Drawn, not a glyph: egui's default fonts have none.
+fn key_button(ui: &mut Ui, keyed: Option<bool>) -> Response {
+    let size = egui::vec2(16.0, ui.spacing().interact_size.y);
+    let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click());
+    let visuals = ui.style().interact(&response);
+    let c = rect.center();
+    let r = 5.0;
+    let diamond = vec![
+        egui::pos2(c.x, c.y - r),
+        egui::pos2(c.x + r, c.y),
+        egui::pos2(c.x, c.y + r),
+        egui::pos2(c.x - r, c.y),
+    ];
+    let fill = match keyed {
+        Some(true) => KEYED_HERE,
+        Some(false) => KEYED_ELSEWHERE,
+        None => Color32::TRANSPARENT,
+    };
+    ui.painter().add(egui::Shape::convex_polygon(
+        diamond,
+        fill,
+        egui::Stroke::new(1.2, visuals.fg_stroke.color),
+    ));
+    response
+}
+
+/// Blender's tints: a key at the current frame, and an animated value
+/// between keys.
+const KEYED_HERE: Color32 = Color32::from_rgb(0xd8, 0xb0, 0x30);
+const KEYED_ELSEWHERE: Color32 = Color32::from_rgb(0x60, 0xb0, 0x50);
+
 fn components(
     ui: &mut Ui,
     path: &ParamPath,
@@ -125,11 +158,7 @@ fn components(
                 if r.changed() {
                     request(shown.clone());
                 }
-                let tint = if *on_key {
-                    Color32::from_rgb(0xd8, 0xb0, 0x30)
-                } else {
-                    Color32::from_rgb(0x60, 0xb0, 0x50)
-                };
+                let tint = if *on_key { KEYED_HERE } else { KEYED_ELSEWHERE };
                 ui.painter().rect_stroke(
                     r.rect.expand(1.0),
                     2.0,
@@ -143,8 +172,7 @@ fn components(
         let shown: Vec<f32> = keyed
             .as_ref()
             .map_or_else(|| value.to_vec(), |(v, _)| v.clone());
-        let button = ui
-            .small_button("◆")
+        let button = key_button(ui, keyed.as_ref().map(|(_, on_key)| *on_key))
             .on_hover_text(format!("Insert a key on {text} at {time:.2} s"));
         if button.clicked() {
             request(shown);

@@ -354,8 +354,10 @@ fn swatch_ui(ui: &mut Ui, texture: &Texture, place: &SwatchPlace) {
 /// flick of the mouse.
 pub(super) fn octaves_slider(ui: &mut Ui, octaves: &mut f32) -> egui::Response {
     ui.scope(|ui| {
-        // Room for the value box and the label beside the rail.
-        ui.spacing_mut().slider_width = (ui.available_width() - 130.0).max(160.0);
+        // Room for the value box, the label and a key button beside the
+        // rail: a rail wider than the row would widen the panel, and the
+        // next frame's rail with it.
+        ui.spacing_mut().slider_width = (ui.available_width() - 160.0).max(120.0);
         ui.add(slider(octaves, FractalParams::OCTAVES, "octaves").step_by(0.25))
             .on_hover_text(
                 "More octaves: finer detail, one noise evaluation each; a fractional part fades \
