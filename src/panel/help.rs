@@ -59,6 +59,10 @@ pub const SHORTCUTS: &[Shortcut] = &[
         action: "Open a preset",
     },
     Shortcut {
+        keys: "Space",
+        action: "Play or pause the scene's time (Time section)",
+    },
+    Shortcut {
         keys: "Ctrl+1–9",
         action: "Go to saved view 1 to 9 (Camera section)",
     },

@@ -439,7 +439,15 @@ mod tests {
         let mut state = PanelState::new("presets/a.ron".into(), String::new());
         state.error("something failed");
         let mut actions = Vec::new();
-        frame(|ui| actions = draw(ui, &mut scene, &mut state, &Stats::default()));
+        frame(|ui| {
+            actions = draw(
+                ui,
+                &mut scene,
+                &mut state,
+                &Stats::default(),
+                &mut timeline::Timeline::default(),
+            )
+        });
         assert_eq!(scene, before);
         assert!(actions.is_empty(), "{actions:?}");
     }
@@ -634,7 +642,13 @@ mod tests {
         let ctx = egui::Context::default();
         let output = ctx.run_ui(egui::RawInput::default(), |ui| {
             egui::CentralPanel::default().show(ui, |ui| {
-                draw(ui, &mut scene, &mut state, &stats);
+                draw(
+                    ui,
+                    &mut scene,
+                    &mut state,
+                    &stats,
+                    &mut timeline::Timeline::default(),
+                );
             });
         });
         let texts: Vec<(f32, String)> = output

@@ -128,11 +128,10 @@ pub(super) fn canvas(
         let top_left = origin + vec2(position.x, position.y);
         let swatch = swatches(key, &node.path, texture);
         let drawn = texture_node(
-            key,
             ui,
             rect,
             top_left,
-            &node.path,
+            (key, &node.path),
             texture,
             swatch,
             &mut sockets,
@@ -314,11 +313,10 @@ struct DrawnNode {
 /// inputs the pattern reads, each a socket with its value inline when no
 /// texture is linked.
 fn texture_node(
-    key: MaterialKey,
     ui: &mut Ui,
     canvas: Rect,
     top_left: Pos2,
-    path: &NodePath,
+    (key, path): (MaterialKey, &NodePath),
     texture: &mut Texture,
     swatch: Option<egui::TextureId>,
     sockets: &mut Sockets,

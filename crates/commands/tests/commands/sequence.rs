@@ -216,7 +216,7 @@ fn an_animation_holds_every_frame() {
             "--preset",
             preset.to_str().unwrap(),
             "-o",
-            &dir.join("f_#.png").to_str().unwrap().to_owned(),
+            dir.join("f_#.png").to_str().unwrap(),
             "--size",
             "40x20",
             "--spp",
@@ -226,7 +226,7 @@ fn an_animation_holds_every_frame() {
             "--frames",
             "0..3",
             "--animation",
-            &dir.join(animated).to_str().unwrap().to_owned(),
+            dir.join(animated).to_str().unwrap(),
         ]
         .map(str::to_owned);
         let flags: Vec<&str> = flags.iter().map(String::as_str).collect();

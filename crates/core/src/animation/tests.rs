@@ -227,3 +227,72 @@ fn presets_without_an_animation_read_and_write_as_before() {
         .scene;
     assert_eq!(back.animation, scene.animation);
 }
+
+fn shipped_animations() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/animated");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4, "{files:?}");
+    files
+}
+
+/// The shipped animations load with nothing to note, move, and those that
+/// loop meet their first frame at their end: the lava's evolving colour
+/// bit for bit at points all over the sphere, the turntable's camera to
+/// rounding (yaw 380° is 20°).
+#[test]
+fn shipped_animations_move_and_loops_meet_themselves() {
+    for file in shipped_animations() {
+        let loaded = preset::load(&file).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            loaded.notes.is_empty(),
+            "{}: {:?}",
+            file.display(),
+            loaded.notes
+        );
+        let scene = loaded.preset.scene;
+        let animation = scene.animation.clone().expect("an animation");
+        assert!(animation.problems(&scene).is_empty());
+        assert!(scene.moves(), "{}", file.display());
+        let (first, last) = (scene.at_time(0.0), scene.at_time(animation.duration));
+        let half = scene.at_time(animation.duration / 2.0);
+        let name = file.file_stem().unwrap().to_string_lossy().into_owned();
+        let colour =
+            |s: &Scene, p: glam::Vec3| s.spheres[0].material.diffuse.eval(p, glam::Vec2::ZERO);
+        let points: Vec<glam::Vec3> = (0..64)
+            .map(|i| {
+                let a = i as f32 * 0.7;
+                glam::Vec3::new(a.cos(), (i as f32 / 32.0) - 1.0, a.sin())
+            })
+            .collect();
+        match name.as_str() {
+            "lava_loop" => {
+                for &p in &points {
+                    assert_eq!(colour(&first, p), colour(&last, p), "{name} at {p}");
+                }
+                assert!(
+                    points
+                        .iter()
+                        .any(|&p| colour(&first, p) != colour(&half, p))
+                );
+            }
+            "studio_turntable" => {
+                let (a, b) = (first.camera.frame(), last.camera.frame());
+                assert!(a.position.distance(b.position) < 1e-4, "{a:?} {b:?}");
+                assert!(
+                    first
+                        .camera
+                        .frame()
+                        .position
+                        .distance(half.camera.frame().position)
+                        > 1.0
+                );
+            }
+            _ => assert!(first != half, "{name}: half way is the first frame"),
+        }
+    }
+}
