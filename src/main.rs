@@ -5,8 +5,8 @@
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
 use marbre_commands::{
-    accuracy_bench, bake, bvh_bench, convergence_bench, edit_bench, noise, presets_bench, render,
-    tx,
+    accuracy_bench, bake, bvh_bench, convergence_bench, edit_bench, noise, parameters,
+    presets_bench, render, tx,
 };
 use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
@@ -75,6 +75,10 @@ enum Command {
     /// square (sRGB PNG for colours, linear EXR for data), with the
     /// mapping written beside it.
     Bake(bake::BakeArgs),
+    /// List every number of a preset a keyframe track can animate, by the
+    /// path tracks name it with (as the panel's key buttons do), and its
+    /// value (or the animation's value at --at T).
+    Parameters(parameters::ParametersArgs),
     /// Accuracy against time: one knob at a time (samples, bounces, light
     /// selection, strategies, environment sampling, octaves, filtering,
     /// hash, shader), each variant's error against a cached high-spp
@@ -134,6 +138,7 @@ fn main() -> ExitCode {
         Some(Command::Noise(args)) => noise::run(&args),
         Some(Command::Tx(args)) => tx::run(&args),
         Some(Command::Bake(args)) => bake::run(&args),
+        Some(Command::Parameters(args)) => parameters::run(&args),
         Some(Command::Bench(args)) => accuracy_bench::run(&args),
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),

@@ -258,7 +258,7 @@ fn texture_ui(
                         &place.child(Socket::Factor),
                     );
                 }
-                ramp_ui(ui, texture);
+                ramp_ui(ui, texture, &node);
                 // An image gives its own colour: it has no children.
                 let is_image = matches!(texture.pattern, Pattern::Image { .. });
                 if texture.ramp.is_empty() && !is_image {
@@ -501,7 +501,7 @@ pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
                     MathOp::Abs | MathOp::Invert => {}
                 }
                 if ui
-                    .small_button("✕")
+                    .small_button("×")
                     .on_hover_text("Remove this step")
                     .clicked()
                 {
@@ -525,7 +525,8 @@ pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
 
 /// The colour ramp: ticked, the pattern's blend factor picks a colour from
 /// the stops instead of blending `a` and `b` (which seed the first two).
-pub(super) fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
+/// `path`: the node's parameter path, for the stops' key buttons.
+pub(super) fn ramp_ui(ui: &mut Ui, texture: &mut Texture, path: &ParamPath) {
     let mut on = !texture.ramp.is_empty();
     if ui
         .checkbox(&mut on, "colour ramp")
@@ -552,11 +553,16 @@ pub(super) fn ramp_ui(ui: &mut Ui, texture: &mut Texture) {
     for (i, stop) in texture.ramp.iter_mut().enumerate() {
         ui.push_id(("stop", i), |ui| {
             ui.horizontal(|ui| {
-                color_button(ui, &mut stop.color).on_hover_text("This stop's colour");
-                ui.add(slider(&mut stop.position, 0.0..=1.0, "at"))
-                    .on_hover_text("The pattern's t at which this colour is reached, 0 to 1");
+                let at = path.field("ramp").index(i);
+                super::keying::vector(ui, &at.field("color"), &mut stop.color, |ui, c| {
+                    color_button(ui, c).on_hover_text("This stop's colour")
+                });
+                keyed(ui, &at.field("position"), &mut stop.position, |ui, v| {
+                    ui.add(slider(v, 0.0..=1.0, "at"))
+                })
+                .on_hover_text("The pattern's t at which this colour is reached, 0 to 1");
                 if ui
-                    .small_button("✕")
+                    .small_button("×")
                     .on_hover_text("Remove this stop")
                     .clicked()
                 {

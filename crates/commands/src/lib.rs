@@ -8,6 +8,7 @@ pub mod edit_bench;
 pub mod interrupt;
 pub mod noise;
 pub mod noise_figure;
+pub mod parameters;
 pub mod presets_bench;
 pub mod references;
 pub mod render;

@@ -353,7 +353,7 @@ fn texture_node(
                     image_source_ui(ui, &mut texture.image);
                 }
                 mapping_ui(ui, &mut texture.mapping);
-                ramp_ui(ui, texture);
+                ramp_ui(ui, texture, &node);
                 math_ui(ui, &mut texture.ops);
             });
         let reads_children =
