@@ -729,14 +729,18 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture, path: &ParamPath) {
             );
         }
         Pattern::Checker2d { size, phase } => {
-            keyed(ui, &path.field("size").index(0), &mut size.x, |ui, v| {
-                ui.add(slider(v, 0.01..=4.0, "cell width (u)").logarithmic(true))
-            })
-            .on_hover_text("Width of a cell in (u, v): 0.125 gives 8 cells per unit");
-            keyed(ui, &path.field("size").index(1), &mut size.y, |ui, v| {
-                ui.add(slider(v, 0.01..=4.0, "cell height (v)").logarithmic(true))
-            })
-            .on_hover_text("Height of a cell in (u, v)");
+            size_ui(
+                ui,
+                &path.field("size"),
+                size,
+                [
+                    (
+                        "cell width (u)",
+                        "Width of a cell in (u, v): 0.125 gives 8 cells per unit",
+                    ),
+                    ("cell height (v)", "Height of a cell in (u, v)"),
+                ],
+            );
             keyed(ui, &path.field("phase"), phase, |ui, v| {
                 ui.add(slider(v, 0.0..=1.0, "row phase"))
             })
@@ -747,14 +751,21 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture, path: &ParamPath) {
             mortar,
             row_offset,
         } => {
-            keyed(ui, &path.field("size").index(0), &mut size.x, |ui, v| {
-                ui.add(slider(v, 0.01..=4.0, "brick width (u)").logarithmic(true))
-            })
-            .on_hover_text("Width of a brick and its joint, in (u, v) units");
-            keyed(ui, &path.field("size").index(1), &mut size.y, |ui, v| {
-                ui.add(slider(v, 0.01..=4.0, "brick height (v)").logarithmic(true))
-            })
-            .on_hover_text("Height of a brick and its joint, in (u, v) units");
+            size_ui(
+                ui,
+                &path.field("size"),
+                size,
+                [
+                    (
+                        "brick width (u)",
+                        "Width of a brick and its joint, in (u, v) units",
+                    ),
+                    (
+                        "brick height (v)",
+                        "Height of a brick and its joint, in (u, v) units",
+                    ),
+                ],
+            );
             keyed(ui, &path.field("mortar"), mortar, |ui, v| {
                 ui.add(slider(v, 0.0..=0.2, "mortar width"))
             })
@@ -868,6 +879,17 @@ pub(super) fn pattern_ui(ui: &mut Ui, texture: &mut Texture, path: &ParamPath) {
             );
             noise_ui(ui, noise, &path.field("noise"));
         }
+    }
+}
+
+/// A cell's width and height in (u, v), each keyable (`path`: the
+/// size's), with their labels and hints.
+fn size_ui(ui: &mut Ui, path: &ParamPath, size: &mut glam::Vec2, labels: [(&str, &str); 2]) {
+    for (i, (label, hint)) in labels.into_iter().enumerate() {
+        keyed(ui, &path.index(i), &mut size[i], |ui, v| {
+            ui.add(slider(v, 0.01..=4.0, label).logarithmic(true))
+        })
+        .on_hover_text(hint);
     }
 }
 

@@ -251,9 +251,6 @@ pub fn draw(
             section_headed(ui, "Preset", header, true, |ui| {
                 file_ui::preset_ui(ui, state, &mut actions);
             });
-            section(ui, "Time", true, |ui| {
-                timeline::timeline_ui(ui, scene, timeline);
-            });
             section(ui, "Materials", true, |ui| {
                 if let Some((object, property)) = materials_ui(ui, scene, &mut state.node_graph) {
                     actions.push(PanelAction::Bake { object, property });
@@ -275,6 +272,11 @@ pub fn draw(
                 render_ui(ui, &mut scene.render, &mut actions);
                 kernel_ui(ui, stats, &mut actions);
                 render_dialog::button(ui, &mut state.render_dialog);
+            });
+            // Under the sections above, whose places the window tests
+            // know; open, so that a scene's time is found at once.
+            section(ui, "Time", true, |ui| {
+                timeline::timeline_ui(ui, scene, timeline);
             });
 
             section(ui, "Stats", true, |ui| stats_ui(ui, stats));

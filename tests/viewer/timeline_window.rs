@@ -5,10 +5,10 @@
 //! again; the environment intensity's key button adds a track, which the
 //! preset Ctrl+S writes holds, and Ctrl+Z removes it again.
 //!
-//! The panel is found by its layout, as in `e2e_window`: the Preset
-//! section folded, the Time section (open) under it, then the Materials
-//! section folded by a click, so that the Environment section's rows sit
-//! at fixed heights.
+//! The panel is found by its layout, as in `e2e_window`: the Preset,
+//! Materials, Light transport and Render sections folded by clicks, so
+//! that the Environment section's rows and the Time section's (the last
+//! but Stats) sit at fixed heights.
 
 use crate::e2e_window::{PANEL_LEFT, Session, assert_clean_log, open};
 use crate::xvfb::{TempDir, display_or_skip, serial};
@@ -73,9 +73,13 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
     std::fs::copy(Path::new(REPO).join("tests/data/e2e/timeline.ron"), &preset).unwrap();
     let (_child, session) = open(&x, &dir, &preset);
     session.wait_for("the light on at 0 s", |l| l.centre_luma > 0.6);
-    // Fold the Preset section: Time's rows then start at y = 58.
+    // Fold the Preset, Materials, Light transport and Render sections: the
+    // Environment section's rows are then at y = 81 to 150, and the Time
+    // section's (under Render) start at y = 288.
     session.focus();
-    session.click(PANEL_LEFT + 50, 12);
+    for header in [12, 35, 219, 242] {
+        session.click(PANEL_LEFT + 50, header);
+    }
 
     // Space over the image plays: past 1 s the keyed light is off.
     session.run(&["mousemove", "400", "300"]);
@@ -88,13 +92,11 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
 
     // A press at the time slider's left end scrubs back to 0 s (the
     // pointer first rests there: egui reads it once per slow frame).
-    press(&session, PANEL_LEFT + 29, 81);
+    press(&session, PANEL_LEFT + 29, 311);
     session.wait_for("scrubbed to 0 s (the light on)", |l| l.centre_luma > 0.6);
 
-    // Fold Materials; the Environment's intensity row is then at y = 242,
-    // its key button at the row's end.
-    session.click(PANEL_LEFT + 50, 150);
-    press(&session, PANEL_LEFT + 251, 242);
+    // The Environment's intensity row, its key button at the row's end.
+    press(&session, PANEL_LEFT + 251, 127);
     let keyed = save_and_count(&session, &preset, 2);
     let track = &keyed.tracks[1];
     assert_eq!(track.path, "environment.intensity");

@@ -87,23 +87,40 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn render_board(dir: &Path, extra: &[&str]) {
-    let preset = dir.join("board.ron");
-    let output = dir.join("frame_##.exr");
+/// `marbre render` of `preset` to `output` at `size`, `spp` samples, the
+/// fragment kernel, with the `extra` flags.
+fn try_render(
+    preset: &Path,
+    output: &Path,
+    size: &str,
+    spp: &str,
+    extra: &[&str],
+) -> anyhow::Result<()> {
     let mut flags = vec![
         "--preset",
         preset.to_str().unwrap(),
         "-o",
         output.to_str().unwrap(),
         "--size",
-        "100x50",
+        size,
         "--spp",
-        "64",
+        spp,
         "--kernel",
         "fragment",
     ];
     flags.extend_from_slice(extra);
-    render::run(&args(&flags)).unwrap();
+    render::run(&args(&flags))
+}
+
+fn render_board(dir: &Path, extra: &[&str]) {
+    try_render(
+        &dir.join("board.ron"),
+        &dir.join("frame_##.exr"),
+        "100x50",
+        "64",
+        extra,
+    )
+    .unwrap();
 }
 
 /// Frames 0, 1, 2 at 4 fps are t = 0, 0.25, 0.5 s: sizes 1.0, 1.2 and
@@ -167,27 +184,12 @@ fn each_frame_traces_its_own_samples() {
     }
     let dir = scratch("seeds");
     let preset = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
-    let out = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-    let common = |output: String, extra: &[&str]| {
-        let mut flags = vec![
-            "--preset".to_owned(),
-            preset.to_str().unwrap().to_owned(),
-            "-o".to_owned(),
-            output,
-            "--size".to_owned(),
-            "32x24".to_owned(),
-            "--spp".to_owned(),
-            "1".to_owned(),
-            "--kernel".to_owned(),
-            "fragment".to_owned(),
-        ];
-        flags.extend(extra.iter().map(|s| s.to_string()));
-        let flags: Vec<&str> = flags.iter().map(String::as_str).collect();
-        render::run(&args(&flags)).unwrap();
+    let common = |output: &str, extra: &[&str]| {
+        try_render(&preset, &dir.join(output), "32x24", "1", extra).unwrap()
     };
-    common(out("f_#.exr"), &["--frames", "0..1"]);
-    common(out("still.exr"), &[]);
-    common(out("at.exr"), &["--time", "0.5", "--fps", "2"]);
+    common("f_#.exr", &["--frames", "0..1"]);
+    common("still.exr", &[]);
+    common("at.exr", &["--time", "0.5", "--fps", "2"]);
     let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
     assert!(
         read("f_0.exr") != read("f_1.exr"),
@@ -212,25 +214,14 @@ fn an_animation_holds_every_frame() {
     let dir = scratch("animated");
     let preset = dir.join("board.ron");
     for animated in ["board.apng", "board.gif"] {
-        let flags = [
-            "--preset",
-            preset.to_str().unwrap(),
-            "-o",
-            dir.join("f_#.png").to_str().unwrap(),
-            "--size",
-            "40x20",
-            "--spp",
-            "4",
-            "--kernel",
-            "fragment",
+        let animation = dir.join(animated);
+        let extra = [
             "--frames",
             "0..3",
             "--animation",
-            dir.join(animated).to_str().unwrap(),
-        ]
-        .map(str::to_owned);
-        let flags: Vec<&str> = flags.iter().map(String::as_str).collect();
-        render::run(&args(&flags)).unwrap();
+            animation.to_str().unwrap(),
+        ];
+        try_render(&preset, &dir.join("f_#.png"), "40x20", "4", &extra).unwrap();
     }
     let file = |n: &str| std::io::BufReader::new(std::fs::File::open(dir.join(n)).unwrap());
     let apng = image::codecs::png::PngDecoder::new(file("board.apng")).unwrap();
@@ -259,17 +250,9 @@ fn bad_timing_is_refused_before_writing() {
     let dir = scratch("bad");
     let preset = dir.join("board.ron");
     let run = |extra: &[&str], output: &str| {
-        let output = dir.join(output);
-        let mut flags = vec![
-            "--preset",
-            preset.to_str().unwrap(),
-            "-o",
-            output.to_str().unwrap(),
-            "--size",
-            "8x8",
-        ];
-        flags.extend_from_slice(extra);
-        render::run(&args(&flags)).unwrap_err().to_string()
+        try_render(&preset, &dir.join(output), "8x8", "1", extra)
+            .unwrap_err()
+            .to_string()
     };
     let e = run(&["--frames", "0..3", "--fps", "0"], "f_#.png");
     assert!(e.contains("--fps must be a positive number"), "{e}");

@@ -3,14 +3,22 @@ use crate::preset::{self, Preset, PresetError};
 use crate::scene::Change;
 use std::path::{Path, PathBuf};
 
-fn shipped_presets() -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets");
+/// The presets (`.ron`) in `folder` of the repository's `presets/`.
+fn presets_in(folder: &str) -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../presets")
+        .join(folder);
     let mut files: Vec<PathBuf> = std::fs::read_dir(&root)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
         .collect();
     files.sort();
+    files
+}
+
+fn shipped_presets() -> Vec<PathBuf> {
+    let files = presets_in("");
     assert!(files.len() >= 10, "{files:?}");
     files
 }
@@ -229,13 +237,7 @@ fn presets_without_an_animation_read_and_write_as_before() {
 }
 
 fn shipped_animations() -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/animated");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&root)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
-    files.sort();
+    let files = presets_in("animated");
     assert_eq!(files.len(), 4, "{files:?}");
     files
 }
