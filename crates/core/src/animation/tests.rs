@@ -1,6 +1,6 @@
 use super::*;
 use crate::preset::{self, Preset, PresetError};
-use crate::scene::Change;
+use crate::scene::{Change, Scene};
 use std::path::{Path, PathBuf};
 
 /// The presets (`.ron`) in `folder` of the repository's `presets/`.

@@ -22,6 +22,7 @@ pub mod render_view;
 pub mod text_property;
 pub mod texture_graph;
 pub mod texture_tree;
+mod time;
 pub mod transport;
 pub mod uv_frame;
 
