@@ -33,14 +33,18 @@ fn id() -> Id {
 }
 
 /// Sets what the key buttons show this frame: the play head's `time`, and
-/// each keyed parameter of `scene` at it (`traced`).
-pub fn begin_frame(ctx: &egui::Context, time: f32, scene: &Scene, traced: &Scene) {
+/// each keyed parameter of `scene` there: its track's value, the number the
+/// traced scene holds (read from the track, not from a scene traced for
+/// the purpose, each frame).
+pub fn begin_frame(ctx: &egui::Context, time: f32, scene: &Scene) {
     let mut keyed = HashMap::new();
     for track in scene.animation.iter().flat_map(|a| &a.tracks) {
         let Ok(path) = track.parsed_path() else {
             continue;
         };
-        if let Ok(value) = traced.parameter(&path) {
+        // A track whose path no longer names a number animates nothing
+        // (the Time section lists it; `Animation::problems` says why).
+        if let (Ok(_), Some(value)) = (scene.parameter(&path), track.value_at(time)) {
             let on_key = track.keys.iter().any(|k| (k.time - time).abs() < 1e-4);
             keyed.insert(path.to_string(), (value, on_key));
         }

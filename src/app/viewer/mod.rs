@@ -861,7 +861,7 @@ impl Viewer {
             self.window.request_redraw();
         }
         let time = self.timeline.time;
-        panel::keying::begin_frame(&self.egui_ctx, time, &self.scene, &self.traced(&self.scene));
+        panel::keying::begin_frame(&self.egui_ctx, time, &self.scene);
         let (scene, panel_state, timeline) = (&mut self.scene, &mut self.panel, &mut self.timeline);
         let (prompt, ui_hidden) = (&self.edits.prompt, self.ui_hidden);
         let mut show_help = self.show_help;

@@ -339,55 +339,72 @@ fn write_numbers(value: &mut Value, components: &[f32]) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads or writes through one part, typed `T`.
-fn through<T: Serialize + DeserializeOwned>(
+/// Writes `components` at `steps` inside one part, typed `T`.
+fn write_through<T: Serialize + DeserializeOwned>(
     part: &mut T,
     steps: &[Step],
-    new: Option<&[f32]>,
-) -> Result<Vec<f32>, String> {
-    let mut tree = serde_json::to_value(&*part).map_err(|e| e.to_string())?;
+    components: &[f32],
+) -> Result<(), String> {
+    let mut tree = to_tree(&*part);
     let mut at = &mut tree;
     for step in steps {
         at = child(at, step)?;
     }
-    let old = numbers(at).ok_or("not a number or a vector of numbers")?;
-    if let Some(components) = new {
-        write_numbers(at, components)?;
-        *part = serde_json::from_value(tree).map_err(|e| format!("the new value: {e}"))?;
-    }
-    Ok(old)
+    write_numbers(at, components)?;
+    *part = serde_json::from_value(tree).map_err(|e| format!("the new value: {e}"))?;
+    Ok(())
 }
 
-/// Reads the parameter at `path` (with `new`, writes it and returns the
-/// value it had).
-fn access(scene: &mut Scene, path: &ParamPath, new: Option<&[f32]>) -> Result<Vec<f32>, String> {
-    let (part, steps) = locate(scene, path)?;
+/// The value tree of one part of the scene.
+fn part_tree(scene: &Scene, part: Part) -> Value {
     match part {
-        Part::Camera => through(&mut scene.camera, steps, new),
-        Part::Sphere(i) => through(&mut scene.spheres[i], steps, new),
-        Part::Cylinder(i) => through(&mut scene.cylinders[i], steps, new),
-        Part::Polygon(i) => through(&mut scene.polygons[i], steps, new),
-        Part::Ground => through(scene.ground.as_mut().expect("located"), steps, new),
-        Part::MeshPlacement(i) => through(&mut scene.meshes[i].placement, steps, new),
-        Part::MeshMaterial(i, j) => through(&mut scene.meshes[i].materials[j].material, steps, new),
-        Part::PointLight => through(scene.point_light.as_mut().expect("located"), steps, new),
-        Part::Environment => through(&mut scene.environment, steps, new),
-        Part::Render => through(&mut scene.render, steps, new),
+        Part::Camera => to_tree(&scene.camera),
+        Part::Sphere(i) => to_tree(&scene.spheres[i]),
+        Part::Cylinder(i) => to_tree(&scene.cylinders[i]),
+        Part::Polygon(i) => to_tree(&scene.polygons[i]),
+        Part::Ground => to_tree(scene.ground.as_ref().expect("located")),
+        Part::MeshPlacement(i) => to_tree(&scene.meshes[i].placement),
+        Part::MeshMaterial(i, j) => to_tree(&scene.meshes[i].materials[j].material),
+        Part::PointLight => to_tree(scene.point_light.as_ref().expect("located")),
+        Part::Environment => to_tree(&scene.environment),
+        Part::Render => to_tree(&scene.render),
     }
 }
 
 impl Scene {
-    /// The number(s) at `path`, or why the path names none.
+    /// The number(s) at `path`, or why the path names none. Only the part
+    /// the path starts in is read (the panel asks for each keyed number
+    /// every frame).
     pub fn parameter(&self, path: &ParamPath) -> Result<Vec<f32>, String> {
-        // Reading goes through the same code as writing, on a copy of the
-        // part alone.
-        let mut part_only = self.clone();
-        access(&mut part_only, path, None)
+        let (part, steps) = locate(self, path)?;
+        let mut tree = part_tree(self, part);
+        let mut at = &mut tree;
+        for step in steps {
+            at = child(at, step)?;
+        }
+        numbers(at).ok_or_else(|| "not a number or a vector of numbers".to_owned())
     }
 
     /// Sets the number(s) at `path`.
     pub fn set_parameter(&mut self, path: &ParamPath, components: &[f32]) -> Result<(), String> {
-        access(self, path, Some(components)).map(drop)
+        let (part, steps) = locate(self, path)?;
+        let c = components;
+        match part {
+            Part::Camera => write_through(&mut self.camera, steps, c),
+            Part::Sphere(i) => write_through(&mut self.spheres[i], steps, c),
+            Part::Cylinder(i) => write_through(&mut self.cylinders[i], steps, c),
+            Part::Polygon(i) => write_through(&mut self.polygons[i], steps, c),
+            Part::Ground => write_through(self.ground.as_mut().expect("located"), steps, c),
+            Part::MeshPlacement(i) => write_through(&mut self.meshes[i].placement, steps, c),
+            Part::MeshMaterial(i, j) => {
+                write_through(&mut self.meshes[i].materials[j].material, steps, c)
+            }
+            Part::PointLight => {
+                write_through(self.point_light.as_mut().expect("located"), steps, c)
+            }
+            Part::Environment => write_through(&mut self.environment, steps, c),
+            Part::Render => write_through(&mut self.render, steps, c),
+        }
     }
 
     /// Every animatable parameter of the scene with its current value: the
