@@ -15,6 +15,13 @@
 //! whole pass each time (100 to 300 ms on lavapipe): under the recovery
 //! prompt the window fell to about a third of its frames, and the image
 //! hardly accumulated (issue 28).
+//!
+//! While an animation plays the panel changes every frame, but only in a
+//! few rows (the play head, the frame and time, keyed fields). A copied
+//! layer is compared with the new output in bands of [`BAND`] pixel rows
+//! ([`band_fingerprints`]), and only the bands that differ are cleared and
+//! drawn again, egui's clip rectangles cut to them: egui's pass then costs
+//! what those rows cost, not the whole panel's (issue 29).
 
 use std::hash::{Hash, Hasher};
 
@@ -81,6 +88,155 @@ pub fn drawn_inside(
         .reduce(|a, b| a.union(b))
 }
 
+/// Height of the bands, in pixel rows, in which a copied layer is
+/// compared with egui's new output and drawn again.
+pub const BAND: u32 = 16;
+
+/// A fingerprint of what egui draws in each band of [`BAND`] pixel rows of
+/// a window `screen.size_in_pixels` big: each triangle reaching the band
+/// (its vertices, texture and clip rectangle), in drawing order. Equal
+/// fingerprints draw equal pixels in the band, and a band whose
+/// fingerprint differs is drawn whole again, so the kept pixels are what a
+/// full redraw gives. `None` when a callback draws (it draws what it likes).
+pub fn band_fingerprints(
+    jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+) -> Option<Vec<u64>> {
+    let [width, height] = screen.size_in_pixels;
+    let ppp = screen.pixels_per_point;
+    let mut bands = vec![0u64; height.div_ceil(BAND) as usize];
+    for job in jobs {
+        let egui::epaint::Primitive::Mesh(mesh) = &job.primitive else {
+            return None;
+        };
+        let c = job.clip_rect;
+        let clip = [c.min.x, c.min.y, c.max.x, c.max.y].map(|v| (v * ppp).clamp(0.0, 1e7));
+        let clip = [
+            clip[0],
+            clip[1],
+            clip[2].min(width as f32),
+            clip[3].min(height as f32),
+        ];
+        if clip[0] >= clip[2] || clip[1] >= clip[3] {
+            continue;
+        }
+        let texture = match mesh.texture_id {
+            egui::TextureId::Managed(id) => id,
+            egui::TextureId::User(id) => id ^ (1 << 63),
+        };
+        let head = fx(texture, clip.map(f32::to_bits));
+        for triangle in mesh.indices.chunks_exact(3) {
+            let v: [&egui::epaint::Vertex; 3] =
+                std::array::from_fn(|k| &mesh.vertices[triangle[k] as usize]);
+            let ys = v.map(|v| v.pos.y * ppp);
+            let top = ys
+                .iter()
+                .copied()
+                .fold(f32::INFINITY, f32::min)
+                .max(clip[1]);
+            let bottom = ys
+                .iter()
+                .copied()
+                .fold(f32::NEG_INFINITY, f32::max)
+                .min(clip[3]);
+            if top >= bottom {
+                continue;
+            }
+            let words: [u32; 15] = std::array::from_fn(|k| {
+                let v = v[k / 5];
+                match k % 5 {
+                    0 => v.pos.x.to_bits(),
+                    1 => v.pos.y.to_bits(),
+                    2 => v.uv.x.to_bits(),
+                    3 => v.uv.y.to_bits(),
+                    _ => u32::from_le_bytes(v.color.to_array()),
+                }
+            });
+            let h = fx(head, words);
+            let first = (top as u32 / BAND) as usize;
+            let last = ((bottom.ceil() as u32).saturating_sub(1) / BAND) as usize;
+            let last = last.min(bands.len() - 1);
+            for band in &mut bands[first..=last] {
+                *band = (band.rotate_left(5) ^ h).wrapping_mul(FX);
+            }
+        }
+    }
+    Some(bands)
+}
+
+/// FxHash's multiplier (rustc's hasher): fast and good enough to tell
+/// panel outputs apart; SipHash cost milliseconds over a panel's
+/// triangles.
+const FX: u64 = 0x51_7c_c1_b7_27_22_0a_95;
+
+fn fx<const N: usize>(seed: u64, words: [u32; N]) -> u64 {
+    words.iter().fold(seed, |h, &w| {
+        (h.rotate_left(5) ^ u64::from(w)).wrapping_mul(FX)
+    })
+}
+
+/// The runs of bands (as pixel rows, `start..end`) whose fingerprints
+/// differ between two outputs of the same window.
+pub fn changed_rows(before: &[u64], after: &[u64], height: u32) -> Vec<std::ops::Range<u32>> {
+    let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
+    for (i, (b, a)) in before.iter().zip(after).enumerate() {
+        if b == a {
+            continue;
+        }
+        let rows = i as u32 * BAND..((i as u32 + 1) * BAND).min(height);
+        match runs.last_mut() {
+            Some(last) if last.end == rows.start => last.end = rows.end,
+            _ => runs.push(rows),
+        }
+    }
+    runs
+}
+
+/// Records egui's output `jobs` drawn again within pixel rows `rows` of
+/// `pass`'s target (a layer holding a copied output): each run of rows
+/// cleared to `background`, then every job drawn with its clip rectangle
+/// cut to the run (egui's scissor is its clip rectangle in pixels,
+/// rounded, so the cut is exact). The buffers must hold `jobs`.
+pub fn draw_rows(
+    renderer: &egui_wgpu::Renderer,
+    compositor: &Compositor,
+    pass: &mut wgpu::RenderPass<'static>,
+    jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+    rows: &[std::ops::Range<u32>],
+    background: wgpu::Color,
+) {
+    let mut cut_jobs = jobs.to_vec();
+    let ppp = screen.pixels_per_point;
+    for run in rows {
+        compositor.fill(pass, run.clone(), screen.size_in_pixels[0], background);
+        let cut = egui::Rect::from_x_y_ranges(
+            egui::Rangef::EVERYTHING,
+            run.start as f32 / ppp..=run.end as f32 / ppp,
+        );
+        for (job, original) in cut_jobs.iter_mut().zip(jobs) {
+            let clip = original.clip_rect.intersect(cut);
+            job.clip_rect = if clip.is_positive() {
+                clip
+            } else {
+                egui::Rect::ZERO
+            };
+        }
+        renderer.render(pass, &cut_jobs, screen);
+    }
+}
+
+/// What egui's output asks of the kept layer.
+pub enum Redraw<'a> {
+    /// It already holds it.
+    Nothing,
+    /// Draw it whole into this view.
+    Whole(&'a wgpu::TextureView),
+    /// Clear these pixel rows of this view and draw them again: the rest
+    /// holds the output already.
+    Rows(&'a wgpu::TextureView, Vec<std::ops::Range<u32>>),
+}
+
 /// What the kept layer is drawn over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
@@ -101,6 +257,8 @@ pub struct UiLayer {
     bind_group: wgpu::BindGroup,
     /// The output the texture holds, and how it was drawn, if any.
     key: Option<(u64, Mode)>,
+    /// Its bands' fingerprints, when it was copied and has them.
+    bands: Option<Vec<u64>>,
 }
 
 impl UiLayer {
@@ -139,6 +297,7 @@ impl UiLayer {
             view,
             bind_group,
             key: None,
+            bands: None,
         }
     }
 
@@ -149,15 +308,32 @@ impl UiLayer {
             && self.texture.format() == config.format
     }
 
-    /// The view to draw egui into when output `key` drawn for `mode` is
-    /// not what the layer holds; `None` when it already holds it. The
-    /// layer then holds it.
-    pub fn view_to_redraw(&mut self, key: u64, mode: Mode) -> Option<&wgpu::TextureView> {
+    /// What to draw of output `key` drawn for `mode` (its bands'
+    /// fingerprints `bands`, for a copied layer): nothing when the layer
+    /// holds it, only the rows that changed when the layer holds a copied
+    /// output with fingerprints and fewer than half the rows changed, the
+    /// whole output otherwise. The layer then holds it.
+    pub fn redraw(&mut self, key: u64, mode: Mode, bands: Option<Vec<u64>>) -> Redraw<'_> {
         if self.key == Some((key, mode)) {
-            return None;
+            return Redraw::Nothing;
         }
+        let held = self.key.map(|(_, m)| m);
+        let before = std::mem::replace(&mut self.bands, bands);
         self.key = Some((key, mode));
-        Some(&self.view)
+        let height = self.texture.height();
+        match (held, before, &self.bands) {
+            (Some(Mode::Copied), Some(before), Some(after))
+                if mode == Mode::Copied && before.len() == after.len() =>
+            {
+                let rows = changed_rows(&before, after, height);
+                let changed: u32 = rows.iter().map(|r| r.end - r.start).sum();
+                if 2 * changed < height {
+                    return Redraw::Rows(&self.view, rows);
+                }
+                Redraw::Whole(&self.view)
+            }
+            _ => Redraw::Whole(&self.view),
+        }
     }
 
     /// Records the copy of the whole layer onto `target`.
@@ -176,6 +352,9 @@ impl UiLayer {
 /// as egui itself would have gone.
 pub struct Compositor {
     pipeline: wgpu::RenderPipeline,
+    /// Writes the blend constant within a scissor: the clear of a layer's
+    /// rows that are drawn again (a pass clears only whole targets).
+    fill_pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     format: wgpu::TextureFormat,
 }
@@ -194,6 +373,11 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     return textureLoad(layer, vec2<i32>(position.xy), 0);
+}
+
+@fragment
+fn fs_fill() -> @location(0) vec4<f32> {
+    return vec4<f32>(1.0);
 }
 ";
 
@@ -247,11 +431,66 @@ impl Compositor {
             multiview_mask: None,
             cache: None,
         });
+        let fill_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("panel layer fill"),
+            bind_group_layouts: &[],
+            immediate_size: 0,
+        });
+        let constant = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Constant,
+            dst_factor: wgpu::BlendFactor::Zero,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let fill_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("panel layer fill"),
+            layout: Some(&fill_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_fill"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format,
+                    blend: Some(wgpu::BlendState {
+                        color: constant,
+                        alpha: constant,
+                    }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         Self {
             pipeline,
+            fill_pipeline,
             layout,
             format,
         }
+    }
+
+    /// Records, in `pass`, pixel rows `rows` of its `width`-pixel target
+    /// set to `color`, as a clear would set them.
+    pub fn fill(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        rows: std::ops::Range<u32>,
+        width: u32,
+        color: wgpu::Color,
+    ) {
+        pass.set_viewport(0.0, 0.0, width as f32, rows.end as f32, 0.0, 1.0);
+        pass.set_scissor_rect(0, rows.start, width, rows.end - rows.start);
+        pass.set_pipeline(&self.fill_pipeline);
+        pass.set_blend_constant(color);
+        pass.draw(0..3, 0..1);
     }
 
     /// The format of the targets it blends onto.
@@ -348,6 +587,195 @@ mod tests {
             pixels_per_point: 1.0,
         };
         assert_ne!(key, output_key(&a, &larger));
+    }
+
+    fn screen_of(width: u32, height: u32) -> egui_wgpu::ScreenDescriptor {
+        egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [width, height],
+            pixels_per_point: 1.0,
+        }
+    }
+
+    /// A change marks the bands its triangles reach and no other: a moved
+    /// square, a recoloured one, two overlapping squares drawn in the
+    /// other order, a tall square across four bands; a clip rectangle
+    /// cutting a square away leaves its bands alone.
+    #[test]
+    fn a_change_marks_the_bands_it_reaches() {
+        let all = Rect::EVERYTHING;
+        let screen = screen_of(64, 64);
+        let bands = |jobs: &[egui::ClippedPrimitive]| band_fingerprints(jobs, &screen).unwrap();
+        let changed = |a: &[egui::ClippedPrimitive], b: &[egui::ClippedPrimitive]| {
+            changed_rows(&bands(a), &bands(b), 64)
+        };
+        let base = [
+            job(all, pos2(2.0, 2.0), Color32::WHITE),
+            job(all, pos2(2.0, 40.0), Color32::RED),
+        ];
+        assert_eq!(bands(&base), bands(&base.clone()));
+        assert_eq!(bands(&base).len(), 4);
+        let moved = [base[0].clone(), job(all, pos2(3.0, 40.0), Color32::RED)];
+        assert_eq!(changed(&base, &moved), vec![32..64]);
+        let recoloured = [job(all, pos2(2.0, 2.0), Color32::BLUE), base[1].clone()];
+        assert_eq!(changed(&base, &recoloured), vec![0..16]);
+        let swapped = [base[1].clone(), base[0].clone()];
+        assert!(
+            changed(&base, &swapped).is_empty(),
+            "disjoint: no pixel differs"
+        );
+        let over = [
+            job(all, pos2(2.0, 2.0), Color32::WHITE),
+            job(all, pos2(6.0, 4.0), Color32::RED),
+        ];
+        let under = [over[1].clone(), over[0].clone()];
+        assert_eq!(changed(&over, &under), vec![0..16]);
+        let mut tall = Mesh::default();
+        tall.add_colored_rect(
+            Rect::from_min_size(pos2(0.0, 0.0), egui::vec2(4.0, 64.0)),
+            Color32::GREEN,
+        );
+        let tall = [egui::ClippedPrimitive {
+            clip_rect: all,
+            primitive: Primitive::Mesh(tall),
+        }];
+        assert_eq!(changed(&[], &tall), vec![0..64]);
+        let clipped_away = [job(
+            Rect::from_min_max(pos2(0.0, 0.0), pos2(64.0, 30.0)),
+            pos2(2.0, 40.0),
+            Color32::RED,
+        )];
+        assert!(changed(&[], &clipped_away).is_empty());
+    }
+
+    /// Rows drawn again over a layer that held an earlier output give the
+    /// pixels of the new output drawn whole, with egui's own renderer on
+    /// the adapter (lavapipe in CI): a translucent square moved and
+    /// recoloured across the edge of a panel's fill, so that rows of the
+    /// earlier square beside the fill must be cleared.
+    #[test]
+    fn rows_drawn_again_equal_the_output_drawn_whole() {
+        let Some(ctx) = marbre_render::gpu::testing::gpu_or_skip(
+            "rows_drawn_again_equal_the_output_drawn_whole",
+        ) else {
+            return;
+        };
+        let (device, queue) = (&ctx.device, &ctx.queue);
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let (width, height) = (64, 80);
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width,
+            height,
+            present_mode: wgpu::PresentMode::Fifo,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: wgpu::CompositeAlphaMode::Auto,
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        let compositor = Compositor::new(device, format);
+        let mut renderer = egui_wgpu::Renderer::new(device, format, Default::default());
+        let white = egui::ImageData::Color(std::sync::Arc::new(egui::ColorImage::filled(
+            [1, 1],
+            Color32::WHITE,
+        )));
+        renderer.update_texture(
+            device,
+            queue,
+            egui::TextureId::default(),
+            &egui::epaint::ImageDelta::full(white, egui::TextureOptions::NEAREST),
+        );
+        let screen = screen_of(width, height);
+        let panel = |accent: Color32, y: f32| {
+            let mut mesh = Mesh::default();
+            mesh.add_colored_rect(
+                Rect::from_min_size(pos2(8.0, 0.0), egui::vec2(48.0, 80.0)),
+                Color32::from_gray(40),
+            );
+            mesh.add_colored_rect(
+                Rect::from_min_size(pos2(10.5, 3.25), egui::vec2(20.0, 9.5)),
+                Color32::from_rgba_unmultiplied(200, 100, 50, 128),
+            );
+            // Reaching past the panel's fill, over the cleared layer.
+            mesh.add_colored_rect(
+                Rect::from_min_size(pos2(36.0, y), egui::vec2(26.0, 7.5)),
+                accent,
+            );
+            vec![egui::ClippedPrimitive {
+                clip_rect: Rect::EVERYTHING,
+                primitive: Primitive::Mesh(mesh),
+            }]
+        };
+        let before = panel(Color32::from_rgba_unmultiplied(0, 90, 255, 100), 50.0);
+        let after = panel(Color32::from_rgba_unmultiplied(255, 200, 0, 160), 52.5);
+        let draw = |layer: &mut UiLayer,
+                    renderer: &mut egui_wgpu::Renderer,
+                    jobs: &[egui::ClippedPrimitive]| {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            let extra = renderer.update_buffers(device, queue, &mut encoder, jobs, &screen);
+            let key = output_key(jobs, &screen);
+            let bands = band_fingerprints(jobs, &screen);
+            let drew_rows = match layer.redraw(key, Mode::Copied, bands) {
+                Redraw::Nothing => None,
+                Redraw::Whole(view) => {
+                    let mut pass = begin(&mut encoder, view, wgpu::LoadOp::Clear(GREY));
+                    renderer.render(&mut pass, jobs, &screen);
+                    Some(false)
+                }
+                Redraw::Rows(view, rows) => {
+                    let mut pass = begin(&mut encoder, view, wgpu::LoadOp::Load);
+                    draw_rows(renderer, &compositor, &mut pass, jobs, &screen, &rows, GREY);
+                    Some(true)
+                }
+            };
+            queue.submit(extra.into_iter().chain([encoder.finish()]));
+            let pixels =
+                marbre_render::gpu::readback::read_texture(device, queue, &layer.texture, 4)
+                    .unwrap();
+            (drew_rows, pixels)
+        };
+        let mut kept = UiLayer::new(device, &config, &compositor);
+        assert_eq!(draw(&mut kept, &mut renderer, &before).0, Some(false));
+        let (drew_rows, by_rows) = draw(&mut kept, &mut renderer, &after);
+        assert_eq!(drew_rows, Some(true), "a small change draws rows only");
+        let mut fresh = UiLayer::new(device, &config, &compositor);
+        let (_, whole) = draw(&mut fresh, &mut renderer, &after);
+        let differing = by_rows.iter().zip(&whole).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differing, 0,
+            "bytes that differ from the output drawn whole"
+        );
+        let (_, before_whole) = draw(&mut fresh, &mut renderer, &before);
+        assert_ne!(before_whole, whole, "the two outputs differ");
+    }
+
+    const GREY: wgpu::Color = wgpu::Color {
+        r: 0.05,
+        g: 0.06,
+        b: 0.07,
+        a: 1.0,
+    };
+
+    fn begin(
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) -> wgpu::RenderPass<'static> {
+        encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("test egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            })
+            .forget_lifetime()
     }
 
     /// A panel beside the image draws nothing inside it; a popup over the

@@ -14,7 +14,7 @@
 //! applies the keys asked for after.
 
 use egui::{Color32, Id, Response, Ui};
-use marbre_core::animation::ParamPath;
+use marbre_core::animation::{Naming, ParamPath};
 use marbre_core::scene::Scene;
 use std::collections::HashMap;
 
@@ -39,7 +39,12 @@ fn id() -> Id {
 pub fn begin_frame(ctx: &egui::Context, time: f32, scene: &Scene) {
     let mut keyed = HashMap::new();
     for track in scene.animation.iter().flat_map(|a| &a.tracks) {
-        let Ok(path) = track.parsed_path() else {
+        // The panel names a number by where its control sits (elements
+        // by index); a track may name it by name.
+        let Ok(path) = track
+            .parsed_path()
+            .and_then(|p| scene.parameter_name(&p, Naming::Indices))
+        else {
             continue;
         };
         // A track whose path no longer names a number animates nothing

@@ -33,6 +33,8 @@ pub fn material_ui(ui: &mut Ui, key: MaterialKey, m: &mut Material) -> Option<Ba
         key,
         path: NodePath::root(root),
     };
+    let material = ParamPath::parse(&format!("{key}.material"))
+        .expect("a material key prints as a parameter path");
     for property in Property::ALL {
         let (kind, hint) = property_ui_info(property);
         texture_ui(
@@ -51,13 +53,20 @@ pub fn material_ui(ui: &mut Ui, key: MaterialKey, m: &mut Material) -> Option<Ba
             ui.indent(("tx", property.name()), |ui| tx_ui(ui, m, property));
         }
         if property == Property::Emission {
-            ui.add(
-                slider(
-                    &mut m.emission_strength,
-                    0.0..=Material::MAX_EMISSION_STRENGTH,
-                    "emission strength",
-                )
-                .logarithmic(true),
+            keyed(
+                ui,
+                &material.field("emission_strength"),
+                &mut m.emission_strength,
+                |ui, v| {
+                    ui.add(
+                        slider(
+                            v,
+                            0.0..=Material::MAX_EMISSION_STRENGTH,
+                            "emission strength",
+                        )
+                        .logarithmic(true),
+                    )
+                },
             )
             .on_hover_text("Emitted radiance is the emission colour times this");
         }
@@ -71,11 +80,18 @@ pub fn material_ui(ui: &mut Ui, key: MaterialKey, m: &mut Material) -> Option<Ba
         &place(Root::Bump),
     );
     bake = bake.or(Some(BakeProperty::Bump).filter(|&b| bake_button(ui, b)));
-    ui.add(typed_beyond(slider(
+    keyed(
+        ui,
+        &material.field("bump_height"),
         &mut m.bump_height,
-        -Material::BUMP_HEIGHT_DRAG_RANGE..=Material::BUMP_HEIGHT_DRAG_RANGE,
-        "bump height",
-    )))
+        |ui, v| {
+            ui.add(typed_beyond(slider(
+                v,
+                -Material::BUMP_HEIGHT_DRAG_RANGE..=Material::BUMP_HEIGHT_DRAG_RANGE,
+                "bump height",
+            )))
+        },
+    )
     .on_hover_text(
         "Height in scene units of a bump value of 1; 0 turns the bump off (drag within ±0.5, \
          or type any value: a steep bump bends shading normals away, and marbre falls back)",
@@ -244,7 +260,7 @@ fn texture_ui(
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
                 }
-                mapping_ui(ui, &mut texture.mapping);
+                mapping_ui(ui, &mut texture.mapping, &node);
                 if texture.pattern == Pattern::Mix {
                     let factor = texture
                         .factor
@@ -281,7 +297,7 @@ fn texture_ui(
                         );
                     }
                 }
-                math_ui(ui, &mut texture.ops);
+                math_ui(ui, &mut texture.ops, &node);
             });
         header
             .header_response
@@ -402,7 +418,8 @@ pub(super) fn image_source_ui(ui: &mut Ui, image: &mut Option<ImageSource>) {
 /// The texture's own mapping: ticked, it and its subtree read the surface's
 /// coordinates (object or world for 3D patterns, the primitive's (u, v) for
 /// 2D ones) through a transform.
-pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
+/// `node`: the texture's parameter path, for the key buttons.
+pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>, node: &ParamPath) {
     let mut on = mapping.is_some();
     if ui
         .checkbox(&mut on, "mapping")
@@ -420,8 +437,10 @@ pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
         ui.selectable_value(&mut m.space, MappingSpace::World, "world")
             .on_hover_text("Objects move through the 3D pattern");
     });
+    let at = node.field("mapping");
     uv_frame_ui(
         ui,
+        &at.field("frame"),
         &mut m.frame,
         "3D frame",
         "The report's ATX3D: 3D patterns read the point's coordinates along an origin and \
@@ -436,6 +455,7 @@ pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
     let t = &mut m.transform;
     vec3_ui(
         ui,
+        &at.field("transform").field("translate"),
         "translate",
         &mut t.translate,
         0.01,
@@ -443,6 +463,7 @@ pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
     );
     vec3_ui(
         ui,
+        &at.field("transform").field("rotate_degrees"),
         "rotate °",
         &mut t.rotate_degrees,
         0.5,
@@ -450,6 +471,7 @@ pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
     );
     vec3_ui(
         ui,
+        &at.field("transform").field("scale"),
         "scale",
         &mut t.scale,
         0.01,
@@ -459,9 +481,11 @@ pub(super) fn mapping_ui(ui: &mut Ui, mapping: &mut Option<TextureMapping>) {
 
 /// The math steps after a texture: each a dropdown, its parameters, and a
 /// remove button.
-pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
+/// `node`: the texture's parameter path, for the key buttons.
+pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>, node: &ParamPath) {
     let mut remove = None;
     for (i, op) in ops.iter_mut().enumerate() {
+        let at = node.field("ops").index(i);
         ui.push_id(("op", i), |ui| {
             ui.horizontal(|ui| {
                 let mut index = op.index();
@@ -471,28 +495,33 @@ pub(super) fn math_ui(ui: &mut Ui, ops: &mut Vec<MathOp>) {
                 if index != op.index() {
                     *op = MathOp::with_index(index);
                 }
+                let drag = |ui: &mut Ui, path: &ParamPath, v: &mut f32, prefix: &str| {
+                    keyed(ui, path, v, |ui, v| {
+                        ui.add(egui::DragValue::new(v).speed(0.01).prefix(prefix))
+                    })
+                };
                 match op {
                     MathOp::Scale(x) => {
-                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("× "))
-                            .on_hover_text("Multiplies the value by this");
+                        drag(ui, &at, x, "× ").on_hover_text("Multiplies the value by this");
                     }
                     MathOp::Bias(x) => {
-                        ui.add(egui::DragValue::new(x).speed(0.01).prefix("+ "))
-                            .on_hover_text("Adds this to the value");
+                        drag(ui, &at, x, "+ ").on_hover_text("Adds this to the value");
                     }
                     MathOp::Clamp { min, max } => {
-                        ui.add(egui::DragValue::new(min).speed(0.01).prefix("min "))
+                        drag(ui, &at.field("min"), min, "min ")
                             .on_hover_text("Values below this are raised to it");
-                        ui.add(egui::DragValue::new(max).speed(0.01).prefix("max "))
+                        drag(ui, &at.field("max"), max, "max ")
                             .on_hover_text("Values above this are lowered to it");
                     }
                     MathOp::Power(e) => {
-                        ui.add(
-                            egui::DragValue::new(e)
-                                .speed(0.01)
-                                .range(MathOp::MIN_EXPONENT..=100.0)
-                                .prefix("^ "),
-                        )
+                        keyed(ui, &at, e, |ui, e| {
+                            ui.add(
+                                egui::DragValue::new(e)
+                                    .speed(0.01)
+                                    .range(MathOp::MIN_EXPONENT..=100.0)
+                                    .prefix("^ "),
+                            )
+                        })
                         .on_hover_text(format!(
                             "Raises the value (negatives taken as 0) to this exponent, at least {}",
                             MathOp::MIN_EXPONENT
@@ -632,16 +661,21 @@ fn child_ui(ui: &mut Ui, label: &str, child: &mut Child, kind: ValueKind, place:
             } else {
                 constant.to_owned()
             };
+            let at = node_param_path(place);
             match child {
                 Child::Color(c) if kind == ValueKind::Color => {
-                    labelled_color(ui, c, label).on_hover_text(hint);
-                }
-                Child::Color(c) => {
-                    ui.add(slider(&mut c.x, 0.0..=1.0, label))
+                    super::keying::vector(ui, &at, c, |ui, c| labelled_color(ui, c, label))
                         .on_hover_text(hint);
                 }
+                Child::Color(c) => {
+                    keyed(ui, &at.index(0), &mut c.x, |ui, v| {
+                        ui.add(slider(v, 0.0..=1.0, label))
+                    })
+                    .on_hover_text(hint);
+                }
                 Child::Scalar(v) => {
-                    ui.add(slider(v, 0.0..=1.0, label)).on_hover_text(hint);
+                    keyed(ui, &at, v, |ui, v| ui.add(slider(v, 0.0..=1.0, label)))
+                        .on_hover_text(hint);
                 }
                 Child::Texture(_) => {}
             }

@@ -24,6 +24,10 @@ pub struct RenderDialog {
     /// Render every frame of the scene's animation (the output's name
     /// numbered with #), not the moment under the play head.
     pub all_frames: bool,
+    /// With every frame, also assemble them into one animated file.
+    pub assemble: bool,
+    /// That file (.gif, .apng, .webp or .mp4), as `render --animation`.
+    pub animation: String,
     pub spp: u32,
     /// The target relative error, in percent.
     pub target_percent: f64,
@@ -61,6 +65,8 @@ impl Default for RenderDialog {
             size: DEFAULT_SIZE.to_owned(),
             by_error: false,
             all_frames: false,
+            assemble: false,
+            animation: "render.gif".to_owned(),
             spp: DEFAULT_SPP,
             target_percent: DEFAULT_TARGET_PERCENT,
             max_spp: DEFAULT_MAX_SPP,
@@ -106,6 +112,12 @@ impl RenderDialog {
             allow_placeholders: true,
             timing: Default::default(),
         })
+    }
+
+    /// The animated file to assemble the frames into, when every frame
+    /// is rendered and one is asked for.
+    pub fn animation_file(&self) -> Option<PathBuf> {
+        (self.all_frames && self.assemble).then(|| PathBuf::from(self.animation.trim()))
     }
 
     /// The output's format as its extension says, if it says one.
@@ -240,6 +252,25 @@ fn dialog_ui(ui: &mut Ui, dialog: &mut RenderDialog, actions: &mut Vec<PanelActi
                          the frame number (out/frame_####.png); off, the moment under the play head",
                     );
                 ui.end_row();
+                if dialog.all_frames {
+                    ui.label("animation");
+                    ui.horizontal(|ui| {
+                        ui.checkbox(&mut dialog.assemble, "also as")
+                            .on_hover_text(
+                                "As `render --animation`: the PNG frames assembled into one \
+                                 looping file",
+                            );
+                        ui.add_enabled(
+                            dialog.assemble,
+                            egui::TextEdit::singleline(&mut dialog.animation).desired_width(140.0),
+                        )
+                        .on_hover_text(
+                            ".gif or .apng (written by marbre), .webp or .mp4 (through ffmpeg, \
+                             when it is installed)",
+                        );
+                    });
+                    ui.end_row();
+                }
                 ui.label("auto exposure");
                 ComboBox::new("render auto exposure", "")
                     .selected_text(auto_exposure_label(dialog.auto_exposure))
@@ -329,6 +360,25 @@ mod tests {
         assert_eq!(dialog.job().unwrap().stop, Stop::Samples(7));
         dialog.set_format(ImageFormat::Png);
         assert_eq!(dialog.output, "out/final.png");
+    }
+
+    /// The frames are assembled into the animated file only when every
+    /// frame is rendered and "also as" is ticked.
+    #[test]
+    fn the_animated_file_is_asked_for_with_every_frame_only() {
+        let mut dialog = RenderDialog {
+            animation: " out/loop.webp ".to_owned(),
+            assemble: true,
+            ..RenderDialog::default()
+        };
+        assert_eq!(dialog.animation_file(), None);
+        dialog.all_frames = true;
+        assert_eq!(
+            dialog.animation_file(),
+            Some(PathBuf::from("out/loop.webp"))
+        );
+        dialog.assemble = false;
+        assert_eq!(dialog.animation_file(), None);
     }
 
     #[test]

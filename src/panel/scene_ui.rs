@@ -51,19 +51,26 @@ pub(super) fn materials_ui(
             ("cylinder", i),
             format!("cylinder “{}”", cylinder.name),
             &mut |ui| {
+                let at = |field: &str| {
+                    ParamPath::parse(&format!("cylinders[{i}].{field}"))
+                        .expect("a cylinder's field is a parameter path")
+                };
                 vec3_ui(
                     ui,
+                    &at("base"),
                     "base",
                     &mut cylinder.base,
                     0.01,
                     "Centre of the bottom cap",
                 );
-                ui.add(slider(&mut cylinder.radius, 0.01..=10.0, "radius").logarithmic(true))
-                    .on_hover_text("Radius of the side and caps, in scene units");
-                ui.add(slider(&mut cylinder.height, 0.01..=10.0, "height").logarithmic(true))
-                    .on_hover_text(
-                        "Along +y; the side's v runs from 0 at the base to 1 at the top",
-                    );
+                keying::number(ui, &at("radius"), &mut cylinder.radius, |ui, v| {
+                    ui.add(slider(v, 0.01..=10.0, "radius").logarithmic(true))
+                })
+                .on_hover_text("Radius of the side and caps, in scene units");
+                keying::number(ui, &at("height"), &mut cylinder.height, |ui, v| {
+                    ui.add(slider(v, 0.01..=10.0, "height").logarithmic(true))
+                })
+                .on_hover_text("Along +y; the side's v runs from 0 at the base to 1 at the top");
                 node_graph::toggle(ui, graph, MaterialKey::Cylinder(i));
                 let pressed = material_ui(ui, MaterialKey::Cylinder(i), &mut cylinder.material);
                 bake = bake.or(pressed.map(|p| (ObjectRef::Cylinder(i), p)));
@@ -85,8 +92,10 @@ pub(super) fn materials_ui(
     if let Some(ground) = &mut scene.ground {
         object(ui, ("ground", 0), "ground".into(), &mut |ui| {
             let default = Ground::default().frame();
+            let frame = ParamPath::parse("ground.uv_frame").expect("a parameter path");
             uv_frame_ui(
                 ui,
+                &frame,
                 &mut ground.uv_frame,
                 "uv frame",
                 "The report's APTX: 2D textures read (u, v) along an origin and two axes \
@@ -130,11 +139,29 @@ pub(super) fn mesh_ui(
         mesh.obj.display()
     ));
     let p = &mut mesh.placement;
-    vec3_ui(ui, "translate", &mut p.translate, 0.01, "Moves the mesh");
-    ui.add(slider(&mut p.rotate_y_degrees, -180.0..=180.0, "turn").suffix("°"))
-        .on_hover_text("Turns the mesh about the vertical axis (rebuilds the BVH)");
-    ui.add(slider(&mut p.scale, 0.01..=100.0, "scale").logarithmic(true))
-        .on_hover_text("Scales the mesh about its file's origin (rebuilds the BVH)");
+    let at = |field: &str| {
+        ParamPath::parse(&format!("meshes[{index}].placement.{field}"))
+            .expect("a placement's field is a parameter path")
+    };
+    vec3_ui(
+        ui,
+        &at("translate"),
+        "translate",
+        &mut p.translate,
+        0.01,
+        "Moves the mesh",
+    );
+    keying::number(
+        ui,
+        &at("rotate_y_degrees"),
+        &mut p.rotate_y_degrees,
+        |ui, v| ui.add(slider(v, -180.0..=180.0, "turn").suffix("°")),
+    )
+    .on_hover_text("Turns the mesh about the vertical axis (rebuilds the BVH)");
+    keying::number(ui, &at("scale"), &mut p.scale, |ui, v| {
+        ui.add(slider(v, 0.01..=100.0, "scale").logarithmic(true))
+    })
+    .on_hover_text("Scales the mesh about its file's origin (rebuilds the BVH)");
     for (k, m) in mesh.materials.iter_mut().enumerate() {
         ui.push_id(("mesh material", k), |ui| {
             CollapsingHeader::new(format!("material “{}”", m.name))

@@ -1,9 +1,11 @@
 //! Small widgets every section uses: a collapsing section, sliders that
 //! do not clamp what they show, colour buttons that write only on a change.
 
+use super::keying;
 use egui::emath::Numeric;
 use egui::{CollapsingHeader, DragValue, Response, Slider, SliderClamping, Ui};
 use glam::Vec3;
+use marbre_core::animation::ParamPath;
 use marbre_core::scene::UvFrame;
 use marbre_core::scene::color_encoding::{srgb_decode, srgb_encode};
 use std::ops::RangeInclusive;
@@ -110,9 +112,17 @@ pub(super) fn labelled_color(ui: &mut Ui, color: &mut Vec3, label: &str) -> Resp
     .inner
 }
 
-/// Three drag values for a point or direction, each with the same tooltip.
-pub(super) fn vec3_ui(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, hint: &str) {
-    let _ = vec3_field(ui, label, v, speed, hint);
+/// Three drag values for a point or direction, each with the same
+/// tooltip, and the key button of the vector at `path`.
+pub(super) fn vec3_ui(
+    ui: &mut Ui,
+    path: &ParamPath,
+    label: &str,
+    v: &mut Vec3,
+    speed: f32,
+    hint: &str,
+) {
+    keying::vector(ui, path, v, |ui, v| vec3_field(ui, label, v, speed, hint));
 }
 
 /// [`vec3_ui`], its three fields' response joined (changed if any is).
@@ -143,8 +153,10 @@ pub(super) fn vec3_field(
 /// A texture frame (the report's ATX, APTX, ATX3D): ticked, its origin and
 /// two axes as vector fields; unticked, None. A frame that spans no plane
 /// is shown with the reason (the renderer reads it as no frame).
+/// `path`: the frame's parameter path, for its vectors' key buttons.
 pub(super) fn uv_frame_ui(
     ui: &mut Ui,
+    path: &ParamPath,
     frame: &mut Option<UvFrame>,
     label: &str,
     hint: &str,
@@ -159,6 +171,7 @@ pub(super) fn uv_frame_ui(
     };
     vec3_ui(
         ui,
+        &path.field("origin"),
         "origin",
         &mut f.origin,
         0.01,
@@ -166,6 +179,7 @@ pub(super) fn uv_frame_ui(
     );
     vec3_ui(
         ui,
+        &path.field("u_axis"),
         "u axis",
         &mut f.u_axis,
         0.01,
@@ -173,6 +187,7 @@ pub(super) fn uv_frame_ui(
     );
     vec3_ui(
         ui,
+        &path.field("v_axis"),
         "v axis",
         &mut f.v_axis,
         0.01,

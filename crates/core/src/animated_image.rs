@@ -232,6 +232,88 @@ mod tests {
         );
     }
 
+    /// Whether ffmpeg is here; without it, a loud banner (a failure
+    /// under `MARBRE_REQUIRE_GPU=1`, as CI runs, where `.ci/run` installs
+    /// it).
+    fn ffmpeg_or_skip(test: &str) -> bool {
+        if ffmpeg_available() {
+            return true;
+        }
+        let banner = format!(
+            "SKIPPED {test}: ffmpeg is not installed (Debian package `ffmpeg`); \
+             its WebP and MP4 files are not checked"
+        );
+        assert!(
+            std::env::var("MARBRE_REQUIRE_GPU").as_deref() != Ok("1"),
+            "{banner} (MARBRE_REQUIRE_GPU=1 turns the skip into a failure)"
+        );
+        eprintln!("\n{}\n{banner}\n{}\n", "!".repeat(72), "!".repeat(72));
+        false
+    }
+
+    /// The frames of an animated WebP, read from its RIFF chunks (ffmpeg
+    /// 5 writes animated WebP but does not read it back): the canvas
+    /// (VP8X) and the number of frames (ANMF).
+    fn webp_canvas_and_frames(bytes: &[u8]) -> ((u32, u32), usize) {
+        assert_eq!(&bytes[0..4], b"RIFF");
+        assert_eq!(&bytes[8..12], b"WEBP");
+        let (mut at, mut canvas, mut frames) = (12, (0, 0), 0);
+        while at + 8 <= bytes.len() {
+            let id = &bytes[at..at + 4];
+            let size = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap()) as usize;
+            let data = &bytes[at + 8..at + 8 + size];
+            let u24 = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], 0]) + 1;
+            match id {
+                b"VP8X" => canvas = (u24(&data[4..7]), u24(&data[7..10])),
+                b"ANMF" => frames += 1,
+                _ => {}
+            }
+            at += 8 + size + size % 2;
+        }
+        (canvas, frames)
+    }
+
+    /// Through ffmpeg: the WebP holds every frame at the frames' size;
+    /// the MP4, probed by ffprobe, holds every frame, its sides padded
+    /// to even numbers (yuv420p), at the frame rate asked.
+    #[test]
+    fn webp_and_mp4_hold_every_frame() {
+        if !ffmpeg_or_skip("webp_and_mp4_hold_every_frame") {
+            return;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let written: Vec<RgbaImage> = (0..7u8)
+            .map(|i| RgbaImage::from_fn(9, 5, |x, _| image::Rgba([i * 30, x as u8 * 25, 0, 255])))
+            .collect();
+        let webp = dir.path().join("a.webp");
+        save_animation(&written, 12.0, &webp).unwrap();
+        assert_eq!(
+            webp_canvas_and_frames(&std::fs::read(&webp).unwrap()),
+            ((9, 5), 7)
+        );
+        let mp4 = dir.path().join("a.mp4");
+        save_animation(&written, 12.0, &mp4).unwrap();
+        let probe = Command::new("ffprobe")
+            .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
+            .args([
+                "-show_entries",
+                "stream=nb_read_frames,width,height,r_frame_rate",
+            ])
+            .args(["-of", "default=noprint_wrappers=1"])
+            .arg(&mp4)
+            .output()
+            .unwrap();
+        let text = String::from_utf8(probe.stdout).unwrap();
+        for expected in [
+            "width=10",
+            "height=6",
+            "r_frame_rate=12/1",
+            "nb_read_frames=7",
+        ] {
+            assert!(text.lines().any(|l| l == expected), "{expected} in {text}");
+        }
+    }
+
     /// An unknown extension, and WebP or MP4 without ffmpeg, are refused
     /// naming the file (and the package), nothing written.
     #[test]

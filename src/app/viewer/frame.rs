@@ -4,7 +4,7 @@
 
 use super::Viewer;
 use crate::app::screenshots;
-use crate::app::ui_layer::{self, Compositor, Mode, UiLayer};
+use crate::app::ui_layer::{self, Compositor, Mode, Redraw, UiLayer};
 use crate::panel::{QualityStats, Stats};
 use anyhow::{Context as _, Result};
 use marbre_core::scene::Change;
@@ -390,21 +390,37 @@ impl Viewer {
             self.ui_layer = Some(UiLayer::new(&self.ctx.device, &self.config, &compositor));
         }
         let key = ui_layer::output_key(paint_jobs, screen);
+        let bands = match mode {
+            Mode::Copied => ui_layer::band_fingerprints(paint_jobs, screen),
+            Mode::Blended => None,
+        };
         let mut layer = self.ui_layer.take().expect("made above");
         let mut extra = Vec::new();
-        if let Some(view) = layer.view_to_redraw(key, mode) {
-            extra = self.update_egui_buffers(encoder, paint_jobs, screen);
-            let clear = match mode {
-                Mode::Copied => BACKGROUND,
-                Mode::Blended => wgpu::Color::TRANSPARENT,
-            };
-            self.draw_egui(
-                encoder,
-                view,
-                wgpu::LoadOp::Clear(clear),
-                paint_jobs,
-                screen,
-            );
+        match layer.redraw(key, mode, bands) {
+            Redraw::Nothing => {}
+            Redraw::Whole(view) => {
+                extra = self.update_egui_buffers(encoder, paint_jobs, screen);
+                let clear = match mode {
+                    Mode::Copied => BACKGROUND,
+                    Mode::Blended => wgpu::Color::TRANSPARENT,
+                };
+                let mut pass = self.egui_pass(encoder, view, wgpu::LoadOp::Clear(clear));
+                self.egui_renderer.render(&mut pass, paint_jobs, screen);
+            }
+            Redraw::Rows(_, rows) if rows.is_empty() => {}
+            Redraw::Rows(view, rows) => {
+                extra = self.update_egui_buffers(encoder, paint_jobs, screen);
+                let mut pass = self.egui_pass(encoder, view, wgpu::LoadOp::Load);
+                ui_layer::draw_rows(
+                    &self.egui_renderer,
+                    &compositor,
+                    &mut pass,
+                    paint_jobs,
+                    screen,
+                    &rows,
+                    BACKGROUND,
+                );
+            }
         }
         let mut drawn = Ok(());
         for &(texture, view) in targets {
@@ -426,16 +442,14 @@ impl Viewer {
         drawn.map(|()| extra)
     }
 
-    /// Records egui's pass onto `view`.
-    fn draw_egui(
-        &mut self,
+    /// Begins egui's pass onto `view`.
+    fn egui_pass(
+        &self,
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::TextureView,
         load: wgpu::LoadOp<wgpu::Color>,
-        paint_jobs: &[egui::ClippedPrimitive],
-        screen: &egui_wgpu::ScreenDescriptor,
-    ) {
-        let mut pass = encoder
+    ) -> wgpu::RenderPass<'static> {
+        encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("egui"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -454,8 +468,7 @@ impl Viewer {
                     .and_then(|t| t.render_pass(Pass::Ui)),
                 ..Default::default()
             })
-            .forget_lifetime();
-        self.egui_renderer.render(&mut pass, paint_jobs, screen);
+            .forget_lifetime()
     }
 
     fn take_screenshot(&mut self) {
@@ -505,9 +518,10 @@ impl Viewer {
                 .collect()
         });
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames ({} kernel); estimated error {error}; trace pass {trace}; other passes: {}",
+            "quality: {spp} spp accumulated in {} frames ({} kernel, window at {:.1} fps); estimated error {error}; trace pass {trace}; other passes: {}",
             self.clock.frames,
             self.renderer.kernel(),
+            self.clock.fps,
             if passes.is_empty() {
                 "not timed".to_owned()
             } else {

@@ -663,7 +663,7 @@ impl Viewer {
                 frames: 0..=animation.frame_count() - 1,
                 fps: animation.fps,
                 overwrite: true,
-                animation: None,
+                animation: self.panel.render_dialog.animation_file(),
             }
         } else {
             Timing::Still {
@@ -932,10 +932,9 @@ impl Viewer {
         self.handle_actions(actions);
         self.handle_shortcuts(pressed);
         let keys = panel::keying::take_requests(&self.egui_ctx);
-        if !keys.is_empty() {
-            let animation = self.scene.animation.get_or_insert_with(Default::default);
-            for (path, value) in keys {
-                animation.insert_key(&path, time, &value);
+        for (path, value) in keys {
+            if let Err(why) = self.scene.insert_key(&path, time, &value) {
+                self.panel.error(format!("No key on {path}: {why}"));
             }
         }
         if let Some(answer) = answer {

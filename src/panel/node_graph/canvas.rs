@@ -5,6 +5,7 @@
 
 use super::Swatches;
 use super::layout::{NODE_WIDTH, UNMEASURED_HEIGHT, auto_positions};
+use crate::panel::keying;
 use crate::panel::material_editor::{image_source_ui, mapping_ui, math_ui, pattern_ui, ramp_ui};
 use crate::panel::widgets::{color_button, slider};
 use egui::epaint::CubicBezierShape;
@@ -352,9 +353,9 @@ fn texture_node(
                 if matches!(texture.pattern, Pattern::Image { .. }) {
                     image_source_ui(ui, &mut texture.image);
                 }
-                mapping_ui(ui, &mut texture.mapping);
+                mapping_ui(ui, &mut texture.mapping, &node);
                 ramp_ui(ui, texture, &node);
-                math_ui(ui, &mut texture.ops);
+                math_ui(ui, &mut texture.ops, &node);
             });
         let reads_children =
             texture.ramp.is_empty() && !matches!(texture.pattern, Pattern::Image { .. });
@@ -373,7 +374,10 @@ fn texture_node(
             let label = if constant { "value" } else { label };
             let input = path.child(socket_kind);
             let row = ui
-                .horizontal(|ui| value_input(ui, label, child, input.is_color()))
+                .horizontal(|ui| {
+                    let at = node.field(if socket_kind == Socket::A { "a" } else { "b" });
+                    value_input(ui, &at, label, child, input.is_color())
+                })
                 .response
                 .rect;
             input_socket(ui, top_left.x, row, input, linked, sockets);
@@ -420,21 +424,27 @@ fn input_socket(
     sockets.inputs.push((path, at));
 }
 
-/// An input's inline value, or its name alone when a texture is linked.
-fn value_input(ui: &mut Ui, label: &str, child: &mut Child, is_color: bool) {
+/// An input's inline value (`path`: its parameter path, for the key
+/// button), or its name alone when a texture is linked.
+fn value_input(ui: &mut Ui, path: &ParamPath, label: &str, child: &mut Child, is_color: bool) {
     match child {
         Child::Texture(_) => {
             ui.add(Label::new(label).selectable(false));
         }
         Child::Color(c) if is_color => {
-            color_button(ui, c);
-            ui.label(label);
+            keying::vector(ui, path, c, |ui, c| {
+                let r = color_button(ui, c);
+                ui.label(label);
+                r
+            });
         }
         Child::Color(c) => {
-            ui.add(slider(&mut c.x, 0.0..=1.0, label));
+            keying::number(ui, &path.index(0), &mut c.x, |ui, v| {
+                ui.add(slider(v, 0.0..=1.0, label))
+            });
         }
         Child::Scalar(v) => {
-            ui.add(slider(v, 0.0..=1.0, label));
+            keying::number(ui, path, v, |ui, v| ui.add(slider(v, 0.0..=1.0, label)));
         }
     }
 }

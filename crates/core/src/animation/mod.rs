@@ -12,7 +12,7 @@ pub mod curve;
 pub mod param_path;
 
 pub use curve::{Extrapolation, Interpolation, Key, KeyValue};
-pub use param_path::{ParamPath, Step};
+pub use param_path::{Naming, ParamPath, Step};
 
 use serde::{Deserialize, Serialize};
 

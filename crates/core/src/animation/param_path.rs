@@ -15,7 +15,7 @@
 //! (`spheres["marble"]`, stable when spheres are added or reordered), by
 //! its index otherwise (`ramp[2]`).
 
-use crate::scene::Scene;
+use crate::scene::{Property, Scene};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
@@ -246,6 +246,84 @@ fn locate<'p>(scene: &Scene, path: &'p ParamPath) -> Result<(Part, &'p [Step]), 
     })
 }
 
+/// The value `steps` lead to inside a part's tree, and the same steps
+/// with each list element named as `naming` asks.
+///
+/// A texture written as its value (`specular: 0.04`, `diffuse: (0.8, 0.1,
+/// 0.1)`: a constant's short form) holds that value in its `a` (and `b`):
+/// `….specular.a` names it whichever form the preset uses, as the panel's
+/// key button does, so a key on a constant stays on the same number when
+/// the constant becomes a pattern and the preset writes it whole.
+fn descend<'v>(
+    tree: &'v mut Value,
+    steps: &[Step],
+    naming: Naming,
+) -> Result<(&'v mut Value, Vec<Step>), String> {
+    let mut at = tree;
+    let mut named = Vec::with_capacity(steps.len());
+    let mut holder: Option<&Step> = None;
+    for step in steps {
+        let short_constant = matches!(holder, Some(Step::Field(f)) if is_texture_root(f))
+            && matches!(step, Step::Field(f) if f == "a" || f == "b")
+            && numbers(at).is_some();
+        named.push(step.clone());
+        if !short_constant {
+            at = through_variant(at, step);
+            if let (Step::Index(_) | Step::Name(_), Value::Array(list)) = (step, &*at) {
+                let names: Vec<&str> = list
+                    .iter()
+                    .map(|v| v.get("name").and_then(Value::as_str).unwrap_or(""))
+                    .collect();
+                let i = match step {
+                    Step::Index(i) => Some(*i),
+                    _ => names
+                        .iter()
+                        .position(|n| Step::Name((*n).to_owned()) == *step),
+                };
+                if let Some(i) = i.filter(|&i| i < names.len()) {
+                    *named.last_mut().expect("pushed") = naming.element(&names, i);
+                }
+            }
+            at = child(at, step)?;
+        }
+        holder = Some(step);
+    }
+    Ok((at, named))
+}
+
+/// How a path names the elements of lists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Naming {
+    /// By name where the element has one no other shares (`spheres["marble"]`),
+    /// by index otherwise: the names the CLI lists and keys are saved under,
+    /// which stay true when elements are added or reordered.
+    Names,
+    /// By index (`spheres[0]`): the names the panel builds from where a
+    /// control sits.
+    Indices,
+}
+
+impl Naming {
+    /// The step naming element `i` of a list whose elements are named
+    /// `names` ("" for none).
+    fn element(self, names: &[&str], i: usize) -> Step {
+        let name = names[i];
+        let unique = names.iter().filter(|n| **n == name).count() == 1;
+        if self == Naming::Names && !name.is_empty() && unique {
+            Step::Name(name.to_owned())
+        } else {
+            Step::Index(i)
+        }
+    }
+}
+
+/// Whether a material's field of this name holds a texture tree (a
+/// property, the bump, a layer's mask), which a preset may write as its
+/// value.
+fn is_texture_root(field: &str) -> bool {
+    field == "bump" || field == "mask" || Property::ALL.iter().any(|p| p.name() == field)
+}
+
 /// What a step does to a value tree, read-only or not.
 fn child<'v>(value: &'v mut Value, step: &Step) -> Result<&'v mut Value, String> {
     let value = through_variant(value, step);
@@ -346,13 +424,54 @@ fn write_through<T: Serialize + DeserializeOwned>(
     components: &[f32],
 ) -> Result<(), String> {
     let mut tree = to_tree(&*part);
-    let mut at = &mut tree;
-    for step in steps {
-        at = child(at, step)?;
-    }
-    write_numbers(at, components)?;
+    write_numbers(descend(&mut tree, steps, Naming::Indices)?.0, components)?;
     *part = serde_json::from_value(tree).map_err(|e| format!("the new value: {e}"))?;
     Ok(())
+}
+
+/// The path of one part of the scene, its list elements named as `naming`
+/// asks.
+fn part_path(scene: &Scene, part: Part, naming: Naming) -> ParamPath {
+    let root = |name: &str| ParamPath(vec![Step::Field(name.to_owned())]);
+    let element = |list: &str, names: Vec<&str>, i: usize| {
+        let mut path = root(list);
+        path.0.push(naming.element(&names, i));
+        path
+    };
+    let meshes = || scene.meshes.iter().map(|m| m.name.as_str()).collect();
+    match part {
+        Part::Camera => root("camera"),
+        Part::Sphere(i) => element(
+            "spheres",
+            scene.spheres.iter().map(|s| s.name.as_str()).collect(),
+            i,
+        ),
+        Part::Cylinder(i) => element(
+            "cylinders",
+            scene.cylinders.iter().map(|c| c.name.as_str()).collect(),
+            i,
+        ),
+        Part::Polygon(i) => element(
+            "polygons",
+            scene.polygons.iter().map(|p| p.name.as_str()).collect(),
+            i,
+        ),
+        Part::Ground => root("ground"),
+        Part::MeshPlacement(i) => element("meshes", meshes(), i).field("placement"),
+        Part::MeshMaterial(i, j) => {
+            let mut path = element("meshes", meshes(), i).field("materials");
+            let names = scene.meshes[i]
+                .materials
+                .iter()
+                .map(|m| m.name.as_str())
+                .collect::<Vec<_>>();
+            path.0.push(naming.element(&names, j));
+            path.field("material")
+        }
+        Part::PointLight => root("point_light"),
+        Part::Environment => root("environment"),
+        Part::Render => root("render"),
+    }
 }
 
 /// The value tree of one part of the scene.
@@ -378,11 +497,8 @@ impl Scene {
     pub fn parameter(&self, path: &ParamPath) -> Result<Vec<f32>, String> {
         let (part, steps) = locate(self, path)?;
         let mut tree = part_tree(self, part);
-        let mut at = &mut tree;
-        for step in steps {
-            at = child(at, step)?;
-        }
-        numbers(at).ok_or_else(|| "not a number or a vector of numbers".to_owned())
+        numbers(descend(&mut tree, steps, Naming::Indices)?.0)
+            .ok_or_else(|| "not a number or a vector of numbers".to_owned())
     }
 
     /// Sets the number(s) at `path`.
@@ -407,62 +523,44 @@ impl Scene {
         }
     }
 
+    /// `path` with its list elements named as `naming` asks: a parameter
+    /// named by index and by name has one name of each kind, which is
+    /// how the panel (by index) and the tracks (by name) find each other.
+    pub fn parameter_name(&self, path: &ParamPath, naming: Naming) -> Result<ParamPath, String> {
+        let (part, steps) = locate(self, path)?;
+        let mut tree = part_tree(self, part);
+        let (_, inside) = descend(&mut tree, steps, naming)?;
+        let mut name = part_path(self, part, naming);
+        name.0.extend(inside);
+        Ok(name)
+    }
+
     /// Every animatable parameter of the scene with its current value: the
     /// list the tests check round-trips, and the CLI prints.
     pub fn animatable_parameters(&self) -> Vec<(ParamPath, Vec<f32>)> {
         let mut out = Vec::new();
-        let root = |name: &str| ParamPath(vec![Step::Field(name.to_owned())]);
-        let element = |list: &str, i: usize, name: &str| {
-            let path = root(list);
-            if name.is_empty() || !unique(self, list, name) {
-                path.index(i)
-            } else {
-                path.named(name)
-            }
-        };
-        leaves(&to_tree(&self.camera), root("camera"), &mut out);
-        for (i, s) in self.spheres.iter().enumerate() {
-            leaves(&to_tree(s), element("spheres", i, &s.name), &mut out);
+        for part in parts(self) {
+            let path = part_path(self, part, Naming::Names);
+            leaves(&part_tree(self, part), path, &mut out);
         }
-        for (i, c) in self.cylinders.iter().enumerate() {
-            leaves(&to_tree(c), element("cylinders", i, &c.name), &mut out);
-        }
-        for (i, p) in self.polygons.iter().enumerate() {
-            leaves(&to_tree(p), element("polygons", i, &p.name), &mut out);
-        }
-        if let Some(g) = &self.ground {
-            leaves(&to_tree(g), root("ground"), &mut out);
-        }
-        for (i, m) in self.meshes.iter().enumerate() {
-            let mesh = element("meshes", i, &m.name);
-            leaves(&to_tree(&m.placement), mesh.field("placement"), &mut out);
-            for (j, mm) in m.materials.iter().enumerate() {
-                let materials = mesh.field("materials");
-                let at = if mm.name.is_empty() {
-                    materials.index(j)
-                } else {
-                    materials.named(&mm.name)
-                };
-                leaves(&to_tree(&mm.material), at.field("material"), &mut out);
-            }
-        }
-        if let Some(l) = &self.point_light {
-            leaves(&to_tree(l), root("point_light"), &mut out);
-        }
-        leaves(&to_tree(&self.environment), root("environment"), &mut out);
-        leaves(&to_tree(&self.render), root("render"), &mut out);
         out
     }
 }
 
-fn unique(scene: &Scene, list: &str, name: &str) -> bool {
-    let count = match list {
-        "spheres" => scene.spheres.iter().filter(|s| s.name == name).count(),
-        "cylinders" => scene.cylinders.iter().filter(|c| c.name == name).count(),
-        "polygons" => scene.polygons.iter().filter(|p| p.name == name).count(),
-        _ => scene.meshes.iter().filter(|m| m.name == name).count(),
-    };
-    count == 1
+/// Every part of `scene`, in the order the CLI lists them.
+fn parts(scene: &Scene) -> Vec<Part> {
+    let mut all = vec![Part::Camera];
+    all.extend((0..scene.spheres.len()).map(Part::Sphere));
+    all.extend((0..scene.cylinders.len()).map(Part::Cylinder));
+    all.extend((0..scene.polygons.len()).map(Part::Polygon));
+    all.extend(scene.ground.as_ref().map(|_| Part::Ground));
+    for (i, mesh) in scene.meshes.iter().enumerate() {
+        all.push(Part::MeshPlacement(i));
+        all.extend((0..mesh.materials.len()).map(|j| Part::MeshMaterial(i, j)));
+    }
+    all.extend(scene.point_light.as_ref().map(|_| Part::PointLight));
+    all.extend([Part::Environment, Part::Render]);
+    all
 }
 
 fn to_tree<T: Serialize>(part: &T) -> Value {
@@ -472,6 +570,12 @@ fn to_tree<T: Serialize>(part: &T) -> Value {
 /// The numbers and vectors of numbers under `value`, each with its path.
 fn leaves(value: &Value, path: ParamPath, out: &mut Vec<(ParamPath, Vec<f32>)>) {
     if let Some(n) = numbers(value) {
+        // A texture written as its value: named by its `a`, as `descend`
+        // reads it and the panel's key button names it.
+        let path = match path.0.last() {
+            Some(Step::Field(f)) if is_texture_root(f) => path.field("a"),
+            _ => path,
+        };
         out.push((path, n));
         return;
     }
@@ -490,20 +594,13 @@ fn leaves(value: &Value, path: ParamPath, out: &mut Vec<(ParamPath, Vec<f32>)>) 
             }
         }
         Value::Array(items) => {
-            let names: Vec<Option<&str>> = items
+            let names: Vec<&str> = items
                 .iter()
-                .map(|v| v.get("name").and_then(Value::as_str))
+                .map(|v| v.get("name").and_then(Value::as_str).unwrap_or(""))
                 .collect();
             for (i, v) in items.iter().enumerate() {
-                let at = match names[i] {
-                    Some(n)
-                        if !n.is_empty()
-                            && names.iter().filter(|m| **m == Some(n)).count() == 1 =>
-                    {
-                        path.named(n)
-                    }
-                    _ => path.index(i),
-                };
+                let mut at = path.clone();
+                at.0.push(Naming::Names.element(&names, i));
                 leaves(v, at, out);
             }
         }

@@ -118,6 +118,82 @@ fn parameters_are_named_as_the_preset_writes_them() {
     assert_eq!(scene.parameter(&by_index), Ok(vec![0.9]));
 }
 
+/// A constant property, which a preset writes as its value
+/// (`roughness: 0.15`), is named by its `a` as the panel's key button names
+/// it: the CLI lists that name, a key on it writes the short form back,
+/// and the same path keeps naming `a` once the property is a pattern.
+/// `a` is no field of a plain vector.
+#[test]
+fn a_constant_written_as_its_value_is_named_by_its_a() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
+    let mut scene = preset::load(&file).unwrap().preset.scene;
+    let roughness = ParamPath::parse("spheres[\"marble\"].material.roughness.a").unwrap();
+    assert_eq!(scene.parameter(&roughness), Ok(vec![0.15]));
+    assert!(
+        scene
+            .animatable_parameters()
+            .iter()
+            .any(|(p, v)| *p == roughness && *v == [0.15]),
+        "{roughness} is not listed"
+    );
+    scene.set_parameter(&roughness, &[0.25]).unwrap();
+    let material = &scene.spheres[0].material;
+    assert_eq!(
+        material.roughness.as_constant(),
+        Some(&crate::scene::Child::Scalar(0.25))
+    );
+    let written = ron::to_string(material).unwrap();
+    assert!(written.contains("roughness:0.25"), "{written}");
+    let specular = ParamPath::parse("spheres[0].material.specular.a").unwrap();
+    assert_eq!(scene.parameter(&specular), Ok(vec![0.05; 3]));
+    scene.spheres[0].material.roughness =
+        crate::scene::Texture::blend(crate::scene::Pattern::Checker { size: 1.0 }, 0.5, 0.75);
+    assert_eq!(scene.parameter(&roughness), Ok(vec![0.5]));
+    let b = ParamPath::parse("spheres[\"marble\"].material.roughness.b").unwrap();
+    assert_eq!(scene.parameter(&b), Ok(vec![0.75]));
+    let not_a_texture = ParamPath::parse("camera.target.a").unwrap();
+    assert!(scene.parameter(&not_a_texture).is_err());
+}
+
+/// The panel names a number by index (`spheres[0]`), the CLI and saved
+/// tracks by name (`spheres["marble"]`): a key from the panel lands on the
+/// track of the same number whichever way that track names it, a new
+/// track is named by name, and both names translate into each other.
+/// A path naming no number gets no key.
+#[test]
+fn a_key_finds_its_track_by_index_or_by_name() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
+    let mut scene = preset::load(&file).unwrap().preset.scene;
+    let by_index = ParamPath::parse("spheres[0].material.diffuse.ramp[1].position").unwrap();
+    let by_name =
+        ParamPath::parse("spheres[\"marble\"].material.diffuse.ramp[1].position").unwrap();
+    assert_eq!(
+        scene.parameter_name(&by_index, Naming::Names),
+        Ok(by_name.clone())
+    );
+    assert_eq!(
+        scene.parameter_name(&by_name, Naming::Indices),
+        Ok(by_index.clone())
+    );
+    scene.insert_key(&by_index, 0.0, &[0.2]).unwrap();
+    scene.insert_key(&by_name, 1.0, &[0.8]).unwrap();
+    let tracks = &scene.animation.as_ref().unwrap().tracks;
+    assert_eq!(tracks.len(), 1, "{tracks:?}");
+    assert_eq!(tracks[0].path, by_name.to_string());
+    assert_eq!(tracks[0].keys.len(), 2);
+    // A track a person wrote by index keeps its name and gets the key.
+    scene.animation.as_mut().unwrap().tracks[0].path = by_index.to_string();
+    scene.insert_key(&by_name, 2.0, &[0.5]).unwrap();
+    let tracks = &scene.animation.as_ref().unwrap().tracks;
+    assert_eq!(tracks.len(), 1, "{tracks:?}");
+    assert_eq!(tracks[0].path, by_index.to_string());
+    assert_eq!(tracks[0].keys.len(), 3);
+    let nowhere = ParamPath::parse("spheres[\"ghost\"].radius").unwrap();
+    let e = scene.insert_key(&nowhere, 0.0, &[1.0]).unwrap_err();
+    assert!(e.contains("ghost"), "{e}");
+    assert_eq!(scene.animation.as_ref().unwrap().tracks.len(), 1);
+}
+
 fn keyed(path: &str, keys: &[(f32, f32)]) -> Scene {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/default.ron");
     let mut scene = preset::load(&file).unwrap().preset.scene;

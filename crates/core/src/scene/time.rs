@@ -4,7 +4,7 @@
 //! not import the scene back.
 
 use super::Scene;
-use crate::animation::{Animation, Track};
+use crate::animation::{Animation, Naming, ParamPath, Track};
 
 impl Animation {
     /// Why the animation cannot be traced on `scene`, each problem naming
@@ -79,6 +79,38 @@ impl Scene {
             || self
                 .materials()
                 .any(|m| m.signals().iter().any(|s| s.noise.evolution.is_some()))
+    }
+
+    /// Inserts a key of value `components` at `time` on the track of the
+    /// parameter `path` names, however it names it (the panel names
+    /// elements by index): an existing track on the same parameter gets
+    /// the key, a new track is named as the CLI lists parameters
+    /// ([`Naming::Names`]). A path that names no number is refused.
+    pub fn insert_key(
+        &mut self,
+        path: &ParamPath,
+        time: f32,
+        components: &[f32],
+    ) -> Result<(), String> {
+        self.parameter(path)?;
+        let name = self.parameter_name(path, Naming::Names)?;
+        let same = |track: &Track| {
+            track
+                .parsed_path()
+                .and_then(|p| self.parameter_name(&p, Naming::Names))
+                .is_ok_and(|p| p == name)
+        };
+        let track_path = self
+            .animation
+            .iter()
+            .flat_map(|a| &a.tracks)
+            .find(|t| same(t))
+            .and_then(|t| t.parsed_path().ok())
+            .unwrap_or(name);
+        self.animation
+            .get_or_insert_with(Default::default)
+            .insert_key(&track_path, time, components);
+        Ok(())
     }
 
     /// The scene as traced at `time` seconds: each track's value written
