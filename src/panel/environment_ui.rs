@@ -81,10 +81,12 @@ pub(super) fn source_fields_ui(
     match source {
         EnvSource::None => {}
         EnvSource::Constant { radiance } => {
-            labelled_color(ui, radiance, "colour").on_hover_text(
-                "Radiance arriving from every direction, times the intensity below \
-                 (white at intensity 1 is the white-furnace test)",
-            );
+            let path = ParamPath::parse("environment.source.radiance").expect("a path");
+            keying::vector(ui, &path, radiance, |ui, c| labelled_color(ui, c, "colour"))
+                .on_hover_text(
+                    "Radiance arriving from every direction, times the intensity below \
+                     (white at intensity 1 is the white-furnace test)",
+                );
         }
         EnvSource::LatLong { path } => {
             ui.label(format!("current: {}", path.display()))

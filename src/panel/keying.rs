@@ -111,7 +111,11 @@ pub fn vector(
 /// and yellow on a key, green between keys (`keyed`: whether a key sits
 /// at the play head). Drawn, not a glyph: egui's default fonts have none.
 fn key_button(ui: &mut Ui, keyed: Option<bool>) -> Response {
-    let size = egui::vec2(16.0, ui.spacing().interact_size.y);
+    // Close to the control and narrow: a row with its button must fit the
+    // panel's default width (a nested constant colour's row is the
+    // widest), or the panel grows.
+    ui.spacing_mut().item_spacing.x = 3.0;
+    let size = egui::vec2(12.0, ui.spacing().interact_size.y);
     let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click());
     let visuals = ui.style().interact(&response);
     let c = rect.center();

@@ -18,7 +18,7 @@
 //! kept for the scene).
 //!
 //! The panel is found by its layout: a 1280×720 window (the default size,
-//! with a fresh settings folder), the side panel its default 380 points
+//! with a fresh settings folder), the side panel its default 396 points
 //! wide on the right at scale 1, and the sections folded from the top so
 //! that the Point light section sits at a fixed height whatever messages
 //! the Preset section shows.
@@ -36,7 +36,7 @@ use std::time::{Duration, Instant};
 use crate::REPO;
 
 /// The side panel's left edge at the default window size.
-pub(crate) const PANEL_LEFT: i32 = 900;
+pub(crate) const PANEL_LEFT: i32 = 884;
 /// Height of a folded section header, in pixels.
 const HEADER_STEP: i32 = 23;
 /// How long one step may take to show: a preset load builds a shader

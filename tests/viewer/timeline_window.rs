@@ -96,7 +96,7 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
     session.wait_for("scrubbed to 0 s (the light on)", |l| l.centre_luma > 0.6);
 
     // The Environment's intensity row, its key button at the row's end.
-    press(&session, PANEL_LEFT + 251, 127);
+    press(&session, PANEL_LEFT + 244, 127);
     let keyed = save_and_count(&session, &preset, 2);
     let track = &keyed.tracks[1];
     assert_eq!(track.path, "environment.intensity");

@@ -153,7 +153,7 @@ fn window_shows_panel_and_render() {
     // there is no window manager to change that.
     assert_eq!((w, h), (1280, 720), "window screenshot size");
 
-    // The side panel is 380 px wide; its right 300 px are panel and nothing else.
+    // The side panel is 396 px wide; its right 300 px are panel and nothing else.
     let panel = region(&img, w - 300..w, 0..h);
     // The left 700 px above the Quality strip (its top 500 rows) are
     // rendered image and nothing else.
@@ -349,7 +349,7 @@ fn f12_writes_png_and_exr() {
     let (w, h) = png.dimensions();
     let all = region(&png, 0..w, 0..h);
     eprintln!("{TEST}: {} is {w}x{h}, {all:?}", png_path.display());
-    // The image area of a 1280x720 window: the width left of the ~380 px
+    // The image area of a 1280x720 window: the width left of the ~396 px
     // panel, the height above the ~158 px Quality strip (562 measured).
     assert!((520..=600).contains(&h), "screenshot height {h}");
     assert!((800..1280).contains(&w), "screenshot width {w}");
@@ -541,7 +541,7 @@ pub(crate) fn cornell_box_in_the_window(test: &str, kernel: &str, open: [&str; 2
     let img = image::open(&shot)
         .unwrap_or_else(|e| panic!("{}: {e}", shot.display()))
         .to_rgba8();
-    // The image is the left 900 px, above the Quality strip; the box fills
+    // The image is the left 884 px, above the Quality strip; the box fills
     // its middle (measured on lavapipe: walls from x ≈ 190 to 705, the
     // light at the top centre, y ≈ 72 to 93, with the preset's camera;
     // x ≈ 209 to 692 and y ≈ 84 to 101 framed from the OBJ file alone):

@@ -518,7 +518,7 @@ impl Viewer {
                 .collect()
         });
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames ({} kernel, window at {:.1} fps); estimated error {error}; trace pass {trace}; other passes: {}",
+            "quality: {spp} spp accumulated in {} frames ({} kernel); window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
             self.clock.frames,
             self.renderer.kernel(),
             self.clock.fps,

@@ -45,8 +45,10 @@ use std::time::Instant;
 use winit::event::WindowEvent;
 use winit::window::{Fullscreen, Window};
 
-/// Width of the side panel, in points, when the window opens.
-const PANEL_WIDTH: f32 = 380.0;
+/// Width of the side panel, in points, when the window opens: room for a
+/// nested constant colour's row with its key button (a wider row would
+/// widen the panel by itself).
+const PANEL_WIDTH: f32 = 396.0;
 /// Height of the Quality strip under the image, in points, when the window
 /// opens: a fifth of a 720-pt window (it was a quarter); it can be dragged
 /// taller, or folded to its header line.
