@@ -111,6 +111,7 @@ impl RenderDialog {
             // what it shows.
             allow_placeholders: true,
             timing: Default::default(),
+            sample_offset: 0,
         })
     }
 

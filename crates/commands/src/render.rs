@@ -104,6 +104,12 @@ pub struct RenderArgs {
     /// ffmpeg, which must be installed).
     #[arg(long, requires = "frames", value_name = "FILE")]
     pub animation: Option<PathBuf>,
+    /// Trace samples [K, K + spp) of the one long render instead of the
+    /// first spp: renders at offsets 0, N, 2N… of --spp N are disjoint
+    /// batches (for a farm) whose mean is the render of all their
+    /// samples. A multiple of the preset's samples_per_frame.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub sample_offset: u32,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -184,6 +190,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         denoise_exr: args.denoise_exr,
         allow_placeholders: args.allow_placeholders,
         timing,
+        sample_offset: args.sample_offset,
     };
     let frames = match &job.timing {
         Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,

@@ -79,6 +79,12 @@ pub struct FinalRender {
     pub allow_placeholders: bool,
     /// The moment traced, or the frames of a sequence.
     pub timing: Timing,
+    /// The first sample traced (`render --sample-offset`): `spp` samples
+    /// from it are samples [offset, offset + spp) of the one long render
+    /// of the frame, so that renders at offsets 0, N, 2N… of N samples
+    /// each are disjoint batches whose mean is the render of all their
+    /// samples. A multiple of the scene's samples per frame.
+    pub sample_offset: u32,
 }
 
 /// How far a render has come, after each round of samples.
@@ -283,6 +289,14 @@ pub fn render_to_file(
     if !job.allow_placeholders {
         refuse_substitutes(&loaded)?;
     }
+    let per_round = loaded.scene.render.samples_per_frame.max(1);
+    if !job.sample_offset.is_multiple_of(per_round) {
+        bail!(
+            "--sample-offset {} is not a multiple of the preset's samples_per_frame ({per_round}): \
+             a batch starts where a round of the long render starts",
+            job.sample_offset
+        );
+    }
     let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
     let mut renderer = renderer_fitting(ctx, &loaded, job.size, kernel)?;
@@ -290,7 +304,7 @@ pub fn render_to_file(
         if index > 0 {
             renderer.set_scene(ctx, &base.at_time(planned.time))?;
         }
-        renderer.restart_at_frame(planned.frame);
+        renderer.restart_at_sample(planned.frame, job.sample_offset);
         let mut in_sequence = InSequence {
             observer: &mut *observer,
             frame: index as u32,
@@ -433,6 +447,8 @@ fn accumulate(
     observer: &mut dyn RenderObserver,
 ) -> Result<ControlFlow<()>> {
     while renderer.accumulated_samples() < spp {
+        // The last round traces only the samples left: `--spp` is exact.
+        renderer.limit_round_samples(spp - renderer.accumulated_samples());
         trace_frame(ctx, renderer)?;
         let progress = Progress {
             samples: renderer.accumulated_samples(),
@@ -467,6 +483,7 @@ fn accumulate_to_error(
     while renderer.accumulated_samples() < max_spp {
         // Waiting for each frame keeps the GPU no further ahead than the
         // check: a target reached is not overshot by a queue of frames.
+        renderer.limit_round_samples(max_spp - renderer.accumulated_samples());
         trace_frame(ctx, renderer)?;
         let due = last_check.is_none_or(|t| t.elapsed() >= ERROR_CHECK_INTERVAL);
         if due {

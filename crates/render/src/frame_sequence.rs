@@ -7,7 +7,7 @@ use anyhow::{Result, bail};
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
-/// The frame index (the sample sequence's seed, `Renderer::restart_at_frame`)
+/// The frame index (the sample sequence's seed, `Renderer::restart_at_sample`)
 /// advances by this from one animation frame to the next: each frame's
 /// samples are its own (the noise of the estimate does not freeze on
 /// moving images), deterministic, and disjoint for up to 2¹⁶ rounds a

@@ -1026,6 +1026,7 @@ impl Viewer {
                     denoise_exr: false,
                     allow_placeholders: true,
                     timing: Default::default(),
+                    sample_offset: 0,
                 })
             }
         }

@@ -91,6 +91,7 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         time: None,
         overwrite: false,
         animation: None,
+        sample_offset: 0,
     }
 }
 
@@ -104,6 +105,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         denoise_exr: false,
         allow_placeholders: false,
         timing: Default::default(),
+        sample_offset: 0,
     }
 }
 

@@ -329,7 +329,7 @@ fn a_looped_evolving_noise_meets_its_first_frame() {
     let mut frame_zero_at = |t: f32| {
         let change = request(&ctx, &mut renderer, &scene.at_time(t));
         assert!(Change::MATERIAL_PARAMETERS.contains(change), "{change:?}");
-        renderer.restart_at_frame(0);
+        renderer.restart_at_sample(0, 0);
         image(&ctx, &mut renderer, 2)
     };
     let first = frame_zero_at(0.0);

@@ -17,6 +17,11 @@ use crate::gpu::{non_finite, scene_gpu, trace_bands};
 use anyhow::Result;
 use marbre_core::scene::{Metering, ToneMap};
 
+/// The step between the seeds of consecutive samples of a pixel: the
+/// golden-ratio constant `shaders/trace.wgsl` multiplies the sample's
+/// number by.
+const SAMPLE_SEED_STEP: u32 = 0x9E37_79B9;
+
 impl Renderer {
     /// Traces the rest of the first round and waits for it, if none is
     /// complete yet (a preview may be on show): for screenshots, which
@@ -60,13 +65,43 @@ impl Renderer {
         self.accumulation.reset();
     }
 
-    /// Starts the accumulation again with the samples of animation frame
-    /// `frame` (`frame_sequence::FRAME_SEED_STRIDE` apart): a sequence's
-    /// frames each trace their own, and a frame traced again traces the
-    /// same ones.
-    pub fn restart_at_frame(&mut self, frame: u32) {
+    /// Starts the accumulation again at sample `first` of the samples of
+    /// animation frame `frame` (`frame_sequence::FRAME_SEED_STRIDE`
+    /// apart): a sequence's frames each trace their own, a frame traced
+    /// again traces the same ones, and a render of N samples from `first`
+    /// traces exactly samples [first, first + N) of the frame's one long
+    /// render (`render --sample-offset`).
+    ///
+    /// Sample s of round r is seeded by `s·φ + frame_index`
+    /// (`shaders/trace.wgsl`, φ = `SAMPLE_SEED_STEP`) where the frame
+    /// index grows by one a round; a long render's round r holds samples
+    /// [r·n, (r + 1)·n) for n samples per frame. Starting at `first`, a
+    /// multiple of n, the accumulation counts from 0 again, so the frame
+    /// index takes `first·φ` for the samples before it and `first / n`
+    /// for the rounds before it.
+    pub fn restart_at_sample(&mut self, frame: u32, first: u32) {
         self.reset_accumulation();
-        self.frame_index = frame.wrapping_mul(crate::frame_sequence::FRAME_SEED_STRIDE);
+        self.round_samples = None;
+        let per_round = self.scene.render.samples_per_frame.max(1);
+        self.frame_index = frame
+            .wrapping_mul(crate::frame_sequence::FRAME_SEED_STRIDE)
+            .wrapping_add(first / per_round)
+            .wrapping_add(first.wrapping_mul(SAMPLE_SEED_STEP));
+    }
+
+    /// Makes the rounds that follow trace at most `samples` per pixel:
+    /// fewer than the scene's samples per frame when the samples asked
+    /// end inside a round (an exact `--spp`), which are the first ones of
+    /// that round of the long render.
+    pub fn limit_round_samples(&mut self, samples: u32) {
+        let per_round = self.scene.render.samples_per_frame.max(1);
+        self.round_samples = (samples < per_round).then_some(samples.max(1));
+    }
+
+    /// The samples per pixel the next round traces.
+    fn samples_per_round(&self) -> u32 {
+        self.round_samples
+            .unwrap_or(self.scene.render.samples_per_frame.max(1))
     }
 
     /// Records one whole round: `samples_per_frame` more samples per pixel
@@ -144,8 +179,7 @@ impl Renderer {
             }
             self.accumulation.traced_to(rows.end);
             if rows.end == size.1 {
-                self.accumulation
-                    .advance(self.scene.render.samples_per_frame.max(1), size);
+                self.accumulation.advance(self.samples_per_round(), size);
                 self.frame_index = self.frame_index.wrapping_add(1);
                 work.rounds += 1;
             }
@@ -178,6 +212,7 @@ impl Renderer {
         uniform.light_count = table.lights.len() as u32;
         uniform.light_total_power = table.total_power;
         uniform.triangle_count = self.bindings.meshes.stats().triangles as u32;
+        uniform.samples_per_frame = self.samples_per_round();
         uniform.band_start = rows.start;
         uniform.band_end = rows.end;
         let stride = frame_stride(&ctx.device);

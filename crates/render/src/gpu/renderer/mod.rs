@@ -77,6 +77,9 @@ pub struct Renderer {
     size: (u32, u32),
     render_scale: f32,
     frame_index: u32,
+    /// The samples per pixel of the rounds that follow when fewer than
+    /// the scene's per frame: the last round of an exact `--spp`.
+    round_samples: Option<u32>,
 }
 
 /// What one trace call did.
@@ -133,6 +136,7 @@ impl Renderer {
             size,
             render_scale: 1.0,
             frame_index: 0,
+            round_samples: None,
         })
     }
 

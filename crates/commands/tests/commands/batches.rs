@@ -1,0 +1,167 @@
+//! `marbre render --sample-offset` (issue 30): a render of N samples from
+//! offset K traces samples [K, K + N) of the one long render, so batches
+//! at offsets 0, N, 2N… differ from each other, rerun bit for bit, and
+//! average to the render of all their samples; `--spp` traces exactly the
+//! samples asked whatever the preset's samples per frame. On the GPU
+//! (lavapipe here), with a small lit scene whose estimate is noisy.
+
+use clap::Parser;
+use marbre_commands::render::{self, RenderArgs};
+use marbre_core::image_decode::{IntegerDecode, decode_file};
+use marbre_render::gpu::testing::gpu_or_skip;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
+/// A diffuse ball on a ground, lit by a point light and a constant sky,
+/// paths of three bounces: every pixel's estimate is noisy. `{spf}`:
+/// the samples per frame.
+const BALL: &str = r#"(
+    format_version: 2,
+    scene: (
+        camera: (target: (0.0, 0.0, 0.0), distance: 4.0, yaw_degrees: 20.0, pitch_degrees: 10.0, fov_degrees: 40.0),
+        spheres: [(name: "ball", center: (0.0, 0.0, 0.0), radius: 1.0, material: (diffuse: (0.7, 0.5, 0.3)))],
+        ground: Some((height: -1.0, material: (diffuse: (0.5, 0.5, 0.5)))),
+        point_light: Some((position: (2.0, 3.0, 3.0), color: (1.0, 1.0, 1.0), intensity: 30.0)),
+        environment: (source: Constant(radiance: (0.3, 0.35, 0.4))),
+        render: (samples_per_frame: {spf}, max_bounces: 3),
+    ),
+)"#;
+
+fn scratch(name: &str, spf: u32) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("marbre-batch-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("ball.ron"),
+        BALL.replace("{spf}", &spf.to_string()),
+    )
+    .unwrap();
+    dir
+}
+
+/// `marbre render` of the ball at 40×24 with the fragment kernel, `spp`
+/// samples from `offset`, to `name` in `dir`; its pixels.
+fn render_ball(dir: &Path, name: &str, spp: u32, offset: u32) -> anyhow::Result<Vec<[f32; 4]>> {
+    let output = dir.join(name);
+    let preset = dir.join("ball.ron");
+    let (spp, offset) = (spp.to_string(), offset.to_string());
+    let flags = [
+        "render",
+        "--preset",
+        preset.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--size",
+        "40x24",
+        "--spp",
+        &spp,
+        "--sample-offset",
+        &offset,
+        "--kernel",
+        "fragment",
+    ];
+    render::run(&Cli::try_parse_from(flags).unwrap().args)?;
+    Ok(decode_file(&output, IntegerDecode::Linear).unwrap().pixels)
+}
+
+/// The largest difference between two images, relative to the second's
+/// value (at least 0.01).
+fn largest_relative_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs() / q[c].abs().max(0.01)))
+        .fold(0.0, f32::max)
+}
+
+/// Four batches of 4 samples at offsets 0, 4, 8 and 12 differ from each
+/// other, the first again is the same bytes, and their mean is the
+/// 16-sample render to float rounding; for 1 and 2 samples per frame.
+#[test]
+fn batches_are_disjoint_and_average_to_the_long_render() {
+    if gpu_or_skip("batches_are_disjoint_and_average_to_the_long_render").is_none() {
+        return;
+    }
+    for spf in [1, 2] {
+        let dir = scratch("mean", spf);
+        let batches: Vec<Vec<[f32; 4]>> = (0..4)
+            .map(|i| render_ball(&dir, &format!("b{i}.exr"), 4, 4 * i).unwrap())
+            .collect();
+        for i in 0..4 {
+            for j in i + 1..4 {
+                assert!(
+                    largest_relative_difference(&batches[i], &batches[j]) > 0.05,
+                    "spf {spf}: batches {i} and {j} trace the same samples"
+                );
+            }
+        }
+        render_ball(&dir, "b0-again.exr", 4, 0).unwrap();
+        assert_eq!(
+            std::fs::read(dir.join("b0.exr")).unwrap(),
+            std::fs::read(dir.join("b0-again.exr")).unwrap(),
+            "spf {spf}: a batch traced again differs"
+        );
+        let long = render_ball(&dir, "all.exr", 16, 0).unwrap();
+        let mean: Vec<[f32; 4]> = (0..long.len())
+            .map(|p| {
+                let mut m = [0.0; 4];
+                for b in &batches {
+                    for c in 0..4 {
+                        m[c] += b[p][c] / 4.0;
+                    }
+                }
+                m
+            })
+            .collect();
+        let d = largest_relative_difference(&mean, &long);
+        assert!(
+            d < 1e-4,
+            "spf {spf}: the mean of the batches is {d} from the long render"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+/// With 3 samples per frame: an offset that is not a multiple of 3 is
+/// refused, naming it, and nothing is written; batches of 3 from 0 and
+/// from 3 average to the render of 6; `--spp 5` traces exactly the long
+/// render's first five samples (the first round's three and the second
+/// round's first two, which weighted 3 : 2 make its image), not six.
+#[test]
+fn spp_is_exact_whatever_the_samples_per_frame() {
+    if gpu_or_skip("spp_is_exact_whatever_the_samples_per_frame").is_none() {
+        return;
+    }
+    let dir = scratch("exact", 3);
+    let e = render_ball(&dir, "bad.exr", 3, 4).unwrap_err();
+    assert!(
+        format!("{e:#}").contains("--sample-offset 4") && format!("{e:#}").contains("(3)"),
+        "{e:#}"
+    );
+    assert!(!dir.join("bad.exr").exists());
+    let first = render_ball(&dir, "first3.exr", 3, 0).unwrap();
+    let second = render_ball(&dir, "second3.exr", 3, 3).unwrap();
+    let six = render_ball(&dir, "six.exr", 6, 0).unwrap();
+    let five = render_ball(&dir, "five.exr", 5, 0).unwrap();
+    let two_of_second = render_ball(&dir, "second2.exr", 2, 3).unwrap();
+    // Five samples: the first round's three and the next round's first two.
+    let expected: Vec<[f32; 4]> = (0..six.len())
+        .map(|p| std::array::from_fn(|c| (3.0 * first[p][c] + 2.0 * two_of_second[p][c]) / 5.0))
+        .collect();
+    let d = largest_relative_difference(&five, &expected);
+    assert!(d < 1e-4, "5 spp is {d} from the first five samples");
+    let halves: Vec<[f32; 4]> = (0..six.len())
+        .map(|p| std::array::from_fn(|c| (first[p][c] + second[p][c]) / 2.0))
+        .collect();
+    let d = largest_relative_difference(&halves, &six);
+    assert!(d < 1e-4, "two batches of 3 are {d} from the render of 6");
+    assert!(
+        largest_relative_difference(&five, &six) > 1e-3,
+        "5 spp traced 6"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
