@@ -92,20 +92,26 @@ pub fn release_free_memory() {
 mod tests {
     use super::*;
 
+    /// Other tests in this binary allocate and free (a GPU device's
+    /// tens of megabytes) on their threads between two readings: a
+    /// reading disturbed so is taken again, up to five times; a heap
+    /// whose usage never shows the block fails all five.
     #[test]
     fn a_large_block_shows_in_use_until_freed() {
-        let before = usage().unwrap();
-        let block = vec![1u8; 256 << 20];
-        let holding = usage().unwrap();
-        assert!(
-            holding.in_use_bytes >= before.in_use_bytes + (240 << 20),
-            "{before:?} -> {holding:?}"
-        );
-        drop(std::hint::black_box(block));
-        let after = usage().unwrap();
-        assert!(
-            after.in_use_bytes + (240 << 20) <= holding.in_use_bytes,
-            "{holding:?} -> {after:?}"
-        );
+        let mut seen = Vec::new();
+        for _ in 0..5 {
+            let before = usage().unwrap();
+            let block = vec![1u8; 256 << 20];
+            let holding = usage().unwrap();
+            drop(std::hint::black_box(block));
+            let after = usage().unwrap();
+            if holding.in_use_bytes >= before.in_use_bytes + (240 << 20)
+                && after.in_use_bytes + (240 << 20) <= holding.in_use_bytes
+            {
+                return;
+            }
+            seen.push((before, holding, after));
+        }
+        panic!("a 256 MiB block did not show in use, then freed: {seen:#?}");
     }
 }

@@ -19,6 +19,6 @@ pub fn save(ctx: &GpuContext, renderer: &mut Renderer, folder: &Path) -> Result<
     renderer.complete_first_round(ctx)?;
     image_io::save_png(&renderer.read_display(ctx)?, &png)?;
     let (w, h, pixels) = renderer.read_radiance(ctx)?;
-    image_io::save_exr(w, h, &pixels, &exr)?;
+    image_io::save_exr(w, h, &pixels, None, &exr)?;
     Ok([png, exr])
 }

@@ -94,7 +94,7 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
     }
     let reference = reference.pixels;
     if let Some(path) = &args.reference_out {
-        image_io::save_exr(w, h, &reference, path)
+        image_io::save_exr(w, h, &reference, None, path)
             .with_context(|| format!("writing {}", path.display()))?;
         println!("reference written to {}", path.display());
     }

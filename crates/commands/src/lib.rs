@@ -6,6 +6,7 @@ pub mod bvh_bench;
 pub mod convergence_bench;
 pub mod edit_bench;
 pub mod interrupt;
+pub mod merge;
 pub mod noise;
 pub mod noise_figure;
 pub mod parameters;

@@ -67,7 +67,7 @@ impl ReferenceCache {
         let pixels = render(ctx, loaded, scene, size, spp, progress)?;
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("creating {}", self.dir.display()))?;
-        image_io::save_exr(size.0, size.1, &pixels, &path)?;
+        image_io::save_exr(size.0, size.1, &pixels, None, &path)?;
         Ok(Reference {
             pixels,
             path,

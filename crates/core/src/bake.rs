@@ -614,7 +614,7 @@ pub fn encode_image(
     texels: &[[f32; 4]],
 ) -> Result<Vec<u8>> {
     match format {
-        ImageFormat::Exr => encode_exr(size, size, texels),
+        ImageFormat::Exr => encode_exr(size, size, texels, None),
         ImageFormat::Png => {
             let srgb = color_space(property, format) == "srgb";
             let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;

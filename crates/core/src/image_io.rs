@@ -7,7 +7,7 @@
 //! filesystem).
 
 use crate::atomic_write::{check_writable, write_atomic};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::io::ErrorKind;
 use std::path::Path;
 
@@ -82,9 +82,41 @@ pub fn encode_png(image: &image::RgbaImage) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Result<()> {
-    write_atomic(path, &encode_exr(width, height, pixels)?)?;
+/// Writes [`encode_exr`]'s file atomically.
+pub fn save_exr(
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    text: Option<(&str, &str)>,
+    path: &Path,
+) -> Result<()> {
+    write_atomic(path, &encode_exr(width, height, pixels, text)?)?;
     Ok(())
+}
+
+/// The text attributes of an EXR file's header (its first part's and
+/// those shared by all parts), by name: where a render's record is
+/// (`render_record`). Only the header is read.
+pub fn read_exr_attributes(path: &Path) -> Result<std::collections::BTreeMap<String, String>> {
+    use exr::meta::attribute::AttributeValue;
+    let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display()))?;
+    let mut attributes = std::collections::BTreeMap::new();
+    if let Some(header) = meta.headers.first() {
+        let all = header
+            .shared_attributes
+            .other
+            .iter()
+            .chain(&header.own_attributes.other);
+        for (name, value) in all {
+            if let AttributeValue::Text(text) = value {
+                attributes.insert(name.to_string(), text.to_string());
+            }
+        }
+    }
+    Ok(attributes)
 }
 
 /// The EXR file (32-bit float RGBA) of `pixels`, row 0 at the top: the
@@ -96,7 +128,18 @@ pub fn save_exr(width: u32, height: u32, pixels: &[[f32; 4]], path: &Path) -> Re
 /// varied from run to run with the threads' timing (often in debug builds,
 /// where compression is slower), though the pixels were the same. An
 /// increasing line order makes it write them in order.
-pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8>> {
+///
+/// `text`: one text attribute (name, value) for the header, such as a
+/// render's record, its characters beyond Latin-1 (which EXR text cannot
+/// hold) written as `?`. One: `exr` keeps a header's attributes in a
+/// `HashMap`, whose order, and so the file's bytes, would vary from run
+/// to run with two.
+pub fn encode_exr(
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    text: Option<(&str, &str)>,
+) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let (w, h) = (width as usize, height as usize);
     let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
@@ -107,7 +150,20 @@ pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8
         line_order: LineOrder::Increasing,
         ..Encoding::FAST_LOSSLESS
     };
-    let image = Image::from_encoded_channels((w, h), encoding, channels);
+    let mut image = Image::from_encoded_channels((w, h), encoding, channels);
+    let latin1 = |s: &str| {
+        let latin1: String = s
+            .chars()
+            .map(|c| if u32::from(c) < 256 { c } else { '?' })
+            .collect();
+        Text::new_or_panic(latin1)
+    };
+    if let Some((name, value)) = text {
+        image.layer_data.attributes.other.insert(
+            latin1(name),
+            exr::meta::attribute::AttributeValue::Text(latin1(value)),
+        );
+    }
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut bytes)?;
     Ok(bytes.into_inner())
@@ -116,6 +172,25 @@ pub fn encode_exr(width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<Vec<u8
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A text attribute written in an EXR's header reads back by name;
+    /// a character EXR text cannot hold is written as `?`; the same
+    /// file is the same bytes.
+    #[test]
+    fn an_exr_text_attribute_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let text = Some(("marbre:render", "spp=16\nadapter=GPU ✓ é"));
+        save_exr(2, 1, &[[0.5; 4]; 2], text, &path).unwrap();
+        let read = read_exr_attributes(&path).unwrap();
+        assert_eq!(
+            read.get("marbre:render").map(String::as_str),
+            Some("spp=16\nadapter=GPU ? é")
+        );
+        let bytes = std::fs::read(&path).unwrap();
+        save_exr(2, 1, &[[0.5; 4]; 2], text, &path).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), bytes);
+    }
 
     /// Many tiles of different content, so that they take different times
     /// to compress: encoded again and again, the bytes never change, and
@@ -135,9 +210,9 @@ mod tests {
                 [v, v * 0.5, 1.0 / (1.0 + v), 1.0]
             })
             .collect();
-        let first = encode_exr(w, h, &pixels).unwrap();
+        let first = encode_exr(w, h, &pixels, None).unwrap();
         for _ in 0..10 {
-            assert!(encode_exr(w, h, &pixels).unwrap() == first);
+            assert!(encode_exr(w, h, &pixels, None).unwrap() == first);
         }
         let meta =
             exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&first), false).unwrap();

@@ -15,6 +15,7 @@ use crate::session::{
 use anyhow::{Context, Result, bail};
 use marbre_core::animated_image;
 use marbre_core::image_io::{self, ImageFormat};
+use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, scene_hash};
 use marbre_core::scene::{Metering, Scene};
 use marbre_core::texture::ImageSet;
 use std::ops::ControlFlow;
@@ -398,7 +399,23 @@ fn write_image(
                 }
                 renderer.read_radiance(ctx)?
             };
-            image_io::save_exr(w, h, &pixels, output)
+            let record = RenderRecord {
+                spp: renderer.accumulated_samples(),
+                sample_offset: job.sample_offset,
+                frame: planned.frame,
+                time: planned.time,
+                scene: scene_hash(renderer.scene()),
+                kernel: renderer.kernel().to_string(),
+                adapter: ctx.describe(),
+                version: env!("CARGO_PKG_VERSION").to_owned(),
+            };
+            image_io::save_exr(
+                w,
+                h,
+                &pixels,
+                Some((RECORD_ATTRIBUTE, &record.to_text())),
+                output,
+            )
         }
     }
     .with_context(|| format!("saving {}", output.display()))?;

@@ -190,7 +190,12 @@ fn each_frame_traces_its_own_samples() {
     common("f_#.exr", &["--frames", "0..1"]);
     common("still.exr", &[]);
     common("at.exr", &["--time", "0.5", "--fps", "2"]);
-    let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
+    // The pixels: each file's render record says its own frame and time.
+    let read = |name: &str| {
+        decode_file(&dir.join(name), IntegerDecode::Linear)
+            .unwrap()
+            .pixels
+    };
     assert!(
         read("f_0.exr") != read("f_1.exr"),
         "frame 1's samples are its own"
