@@ -141,9 +141,11 @@ fn cancel_stops_a_render_that_leaves_the_window_drawing() {
     let (mut child, session) = open(&x, &dir, &preset);
     session.wait_for("the start scene", |_| true);
 
-    // 64 samples of 1600 × 1200 pixels: minutes on lavapipe.
+    // 64 samples of 2400 × 1800 pixels: 1600 × 1200 once ended in CI
+    // before the help overlay showed and Cancel was pressed (the window,
+    // slowed by the render beside it, took that long to draw it).
     let output = dir.path().join("big.png");
-    render_through_the_dialog(&session, &output, "1600x1200");
+    render_through_the_dialog(&session, &output, "2400x1800");
     wait_for_log(&dir, "render: started", STEP_TIMEOUT);
 
     // F1's help overlay shows while the render runs: the window draws.
