@@ -196,17 +196,19 @@ pub fn changed_rows(before: &[u64], after: &[u64], height: u32) -> Vec<std::ops:
 /// `pass`'s target (a layer holding a copied output): each run of rows
 /// cleared to `background`, then every job drawn with its clip rectangle
 /// cut to the run (egui's scissor is its clip rectangle in pixels,
-/// rounded, so the cut is exact). The buffers must hold `jobs`.
+/// rounded, so the cut is exact). The buffers must hold `jobs`, whose
+/// clip rectangles are cut in place and put back (copying the jobs would
+/// copy every mesh, each frame an animation plays).
 pub fn draw_rows(
     renderer: &egui_wgpu::Renderer,
     compositor: &Compositor,
     pass: &mut wgpu::RenderPass<'static>,
-    jobs: &[egui::ClippedPrimitive],
+    jobs: &mut [egui::ClippedPrimitive],
     screen: &egui_wgpu::ScreenDescriptor,
     rows: &[std::ops::Range<u32>],
     background: wgpu::Color,
 ) {
-    let mut cut_jobs = jobs.to_vec();
+    let clips: Vec<egui::Rect> = jobs.iter().map(|j| j.clip_rect).collect();
     let ppp = screen.pixels_per_point;
     for run in rows {
         compositor.fill(pass, run.clone(), screen.size_in_pixels[0], background);
@@ -214,16 +216,45 @@ pub fn draw_rows(
             egui::Rangef::EVERYTHING,
             run.start as f32 / ppp..=run.end as f32 / ppp,
         );
-        for (job, original) in cut_jobs.iter_mut().zip(jobs) {
-            let clip = original.clip_rect.intersect(cut);
+        for (job, original) in jobs.iter_mut().zip(&clips) {
+            let clip = original.intersect(cut);
             job.clip_rect = if clip.is_positive() {
                 clip
             } else {
                 egui::Rect::ZERO
             };
         }
-        renderer.render(pass, &cut_jobs, screen);
+        renderer.render(pass, jobs, screen);
     }
+    for (job, original) in jobs.iter_mut().zip(clips) {
+        job.clip_rect = original;
+    }
+}
+
+/// Begins a pass of egui's onto `view` (a kept layer), timed by
+/// `timestamp_writes` when given.
+pub fn begin_pass(
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) -> wgpu::RenderPass<'static> {
+    encoder
+        .begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            timestamp_writes,
+            ..Default::default()
+        })
+        .forget_lifetime()
 }
 
 /// What egui's output asks of the kept layer.
@@ -308,16 +339,26 @@ impl UiLayer {
             && self.texture.format() == config.format
     }
 
-    /// What to draw of output `key` drawn for `mode` (its bands'
-    /// fingerprints `bands`, for a copied layer): nothing when the layer
-    /// holds it, only the rows that changed when the layer holds a copied
-    /// output with fingerprints and fewer than half the rows changed, the
-    /// whole output otherwise. The layer then holds it.
-    pub fn redraw(&mut self, key: u64, mode: Mode, bands: Option<Vec<u64>>) -> Redraw<'_> {
+    /// What to draw of output `key` drawn for `mode` (`bands`: its bands'
+    /// fingerprints, asked for only when a copied output changed):
+    /// nothing when the layer holds it, only the rows that changed when
+    /// the layer holds a copied output with fingerprints and fewer than
+    /// half the rows changed, the whole output otherwise. The layer then
+    /// holds it.
+    pub fn redraw(
+        &mut self,
+        key: u64,
+        mode: Mode,
+        bands: impl FnOnce() -> Option<Vec<u64>>,
+    ) -> Redraw<'_> {
         if self.key == Some((key, mode)) {
             return Redraw::Nothing;
         }
         let held = self.key.map(|(_, m)| m);
+        let bands = match mode {
+            Mode::Copied => bands(),
+            Mode::Blended => None,
+        };
         let before = std::mem::replace(&mut self.bands, bands);
         self.key = Some((key, mode));
         let height = self.texture.height();
@@ -381,6 +422,50 @@ fn fs_fill() -> @location(0) vec4<f32> {
 }
 ";
 
+/// A pipeline drawing `BLEND_SHADER`'s one triangle over the target with
+/// `fragment_entry`, reading `layout`'s bind group if any, blended by
+/// `blend`. (`marbre_render`'s `fullscreen_pipeline` sets no blend.)
+fn layer_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    label: &str,
+    layout: Option<&wgpu::BindGroupLayout>,
+    fragment_entry: &str,
+    format: wgpu::TextureFormat,
+    blend: wgpu::BlendState,
+) -> wgpu::RenderPipeline {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[layout],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment_entry),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: Some(blend),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 impl Compositor {
     /// The blend pipeline for targets of `format`.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
@@ -401,74 +486,32 @@ impl Compositor {
             label: Some("panel layer blend"),
             source: wgpu::ShaderSource::Wgsl(BLEND_SHADER.into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("panel layer blend"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("panel layer blend"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let fill_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("panel layer fill"),
-            bind_group_layouts: &[],
-            immediate_size: 0,
-        });
+        let pipeline = layer_pipeline(
+            device,
+            &module,
+            "panel layer blend",
+            Some(&layout),
+            "fs_main",
+            format,
+            wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+        );
         let constant = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::Constant,
             dst_factor: wgpu::BlendFactor::Zero,
             operation: wgpu::BlendOperation::Add,
         };
-        let fill_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("panel layer fill"),
-            layout: Some(&fill_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let fill_pipeline = layer_pipeline(
+            device,
+            &module,
+            "panel layer fill",
+            None,
+            "fs_fill",
+            format,
+            wgpu::BlendState {
+                color: constant,
+                alpha: constant,
             },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_fill"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: Some(wgpu::BlendState {
-                        color: constant,
-                        alpha: constant,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         Self {
             pipeline,
             fill_pipeline,
@@ -706,24 +749,25 @@ mod tests {
                 primitive: Primitive::Mesh(mesh),
             }]
         };
-        let before = panel(Color32::from_rgba_unmultiplied(0, 90, 255, 100), 50.0);
-        let after = panel(Color32::from_rgba_unmultiplied(255, 200, 0, 160), 52.5);
+        let mut before = panel(Color32::from_rgba_unmultiplied(0, 90, 255, 100), 50.0);
+        let mut after = panel(Color32::from_rgba_unmultiplied(255, 200, 0, 160), 52.5);
         let draw = |layer: &mut UiLayer,
                     renderer: &mut egui_wgpu::Renderer,
-                    jobs: &[egui::ClippedPrimitive]| {
+                    jobs: &mut [egui::ClippedPrimitive]| {
             let mut encoder = device.create_command_encoder(&Default::default());
             let extra = renderer.update_buffers(device, queue, &mut encoder, jobs, &screen);
             let key = output_key(jobs, &screen);
-            let bands = band_fingerprints(jobs, &screen);
-            let drew_rows = match layer.redraw(key, Mode::Copied, bands) {
+            let drew_rows = match layer
+                .redraw(key, Mode::Copied, || band_fingerprints(jobs, &screen))
+            {
                 Redraw::Nothing => None,
                 Redraw::Whole(view) => {
-                    let mut pass = begin(&mut encoder, view, wgpu::LoadOp::Clear(GREY));
+                    let mut pass = begin_pass(&mut encoder, view, wgpu::LoadOp::Clear(GREY), None);
                     renderer.render(&mut pass, jobs, &screen);
                     Some(false)
                 }
                 Redraw::Rows(view, rows) => {
-                    let mut pass = begin(&mut encoder, view, wgpu::LoadOp::Load);
+                    let mut pass = begin_pass(&mut encoder, view, wgpu::LoadOp::Load, None);
                     draw_rows(renderer, &compositor, &mut pass, jobs, &screen, &rows, GREY);
                     Some(true)
                 }
@@ -735,17 +779,17 @@ mod tests {
             (drew_rows, pixels)
         };
         let mut kept = UiLayer::new(device, &config, &compositor);
-        assert_eq!(draw(&mut kept, &mut renderer, &before).0, Some(false));
-        let (drew_rows, by_rows) = draw(&mut kept, &mut renderer, &after);
+        assert_eq!(draw(&mut kept, &mut renderer, &mut before).0, Some(false));
+        let (drew_rows, by_rows) = draw(&mut kept, &mut renderer, &mut after);
         assert_eq!(drew_rows, Some(true), "a small change draws rows only");
         let mut fresh = UiLayer::new(device, &config, &compositor);
-        let (_, whole) = draw(&mut fresh, &mut renderer, &after);
+        let (_, whole) = draw(&mut fresh, &mut renderer, &mut after);
         let differing = by_rows.iter().zip(&whole).filter(|(a, b)| a != b).count();
         assert_eq!(
             differing, 0,
             "bytes that differ from the output drawn whole"
         );
-        let (_, before_whole) = draw(&mut fresh, &mut renderer, &before);
+        let (_, before_whole) = draw(&mut fresh, &mut renderer, &mut before);
         assert_ne!(before_whole, whole, "the two outputs differ");
     }
 
@@ -755,28 +799,6 @@ mod tests {
         b: 0.07,
         a: 1.0,
     };
-
-    fn begin(
-        encoder: &mut wgpu::CommandEncoder,
-        view: &wgpu::TextureView,
-        load: wgpu::LoadOp<wgpu::Color>,
-    ) -> wgpu::RenderPass<'static> {
-        encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("test egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            })
-            .forget_lifetime()
-    }
 
     /// A panel beside the image draws nothing inside it; a popup over the
     /// image does, where it is, and so does a panel clipped to the image's

@@ -268,7 +268,7 @@ impl Viewer {
             self.renderer
                 .meter_error(&self.ctx, &mut encoder, self.meters.timer.as_ref());
         }
-        let paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
+        let mut paint_jobs = self.egui_ctx.tessellate(output.shapes, ppp);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: ppp,
@@ -286,7 +286,7 @@ impl Viewer {
             &mut encoder,
             &targets,
             viewport,
-            &paint_jobs,
+            &mut paint_jobs,
             &screen,
             inside,
         )?;
@@ -368,7 +368,7 @@ impl Viewer {
         encoder: &mut wgpu::CommandEncoder,
         targets: &[(&wgpu::Texture, &wgpu::TextureView)],
         viewport: Viewport,
-        paint_jobs: &[egui::ClippedPrimitive],
+        paint_jobs: &mut [egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
         inside: Option<egui::Rect>,
     ) -> Result<Vec<wgpu::CommandBuffer>> {
@@ -390,13 +390,11 @@ impl Viewer {
             self.ui_layer = Some(UiLayer::new(&self.ctx.device, &self.config, &compositor));
         }
         let key = ui_layer::output_key(paint_jobs, screen);
-        let bands = match mode {
-            Mode::Copied => ui_layer::band_fingerprints(paint_jobs, screen),
-            Mode::Blended => None,
-        };
         let mut layer = self.ui_layer.take().expect("made above");
         let mut extra = Vec::new();
-        match layer.redraw(key, mode, bands) {
+        match layer.redraw(key, mode, || {
+            ui_layer::band_fingerprints(paint_jobs, screen)
+        }) {
             Redraw::Nothing => {}
             Redraw::Whole(view) => {
                 extra = self.update_egui_buffers(encoder, paint_jobs, screen);
@@ -442,33 +440,19 @@ impl Viewer {
         drawn.map(|()| extra)
     }
 
-    /// Begins egui's pass onto `view`.
+    /// Begins egui's pass onto `view`, timed as the panel's.
     fn egui_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::TextureView,
         load: wgpu::LoadOp<wgpu::Color>,
     ) -> wgpu::RenderPass<'static> {
-        encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                timestamp_writes: self
-                    .meters
-                    .timer
-                    .as_ref()
-                    .and_then(|t| t.render_pass(Pass::Ui)),
-                ..Default::default()
-            })
-            .forget_lifetime()
+        let timestamps = self
+            .meters
+            .timer
+            .as_ref()
+            .and_then(|t| t.render_pass(Pass::Ui));
+        ui_layer::begin_pass(encoder, view, load, timestamps)
     }
 
     fn take_screenshot(&mut self) {
