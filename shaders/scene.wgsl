@@ -72,6 +72,12 @@ struct Frame {
     ground_uv_origin: vec3f,
     ground_uv_u: vec3f,
     ground_uv_v: vec3f,
+    // A crop of a larger image (render --tile): the targets hold the
+    // pixels from `crop_origin` of an image of `image_size`, whose camera
+    // and per-pixel samples they trace, so that tiles assemble to the
+    // whole render. (0, 0) and the render size without a crop.
+    crop_origin: vec2u,
+    image_size: vec2f,
 }
 
 const MAX_SIGNALS: u32 = 4u;

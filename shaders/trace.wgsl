@@ -67,8 +67,10 @@ var<private> sample_albedo: vec3f;
 var<private> sample_normal: vec3f;
 #endif
 
+// `pixel`: a position in the whole image (a crop's target pixel plus its
+// origin).
 fn camera_ray(pixel: vec2f) -> vec3f {
-    let ndc = vec2f(pixel.x / frame.render_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.render_size.y * 2.0);
+    let ndc = vec2f(pixel.x / frame.image_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.image_size.y * 2.0);
     let x = ndc.x * frame.tan_half_fov * frame.aspect;
     let y = ndc.y * frame.tan_half_fov;
     return normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up);
@@ -337,6 +339,9 @@ fn trace_path(pixel: vec2f) -> vec3f {
 // spread. Both kernels call it; `frame` must be set first.
 fn trace_pixel(pixel: vec2u) -> Accumulated {
     let spp = frame.samples_per_frame;
+    // Seeds and rays follow the pixel of the whole image: a crop traces
+    // what the whole render traces there.
+    let image_pixel = pixel + frame.crop_origin;
     var sum = vec3f(0.0);
     var dropped = 0u;
 #if DENOISE_GUIDES
@@ -344,9 +349,9 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
     var normal_sum = vec3f(0.0);
 #endif
     for (var k = 0u; k < spp; k++) {
-        rng_seed(pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
+        rng_seed(image_pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
         let jitter = vec2f(rand(), rand());
-        var l = trace_path(vec2f(pixel) + jitter);
+        var l = trace_path(vec2f(image_pixel) + jitter);
 #if DENOISE_GUIDES
         albedo_sum += sample_albedo / f32(spp);
         normal_sum += sample_normal / f32(spp);

@@ -112,6 +112,8 @@ impl RenderDialog {
             allow_placeholders: true,
             timing: Default::default(),
             sample_offset: 0,
+            tile: None,
+            max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
         })
     }
 

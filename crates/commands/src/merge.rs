@@ -1,7 +1,8 @@
-//! `marbre merge`: a farm's sample batches of one render (EXR files that
-//! `render --sample-offset` wrote, each with its render record) averaged
-//! into one EXR, with the merged image's estimated error
-//! (`marbre_core::merge`).
+//! `marbre merge`: a farm's sample batches and tiles of one render (EXR
+//! files that `render --sample-offset` and `--tile` wrote, each with its
+//! render record) put together into one image (`marbre_core::merge`),
+//! with its estimated error: an EXR of linear radiance, or a PNG
+//! tone-mapped after the merge by the display pass's CPU twin.
 
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
@@ -9,26 +10,33 @@ use marbre_core::image_decode::{IntegerDecode, decode_file};
 use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::merge::{Batch, merge};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord};
+use marbre_core::scene::{DisplaySettings, Metering};
+use marbre_render::cpu_display;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct MergeArgs {
-    /// The batches: EXR files written by `marbre render` (two or more).
+    /// The batches and tiles: EXR files written by `marbre render` (two
+    /// or more).
     #[arg(required = true, num_args = 1..)]
     pub inputs: Vec<PathBuf>,
-    /// The merged EXR (linear radiance, with the merged render's record).
+    /// The merged image: .exr (linear radiance, with the merged render's
+    /// record) or .png (exposed and tone-mapped after the merge).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// For a PNG: show it as this preset's display says (exposure, auto
+    /// exposure, tone map); without it, ACES at exposure 0.
+    #[arg(long)]
+    pub preset: Option<PathBuf>,
+    /// For a PNG: expose it automatically over the merged image, the
+    /// exposure becoming a compensation, by Reinhard's key (`key`, the
+    /// default) or Massal's RMS (`massal`).
+    #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "key", value_name = "METERING")]
+    pub auto_exposure: Option<crate::render::MeteringArg>,
 }
 
 pub fn run(args: &MergeArgs) -> Result<()> {
-    if ImageFormat::from_path(&args.output)? != ImageFormat::Exr {
-        bail!(
-            "{}: merge writes linear radiance, an .exr; tone-map it afterwards, or render the \
-             PNG from the preset",
-            args.output.display()
-        );
-    }
+    let format = ImageFormat::from_path(&args.output)?;
     if let Some(input) = args.inputs.iter().find(|i| same_file(i, &args.output)) {
         bail!(
             "{} is one of the inputs: the merge would write over it",
@@ -36,32 +44,80 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         );
     }
     image_io::check_output(&args.output)?;
+    let display = display_of(args)?;
     let batches = args
         .inputs
         .iter()
         .map(|path| read_batch(path))
         .collect::<Result<Vec<Batch>>>()?;
     let merged = merge(&batches).map_err(|e| anyhow!(e))?;
-    image_io::save_exr(
-        merged.width,
-        merged.height,
-        &merged.pixels,
-        Some((RECORD_ATTRIBUTE, &merged.record.to_text())),
-        &args.output,
-    )?;
+    let record = merged.record.to_text();
+    let text = Some((RECORD_ATTRIBUTE, record.as_str()));
+    match format {
+        ImageFormat::Exr => image_io::save_exr(
+            merged.width,
+            merged.height,
+            &merged.pixels,
+            text,
+            &args.output,
+        )?,
+        ImageFormat::Png => {
+            let (image, metered) =
+                cpu_display::show(&merged.pixels, (merged.width, merged.height), &display);
+            if let Some(stops) = metered {
+                println!("auto exposure: {stops:+.2} stops, metered over the merged image");
+            }
+            image_io::save_png_with_text(&image, text, &args.output)?;
+        }
+    }
     let samples = merged.record.samples();
+    let error = match merged.error {
+        Some(e) => format!(
+            "estimated relative error {:.3} % (RMSE {:.5}), from the spread between the batches",
+            100.0 * e.relative,
+            e.rmse
+        ),
+        None => "no error estimate: every tile is one batch (render two batches or more of a \
+                 tile to measure it)"
+            .to_owned(),
+    };
+    let tiles = if merged.tiles > 1 {
+        format!(" in {} tiles", merged.tiles)
+    } else {
+        String::new()
+    };
     println!(
-        "merged {} batches into {}: {} spp (samples {}..{}); estimated relative error {:.3} % \
-         (RMSE {:.5}), from the spread between the batches",
+        "merged {} files{tiles} into {}: {}×{} at {} spp (samples {}..{}); {error}",
         batches.len(),
         args.output.display(),
+        merged.width,
+        merged.height,
         merged.record.spp,
         samples.start,
         samples.end,
-        100.0 * merged.relative_error,
-        merged.rmse
     );
     Ok(())
+}
+
+/// How a merged PNG is shown: the preset's display, if given, with
+/// `--auto-exposure` on top.
+fn display_of(args: &MergeArgs) -> Result<DisplaySettings> {
+    let mut display = match &args.preset {
+        Some(path) => marbre_core::preset::load(path)?
+            .preset
+            .scene
+            .render
+            .shown_display(),
+        None => DisplaySettings::default(),
+    };
+    if let Some(metering) = args.auto_exposure {
+        display.auto_exposure = true;
+        display.metering = match metering {
+            crate::render::MeteringArg::Key => Metering::Key,
+            crate::render::MeteringArg::Massal => Metering::MassalRms,
+        };
+    }
+    Ok(display)
 }
 
 /// One batch: its pixels and its render's record, or why not.

@@ -7,8 +7,11 @@
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use marbre_core::scene::{LightPoints, Metering, Strategy, View};
+use marbre_core::tile::{Tile, TileGrid};
 pub use marbre_render::final_render::parse_size;
-use marbre_render::final_render::{FinalRender, Progress, RenderObserver, Stop, render_to_file};
+use marbre_render::final_render::{
+    DEFAULT_MAX_TILE_PIXELS, FinalRender, Progress, RenderObserver, Stop, render_to_file,
+};
 use marbre_render::frame_sequence::Timing;
 use marbre_render::gpu::{GpuContext, KernelChoice};
 use marbre_render::session::load_scene;
@@ -110,6 +113,24 @@ pub struct RenderArgs {
     /// samples. A multiple of the preset's samples_per_frame.
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub sample_offset: u32,
+    /// Trace only the pixels [X0, X1) × [Y0, Y1) of the image, with the
+    /// whole image's camera and samples, to an .exr that records its
+    /// place: `marbre merge` assembles the tiles into the whole render.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = Tile::parse, conflicts_with = "tiles")]
+    pub tile: Option<Tile>,
+    /// Cut the image into a grid of COLUMNSxROWS tiles, numbered row by
+    /// row from the top left, and trace tile --tile-index of it (as
+    /// --tile does).
+    #[arg(long, value_name = "CxR", value_parser = TileGrid::parse, requires = "tile_index")]
+    pub tiles: Option<TileGrid>,
+    /// With --tiles, the tile to trace, from 0.
+    #[arg(long, value_name = "I", requires = "tiles")]
+    pub tile_index: Option<u32>,
+    /// Trace at most this many pixels at once: a larger image (or tile)
+    /// is traced in pieces and put together, so that any size completes
+    /// within the GPU's memory. Default: a 4K UHD frame, 8294400.
+    #[arg(long, value_name = "PIXELS", default_value_t = DEFAULT_MAX_TILE_PIXELS)]
+    pub max_tile_pixels: u64,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -191,6 +212,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         allow_placeholders: args.allow_placeholders,
         timing,
         sample_offset: args.sample_offset,
+        tile: match (args.tile, args.tiles, args.tile_index) {
+            (Some(tile), _, _) => Some(tile),
+            (None, Some(grid), Some(index)) => Some(
+                grid.tile(args.size, index)
+                    .map_err(|e| anyhow::anyhow!("--tiles: {e}"))?,
+            ),
+            _ => None,
+        },
+        max_tile_pixels: args.max_tile_pixels,
     };
     let frames = match &job.timing {
         Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,

@@ -74,12 +74,68 @@ pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
 
 /// The PNG file of `image`.
 pub fn encode_png(image: &image::RgbaImage) -> Result<Vec<u8>> {
+    encode_png_with_text(image, None)
+}
+
+/// Writes [`encode_png_with_text`]'s file atomically.
+pub fn save_png_with_text(
+    image: &image::RgbaImage,
+    text: Option<(&str, &str)>,
+    path: &Path,
+) -> Result<()> {
+    write_atomic(path, &encode_png_with_text(image, text)?)?;
+    Ok(())
+}
+
+/// The PNG file of `image` with one text chunk (keyword, text), such as a
+/// render's record: an `iTXt` chunk, which holds any Unicode text (`tEXt`
+/// holds Latin-1 only). Written by the png crate, which the image crate's
+/// encoder wraps without a way to add chunks.
+pub fn encode_png_with_text(
+    image: &image::RgbaImage,
+    text: Option<(&str, &str)>,
+) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
-    image.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )?;
+    let mut encoder = png::Encoder::new(&mut bytes, image.width(), image.height());
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    // The image crate's defaults, so that a PNG without text is the bytes
+    // it always was.
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::Filter::Adaptive);
+    if let Some((keyword, value)) = text {
+        encoder.add_itxt_chunk(keyword.to_owned(), value.to_owned())?;
+    }
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(image.as_raw())?;
+    writer.finish()?;
     Ok(bytes)
+}
+
+/// The text chunks of a PNG file (`tEXt`, `zTXt` and `iTXt`), by keyword:
+/// where a render's record is. Only the chunks before the pixels are read.
+pub fn read_png_text(path: &Path) -> Result<std::collections::BTreeMap<String, String>> {
+    let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let reader = png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .map_err(|e| anyhow::anyhow!("{}: not a readable PNG file ({e})", path.display()))?;
+    let info = reader.info();
+    let mut text = std::collections::BTreeMap::new();
+    for chunk in &info.uncompressed_latin1_text {
+        text.insert(chunk.keyword.clone(), chunk.text.clone());
+    }
+    for chunk in &info.compressed_latin1_text {
+        if let Ok(value) = chunk.get_text() {
+            text.insert(chunk.keyword.clone(), value);
+        }
+    }
+    for chunk in &info.utf8_text {
+        if let Ok(value) = chunk.get_text() {
+            text.insert(chunk.keyword.clone(), value);
+        }
+    }
+    Ok(text)
 }
 
 /// Writes [`encode_exr`]'s file atomically.
@@ -190,6 +246,39 @@ mod tests {
         let bytes = std::fs::read(&path).unwrap();
         save_exr(2, 1, &[[0.5; 4]; 2], text, &path).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), bytes);
+    }
+
+    /// A PNG's text chunk reads back by keyword, any character included,
+    /// and the pixels are the image's.
+    #[test]
+    fn a_png_text_chunk_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        let image = image::RgbaImage::from_raw(2, 1, vec![1, 2, 3, 255, 4, 5, 6, 128]).unwrap();
+        save_png_with_text(
+            &image,
+            Some(("marbre:render", "spp=16\nadapter=GPU ✓")),
+            &path,
+        )
+        .unwrap();
+        let text = read_png_text(&path).unwrap();
+        assert_eq!(
+            text.get("marbre:render").map(String::as_str),
+            Some("spp=16\nadapter=GPU ✓")
+        );
+        let decoded = image::open(&path).unwrap().to_rgba8();
+        assert_eq!(decoded, image);
+        let mut by_image = Vec::new();
+        image
+            .write_to(
+                &mut std::io::Cursor::new(&mut by_image),
+                image::ImageFormat::Png,
+            )
+            .unwrap();
+        assert!(
+            encode_png(&image).unwrap() == by_image,
+            "no text: the image crate's bytes"
+        );
     }
 
     /// Many tiles of different content, so that they take different times

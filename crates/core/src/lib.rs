@@ -29,6 +29,7 @@ pub mod render_record;
 pub mod scene;
 pub mod shown;
 pub mod texture;
+pub mod tile;
 pub mod tx;
 pub mod tx_preview;
 pub mod viewer_files;

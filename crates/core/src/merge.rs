@@ -3,9 +3,14 @@
 //! averaged weighted by their samples, as pbrt-v4's `imgtool average` and
 //! Cycles' sample subsets do. The spread between the batches estimates the
 //! merged image's error, as the Quality strip's does from a render's
-//! frames: the merge says how far it probably is from converged.
+//! frames: the merge says how far it probably is from converged. Tiles
+//! of one image (`render --tile`) are put in their place, each the mean
+//! of its own batches, as pbrt-v4's `imgtool assemble` and Flamenco's
+//! tile merge do.
 
 use crate::render_record::RenderRecord;
+use crate::tile::{Tile, check_cover};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// One input: a file's linear radiance and its render's record.
@@ -24,21 +29,35 @@ pub struct Merged {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<[f32; 4]>,
-    /// The record of the merged render: all the samples, from the first.
+    /// The record of the merged render: all the samples, from the first,
+    /// of the whole image.
     pub record: RenderRecord,
+    /// The error of the merged mean, estimated from the spread between
+    /// the batches of each tile; `None` when no tile has two batches.
+    pub error: Option<MergeError>,
+    /// How many tiles were assembled (1: batches of the whole image).
+    pub tiles: usize,
+}
+
+/// An estimate of a merged image's error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MergeError {
     /// √ of the mean over channels of the merged mean's variance.
     pub rmse: f64,
     /// √relMSE: the same relative to mean² + 0.01, as the Quality strip
     /// and the benchmarks measure it.
-    pub relative_error: f64,
+    pub relative: f64,
 }
 
 /// The relMSE's ε (`shaders/error_meter.wgsl`'s `REL_EPSILON`).
 const REL_EPSILON: f64 = 0.01;
 
-/// Averages `batches` weighted by their samples. Refused, naming the
-/// files: fewer than two, sizes that differ, another scene or frame, and
-/// samples counted twice (overlapping sample ranges).
+/// Assembles `batches` into one image: the batches of each tile averaged
+/// weighted by their samples, the tiles put in their place. Refused,
+/// naming the files: fewer than two, another image size, scene or frame,
+/// a file whose pixels are not its tile's, samples counted twice
+/// (overlapping sample ranges), tiles that overlap or leave pixels out,
+/// and tiles of different sample counts.
 pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
     let [first, rest @ ..] = batches else {
         return Err("a merge needs two files or more (got none)".into());
@@ -50,16 +69,30 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
         ));
     }
     let name = |b: &Batch| b.path.display().to_string();
-    for b in rest {
-        if (b.width, b.height) != (first.width, first.height) {
+    let image = first.record.image;
+    for b in batches {
+        if b.record.tile.size() != (b.width, b.height) {
             return Err(format!(
-                "{} is {}×{}, but {} is {}×{}: batches of one render have its size",
+                "{} is {}×{}, but its record says it holds the tile {}: the file was changed \
+                 after the render",
                 name(b),
                 b.width,
                 b.height,
+                b.record.tile
+            ));
+        }
+    }
+    for b in rest {
+        if b.record.image != image {
+            return Err(format!(
+                "{} is part of a {}×{} image, but {} of a {}×{} one: batches and tiles of one \
+                 render have its size",
+                name(b),
+                b.record.image.0,
+                b.record.image.1,
                 name(first),
-                first.width,
-                first.height
+                image.0,
+                image.1
             ));
         }
         if b.record.scene != first.record.scene {
@@ -81,85 +114,189 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             ));
         }
     }
-    let mut by_samples: Vec<&Batch> = batches.iter().collect();
-    by_samples.sort_by_key(|b| b.record.sample_offset);
-    for pair in by_samples.windows(2) {
-        let (a, b) = (pair[0].record.samples(), pair[1].record.samples());
-        if b.start < a.end {
-            return Err(format!(
-                "{} (samples {}..{}) and {} (samples {}..{}) overlap: those samples would \
-                 count twice; render batches at offsets spp apart (--sample-offset)",
-                name(pair[0]),
-                a.start,
-                a.end,
-                name(pair[1]),
-                b.start,
-                b.end
-            ));
-        }
+    let mut by_tile: BTreeMap<Tile, Vec<&Batch>> = BTreeMap::new();
+    for b in batches {
+        by_tile.entry(b.record.tile).or_default().push(b);
     }
-    let total: u64 = batches.iter().map(|b| u64::from(b.record.spp)).sum();
-    let n = total as f64;
-    let mut pixels = vec![[0.0f32; 4]; first.pixels.len()];
-    let (mut variance_sum, mut relative_sum, mut channels) = (0.0f64, 0.0f64, 0u64);
-    for (p, merged) in pixels.iter_mut().enumerate() {
-        for (c, out) in merged.iter_mut().enumerate() {
-            let mean = batches
-                .iter()
-                .map(|b| f64::from(b.record.spp) * f64::from(b.pixels[p][c]))
-                .sum::<f64>()
-                / n;
-            *out = mean as f32;
-            if c == 3 || !mean.is_finite() {
-                continue;
-            }
-            // Each batch's mean x_i of n_i samples has variance σ²/n_i:
-            // Σ n_i (x_i − m)² / (K − 1) estimates σ², and the merged
-            // mean's variance is σ² / N.
-            let spread: f64 = batches
-                .iter()
-                .map(|b| f64::from(b.record.spp) * (f64::from(b.pixels[p][c]) - mean).powi(2))
-                .sum();
-            let variance = spread / ((batches.len() - 1) as f64 * n);
-            variance_sum += variance;
-            relative_sum += variance / (mean * mean + REL_EPSILON);
-            channels += 1;
-        }
+    let groups: Vec<TileGroup> = by_tile
+        .into_iter()
+        .map(|(tile, mut batches)| {
+            batches.sort_by_key(|b| b.record.sample_offset);
+            TileGroup::new(tile, batches)
+        })
+        .collect::<Result<_, _>>()?;
+    let named: Vec<(String, Tile)> = groups
+        .iter()
+        .map(|g| (name(g.batches[0]), g.tile))
+        .collect();
+    check_cover(image, &named)?;
+    if let Some(g) = groups.iter().find(|g| g.samples != groups[0].samples) {
+        return Err(format!(
+            "{} (tile {}) has {} samples per pixel, but {} (tile {}) {}: every tile of an \
+             image needs the same samples",
+            name(g.batches[0]),
+            g.tile,
+            g.samples,
+            name(groups[0].batches[0]),
+            groups[0].tile,
+            groups[0].samples
+        ));
     }
-    let per_channel = |sum: f64| (sum / channels.max(1) as f64).sqrt();
-    let mut kernels: Vec<&str> = batches.iter().map(|b| b.record.kernel.as_str()).collect();
-    kernels.dedup();
-    let mut adapters: Vec<&str> = batches.iter().map(|b| b.record.adapter.as_str()).collect();
-    adapters.dedup();
+    let mut pixels = vec![[0.0f32; 4]; image.0 as usize * image.1 as usize];
+    let mut spread = SpreadSum::default();
+    for group in &groups {
+        group.assemble(image.0, &mut pixels, &mut spread);
+    }
+    let kernels = distinct(batches.iter().map(|b| b.record.kernel.as_str()));
+    let adapters = distinct(batches.iter().map(|b| b.record.adapter.as_str()));
     Ok(Merged {
-        width: first.width,
-        height: first.height,
+        width: image.0,
+        height: image.1,
         pixels,
         record: RenderRecord {
-            spp: total.min(u64::from(u32::MAX)) as u32,
-            sample_offset: by_samples[0].record.sample_offset,
-            kernel: kernels.join(" + "),
-            adapter: adapters.join(" + "),
+            spp: groups[0].samples.min(u64::from(u32::MAX)) as u32,
+            sample_offset: groups[0].batches[0].record.sample_offset,
+            tile: Tile::whole(image),
+            kernel: kernels,
+            adapter: adapters,
             ..first.record.clone()
         },
-        rmse: per_channel(variance_sum),
-        relative_error: per_channel(relative_sum),
+        error: spread.error(),
+        tiles: groups.len(),
     })
+}
+
+/// The values of `names` joined by ` + `, each once, in first-seen order.
+fn distinct<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let mut seen: Vec<&str> = Vec::new();
+    for n in names {
+        if !seen.contains(&n) {
+            seen.push(n);
+        }
+    }
+    seen.join(" + ")
+}
+
+/// The batches of one tile, sorted by their first sample.
+struct TileGroup<'a> {
+    tile: Tile,
+    batches: Vec<&'a Batch>,
+    samples: u64,
+}
+
+impl<'a> TileGroup<'a> {
+    /// Refused if two batches' sample ranges overlap.
+    fn new(tile: Tile, batches: Vec<&'a Batch>) -> Result<Self, String> {
+        for pair in batches.windows(2) {
+            let (a, b) = (pair[0].record.samples(), pair[1].record.samples());
+            if b.start < a.end {
+                return Err(format!(
+                    "{} (samples {}..{}) and {} (samples {}..{}) overlap: those samples would \
+                     count twice; render batches at offsets spp apart (--sample-offset)",
+                    pair[0].path.display(),
+                    a.start,
+                    a.end,
+                    pair[1].path.display(),
+                    b.start,
+                    b.end
+                ));
+            }
+        }
+        let samples = batches.iter().map(|b| u64::from(b.record.spp)).sum();
+        Ok(Self {
+            tile,
+            batches,
+            samples,
+        })
+    }
+
+    /// Writes the tile's mean into `image` (rows of `width`), and adds
+    /// the spread between its batches, if two or more, to `spread`.
+    fn assemble(&self, width: u32, image: &mut [[f32; 4]], spread: &mut SpreadSum) {
+        let n = self.samples as f64;
+        let (tile_width, _) = self.tile.size();
+        for (p, out) in (0..self.tile.pixels() as usize).map(|p| {
+            let (x, y) = (p as u32 % tile_width, p as u32 / tile_width);
+            let at = (self.tile.y0 + y) as usize * width as usize + (self.tile.x0 + x) as usize;
+            (p, at)
+        }) {
+            for c in 0..4 {
+                let mean = self
+                    .batches
+                    .iter()
+                    .map(|b| f64::from(b.record.spp) * f64::from(b.pixels[p][c]))
+                    .sum::<f64>()
+                    / n;
+                image[out][c] = mean as f32;
+                if c == 3 || !mean.is_finite() || self.batches.len() < 2 {
+                    continue;
+                }
+                // Each batch's mean x_i of n_i samples has variance σ²/n_i:
+                // Σ n_i (x_i − m)² / (K − 1) estimates σ², and the merged
+                // mean's variance is σ² / N.
+                let squares: f64 = self
+                    .batches
+                    .iter()
+                    .map(|b| f64::from(b.record.spp) * (f64::from(b.pixels[p][c]) - mean).powi(2))
+                    .sum();
+                spread.add(squares / ((self.batches.len() - 1) as f64 * n), mean);
+            }
+        }
+    }
+}
+
+/// Sums of the per-channel variances of the merged means.
+#[derive(Default)]
+struct SpreadSum {
+    variance: f64,
+    relative: f64,
+    channels: u64,
+}
+
+impl SpreadSum {
+    fn add(&mut self, variance: f64, mean: f64) {
+        self.variance += variance;
+        self.relative += variance / (mean * mean + REL_EPSILON);
+        self.channels += 1;
+    }
+
+    fn error(&self) -> Option<MergeError> {
+        let per_channel = |sum: f64| (sum / self.channels as f64).sqrt();
+        (self.channels > 0).then(|| MergeError {
+            rmse: per_channel(self.variance),
+            relative: per_channel(self.relative),
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A batch of a 2×1 image, every pixel `value`.
     fn batch(name: &str, offset: u32, spp: u32, value: f32) -> Batch {
+        tile_batch(name, Tile::whole((2, 1)), (2, 1), offset, spp, value)
+    }
+
+    fn tile_batch(
+        name: &str,
+        tile: Tile,
+        image: (u32, u32),
+        offset: u32,
+        spp: u32,
+        value: f32,
+    ) -> Batch {
+        let (width, height) = tile.size();
         Batch {
             path: PathBuf::from(name),
-            width: 2,
-            height: 1,
-            pixels: vec![[value, value, value, 1.0]; 2],
+            width,
+            height,
+            pixels: vec![[value, value, value, 1.0]; tile.pixels() as usize],
             record: RenderRecord {
                 spp,
                 sample_offset: offset,
+                image,
+                tile,
                 frame: 0,
                 time: 0.0,
                 scene: "0123456789abcdef".into(),
@@ -185,9 +322,43 @@ mod tests {
         .unwrap();
         assert_eq!(merged.pixels, vec![[2.0, 2.0, 2.0, 1.0]; 2]);
         assert_eq!((merged.record.spp, merged.record.sample_offset), (4, 0));
-        assert!((merged.rmse - 0.5).abs() < 1e-12, "{}", merged.rmse);
+        let error = merged.error.unwrap();
+        assert!((error.rmse - 0.5).abs() < 1e-12, "{}", error.rmse);
         let relative = 0.5 / (4.0f64 + REL_EPSILON).sqrt();
-        assert!((merged.relative_error - relative).abs() < 1e-12);
+        assert!((error.relative - relative).abs() < 1e-12);
+    }
+
+    /// Two tiles of a 3×2 image, the left one in two batches: each pixel
+    /// is its tile's mean, in its place; the error comes from the left
+    /// tile only (the right has one batch).
+    #[test]
+    fn tiles_are_put_in_their_place() {
+        let (left, right) = (
+            Tile::parse("0,0,1,2").unwrap(),
+            Tile::parse("1,0,3,2").unwrap(),
+        );
+        let merged = merge(&[
+            tile_batch("r.exr", right, (3, 2), 0, 4, 5.0),
+            tile_batch("l0.exr", left, (3, 2), 0, 2, 1.0),
+            tile_batch("l1.exr", left, (3, 2), 2, 2, 3.0),
+        ])
+        .unwrap();
+        let v = |x: f32| [x, x, x, 1.0];
+        assert_eq!(
+            merged.pixels,
+            vec![v(2.0), v(5.0), v(5.0), v(2.0), v(5.0), v(5.0)]
+        );
+        assert_eq!((merged.width, merged.height, merged.tiles), (3, 2, 2));
+        assert_eq!(merged.record.tile, Tile::whole((3, 2)));
+        assert_eq!(merged.record.spp, 4);
+        // Σ 2·(x − 2)² = 4 over K − 1 = 1, over N = 4: variance 1.
+        assert!((merged.error.unwrap().rmse - 1.0).abs() < 1e-12);
+        let alone = merge(&[
+            tile_batch("r.exr", right, (3, 2), 0, 4, 5.0),
+            tile_batch("l.exr", left, (3, 2), 0, 4, 1.0),
+        ])
+        .unwrap();
+        assert_eq!(alone.error, None, "one batch a tile: no spread to measure");
     }
 
     /// Every refusal names its files and its cause.
@@ -196,12 +367,17 @@ mod tests {
         let a = batch("a.exr", 0, 4, 1.0);
         let e = merge(std::slice::from_ref(&a)).unwrap_err();
         assert!(e.contains("two files") && e.contains("a.exr"), "{e}");
-        let mut wide = batch("wide.exr", 4, 4, 1.0);
-        wide.width = 3;
-        wide.pixels.push([1.0; 4]);
+        let wide = tile_batch("wide.exr", Tile::whole((3, 1)), (3, 1), 4, 4, 1.0);
         let e = merge(&[a.clone(), wide]).unwrap_err();
         assert!(
-            e.contains("wide.exr is 3×1") && e.contains("a.exr is 2×1"),
+            e.contains("wide.exr is part of a 3×1 image") && e.contains("a.exr of a 2×1"),
+            "{e}"
+        );
+        let mut cut = batch("cut.exr", 4, 4, 1.0);
+        cut.width = 1;
+        let e = merge(&[a.clone(), cut]).unwrap_err();
+        assert!(
+            e.contains("cut.exr is 1×1") && e.contains("tile 0,0,2,1"),
             "{e}"
         );
         let mut other = batch("other.exr", 4, 4, 1.0);
@@ -218,5 +394,36 @@ mod tests {
             e.contains("a.exr (samples 0..4) and again.exr (samples 2..6) overlap"),
             "{e}"
         );
+    }
+
+    /// Tiles that leave a pixel out, overlap, or differ in samples.
+    #[test]
+    fn bad_tile_sets_are_refused_naming_the_files() {
+        let image = (4, 1);
+        let t = |s: &str| Tile::parse(s).unwrap();
+        let e = merge(&[
+            tile_batch("t0.exr", t("0,0,1,1"), image, 0, 4, 1.0),
+            tile_batch("t1.exr", t("1,0,2,1"), image, 0, 4, 1.0),
+        ])
+        .unwrap_err();
+        assert!(
+            e.contains("leave 2 of the 4 × 1") && e.contains("(2, 0)"),
+            "{e}"
+        );
+        let e = merge(&[
+            tile_batch("t0.exr", t("0,0,3,1"), image, 0, 4, 1.0),
+            tile_batch("t1.exr", t("2,0,4,1"), image, 0, 4, 1.0),
+        ])
+        .unwrap_err();
+        assert!(
+            e.contains("t0.exr (tile 0,0,3,1) and t1.exr (tile 2,0,4,1) overlap"),
+            "{e}"
+        );
+        let e = merge(&[
+            tile_batch("t0.exr", t("0,0,2,1"), image, 0, 4, 1.0),
+            tile_batch("t1.exr", t("2,0,4,1"), image, 0, 8, 1.0),
+        ])
+        .unwrap_err();
+        assert!(e.contains("t1.exr (tile 2,0,4,1) has 8 samples"), "{e}");
     }
 }

@@ -7,6 +7,7 @@
 //! (`exrheader`, Blender's metadata panel).
 
 use crate::scene::Scene;
+use crate::tile::Tile;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -16,6 +17,10 @@ pub struct RenderRecord {
     pub spp: u32,
     /// The first of them in the long render (`render --sample-offset`).
     pub sample_offset: u32,
+    /// The size of the whole image, and the tile of it the file holds
+    /// (the whole image but for `render --tile`).
+    pub image: (u32, u32),
+    pub tile: Tile,
     /// The animation frame whose samples they are, and its time.
     pub frame: u32,
     pub time: f32,
@@ -35,6 +40,8 @@ pub const RECORD_ATTRIBUTE: &str = "marbre:render";
 /// The keys, in the order they are written.
 const SPP: &str = "spp";
 const SAMPLE_OFFSET: &str = "sampleOffset";
+const IMAGE: &str = "image";
+const TILE: &str = "tile";
 const FRAME: &str = "frame";
 const TIME: &str = "time";
 const SCENE: &str = "scene";
@@ -54,6 +61,8 @@ impl RenderRecord {
         [
             (SPP, self.spp.to_string()),
             (SAMPLE_OFFSET, self.sample_offset.to_string()),
+            (IMAGE, format!("{}x{}", self.image.0, self.image.1)),
+            (TILE, self.tile.to_string()),
             (FRAME, self.frame.to_string()),
             (TIME, self.time.to_string()),
             (SCENE, self.scene.clone()),
@@ -85,9 +94,22 @@ impl RenderRecord {
                 .parse()
                 .map_err(|_| format!("its render record's `{key}` is not a number: {text:?}"))
         }
+        let image = text(IMAGE)?;
+        let image = image
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)))
+            .ok_or_else(|| {
+                format!("its render record's `{IMAGE}` is not WIDTHxHEIGHT: {image:?}")
+            })?;
+        let tile =
+            Tile::parse(&text(TILE)?).map_err(|e| format!("its render record's `{TILE}`: {e}"))?;
+        tile.check_within(image)
+            .map_err(|e| format!("its render record's `{TILE}`: {e}"))?;
         Ok(Some(Self {
             spp: number(SPP, text(SPP)?)?,
             sample_offset: number(SAMPLE_OFFSET, text(SAMPLE_OFFSET)?)?,
+            image,
+            tile,
             frame: number(FRAME, text(FRAME)?)?,
             time: number(TIME, text(TIME)?)?,
             scene: text(SCENE)?,
@@ -129,6 +151,8 @@ mod tests {
         RenderRecord {
             spp: 16,
             sample_offset: 32,
+            image: (64, 48),
+            tile: Tile::parse("16,0,48,24").unwrap(),
             frame: 3,
             time: 0.125,
             scene: "0123456789abcdef".into(),
@@ -156,6 +180,9 @@ mod tests {
         let bad = text.replace("spp=16", "spp=many");
         let e = RenderRecord::from_attributes(&attributes(bad)).unwrap_err();
         assert!(e.contains("`spp`") && e.contains("many"), "{e}");
+        let outside = text.replace("tile=16,0,48,24", "tile=16,0,80,24");
+        let e = RenderRecord::from_attributes(&attributes(outside)).unwrap_err();
+        assert!(e.contains("`tile`") && e.contains("64 × 48"), "{e}");
     }
 
     /// FNV-1a's published value for "a" (0xaf63dc4c8601ec8c) pins the

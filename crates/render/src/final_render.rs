@@ -4,6 +4,7 @@
 //! that the dialog's image is the command's, byte for byte; each caller
 //! only says how progress is shown and whether to stop early.
 
+use crate::cpu_display;
 use crate::frame_sequence::{self, PlannedFrame, Timing};
 use crate::gpu::auto_exposure;
 use crate::gpu::error_meter::ErrorEstimate;
@@ -18,6 +19,7 @@ use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, scene_hash};
 use marbre_core::scene::{Metering, Scene};
 use marbre_core::texture::ImageSet;
+use marbre_core::tile::{self, Tile};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -86,7 +88,21 @@ pub struct FinalRender {
     /// each are disjoint batches whose mean is the render of all their
     /// samples. A multiple of the scene's samples per frame.
     pub sample_offset: u32,
+    /// The tile of the image to trace (`render --tile`): the output holds
+    /// its pixels only, traced with the whole image's camera and samples,
+    /// for `marbre merge` to assemble; `None`: the whole image.
+    pub tile: Option<Tile>,
+    /// The most pixels one set of GPU targets holds: a larger image (or
+    /// tile) is traced a piece at a time ([`tile::split`]) and put
+    /// together on the CPU, so that any size completes in bounded GPU
+    /// memory.
+    pub max_tile_pixels: u64,
 }
+
+/// [`FinalRender::max_tile_pixels`] by default: a 4K UHD frame (3840 ×
+/// 2160), about 1.3 GB of targets at 160 bytes a pixel; every size up to
+/// it is traced whole, as it always was.
+pub const DEFAULT_MAX_TILE_PIXELS: u64 = 3840 * 2160;
 
 /// How far a render has come, after each round of samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -240,6 +256,20 @@ pub fn check_job(job: &FinalRender) -> Result<(ImageFormat, Option<&PathBuf>)> {
         }
         _ => None,
     };
+    if let Some(tile) = job.tile {
+        tile.check_within(job.size)
+            .map_err(|e| anyhow::anyhow!("--tile: {e}"))?;
+        if format != ImageFormat::Exr {
+            bail!(
+                "{}: a tile is written as linear radiance, an .exr, for `marbre merge` to \
+                 assemble and tone-map",
+                job.output.display()
+            );
+        }
+    }
+    if job.max_tile_pixels == 0 {
+        bail!("the largest piece traced at once must hold at least 1 pixel");
+    }
     frame_sequence::plan(&job.timing, &job.output)?;
     Ok((format, animation))
 }
@@ -298,27 +328,154 @@ pub fn render_to_file(
             job.sample_offset
         );
     }
-    let (kernel, timings) = pick_kernel(ctx, &loaded, job.size, job.kernel)?;
+    let region = job.tile.unwrap_or(Tile::whole(job.size));
+    let max_side = ctx.device.limits().max_texture_dimension_2d;
+    let pieces = tile::split(region, max_side, job.max_tile_pixels);
+    let cropped = pieces != [Tile::whole(job.size)];
+    if cropped {
+        check_piecewise(&loaded.scene, job, format, pieces.len())?;
+        observer.note(&format!(
+            "traced in {} piece{} of at most {} × {} pixels",
+            pieces.len(),
+            if pieces.len() == 1 { "" } else { "s" },
+            pieces[0].size().0,
+            pieces[0].size().1
+        ));
+    }
+    let (kernel, timings) = pick_kernel(ctx, &loaded, pieces[0].size(), job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
-    let mut renderer = renderer_fitting(ctx, &loaded, job.size, kernel)?;
+    let mut renderer = renderer_fitting(ctx, &loaded, pieces[0].size(), kernel)?;
     for (index, planned) in frames.iter().enumerate() {
         if index > 0 {
             renderer.set_scene(ctx, &base.at_time(planned.time))?;
         }
-        renderer.restart_at_sample(planned.frame, job.sample_offset);
         let mut in_sequence = InSequence {
             observer: &mut *observer,
             frame: index as u32,
             frames: frames.len() as u32,
         };
-        if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
-            return Ok(Outcome::Cancelled);
+        if !cropped {
+            renderer.restart_at_sample(planned.frame, job.sample_offset);
+            if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
+                return Ok(Outcome::Cancelled);
+            }
+            write_image(ctx, &mut renderer, job, format, planned, observer)?;
+            continue;
         }
-        write_image(ctx, &mut renderer, job, format, planned, observer)?;
+        let mut pixels = vec![[0.0f32; 4]; region.pixels() as usize];
+        for piece in &pieces {
+            renderer.set_crop(ctx, Some((*piece, job.size)));
+            renderer.restart_at_sample(planned.frame, job.sample_offset);
+            if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
+                return Ok(Outcome::Cancelled);
+            }
+            let (_, _, traced) = renderer.read_radiance(ctx)?;
+            place(&mut pixels, region, *piece, &traced);
+        }
+        let record = record_of(ctx, &renderer, job, planned, region);
+        write_assembled(&renderer, &pixels, &record, format, planned, observer)?;
     }
     let mut all: Vec<PlannedFrame> = frames.into_iter().chain(written).collect();
     all.sort_by_key(|f| f.frame);
     assemble(animation, &all, job, observer)
+}
+
+/// Refuses what a render traced in pieces cannot do: the denoiser and an
+/// error target need the whole image on the GPU.
+fn check_piecewise(
+    scene: &Scene,
+    job: &FinalRender,
+    format: ImageFormat,
+    pieces: usize,
+) -> Result<()> {
+    let why = if job.tile.is_some() {
+        "a tile".to_owned()
+    } else {
+        format!(
+            "a {} × {} render is traced in {pieces} pieces (--max-tile-pixels {})",
+            job.size.0, job.size.1, job.max_tile_pixels
+        )
+    };
+    if job.denoise_exr || (format == ImageFormat::Png && scene.render.shown_display().denoise) {
+        bail!(
+            "{why}, which the denoiser cannot filter (it needs the whole image); denoise the \
+             merged image, or render without --denoise"
+        );
+    }
+    if let Stop::TargetError { .. } = job.stop {
+        bail!(
+            "{why}, whose pieces would each stop at their own samples; give --spp instead of \
+             --target-error"
+        );
+    }
+    Ok(())
+}
+
+/// Copies `piece`'s pixels (`traced`, rows of its width) into `region`'s
+/// (rows of the region's width); `piece` lies within `region`.
+fn place(region_pixels: &mut [[f32; 4]], region: Tile, piece: Tile, traced: &[[f32; 4]]) {
+    let (region_width, _) = region.size();
+    let (piece_width, _) = piece.size();
+    for (row, line) in traced.chunks_exact(piece_width as usize).enumerate() {
+        let y = piece.y0 - region.y0 + row as u32;
+        let start = (y * region_width + piece.x0 - region.x0) as usize;
+        region_pixels[start..start + line.len()].copy_from_slice(line);
+    }
+}
+
+/// What the file of `planned` records of its render.
+fn record_of(
+    ctx: &GpuContext,
+    renderer: &Renderer,
+    job: &FinalRender,
+    planned: &PlannedFrame,
+    region: Tile,
+) -> RenderRecord {
+    RenderRecord {
+        spp: renderer.accumulated_samples(),
+        sample_offset: job.sample_offset,
+        image: job.size,
+        tile: region,
+        frame: planned.frame,
+        time: planned.time,
+        scene: scene_hash(renderer.scene()),
+        kernel: renderer.kernel().to_string(),
+        adapter: ctx.describe(),
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+    }
+}
+
+/// Writes an image traced in pieces: an EXR of its radiance, or a PNG
+/// shown by the display pass's CPU twin (exposure metered over the whole
+/// image).
+fn write_assembled(
+    renderer: &Renderer,
+    pixels: &[[f32; 4]],
+    record: &RenderRecord,
+    format: ImageFormat,
+    planned: &PlannedFrame,
+    observer: &mut dyn RenderObserver,
+) -> Result<()> {
+    let output = &planned.output;
+    let (w, h) = record.tile.size();
+    let text = Some((RECORD_ATTRIBUTE, record.to_text()));
+    let text = text.as_ref().map(|(k, v)| (*k, v.as_str()));
+    match format {
+        ImageFormat::Exr => image_io::save_exr(w, h, pixels, text, output),
+        ImageFormat::Png => {
+            let (image, metered) =
+                cpu_display::show(pixels, (w, h), &renderer.scene().render.shown_display());
+            if let Some(stops) = metered {
+                observer.note(&format!(
+                    "auto exposure: {stops:+.2} stops (over the whole image)"
+                ));
+            }
+            image_io::save_png_with_text(&image, text, output)
+        }
+    }
+    .with_context(|| format!("saving {}", output.display()))?;
+    observer.note(&format!("wrote {}", output.display()));
+    Ok(())
 }
 
 /// The observer of one frame of a sequence: its progress counts the
@@ -385,10 +542,12 @@ fn write_image(
         }
         observer.note(&describe_auto_exposure(ctx, renderer)?);
     }
+    let record = record_of(ctx, renderer, job, planned, Tile::whole(job.size)).to_text();
+    let text = Some((RECORD_ATTRIBUTE, record.as_str()));
     match format {
         ImageFormat::Png => {
             let image = renderer.read_display(ctx)?;
-            image_io::save_png(&image, output)
+            image_io::save_png_with_text(&image, text, output)
         }
         ImageFormat::Exr => {
             let (w, h, pixels) = if job.denoise_exr {
@@ -399,23 +558,7 @@ fn write_image(
                 }
                 renderer.read_radiance(ctx)?
             };
-            let record = RenderRecord {
-                spp: renderer.accumulated_samples(),
-                sample_offset: job.sample_offset,
-                frame: planned.frame,
-                time: planned.time,
-                scene: scene_hash(renderer.scene()),
-                kernel: renderer.kernel().to_string(),
-                adapter: ctx.describe(),
-                version: env!("CARGO_PKG_VERSION").to_owned(),
-            };
-            image_io::save_exr(
-                w,
-                h,
-                &pixels,
-                Some((RECORD_ATTRIBUTE, &record.to_text())),
-                output,
-            )
+            image_io::save_exr(w, h, &pixels, text, output)
         }
     }
     .with_context(|| format!("saving {}", output.display()))?;

@@ -3,6 +3,7 @@
 //! sessions that turn a preset into a ready renderer. No window, no UI.
 
 pub mod bake_file;
+pub mod cpu_display;
 pub mod final_render;
 pub mod frame_sequence;
 pub mod gpu;

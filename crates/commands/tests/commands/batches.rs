@@ -40,7 +40,7 @@ const BALL: &str = r#"(
     ),
 )"#;
 
-fn scratch(name: &str, spf: u32) -> PathBuf {
+pub(crate) fn scratch(name: &str, spf: u32) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marbre-batch-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -54,11 +54,26 @@ fn scratch(name: &str, spf: u32) -> PathBuf {
 
 /// `marbre render` of the ball at 40×24 with the fragment kernel, `spp`
 /// samples from `offset`, to `name` in `dir`; its pixels.
-fn render_ball(dir: &Path, name: &str, spp: u32, offset: u32) -> anyhow::Result<Vec<[f32; 4]>> {
+pub(crate) fn render_ball(
+    dir: &Path,
+    name: &str,
+    spp: u32,
+    offset: u32,
+) -> anyhow::Result<Vec<[f32; 4]>> {
+    let (spp, offset) = (spp.to_string(), offset.to_string());
+    render_ball_with(dir, name, &["--spp", &spp, "--sample-offset", &offset])
+}
+
+/// `marbre render` of the ball at 40×24 with the fragment kernel and
+/// `flags`, to `name` in `dir`; its pixels.
+pub(crate) fn render_ball_with(
+    dir: &Path,
+    name: &str,
+    flags: &[&str],
+) -> anyhow::Result<Vec<[f32; 4]>> {
     let output = dir.join(name);
     let preset = dir.join("ball.ron");
-    let (spp, offset) = (spp.to_string(), offset.to_string());
-    let flags = [
+    let mut all = vec![
         "render",
         "--preset",
         preset.to_str().unwrap(),
@@ -66,20 +81,25 @@ fn render_ball(dir: &Path, name: &str, spp: u32, offset: u32) -> anyhow::Result<
         output.to_str().unwrap(),
         "--size",
         "40x24",
-        "--spp",
-        &spp,
-        "--sample-offset",
-        &offset,
         "--kernel",
         "fragment",
     ];
-    render::run(&Cli::try_parse_from(flags).unwrap().args)?;
+    all.extend_from_slice(flags);
+    render::run(&Cli::try_parse_from(all).unwrap().args)?;
     Ok(decode_file(&output, IntegerDecode::Linear).unwrap().pixels)
+}
+
+/// `marbre merge` of `inputs` to `output` with `flags`.
+pub(crate) fn merge_files(inputs: &[PathBuf], output: &Path, flags: &[&str]) -> anyhow::Result<()> {
+    let mut all: Vec<&str> = vec!["merge", "-o", output.to_str().unwrap()];
+    all.extend(inputs.iter().map(|p| p.to_str().unwrap()));
+    all.extend_from_slice(flags);
+    merge::run(&MergeCli::try_parse_from(&all).unwrap().args)
 }
 
 /// The largest difference between two images, relative to the second's
 /// value (at least 0.01).
-fn largest_relative_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+pub(crate) fn largest_relative_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
     a.iter()
         .zip(b)
         .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs() / q[c].abs().max(0.01)))
@@ -207,9 +227,7 @@ fn merged_batches_are_the_long_render_with_half_the_error() {
     let long = render_ball(&dir, "all.exr", 16, 0).unwrap();
     let reference = render_ball(&dir, "reference.exr", 256, 4096).unwrap();
     let merged_path = dir.join("merged.exr");
-    let mut flags: Vec<&str> = vec!["merge", "-o", merged_path.to_str().unwrap()];
-    flags.extend(inputs.iter().map(|p| p.to_str().unwrap()));
-    merge::run(&MergeCli::try_parse_from(&flags).unwrap().args).unwrap();
+    merge_files(&inputs, &merged_path, &[]).unwrap();
     let merged = merge::read_batch(&merged_path).unwrap();
     assert_eq!((merged.record.spp, merged.record.sample_offset), (16, 0));
     let d = largest_relative_difference(&merged.pixels, &long);
@@ -226,7 +244,11 @@ fn merged_batches_are_the_long_render_with_half_the_error() {
         .iter()
         .map(|p| merge::read_batch(p).unwrap())
         .collect();
-    let estimate = marbre_core::merge::merge(&batches).unwrap().rmse;
+    let estimate = marbre_core::merge::merge(&batches)
+        .unwrap()
+        .error
+        .unwrap()
+        .rmse;
     let measured = rmse(&merged.pixels, &reference);
     eprintln!(
         "merged / one batch's error: {ratio:.3}; estimated RMSE {estimate:.5}, measured {measured:.5}"

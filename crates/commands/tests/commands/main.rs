@@ -7,3 +7,4 @@ mod accuracy_bench;
 mod batches;
 mod render;
 mod sequence;
+mod tiles;

@@ -92,6 +92,10 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         overwrite: false,
         animation: None,
         sample_offset: 0,
+        tile: None,
+        tiles: None,
+        tile_index: None,
+        max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
     }
 }
 
@@ -106,6 +110,8 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         allow_placeholders: false,
         timing: Default::default(),
         sample_offset: 0,
+        tile: None,
+        max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
     }
 }
 

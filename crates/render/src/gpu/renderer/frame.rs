@@ -16,6 +16,7 @@ use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
 use crate::gpu::{non_finite, scene_gpu, trace_bands};
 use anyhow::Result;
 use marbre_core::scene::{Metering, ToneMap};
+use marbre_core::tile::Tile;
 
 /// The step between the seeds of consecutive samples of a pixel: the
 /// golden-ratio constant `shaders/trace.wgsl` multiplies the sample's
@@ -58,6 +59,21 @@ impl Renderer {
         if scale != self.render_scale {
             self.render_scale = scale;
             self.reset_accumulation();
+        }
+    }
+
+    /// Makes the targets hold `tile` of an image of `image` (resized to
+    /// the tile), traced with that image's camera and per-pixel samples,
+    /// so that tiles assemble to its render (`render --tile`, and a large
+    /// render traced a tile at a time); `None`: the whole image again.
+    /// Restarts the accumulation; no pipeline is built.
+    pub fn set_crop(&mut self, ctx: &GpuContext, crop: Option<(Tile, (u32, u32))>) {
+        if crop != self.crop {
+            self.crop = crop;
+            self.reset_accumulation();
+        }
+        if let Some((tile, _)) = crop {
+            self.resize(ctx, tile.size());
         }
     }
 
@@ -204,6 +220,7 @@ impl Renderer {
         let mut uniform: Frame = scene_gpu::frame_uniform(
             &self.scene,
             size,
+            self.crop,
             self.frame_index,
             self.accumulation.samples(),
         );

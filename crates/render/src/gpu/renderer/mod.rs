@@ -75,6 +75,9 @@ pub struct Renderer {
     /// Counts the samples the trace pass dropped for being NaN or infinite.
     non_finite: NonFiniteCounter,
     size: (u32, u32),
+    /// The tile of a larger image the targets hold, and its size
+    /// ([`Renderer::set_crop`]).
+    crop: Option<(marbre_core::tile::Tile, (u32, u32))>,
     render_scale: f32,
     frame_index: u32,
     /// The samples per pixel of the rounds that follow when fewer than
@@ -134,6 +137,7 @@ impl Renderer {
             error_meter: ErrorMeter::new(&ctx.device)?,
             non_finite: NonFiniteCounter::new(&ctx.device),
             size,
+            crop: None,
             render_scale: 1.0,
             frame_index: 0,
             round_samples: None,

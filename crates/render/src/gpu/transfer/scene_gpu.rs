@@ -12,6 +12,7 @@ use marbre_core::scene::{
     self as model, EnvSource, Ground, Integrator, MAX_CYLINDERS, MAX_POLYGONS, MAX_SPHERES,
     MappingSpace, Scene,
 };
+use marbre_core::tile::Tile;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -78,6 +79,10 @@ pub struct Frame {
     pub _pad_ground1: f32,
     pub ground_uv_v: [f32; 3],
     pub _pad_ground2: f32,
+    /// The crop of a larger image the targets hold (`Crop`): its origin
+    /// and the whole image's size, which the camera and the seeds follow.
+    pub crop_origin: [u32; 2],
+    pub image_size: [f32; 2],
 }
 
 /// `NoiseParams` of `crates/core/src/noise/fractal.wgsl`.
@@ -308,15 +313,25 @@ pub fn spheres(scene: &Scene) -> Vec<Sphere> {
     out
 }
 
-/// Per-frame values: camera, lights, counters.
+/// Per-frame values: camera, lights, counters. `crop`: the tile of a
+/// larger image the targets of `render_size` hold, and that image's size
+/// (`Renderer::set_crop`); the camera's aspect and the rays' spread follow
+/// the whole image.
 pub fn frame_uniform(
     scene: &Scene,
     render_size: (u32, u32),
+    crop: Option<(Tile, (u32, u32))>,
     frame_index: u32,
     accumulated: u32,
 ) -> Frame {
     let cam = scene.camera.frame();
     let (w, h) = (render_size.0.max(1) as f32, render_size.1.max(1) as f32);
+    let (crop_origin, image_size) = crop.map_or(([0; 2], [w, h]), |(tile, image)| {
+        (
+            [tile.x0, tile.y0],
+            [image.0.max(1) as f32, image.1.max(1) as f32],
+        )
+    });
     // No light: zero power, so an uber shader that compiles the light in adds nothing.
     let (light_pos, light_power) = scene
         .point_light
@@ -337,7 +352,7 @@ pub fn frame_uniform(
         cam_pos: cam.position.to_array(),
         tan_half_fov: cam.tan_half_fov,
         cam_right: cam.right.to_array(),
-        aspect: w / h,
+        aspect: image_size[0] / image_size[1],
         cam_up: cam.up.to_array(),
         frame_index,
         cam_forward: cam.forward.to_array(),
@@ -369,7 +384,7 @@ pub fn frame_uniform(
         has_ground: u32::from(scene.ground.is_some()),
         cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
         polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
-        pixel_spread: 2.0 * cam.tan_half_fov / h,
+        pixel_spread: 2.0 * cam.tan_half_fov / image_size[1],
         env_sampling: u32::from(env.source.is_map() && scene.render.env_importance),
         // Filled in by the renderer, which holds the distribution and the
         // light table.
@@ -397,6 +412,8 @@ pub fn frame_uniform(
         _pad_ground1: 0.0,
         ground_uv_v: ground_frame.v_axis.to_array(),
         _pad_ground2: 0.0,
+        crop_origin,
+        image_size,
     }
 }
 
@@ -476,6 +493,8 @@ mod tests {
                 ground_uv_origin,
                 ground_uv_u,
                 ground_uv_v,
+                crop_origin,
+                image_size,
             ]
         );
         twin_layout!(
