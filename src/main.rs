@@ -5,7 +5,7 @@
 use clap::{Args, Parser, Subcommand};
 use marbre::app::soak::command as soak;
 use marbre_commands::{
-    accuracy_bench, bake, bvh_bench, convergence_bench, edit_bench, merge, noise, parameters,
+    accuracy_bench, bake, bvh_bench, convergence_bench, edit_bench, farm, merge, noise, parameters,
     presets_bench, render, tx,
 };
 use marbre_render::gpu::KernelChoice;
@@ -79,10 +79,15 @@ enum Command {
     /// path tracks name it with (as the panel's key buttons do), and its
     /// value (or the animation's value at --at T).
     Parameters(parameters::ParametersArgs),
-    /// Average the sample batches of one render (`render --sample-offset`
-    /// EXR files, as a farm writes them) into one EXR, weighted by their
-    /// samples, and print its estimated error.
+    /// Put the sample batches and tiles of one render (`render
+    /// --sample-offset` and `--tile` EXR files, as a farm writes them)
+    /// together into one EXR or PNG, batches weighted by their samples,
+    /// and print its estimated error.
     Merge(merge::MergeArgs),
+    /// Cut a render into independent tasks for a render farm (frames,
+    /// sample batches, tiles): write a Slurm job array or a Kubernetes
+    /// Indexed Job with its merge, run one task, or merge a job.
+    Farm(farm::FarmArgs),
     /// Accuracy against time: one knob at a time (samples, bounces, light
     /// selection, strategies, environment sampling, octaves, filtering,
     /// hash, shader), each variant's error against a cached high-spp
@@ -144,6 +149,7 @@ fn main() -> ExitCode {
         Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::Parameters(args)) => parameters::run(&args),
         Some(Command::Merge(args)) => merge::run(&args),
+        Some(Command::Farm(args)) => farm::run(&args),
         Some(Command::Bench(args)) => accuracy_bench::run(&args),
         Some(Command::BenchPresets(args)) => presets_bench::run(&args),
         Some(Command::BenchBvh(args)) => bvh_bench::run(&args),

@@ -5,6 +5,7 @@ pub mod bake;
 pub mod bvh_bench;
 pub mod convergence_bench;
 pub mod edit_bench;
+pub mod farm;
 pub mod interrupt;
 pub mod merge;
 pub mod noise;

@@ -220,14 +220,14 @@ impl<'a> TileGroup<'a> {
             let at = (self.tile.y0 + y) as usize * width as usize + (self.tile.x0 + x) as usize;
             (p, at)
         }) {
-            for c in 0..4 {
+            for (c, merged) in image[out].iter_mut().enumerate() {
                 let mean = self
                     .batches
                     .iter()
                     .map(|b| f64::from(b.record.spp) * f64::from(b.pixels[p][c]))
                     .sum::<f64>()
                     / n;
-                image[out][c] = mean as f32;
+                *merged = mean as f32;
                 if c == 3 || !mean.is_finite() || self.batches.len() < 2 {
                     continue;
                 }

@@ -1,0 +1,236 @@
+//! `marbre farm`: a render cut into independent tasks (frames, sample
+//! batches, tiles) for a render farm (issue 30). `farm slurm` and `farm
+//! k8s` write the job's plan and the scheduler's files into a shared
+//! folder; on the nodes, `farm task DIR I` traces task I and `farm merge
+//! DIR` checks that every task wrote its file and merges each frame.
+
+mod plan;
+mod scripts;
+mod task;
+
+pub use plan::{FarmPlan, Split};
+pub use scripts::{KubernetesOptions, SlurmOptions};
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Subcommand};
+use marbre_core::tile::TileGrid;
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct FarmArgs {
+    #[command(subcommand)]
+    pub command: FarmCommand,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum FarmCommand {
+    /// Write a Slurm job: a job array of the tasks, a merge job after them
+    /// (afterok), and submit.sh, which submits both.
+    Slurm {
+        #[command(flatten)]
+        job: JobArgs,
+        /// The partition to run in.
+        #[arg(long)]
+        partition: Option<String>,
+        /// Generic resources each task asks for, such as gpu:1.
+        #[arg(long)]
+        gres: Option<String>,
+        /// Each task's time limit, as sbatch --time takes it.
+        #[arg(long)]
+        time: Option<String>,
+        /// CPUs per task (lavapipe's threads follow it).
+        #[arg(long)]
+        cpus: Option<u32>,
+        /// marbre's path on the nodes (default: this binary's).
+        #[arg(long)]
+        marbre: Option<PathBuf>,
+    },
+    /// Write a Kubernetes Indexed Job of the tasks, a merge Job, and
+    /// submit-k8s.sh, which applies the first, waits, then the second.
+    K8s {
+        #[command(flatten)]
+        job: JobArgs,
+        /// The container image with marbre on its PATH.
+        #[arg(long)]
+        image: String,
+        /// The persistent volume claim that holds the job's folder (mounted
+        /// at the same path in every pod).
+        #[arg(long)]
+        claim: String,
+        /// Tasks running at once.
+        #[arg(long, default_value_t = 8)]
+        parallelism: u32,
+        /// GPUs per task (nvidia.com/gpu); 0 for lavapipe on the CPU.
+        #[arg(long, default_value_t = 1)]
+        gpus: u32,
+        /// CPUs per task.
+        #[arg(long, default_value_t = 4)]
+        cpus: u32,
+    },
+    /// Trace task INDEX of the job in DIR (what a node runs); a task whose
+    /// file is written already does nothing.
+    Task { dir: PathBuf, index: u32 },
+    /// Check that every task of the job in DIR wrote its file (naming
+    /// those that failed or never ran) and merge each frame's parts.
+    Merge { dir: PathBuf },
+}
+
+/// What to render and how to cut it.
+#[derive(Args, Debug)]
+pub struct JobArgs {
+    /// The preset to render (it must be readable from the nodes).
+    #[arg(long)]
+    pub preset: PathBuf,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, value_parser = crate::render::parse_size)]
+    pub size: (u32, u32),
+    /// Samples per pixel of each frame, all its tasks together.
+    #[arg(long, default_value_t = 64, value_parser = crate::parse_spp)]
+    pub spp: u32,
+    /// Cut each frame into this many sample batches (they must divide
+    /// --spp).
+    #[arg(long, conflicts_with = "tiles")]
+    pub batches: Option<u32>,
+    /// Cut each frame into a COLUMNSxROWS grid of tiles.
+    #[arg(long, value_name = "CxR", value_parser = TileGrid::parse)]
+    pub tiles: Option<TileGrid>,
+    /// The animation frames FIRST..LAST (both included); without it, one
+    /// still.
+    #[arg(long, value_parser = marbre_render::frame_sequence::parse_frame_range)]
+    pub frames: Option<std::ops::RangeInclusive<u32>>,
+    /// Frames a second (default: the preset's animation's, else 24).
+    #[arg(long)]
+    pub fps: Option<f32>,
+    /// The trace kernel: fragment, compute or auto.
+    #[arg(long, default_value = "auto", value_parser = crate::kernel_choice_parser())]
+    pub kernel: marbre_render::gpu::KernelChoice,
+    /// The finished images' format: exr (linear radiance) or png.
+    #[arg(long, default_value = "exr", value_parser = ["exr", "png"])]
+    pub format: String,
+    /// The job's folder, shared with the nodes: the plan, the scripts,
+    /// the tasks' files, logs and the finished images go there.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+pub fn run(args: &FarmArgs) -> Result<()> {
+    match &args.command {
+        FarmCommand::Slurm {
+            job,
+            partition,
+            gres,
+            time,
+            cpus,
+            marbre,
+        } => {
+            let (plan, dir) = write_plan(job)?;
+            let marbre = match marbre {
+                Some(path) => path.clone(),
+                None => std::env::current_exe().context("finding marbre's own path")?,
+            };
+            let options = SlurmOptions {
+                partition: partition.clone(),
+                gres: gres.clone(),
+                time: time.clone(),
+                cpus: *cpus,
+            };
+            write_files(&dir, scripts::slurm(&plan, &dir, &marbre, &options))?;
+            println!(
+                "wrote a Slurm job of {} tasks to {}: submit it with `sh {}`",
+                plan.tasks(),
+                dir.display(),
+                dir.join("submit.sh").display()
+            );
+            Ok(())
+        }
+        FarmCommand::K8s {
+            job,
+            image,
+            claim,
+            parallelism,
+            gpus,
+            cpus,
+        } => {
+            let (plan, dir) = write_plan(job)?;
+            let options = KubernetesOptions {
+                image: image.clone(),
+                claim: claim.clone(),
+                parallelism: (*parallelism).max(1),
+                gpus: *gpus,
+                cpus: (*cpus).max(1),
+            };
+            write_files(&dir, scripts::kubernetes(&plan, &dir, &options))?;
+            println!(
+                "wrote a Kubernetes job of {} tasks to {}: run it with `sh {}`",
+                plan.tasks(),
+                dir.display(),
+                dir.join("submit-k8s.sh").display()
+            );
+            Ok(())
+        }
+        FarmCommand::Task { dir, index } => task::run_task(dir, *index),
+        FarmCommand::Merge { dir } => task::merge_job(dir),
+    }
+}
+
+/// The job's plan from the flags, checked (the preset read, batches that
+/// start on a round of its samples) and written to its folder, made
+/// absolute so that the nodes find it.
+fn write_plan(job: &JobArgs) -> Result<(FarmPlan, PathBuf)> {
+    let absolute = |p: &Path| -> Result<PathBuf> {
+        std::path::absolute(p).with_context(|| format!("making {} absolute", p.display()))
+    };
+    let preset_path = absolute(&job.preset)?;
+    let preset = marbre_core::preset::load(&preset_path)
+        .with_context(|| format!("reading the preset {}", preset_path.display()))?
+        .preset;
+    let plan = FarmPlan {
+        preset: preset_path,
+        size: job.size,
+        spp: job.spp,
+        split: match (job.batches, job.tiles) {
+            (Some(batches), _) => Split::Batches { batches },
+            (None, Some(grid)) => Split::Tiles {
+                columns: grid.columns,
+                rows: grid.rows,
+            },
+            (None, None) => Split::Whole,
+        },
+        frames: job.frames.clone(),
+        fps: job
+            .fps
+            .or(preset.scene.animation.as_ref().map(|a| a.fps))
+            .unwrap_or(24.0),
+        kernel: job.kernel.to_string(),
+        format: job.format.clone(),
+    };
+    plan.check()?;
+    let per_round = preset.scene.render.samples_per_frame.max(1);
+    if let Split::Batches { batches } = plan.split
+        && !(plan.spp / batches).is_multiple_of(per_round)
+    {
+        bail!(
+            "each batch traces {} samples, not a multiple of the preset's samples_per_frame \
+             ({per_round}): a batch starts where a round of the long render starts",
+            plan.spp / batches
+        );
+    }
+    let dir = absolute(&job.output)?;
+    plan.write(&dir)?;
+    Ok((plan, dir))
+}
+
+/// Writes the scheduler's files into `dir`, scripts executable.
+fn write_files(dir: &Path, files: Vec<(&str, String)>) -> Result<()> {
+    for (name, text) in files {
+        let path = dir.join(name);
+        marbre_core::atomic_write::write_atomic(&path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        if name.ends_with(".sh") || name.ends_with(".sbatch") {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755))
+                .with_context(|| format!("making {} executable", path.display()))?;
+        }
+    }
+    Ok(())
+}

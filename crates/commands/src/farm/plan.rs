@@ -1,0 +1,293 @@
+//! A farm job's plan (`DIR/farm.ron`): what the render is and how it is
+//! cut into tasks. Every task and the merge read it, so that the mapping
+//! from an array index to a frame and a part of it (a sample batch or a
+//! tile) is written in one place, not in each scheduler's script.
+
+use anyhow::{Context, Result, bail};
+use marbre_core::image_io::ImageFormat;
+use marbre_core::tile::{Tile, TileGrid};
+use serde::{Deserialize, Serialize};
+use std::ops::RangeInclusive;
+use std::path::{Path, PathBuf};
+
+/// The plan's file name in the job's folder.
+pub const PLAN_FILE: &str = "farm.ron";
+
+/// How each frame is cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Split {
+    /// One task traces the whole frame.
+    Whole,
+    /// `batches` tasks each trace `spp / batches` samples from their own
+    /// offset (`render --sample-offset`).
+    Batches { batches: u32 },
+    /// One task per tile of a `columns` × `rows` grid (`render --tiles`).
+    Tiles { columns: u32, rows: u32 },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FarmPlan {
+    /// The preset, as an absolute path: the nodes read it from the shared
+    /// folder.
+    pub preset: PathBuf,
+    pub size: (u32, u32),
+    /// Samples per pixel of each frame, all its tasks together.
+    pub spp: u32,
+    pub split: Split,
+    /// The animation frames to render (both ends included); `None`: one
+    /// still, frame 0 at time 0.
+    pub frames: Option<RangeInclusive<u32>>,
+    /// Frames a second, which place a frame in time.
+    pub fps: f32,
+    /// `fragment`, `compute` or `auto`.
+    pub kernel: String,
+    /// The merged images' format: `exr` (linear radiance) or `png`.
+    pub format: String,
+}
+
+/// What one array index traces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Task {
+    pub index: u32,
+    pub frame: u32,
+    pub time: f32,
+    /// Which batch or tile of the frame (0 when whole).
+    pub part: u32,
+    pub spp: u32,
+    pub sample_offset: u32,
+    pub tile: Option<Tile>,
+}
+
+impl FarmPlan {
+    /// An error if the plan cannot be cut as it says: batches that do not
+    /// divide the samples, a grid finer than the image, no frame.
+    pub fn check(&self) -> Result<()> {
+        match self.split {
+            Split::Whole => {}
+            Split::Batches { batches } => {
+                if batches < 2 || !self.spp.is_multiple_of(batches) {
+                    bail!(
+                        "--batches {batches} must be 2 or more and divide --spp {} (each batch \
+                         traces spp / batches samples)",
+                        self.spp
+                    );
+                }
+            }
+            Split::Tiles { columns, rows } => {
+                TileGrid { columns, rows }
+                    .tile(self.size, 0)
+                    .map_err(|e| anyhow::anyhow!("--tiles: {e}"))?;
+            }
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            bail!("--fps must be a positive number of frames a second");
+        }
+        ImageFormat::from_path(Path::new(&format!("x.{}", self.format)))?;
+        Ok(())
+    }
+
+    /// Tasks a frame is cut into.
+    pub fn parts(&self) -> u32 {
+        match self.split {
+            Split::Whole => 1,
+            Split::Batches { batches } => batches,
+            Split::Tiles { columns, rows } => columns * rows,
+        }
+    }
+
+    /// The frames traced, in order.
+    pub fn frame_numbers(&self) -> RangeInclusive<u32> {
+        self.frames.clone().unwrap_or(0..=0)
+    }
+
+    /// Tasks in all: the array's length.
+    pub fn tasks(&self) -> u32 {
+        let frames = self.frame_numbers();
+        (frames.end() - frames.start() + 1) * self.parts()
+    }
+
+    /// What array index `index` traces: frame after frame, and each
+    /// frame's parts in order.
+    pub fn task(&self, index: u32) -> Result<Task> {
+        if index >= self.tasks() {
+            bail!(
+                "task {index} is out of range: the job has tasks 0 to {}",
+                self.tasks() - 1
+            );
+        }
+        let parts = self.parts();
+        let (frame, part) = (self.frame_numbers().start() + index / parts, index % parts);
+        let (spp, sample_offset, tile) = match self.split {
+            Split::Whole => (self.spp, 0, None),
+            Split::Batches { batches } => {
+                let each = self.spp / batches;
+                (each, part * each, None)
+            }
+            Split::Tiles { columns, rows } => {
+                let tile = TileGrid { columns, rows }
+                    .tile(self.size, part)
+                    .map_err(|e| anyhow::anyhow!(e))?;
+                (self.spp, 0, Some(tile))
+            }
+        };
+        Ok(Task {
+            index,
+            frame,
+            time: if self.frames.is_some() {
+                frame as f32 / self.fps
+            } else {
+                0.0
+            },
+            part,
+            spp,
+            sample_offset,
+            tile,
+        })
+    }
+
+    /// The file a task writes in the job's folder `dir`: the frame itself
+    /// when it is one task, else a part (always EXR) for the merge.
+    pub fn task_output(&self, dir: &Path, task: &Task) -> PathBuf {
+        if self.parts() == 1 {
+            self.frame_output(dir, task.frame)
+        } else {
+            dir.join("parts")
+                .join(format!("frame_{:04}_part_{:03}.exr", task.frame, task.part))
+        }
+    }
+
+    /// The finished image of `frame`.
+    pub fn frame_output(&self, dir: &Path, frame: u32) -> PathBuf {
+        if self.frames.is_some() {
+            dir.join("frames")
+                .join(format!("frame_{frame:04}.{}", self.format))
+        } else {
+            dir.join(format!("image.{}", self.format))
+        }
+    }
+
+    /// Where a failed task leaves its error, for the merge to name.
+    pub fn failure_note(dir: &Path, index: u32) -> PathBuf {
+        dir.join("status").join(format!("task_{index}.failed"))
+    }
+
+    /// Writes the plan to `dir`, creating the job's folders.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        for sub in ["parts", "frames", "status", "logs"] {
+            std::fs::create_dir_all(dir.join(sub))
+                .with_context(|| format!("creating {}", dir.join(sub).display()))?;
+        }
+        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
+            .context("writing the plan as RON")?;
+        marbre_core::atomic_write::write_atomic(&dir.join(PLAN_FILE), text.as_bytes())?;
+        Ok(())
+    }
+
+    /// The plan of the job in `dir`.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let path = dir.join(PLAN_FILE);
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "reading {}: is {} a folder `marbre farm` wrote?",
+                path.display(),
+                dir.display()
+            )
+        })?;
+        let plan: Self =
+            ron::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
+        plan.check()
+            .with_context(|| format!("{} is not a plan marbre can run", path.display()))?;
+        Ok(plan)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(split: Split, frames: Option<RangeInclusive<u32>>) -> FarmPlan {
+        FarmPlan {
+            preset: PathBuf::from("/shared/p.ron"),
+            size: (64, 48),
+            spp: 64,
+            split,
+            frames,
+            fps: 24.0,
+            kernel: "auto".into(),
+            format: "exr".into(),
+        }
+    }
+
+    /// Index → frame and part, frame after frame: batches take their
+    /// offsets, tiles their grid cell, frames their time.
+    #[test]
+    fn indices_map_to_frames_and_parts() {
+        let p = plan(Split::Batches { batches: 4 }, Some(10..=12));
+        assert_eq!(p.tasks(), 12);
+        let t = p.task(6).unwrap();
+        assert_eq!((t.frame, t.part, t.spp, t.sample_offset), (11, 2, 16, 32));
+        assert!((t.time - 11.0 / 24.0).abs() < 1e-6);
+        let e = p.task(12).unwrap_err().to_string();
+        assert!(e.contains("tasks 0 to 11"), "{e}");
+        let p = plan(
+            Split::Tiles {
+                columns: 2,
+                rows: 2,
+            },
+            None,
+        );
+        let t = p.task(3).unwrap();
+        assert_eq!(t.tile, Some(Tile::parse("32,24,64,48").unwrap()));
+        assert_eq!((t.frame, t.time, t.spp), (0, 0.0, 64));
+        let dir = Path::new("/job");
+        assert_eq!(
+            p.task_output(dir, &t),
+            dir.join("parts/frame_0000_part_003.exr")
+        );
+        assert_eq!(p.frame_output(dir, 0), dir.join("image.exr"));
+        let p = plan(Split::Whole, Some(0..=3));
+        let t = p.task(2).unwrap();
+        assert_eq!(p.task_output(dir, &t), dir.join("frames/frame_0002.exr"));
+    }
+
+    #[test]
+    fn plans_that_cannot_be_cut_are_refused() {
+        let e = plan(Split::Batches { batches: 5 }, None)
+            .check()
+            .unwrap_err();
+        assert!(e.to_string().contains("divide --spp 64"), "{e}");
+        let e = plan(
+            Split::Tiles {
+                columns: 65,
+                rows: 1,
+            },
+            None,
+        )
+        .check()
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("does not divide"), "{e:#}");
+        let mut p = plan(Split::Whole, None);
+        p.format = "jpg".into();
+        assert!(p.check().is_err());
+    }
+
+    #[test]
+    fn a_plan_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(
+            Split::Tiles {
+                columns: 4,
+                rows: 2,
+            },
+            Some(0..=9),
+        );
+        p.write(dir.path()).unwrap();
+        assert_eq!(FarmPlan::read(dir.path()).unwrap(), p);
+        assert!(dir.path().join("status").is_dir());
+        let e = FarmPlan::read(&dir.path().join("nowhere")).unwrap_err();
+        assert!(
+            e.to_string().contains("a folder `marbre farm` wrote"),
+            "{e}"
+        );
+    }
+}

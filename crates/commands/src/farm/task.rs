@@ -1,0 +1,199 @@
+//! What runs on a farm's nodes: one task of a job (`marbre farm task DIR
+//! I`), and the merge that follows every task (`marbre farm merge DIR`).
+//! A task is idempotent: a file already written is left alone, and a
+//! rerun or a requeue rewrites only its own file (written atomically, so
+//! a killed task leaves none). A task that fails leaves its error in
+//! `status/`, which the merge names.
+
+use super::plan::{FarmPlan, Task};
+use anyhow::{Context, Result, anyhow, bail};
+use marbre_core::image_io::{self, ImageFormat};
+use marbre_core::merge::merge;
+use marbre_core::render_record::RECORD_ATTRIBUTE;
+use marbre_render::cpu_display;
+use marbre_render::final_render::{
+    DEFAULT_MAX_TILE_PIXELS, FinalRender, Progress, RenderObserver, Stop, render_to_file,
+};
+use marbre_render::frame_sequence::Timing;
+use marbre_render::gpu::GpuContext;
+use marbre_render::session::load_scene;
+use std::ops::ControlFlow;
+use std::path::Path;
+
+/// Runs task `index` of the job in `dir`, unless its file is written.
+pub fn run_task(dir: &Path, index: u32) -> Result<()> {
+    let plan = FarmPlan::read(dir)?;
+    let task = plan.task(index)?;
+    let output = plan.task_output(dir, &task);
+    let note = FarmPlan::failure_note(dir, index);
+    if output.is_file() {
+        println!(
+            "task {index}: {} is written already; nothing to do",
+            output.display()
+        );
+        let _ = std::fs::remove_file(&note);
+        return Ok(());
+    }
+    match trace(&plan, &task, &output) {
+        Ok(()) => {
+            let _ = std::fs::remove_file(&note);
+            println!("task {index}: wrote {}", output.display());
+            Ok(())
+        }
+        Err(e) => {
+            // Best effort: the error itself goes to the task's log too.
+            let _ = marbre_core::atomic_write::write_atomic(&note, format!("{e:#}\n").as_bytes());
+            Err(e.context(format!("task {index} of {}", dir.display())))
+        }
+    }
+}
+
+/// Traces `task` of `plan` to `output`.
+fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
+    let loaded = load_scene(&plan.preset, None)?;
+    let job = FinalRender {
+        size: plan.size,
+        stop: Stop::Samples(task.spp),
+        auto_exposure: None,
+        kernel: plan
+            .kernel
+            .parse()
+            .map_err(|e| anyhow!("the plan's kernel: {e}"))?,
+        output: output.to_path_buf(),
+        denoise_exr: false,
+        allow_placeholders: false,
+        timing: Timing::Still {
+            time: task.time,
+            frame: task.frame,
+        },
+        sample_offset: task.sample_offset,
+        tile: task.tile,
+        max_tile_pixels: DEFAULT_MAX_TILE_PIXELS,
+    };
+    let ctx = GpuContext::headless()?;
+    render_to_file(&ctx, loaded, &job, &mut Log)?;
+    Ok(())
+}
+
+/// A task's lines go to its log (the scheduler's output file).
+struct Log;
+
+impl RenderObserver for Log {
+    fn note(&mut self, line: &str) {
+        eprintln!("{line}");
+    }
+
+    fn progress(&mut self, _: &Progress) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// Checks that every task of the job in `dir` wrote its file, naming those
+/// that failed (with their error) or never ran, then merges each frame's
+/// parts into its image.
+pub fn merge_job(dir: &Path) -> Result<()> {
+    let plan = FarmPlan::read(dir)?;
+    let tasks: Vec<Task> = (0..plan.tasks())
+        .map(|i| plan.task(i))
+        .collect::<Result<_>>()?;
+    let problems: Vec<String> = tasks
+        .iter()
+        .filter(|t| !plan.task_output(dir, t).is_file())
+        .map(|t| describe_missing(dir, &plan, t))
+        .collect();
+    if !problems.is_empty() {
+        bail!(
+            "{} of the {} tasks of {} have no file; run them again (a finished task is \
+             skipped):\n  {}",
+            problems.len(),
+            tasks.len(),
+            dir.display(),
+            problems.join("\n  ")
+        );
+    }
+    if plan.parts() == 1 {
+        println!(
+            "every one of the {} frames of {} is written; nothing to merge",
+            tasks.len(),
+            dir.display()
+        );
+        return Ok(());
+    }
+    let display = load_scene_display(&plan)?;
+    for frame in plan.frame_numbers() {
+        let parts: Vec<_> = tasks
+            .iter()
+            .filter(|t| t.frame == frame)
+            .map(|t| crate::merge::read_batch(&plan.task_output(dir, t)))
+            .collect::<Result<_>>()?;
+        let merged = merge(&parts).map_err(|e| anyhow!(e))?;
+        let output = plan.frame_output(dir, frame);
+        let record = merged.record.to_text();
+        let text = Some((RECORD_ATTRIBUTE, record.as_str()));
+        match ImageFormat::from_path(&output)? {
+            ImageFormat::Exr => {
+                image_io::save_exr(merged.width, merged.height, &merged.pixels, text, &output)?
+            }
+            ImageFormat::Png => {
+                let (image, _) =
+                    cpu_display::show(&merged.pixels, (merged.width, merged.height), &display);
+                image_io::save_png_with_text(&image, text, &output)?
+            }
+        }
+        let error = merged.error.map_or(String::new(), |e| {
+            format!(
+                "; estimated relative error {:.3} % (RMSE {:.5})",
+                100.0 * e.relative,
+                e.rmse
+            )
+        });
+        println!(
+            "frame {frame}: merged {} parts into {} at {} spp{error}",
+            parts.len(),
+            output.display(),
+            merged.record.spp
+        );
+    }
+    Ok(())
+}
+
+/// Why task `t` has no file: its error, if it left one, or that it did
+/// not run (or was still running).
+fn describe_missing(dir: &Path, plan: &FarmPlan, t: &Task) -> String {
+    let what = match plan.split {
+        super::plan::Split::Whole => format!("frame {}", t.frame),
+        super::plan::Split::Batches { .. } => format!(
+            "frame {}, samples {}..{}",
+            t.frame,
+            t.sample_offset,
+            t.sample_offset + t.spp
+        ),
+        super::plan::Split::Tiles { .. } => format!(
+            "frame {}, tile {}",
+            t.frame,
+            t.tile.map_or(String::new(), |tile| tile.to_string())
+        ),
+    };
+    match std::fs::read_to_string(FarmPlan::failure_note(dir, t.index)) {
+        Ok(error) => format!(
+            "task {} ({what}) FAILED: {}",
+            t.index,
+            error.lines().next().unwrap_or("")
+        ),
+        Err(_) => format!(
+            "task {} ({what}) did not run or did not finish: {} is missing",
+            t.index,
+            plan.task_output(dir, t).display()
+        ),
+    }
+}
+
+/// The preset's display, which a merged PNG is shown with.
+fn load_scene_display(plan: &FarmPlan) -> Result<marbre_core::scene::DisplaySettings> {
+    Ok(marbre_core::preset::load(&plan.preset)
+        .with_context(|| format!("reading the preset {}", plan.preset.display()))?
+        .preset
+        .scene
+        .render
+        .shown_display())
+}
