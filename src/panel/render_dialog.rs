@@ -114,6 +114,7 @@ impl RenderDialog {
             sample_offset: 0,
             tile: None,
             max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
+            moments: false,
         })
     }
 

@@ -54,13 +54,23 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let record = merged.record.to_text();
     let text = Some((RECORD_ATTRIBUTE, record.as_str()));
     match format {
-        ImageFormat::Exr => image_io::save_exr(
-            merged.width,
-            merged.height,
-            &merged.pixels,
-            text,
-            &args.output,
-        )?,
+        ImageFormat::Exr => match &merged.variance {
+            Some(variance) => image_io::save_exr_with_variance(
+                merged.width,
+                merged.height,
+                &merged.pixels,
+                variance,
+                text,
+                &args.output,
+            )?,
+            None => image_io::save_exr(
+                merged.width,
+                merged.height,
+                &merged.pixels,
+                text,
+                &args.output,
+            )?,
+        },
         ImageFormat::Png => {
             let (image, metered) =
                 cpu_display::show(&merged.pixels, (merged.width, merged.height), &display);
@@ -73,12 +83,17 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let samples = merged.record.samples();
     let error = match merged.error {
         Some(e) => format!(
-            "estimated relative error {:.3} % (RMSE {:.5}), from the spread between the batches",
+            "estimated relative error {:.3} % (RMSE {:.5}), from {}",
             100.0 * e.relative,
-            e.rmse
+            e.rmse,
+            if merged.variance.is_some() {
+                "the files' variance layers"
+            } else {
+                "the spread between the batches"
+            }
         ),
         None => "no error estimate: every tile is one batch (render two batches or more of a \
-                 tile to measure it)"
+                 tile, or each with --moments, to measure it)"
             .to_owned(),
     };
     let tiles = if merged.tiles > 1 {
@@ -132,11 +147,21 @@ pub fn read_batch(path: &Path) -> Result<Batch> {
             )
         })?;
     let image = decode_file(path, IntegerDecode::Linear)?;
+    let variance = image_io::read_exr_variance(path)?;
+    if let Some(v) = &variance
+        && v.len() != image.pixels.len()
+    {
+        bail!(
+            "{}: its variance layer is not the picture's size",
+            path.display()
+        );
+    }
     Ok(Batch {
         path: path.to_path_buf(),
         width: image.width,
         height: image.height,
         pixels: image.pixels,
+        variance,
         record,
     })
 }

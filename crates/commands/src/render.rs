@@ -131,6 +131,13 @@ pub struct RenderArgs {
     /// within the GPU's memory. Default: a 4K UHD frame, 8294400.
     #[arg(long, value_name = "PIXELS", default_value_t = DEFAULT_MAX_TILE_PIXELS)]
     pub max_tile_pixels: u64,
+    /// Write each pixel's estimated variance of its mean beside the
+    /// radiance (the EXR's `variance` layer, from the spread of its
+    /// rounds), so that `marbre merge` estimates the merged error even
+    /// with one batch a tile. Needs --spp above the preset's
+    /// samples_per_frame.
+    #[arg(long)]
+    pub moments: bool,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -221,6 +228,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             _ => None,
         },
         max_tile_pixels: args.max_tile_pixels,
+        moments: args.moments,
     };
     let frames = match &job.timing {
         Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,

@@ -150,6 +150,118 @@ pub fn save_exr(
     Ok(())
 }
 
+/// Writes [`encode_exr_with_variance`]'s file atomically.
+pub fn save_exr_with_variance(
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    variance: &[[f32; 3]],
+    text: Option<(&str, &str)>,
+    path: &Path,
+) -> Result<()> {
+    write_atomic(
+        path,
+        &encode_exr_with_variance(width, height, pixels, variance, text)?,
+    )?;
+    Ok(())
+}
+
+/// The name of the layer [`encode_exr_with_variance`] writes.
+pub const VARIANCE_LAYER: &str = "variance";
+
+/// [`encode_exr`]'s file with a second layer, `variance.R`, `.G`, `.B`:
+/// each pixel's estimated variance of its mean (`render --moments`), so
+/// that a merge of such files still knows its error. Readers that want
+/// the picture read the unnamed layer, as compositors do.
+pub fn encode_exr_with_variance(
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    variance: &[[f32; 3]],
+    text: Option<(&str, &str)>,
+) -> Result<Vec<u8>> {
+    use exr::prelude::*;
+    let (w, h) = (width as usize, height as usize);
+    let channel = |name: String, values: Vec<f32>| {
+        AnyChannel::new(Text::new_or_panic(name), FlatSamples::F32(values))
+    };
+    let mut list = SmallVec::new();
+    for (c, name) in ["R", "G", "B", "A"].iter().enumerate() {
+        list.push(channel(
+            (*name).to_owned(),
+            pixels.iter().map(|p| p[c]).collect(),
+        ));
+    }
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        list.push(channel(
+            format!("{VARIANCE_LAYER}.{name}"),
+            variance.iter().map(|v| v[c]).collect(),
+        ));
+    }
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let mut layer = Layer::new(
+        (w, h),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(list),
+    );
+    if let Some((name, value)) = text {
+        layer.attributes.other.insert(
+            latin1_text(name),
+            exr::meta::attribute::AttributeValue::Text(latin1_text(value)),
+        );
+    }
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer).write().to_buffered(&mut bytes)?;
+    Ok(bytes.into_inner())
+}
+
+/// The `variance` layer of an EXR file ([`encode_exr_with_variance`]),
+/// if it has one.
+pub fn read_exr_variance(path: &Path) -> Result<Option<Vec<[f32; 3]>>> {
+    use exr::prelude::*;
+    let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display()))?;
+    let channels = &image.layer_data.channel_data.list;
+    let find = |base: &str| {
+        channels
+            .iter()
+            .find(|c| c.name.to_string() == format!("{VARIANCE_LAYER}.{base}"))
+            .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
+    };
+    let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) else {
+        return Ok(None);
+    };
+    Ok(Some(
+        r.into_iter()
+            .zip(g)
+            .zip(b)
+            .map(|((r, g), b)| [r, g, b])
+            .collect(),
+    ))
+}
+
+/// `s` as EXR text, its characters beyond Latin-1 (which EXR text cannot
+/// hold) written as `?`.
+fn latin1_text(s: &str) -> exr::meta::attribute::Text {
+    let latin1: String = s
+        .chars()
+        .map(|c| if u32::from(c) < 256 { c } else { '?' })
+        .collect();
+    exr::meta::attribute::Text::new_or_panic(latin1)
+}
+
 /// The text attributes of an EXR file's header (its first part's and
 /// those shared by all parts), by name: where a render's record is
 /// (`render_record`). Only the header is read.
@@ -207,17 +319,10 @@ pub fn encode_exr(
         ..Encoding::FAST_LOSSLESS
     };
     let mut image = Image::from_encoded_channels((w, h), encoding, channels);
-    let latin1 = |s: &str| {
-        let latin1: String = s
-            .chars()
-            .map(|c| if u32::from(c) < 256 { c } else { '?' })
-            .collect();
-        Text::new_or_panic(latin1)
-    };
     if let Some((name, value)) = text {
         image.layer_data.attributes.other.insert(
-            latin1(name),
-            exr::meta::attribute::AttributeValue::Text(latin1(value)),
+            latin1_text(name),
+            exr::meta::attribute::AttributeValue::Text(latin1_text(value)),
         );
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
@@ -246,6 +351,26 @@ mod tests {
         let bytes = std::fs::read(&path).unwrap();
         save_exr(2, 1, &[[0.5; 4]; 2], text, &path).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), bytes);
+    }
+
+    /// A variance layer reads back beside the picture, which still decodes
+    /// as the file's RGBA; a file without one has none.
+    #[test]
+    fn an_exr_variance_layer_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("v.exr");
+        let pixels = [[0.5, 1.0, 2.0, 1.0], [3.0, 4.0, 5.0, 1.0]];
+        let variance = [[0.01, 0.02, 0.03], [0.04, 0.05, 0.06]];
+        save_exr_with_variance(2, 1, &pixels, &variance, Some(("k", "v")), &path).unwrap();
+        assert_eq!(read_exr_variance(&path).unwrap(), Some(variance.to_vec()));
+        let decoded =
+            crate::image_decode::decode_file(&path, crate::image_decode::IntegerDecode::Linear)
+                .unwrap();
+        assert_eq!(decoded.pixels, pixels.to_vec());
+        assert_eq!(read_exr_attributes(&path).unwrap()["k"], "v");
+        let plain = dir.path().join("p.exr");
+        save_exr(2, 1, &pixels, None, &plain).unwrap();
+        assert_eq!(read_exr_variance(&plain).unwrap(), None);
     }
 
     /// A PNG's text chunk reads back by keyword, any character included,

@@ -20,6 +20,9 @@ pub struct Batch {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<[f32; 4]>,
+    /// Each pixel's estimated variance of its mean, when the file has the
+    /// layer (`render --moments`).
+    pub variance: Option<Vec<[f32; 3]>>,
     pub record: RenderRecord,
 }
 
@@ -32,8 +35,12 @@ pub struct Merged {
     /// The record of the merged render: all the samples, from the first,
     /// of the whole image.
     pub record: RenderRecord,
-    /// The error of the merged mean, estimated from the spread between
-    /// the batches of each tile; `None` when no tile has two batches.
+    /// Each pixel's estimated variance of its merged mean, when every
+    /// file has the layer: Σ (n_i / N)² v_i over its batches.
+    pub variance: Option<Vec<[f32; 3]>>,
+    /// The error of the merged mean, from the files' variance layers
+    /// where every batch of a tile has one, else from the spread between
+    /// the batches of a tile; `None` when no tile has either.
     pub error: Option<MergeError>,
     /// How many tiles were assembled (1: batches of the whole image).
     pub tiles: usize,
@@ -142,10 +149,13 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             groups[0].samples
         ));
     }
-    let mut pixels = vec![[0.0f32; 4]; image.0 as usize * image.1 as usize];
+    let count = image.0 as usize * image.1 as usize;
+    let mut pixels = vec![[0.0f32; 4]; count];
+    let with_moments = batches.iter().all(|b| b.variance.is_some());
+    let mut variance = with_moments.then(|| vec![[0.0f32; 3]; count]);
     let mut spread = SpreadSum::default();
     for group in &groups {
-        group.assemble(image.0, &mut pixels, &mut spread);
+        group.assemble(image.0, &mut pixels, variance.as_deref_mut(), &mut spread);
     }
     let kernels = distinct(batches.iter().map(|b| b.record.kernel.as_str()));
     let adapters = distinct(batches.iter().map(|b| b.record.adapter.as_str()));
@@ -161,6 +171,7 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             adapter: adapters,
             ..first.record.clone()
         },
+        variance,
         error: spread.error(),
         tiles: groups.len(),
     })
@@ -210,36 +221,57 @@ impl<'a> TileGroup<'a> {
         })
     }
 
-    /// Writes the tile's mean into `image` (rows of `width`), and adds
-    /// the spread between its batches, if two or more, to `spread`.
-    fn assemble(&self, width: u32, image: &mut [[f32; 4]], spread: &mut SpreadSum) {
+    /// Writes the tile's mean into `image` (rows of `width`), and its
+    /// variance into `variance` when the batches have their moments, and
+    /// adds the variance estimated (from the moments, else from the
+    /// spread between two or more batches) to `spread`.
+    fn assemble(
+        &self,
+        width: u32,
+        image: &mut [[f32; 4]],
+        mut variance: Option<&mut [[f32; 3]]>,
+        spread: &mut SpreadSum,
+    ) {
         let n = self.samples as f64;
         let (tile_width, _) = self.tile.size();
-        for (p, out) in (0..self.tile.pixels() as usize).map(|p| {
+        let weight = |b: &Batch| f64::from(b.record.spp) / n;
+        for p in 0..self.tile.pixels() as usize {
             let (x, y) = (p as u32 % tile_width, p as u32 / tile_width);
-            let at = (self.tile.y0 + y) as usize * width as usize + (self.tile.x0 + x) as usize;
-            (p, at)
-        }) {
+            let out = (self.tile.y0 + y) as usize * width as usize + (self.tile.x0 + x) as usize;
             for (c, merged) in image[out].iter_mut().enumerate() {
                 let mean = self
                     .batches
                     .iter()
-                    .map(|b| f64::from(b.record.spp) * f64::from(b.pixels[p][c]))
-                    .sum::<f64>()
-                    / n;
+                    .map(|b| weight(b) * f64::from(b.pixels[p][c]))
+                    .sum::<f64>();
                 *merged = mean as f32;
-                if c == 3 || !mean.is_finite() || self.batches.len() < 2 {
+                if c == 3 || !mean.is_finite() {
                     continue;
                 }
-                // Each batch's mean x_i of n_i samples has variance σ²/n_i:
-                // Σ n_i (x_i − m)² / (K − 1) estimates σ², and the merged
-                // mean's variance is σ² / N.
-                let squares: f64 = self
-                    .batches
-                    .iter()
-                    .map(|b| f64::from(b.record.spp) * (f64::from(b.pixels[p][c]) - mean).powi(2))
-                    .sum();
-                spread.add(squares / ((self.batches.len() - 1) as f64 * n), mean);
+                if let Some(variance) = variance.as_deref_mut() {
+                    // Independent batches: Var(Σ w_i x_i) = Σ w_i² Var(x_i).
+                    let v: f64 = self
+                        .batches
+                        .iter()
+                        .filter_map(|b| {
+                            Some(weight(b).powi(2) * f64::from(b.variance.as_ref()?[p][c]))
+                        })
+                        .sum();
+                    variance[out][c] = v as f32;
+                    spread.add(v, mean);
+                } else if self.batches.len() >= 2 {
+                    // Each batch's mean x_i of n_i samples has variance
+                    // σ²/n_i: Σ n_i (x_i − m)² / (K − 1) estimates σ², and
+                    // the merged mean's variance is σ² / N.
+                    let squares: f64 = self
+                        .batches
+                        .iter()
+                        .map(|b| {
+                            f64::from(b.record.spp) * (f64::from(b.pixels[p][c]) - mean).powi(2)
+                        })
+                        .sum();
+                    spread.add(squares / ((self.batches.len() - 1) as f64 * n), mean);
+                }
             }
         }
     }
@@ -292,6 +324,7 @@ mod tests {
             width,
             height,
             pixels: vec![[value, value, value, 1.0]; tile.pixels() as usize],
+            variance: None,
             record: RenderRecord {
                 spp,
                 sample_offset: offset,
@@ -359,6 +392,25 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(alone.error, None, "one batch a tile: no spread to measure");
+    }
+
+    /// Batches with their moments: the merged variance is Σ (n_i / N)²
+    /// v_i, even for one batch a tile: 2 and 2 samples of variances 0.4
+    /// and 0.8 give 0.25 · 0.4 + 0.25 · 0.8 = 0.3.
+    #[test]
+    fn moments_give_the_merged_variance() {
+        let mut a = batch("a.exr", 0, 2, 1.0);
+        let mut b = batch("b.exr", 2, 2, 3.0);
+        a.variance = Some(vec![[0.4; 3]; 2]);
+        b.variance = Some(vec![[0.8; 3]; 2]);
+        let merged = merge(&[a, b]).unwrap();
+        let variance = merged.variance.unwrap();
+        assert!(
+            variance.iter().flatten().all(|v| (v - 0.3).abs() < 1e-6),
+            "{variance:?}"
+        );
+        let rmse = merged.error.unwrap().rmse;
+        assert!((rmse - 0.3f64.sqrt()).abs() < 1e-6, "{rmse}");
     }
 
     /// Every refusal names its files and its cause.

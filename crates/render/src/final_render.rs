@@ -97,6 +97,11 @@ pub struct FinalRender {
     /// together on the CPU, so that any size completes in bounded GPU
     /// memory.
     pub max_tile_pixels: u64,
+    /// Write each pixel's estimated variance of its mean beside the
+    /// radiance, as the EXR's `variance` layer (`render --moments`), from
+    /// the spread of its rounds: a merge of such files knows its error
+    /// even with one batch a tile. Needs two rounds or more.
+    pub moments: bool,
 }
 
 /// [`FinalRender::max_tile_pixels`] by default: a 4K UHD frame (3840 ×
@@ -267,6 +272,12 @@ pub fn check_job(job: &FinalRender) -> Result<(ImageFormat, Option<&PathBuf>)> {
             );
         }
     }
+    if job.moments && format != ImageFormat::Exr {
+        bail!(
+            "{}: --moments writes a variance layer, which only an .exr holds",
+            job.output.display()
+        );
+    }
     if job.max_tile_pixels == 0 {
         bail!("the largest piece traced at once must hold at least 1 pixel");
     }
@@ -342,6 +353,13 @@ pub fn render_to_file(
             pieces[0].size().1
         ));
     }
+    if job.moments && job.stop.max_samples() <= per_round {
+        bail!(
+            "--moments estimates each pixel's variance from the spread of its rounds, and {} \
+             samples are one round of the preset's {per_round}: give --spp above {per_round}",
+            job.stop.max_samples()
+        );
+    }
     let (kernel, timings) = pick_kernel(ctx, &loaded, pieces[0].size(), job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
     let mut renderer = renderer_fitting(ctx, &loaded, pieces[0].size(), kernel)?;
@@ -363,6 +381,7 @@ pub fn render_to_file(
             continue;
         }
         let mut pixels = vec![[0.0f32; 4]; region.pixels() as usize];
+        let mut variance = job.moments.then(|| vec![[0.0f32; 3]; pixels.len()]);
         for piece in &pieces {
             renderer.set_crop(ctx, Some((*piece, job.size)));
             renderer.restart_at_sample(planned.frame, job.sample_offset);
@@ -371,9 +390,17 @@ pub fn render_to_file(
             }
             let (_, _, traced) = renderer.read_radiance(ctx)?;
             place(&mut pixels, region, *piece, &traced);
+            if let Some(variance) = variance.as_mut() {
+                place(variance, region, *piece, &read_variance(ctx, &renderer)?);
+            }
         }
         let record = record_of(ctx, &renderer, job, planned, region);
-        write_assembled(&renderer, &pixels, &record, format, planned, observer)?;
+        let assembled = Assembled {
+            pixels: &pixels,
+            variance: variance.as_deref(),
+            record: &record,
+        };
+        write_assembled(&renderer, &assembled, format, planned, observer)?;
     }
     let mut all: Vec<PlannedFrame> = frames.into_iter().chain(written).collect();
     all.sort_by_key(|f| f.frame);
@@ -411,9 +438,21 @@ fn check_piecewise(
     Ok(())
 }
 
+/// Each pixel's estimated variance of its mean: the spread of its rounds
+/// over their number less one (`shaders/trace.wgsl`'s weighted Welford:
+/// E[Σ n_i (x_i − m)²] = (F − 1) σ², and the spread is that over N).
+fn read_variance(ctx: &GpuContext, renderer: &Renderer) -> Result<Vec<[f32; 3]>> {
+    let (_, _, spread) = renderer.read_spread(ctx)?;
+    let rounds_less_one = renderer.accumulated_frames().saturating_sub(1).max(1) as f32;
+    Ok(spread
+        .iter()
+        .map(|s| [s[0], s[1], s[2]].map(|v| v / rounds_less_one))
+        .collect())
+}
+
 /// Copies `piece`'s pixels (`traced`, rows of its width) into `region`'s
 /// (rows of the region's width); `piece` lies within `region`.
-fn place(region_pixels: &mut [[f32; 4]], region: Tile, piece: Tile, traced: &[[f32; 4]]) {
+fn place<T: Copy>(region_pixels: &mut [T], region: Tile, piece: Tile, traced: &[T]) {
     let (region_width, _) = region.size();
     let (piece_width, _) = piece.size();
     for (row, line) in traced.chunks_exact(piece_width as usize).enumerate() {
@@ -445,32 +484,44 @@ fn record_of(
     }
 }
 
-/// Writes an image traced in pieces: an EXR of its radiance, or a PNG
-/// shown by the display pass's CPU twin (exposure metered over the whole
-/// image).
+/// An image traced in pieces, put together.
+struct Assembled<'a> {
+    pixels: &'a [[f32; 4]],
+    variance: Option<&'a [[f32; 3]]>,
+    record: &'a RenderRecord,
+}
+
+/// Writes an image traced in pieces: an EXR of its radiance (and its
+/// variance), or a PNG shown by the display pass's CPU twin (exposure
+/// metered over the whole image).
 fn write_assembled(
     renderer: &Renderer,
-    pixels: &[[f32; 4]],
-    record: &RenderRecord,
+    image: &Assembled,
     format: ImageFormat,
     planned: &PlannedFrame,
     observer: &mut dyn RenderObserver,
 ) -> Result<()> {
     let output = &planned.output;
-    let (w, h) = record.tile.size();
-    let text = Some((RECORD_ATTRIBUTE, record.to_text()));
-    let text = text.as_ref().map(|(k, v)| (*k, v.as_str()));
-    match format {
-        ImageFormat::Exr => image_io::save_exr(w, h, pixels, text, output),
-        ImageFormat::Png => {
-            let (image, metered) =
-                cpu_display::show(pixels, (w, h), &renderer.scene().render.shown_display());
+    let (w, h) = image.record.tile.size();
+    let record = image.record.to_text();
+    let text = Some((RECORD_ATTRIBUTE, record.as_str()));
+    match (format, image.variance) {
+        (ImageFormat::Exr, Some(variance)) => {
+            image_io::save_exr_with_variance(w, h, image.pixels, variance, text, output)
+        }
+        (ImageFormat::Exr, None) => image_io::save_exr(w, h, image.pixels, text, output),
+        (ImageFormat::Png, _) => {
+            let (shown, metered) = cpu_display::show(
+                image.pixels,
+                (w, h),
+                &renderer.scene().render.shown_display(),
+            );
             if let Some(stops) = metered {
                 observer.note(&format!(
                     "auto exposure: {stops:+.2} stops (over the whole image)"
                 ));
             }
-            image_io::save_png_with_text(&image, text, output)
+            image_io::save_png_with_text(&shown, text, output)
         }
     }
     .with_context(|| format!("saving {}", output.display()))?;
@@ -558,7 +609,12 @@ fn write_image(
                 }
                 renderer.read_radiance(ctx)?
             };
-            image_io::save_exr(w, h, &pixels, text, output)
+            if job.moments {
+                let variance = read_variance(ctx, renderer)?;
+                image_io::save_exr_with_variance(w, h, &pixels, &variance, text, output)
+            } else {
+                image_io::save_exr(w, h, &pixels, text, output)
+            }
         }
     }
     .with_context(|| format!("saving {}", output.display()))?;

@@ -1029,6 +1029,7 @@ impl Viewer {
                     sample_offset: 0,
                     tile: None,
                     max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
+                    moments: false,
                 })
             }
         }

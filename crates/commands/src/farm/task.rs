@@ -69,6 +69,7 @@ fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
         sample_offset: task.sample_offset,
         tile: task.tile,
         max_tile_pixels: DEFAULT_MAX_TILE_PIXELS,
+        moments: false,
     };
     let ctx = GpuContext::headless()?;
     render_to_file(&ctx, loaded, &job, &mut Log)?;

@@ -195,7 +195,7 @@ fn spp_is_exact_whatever_the_samples_per_frame() {
 }
 
 /// The root of the mean squared difference over the colour channels.
-fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+pub(crate) fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
     let sum: f64 = a
         .iter()
         .zip(b)

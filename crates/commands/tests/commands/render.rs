@@ -96,6 +96,7 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         tiles: None,
         tile_index: None,
         max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
+        moments: false,
     }
 }
 
@@ -112,6 +113,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         sample_offset: 0,
         tile: None,
         max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
+        moments: false,
     }
 }
 
