@@ -1,7 +1,8 @@
 //! `marbre farm slurm` on a real Slurm cluster (issue 30): a one-node
 //! cluster on 127.0.0.1 (`slurm_cluster`) runs the job arrays `farm slurm`
 //! writes, with the marbre binary on lavapipe. A 4-batch sample array and
-//! its merge give the direct render of all the samples; a 4-task frame
+//! its merge give the direct render of all the samples, a 4-tile array
+//! the direct render bit for bit; a 4-task frame
 //! array gives each frame as a direct render of it; a task that fails
 //! shows FAILED, the merge after it is cancelled, `farm merge` names it,
 //! and a rerun of that index alone completes the job. Without Slurm the
@@ -112,8 +113,8 @@ fn largest_relative_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
 }
 
 #[test]
-fn slurm_arrays_render_batches_and_frames_and_name_a_failed_task() {
-    let test = "slurm_arrays_render_batches_and_frames_and_name_a_failed_task";
+fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
+    let test = "slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task";
     let Some(cluster) = start_or_skip(test) else {
         return;
     };
@@ -151,7 +152,9 @@ fn slurm_arrays_render_batches_and_frames_and_name_a_failed_task() {
     let blocked = failing.join("parts/frame_0000_part_002.exr");
     std::fs::create_dir_all(&blocked).unwrap();
     let frames = job("frames", &["--spp", "4", "--frames", "0..3"]);
+    let tiles = job("tiles", &["--spp", "4", "--tiles", "2x2"]);
     let (batch_tasks, batch_merge) = submit(&cluster, &batches);
+    let (tile_tasks, tile_merge) = submit(&cluster, &tiles);
     let (failing_tasks, failing_merge) = submit(&cluster, &failing);
     let (frame_tasks, frame_merge) = submit(&cluster, &frames);
     let ids = [
@@ -171,6 +174,14 @@ fn slurm_arrays_render_batches_and_frames_and_name_a_failed_task() {
     assert!(
         d < 1e-4,
         "the merged batches are {d} from the direct render"
+    );
+
+    assert_eq!(cluster.states(tile_tasks).unwrap(), all("COMPLETED", 4));
+    assert_eq!(cluster.states(tile_merge).unwrap(), all("COMPLETED", 1));
+    let four = direct("direct_4.exr", &["--spp", "4"]);
+    assert!(
+        pixels(&tiles.join("image.exr")) == pixels(&four),
+        "the assembled tiles differ from the direct render"
     );
 
     assert_eq!(cluster.states(frame_tasks).unwrap(), all("COMPLETED", 4));
