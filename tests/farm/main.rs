@@ -215,6 +215,7 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
     assert!(!out.status.success());
     assert!(
         message.contains("1 of the 4 tasks")
+            && message.contains("sbatch --array=2 ")
             && message.contains("task 2 (frame 0, samples 8..12) FAILED"),
         "{message}"
     );

@@ -216,6 +216,19 @@ fn write_plan(job: &JobArgs) -> Result<(FarmPlan, PathBuf)> {
         );
     }
     let dir = absolute(&job.output)?;
+    // Tasks skip the files already written: a folder holding another
+    // job's parts would hand them to this job's merge.
+    if dir.join(plan::PLAN_FILE).exists() {
+        let existing = FarmPlan::read(&dir)?;
+        if existing != plan {
+            bail!(
+                "{} already holds another job (its {} differs from this one's); give a new \
+                 folder, or remove that one",
+                dir.display(),
+                plan::PLAN_FILE
+            );
+        }
+    }
     plan.write(&dir)?;
     Ok((plan, dir))
 }

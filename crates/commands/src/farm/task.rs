@@ -5,7 +5,7 @@
 //! a killed task leaves none). A task that fails leaves its error in
 //! `status/`, which the merge names.
 
-use super::plan::{FarmPlan, Task};
+use super::plan::{FarmPlan, Split, Task};
 use anyhow::{Context, Result, anyhow, bail};
 use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::merge::merge;
@@ -97,19 +97,20 @@ pub fn merge_job(dir: &Path) -> Result<()> {
     let tasks: Vec<Task> = (0..plan.tasks())
         .map(|i| plan.task(i))
         .collect::<Result<_>>()?;
-    let problems: Vec<String> = tasks
+    let missing: Vec<&Task> = tasks
         .iter()
         .filter(|t| !plan.task_output(dir, t).is_file())
-        .map(|t| describe_missing(dir, &plan, t))
         .collect();
-    if !problems.is_empty() {
+    if !missing.is_empty() {
         bail!(
             "{} of the {} tasks of {} have no file; run them again (a finished task is \
-             skipped):\n  {}",
-            problems.len(),
+             skipped), with Slurm `sbatch --array={} {}`:\n  {}",
+            missing.len(),
             tasks.len(),
             dir.display(),
-            problems.join("\n  ")
+            index_ranges(missing.iter().map(|t| t.index)),
+            dir.join("tasks.sbatch").display(),
+            describe_missing(dir, &plan, &missing).join("\n  ")
         );
     }
     if plan.parts() == 1 {
@@ -158,35 +159,86 @@ pub fn merge_job(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Why task `t` has no file: its error, if it left one, or that it did
-/// not run (or was still running).
-fn describe_missing(dir: &Path, plan: &FarmPlan, t: &Task) -> String {
-    let what = match plan.split {
-        super::plan::Split::Whole => format!("frame {}", t.frame),
-        super::plan::Split::Batches { .. } => format!(
+/// The most failed tasks named one by one.
+const FAILURES_LISTED: usize = 20;
+
+/// Why the `missing` tasks have no file: each failed one with its error
+/// (up to [`FAILURES_LISTED`]), then the others, which did not run or did
+/// not finish, as ranges of indices.
+fn describe_missing(dir: &Path, plan: &FarmPlan, missing: &[&Task]) -> Vec<String> {
+    let mut lines = Vec::new();
+    let mut not_run = Vec::new();
+    let mut failed = 0;
+    for t in missing {
+        match std::fs::read_to_string(FarmPlan::failure_note(dir, t.index)) {
+            Ok(error) => {
+                failed += 1;
+                if failed <= FAILURES_LISTED {
+                    lines.push(format!(
+                        "task {} ({}) FAILED: {}",
+                        t.index,
+                        describe_task(plan, t),
+                        error.lines().next().unwrap_or("")
+                    ));
+                }
+            }
+            Err(_) => not_run.push(t.index),
+        }
+    }
+    if failed > FAILURES_LISTED {
+        lines.push(format!(
+            "and {} more failed tasks",
+            failed - FAILURES_LISTED
+        ));
+    }
+    if let Some(first) = missing.iter().find(|t| not_run.contains(&t.index)) {
+        lines.push(format!(
+            "tasks {} did not run or did not finish (no file, no error; the first: {})",
+            index_ranges(not_run.iter().copied()),
+            plan.task_output(dir, first).display()
+        ));
+    }
+    lines
+}
+
+/// What task `t` traces, in words.
+fn describe_task(plan: &FarmPlan, t: &Task) -> String {
+    match plan.split {
+        Split::Whole => format!("frame {}", t.frame),
+        Split::Batches { .. } => format!(
             "frame {}, samples {}..{}",
             t.frame,
             t.sample_offset,
             t.sample_offset + t.spp
         ),
-        super::plan::Split::Tiles { .. } => format!(
+        Split::Tiles { .. } => format!(
             "frame {}, tile {}",
             t.frame,
             t.tile.map_or(String::new(), |tile| tile.to_string())
         ),
-    };
-    match std::fs::read_to_string(FarmPlan::failure_note(dir, t.index)) {
-        Ok(error) => format!(
-            "task {} ({what}) FAILED: {}",
-            t.index,
-            error.lines().next().unwrap_or("")
-        ),
-        Err(_) => format!(
-            "task {} ({what}) did not run or did not finish: {} is missing",
-            t.index,
-            plan.task_output(dir, t).display()
-        ),
     }
+}
+
+/// Increasing indices as Slurm's `--array` writes them: `0-3,7,9-10`.
+fn index_ranges(indices: impl Iterator<Item = u32>) -> String {
+    let mut ranges: Vec<(u32, u32)> = Vec::new();
+    for i in indices {
+        match ranges.last_mut() {
+            Some((_, end)) if *end + 1 == i => *end = i,
+            _ => ranges.push((i, i)),
+        }
+    }
+    ranges
+        .iter()
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}-{b}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// The preset's display, which a merged PNG is shown with.
@@ -197,4 +249,18 @@ fn load_scene_display(plan: &FarmPlan) -> Result<marbre_core::scene::DisplaySett
         .scene
         .render
         .shown_display())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indices_are_written_as_slurm_ranges() {
+        assert_eq!(
+            index_ranges([0, 1, 2, 3, 7, 9, 10].into_iter()),
+            "0-3,7,9-10"
+        );
+        assert_eq!(index_ranges([5].into_iter()), "5");
+    }
 }
