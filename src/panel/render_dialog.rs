@@ -115,6 +115,7 @@ impl RenderDialog {
             tile: None,
             max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
             moments: false,
+            guides: false,
         })
     }
 

@@ -7,11 +7,13 @@
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use marbre_core::image_decode::{IntegerDecode, decode_file};
+use marbre_core::image_io::LayerName;
 use marbre_core::image_io::{self, ImageFormat};
-use marbre_core::merge::{Batch, merge};
+use marbre_core::merge::{Batch, Guides, Merged, merge};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord};
 use marbre_core::scene::{DisplaySettings, Metering};
 use marbre_render::cpu_display;
+use marbre_render::gpu::denoise::{DenoiseImage, DenoiseSettings, denoise_cpu};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -33,10 +35,17 @@ pub struct MergeArgs {
     /// default) or Massal's RMS (`massal`).
     #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "key", value_name = "METERING")]
     pub auto_exposure: Option<crate::render::MeteringArg>,
+    /// Filter the merged image with the denoiser (the viewer's: an
+    /// edge-avoiding à-trous filter), guided by the files' albedo and
+    /// normal (`render --guides`) and weighted by the merged variance
+    /// where known; before tone mapping, for a PNG or an EXR.
+    #[arg(long)]
+    pub denoise: bool,
 }
 
 pub fn run(args: &MergeArgs) -> Result<()> {
-    let format = ImageFormat::from_path(&args.output)?;
+    // Refused before anything is read: an output of another kind.
+    ImageFormat::from_path(&args.output)?;
     if let Some(input) = args.inputs.iter().find(|i| same_file(i, &args.output)) {
         bail!(
             "{} is one of the inputs: the merge would write over it",
@@ -51,34 +60,12 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .map(|path| read_batch(path))
         .collect::<Result<Vec<Batch>>>()?;
     let merged = merge(&batches).map_err(|e| anyhow!(e))?;
-    let record = merged.record.to_text();
-    let text = Some((RECORD_ATTRIBUTE, record.as_str()));
-    match format {
-        ImageFormat::Exr => match &merged.variance {
-            Some(variance) => image_io::save_exr_with_variance(
-                merged.width,
-                merged.height,
-                &merged.pixels,
-                variance,
-                text,
-                &args.output,
-            )?,
-            None => image_io::save_exr(
-                merged.width,
-                merged.height,
-                &merged.pixels,
-                text,
-                &args.output,
-            )?,
-        },
-        ImageFormat::Png => {
-            let (image, metered) =
-                cpu_display::show(&merged.pixels, (merged.width, merged.height), &display);
-            if let Some(stops) = metered {
-                println!("auto exposure: {stops:+.2} stops, metered over the merged image");
-            }
-            image_io::save_png_with_text(&image, text, &args.output)?;
-        }
+    let how = MergedOutput {
+        display,
+        denoise: args.denoise,
+    };
+    for line in write_merged(&merged, &args.output, &how)? {
+        println!("{line}");
     }
     let samples = merged.record.samples();
     let error = match merged.error {
@@ -86,10 +73,10 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             "estimated relative error {:.3} % (RMSE {:.5}), from {}",
             100.0 * e.relative,
             e.rmse,
-            if merged.variance.is_some() {
+            if batches.iter().all(|b| b.variance.is_some()) {
                 "the files' variance layers"
             } else {
-                "the spread between the batches"
+                "the spread between each tile's batches"
             }
         ),
         None => "no error estimate: every tile is one batch (render two batches or more of a \
@@ -112,6 +99,88 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         samples.end,
     );
     Ok(())
+}
+
+/// What happens to a merged image on its way to its file.
+pub struct MergedOutput {
+    /// How a PNG is shown.
+    pub display: DisplaySettings,
+    /// Filter it with the denoiser first.
+    pub denoise: bool,
+}
+
+/// Writes `merged` to `output` as `how` says: an EXR of its radiance with
+/// the merged record and layers (its variance, unless denoised, and its
+/// guides), or a PNG through the display pass's CPU twin. Returns lines
+/// for the user.
+pub fn write_merged(merged: &Merged, output: &Path, how: &MergedOutput) -> Result<Vec<String>> {
+    let mut lines = Vec::new();
+    let size = (merged.width, merged.height);
+    let pixels = if how.denoise {
+        lines.push("denoised after the merge".to_owned());
+        denoise_merged(merged, output)?
+    } else {
+        merged.pixels.clone()
+    };
+    let record = merged.record.to_text();
+    let text = Some((RECORD_ATTRIBUTE, record.as_str()));
+    match ImageFormat::from_path(output)? {
+        ImageFormat::Exr => {
+            let mut layers: Vec<(LayerName, &[[f32; 3]])> = Vec::new();
+            if let Some(variance) = merged.variance.as_ref().filter(|_| !how.denoise) {
+                layers.push((image_io::VARIANCE, variance));
+            }
+            if let Some(guides) = &merged.guides {
+                layers.push((image_io::ALBEDO, &guides.albedo));
+                layers.push((image_io::NORMAL, &guides.normal));
+            }
+            image_io::save_exr_layers(size.0, size.1, &pixels, &layers, text, output)?;
+        }
+        ImageFormat::Png => {
+            let (image, metered) = cpu_display::show(&pixels, size, &how.display);
+            if let Some(stops) = metered {
+                lines.push(format!(
+                    "auto exposure: {stops:+.2} stops, metered over the merged image"
+                ));
+            }
+            image_io::save_png_with_text(&image, text, output)?;
+        }
+    }
+    Ok(lines)
+}
+
+/// The merged image through the denoiser's CPU twin, guided by the files'
+/// guides; each pixel's variance of its mean, where known, weighs its
+/// neighbours (the filter's two-frame form: spread / (F − 1) with F = 2),
+/// else the filter estimates it from the pixel's neighbourhood.
+fn denoise_merged(merged: &Merged, output: &Path) -> Result<Vec<[f32; 4]>> {
+    let Some(guides) = &merged.guides else {
+        bail!(
+            "{}: --denoise needs the files' guides; render them with --guides",
+            output.display()
+        );
+    };
+    let with_alpha = |v: &[f32; 3]| [v[0], v[1], v[2], 1.0];
+    let spread: Vec<[f32; 4]> = merged.variance.as_ref().map_or_else(
+        || vec![[0.0; 4]; merged.pixels.len()],
+        |v| v.iter().map(with_alpha).collect(),
+    );
+    let albedo: Vec<[f32; 4]> = guides.albedo.iter().map(with_alpha).collect();
+    // The filter reads normals as the guide target holds them.
+    let normal: Vec<[f32; 4]> = guides
+        .normal
+        .iter()
+        .map(|n| with_alpha(&n.map(|v| 0.5 + 0.5 * v)))
+        .collect();
+    let image = DenoiseImage {
+        size: (merged.width, merged.height),
+        mean: &merged.pixels,
+        spread: &spread,
+        frames: if merged.variance.is_some() { 2 } else { 1 },
+        albedo: &albedo,
+        normal: &normal,
+    };
+    denoise_cpu(&image, &DenoiseSettings::default())
 }
 
 /// How a merged PNG is shown: the preset's display, if given, with
@@ -147,21 +216,23 @@ pub fn read_batch(path: &Path) -> Result<Batch> {
             )
         })?;
     let image = decode_file(path, IntegerDecode::Linear)?;
-    let variance = image_io::read_exr_variance(path)?;
-    if let Some(v) = &variance
-        && v.len() != image.pixels.len()
-    {
-        bail!(
-            "{}: its variance layer is not the picture's size",
-            path.display()
-        );
-    }
+    // Every channel of an EXR part has the picture's size.
+    let [variance, albedo, normal]: [Option<Vec<[f32; 3]>>; 3] = image_io::read_exr_layers(
+        path,
+        &[image_io::VARIANCE, image_io::ALBEDO, image_io::NORMAL],
+    )?
+    .try_into()
+    .expect("one answer a layer asked");
     Ok(Batch {
         path: path.to_path_buf(),
         width: image.width,
         height: image.height,
         pixels: image.pixels,
         variance,
+        guides: match (albedo, normal) {
+            (Some(albedo), Some(normal)) => Some(Guides { albedo, normal }),
+            _ => None,
+        },
         record,
     })
 }

@@ -138,6 +138,12 @@ pub struct RenderArgs {
     /// samples_per_frame.
     #[arg(long)]
     pub moments: bool,
+    /// Write the denoiser's guides beside the radiance (the EXR's
+    /// `albedo` and `normal` layers: the means of the samples' first-hit
+    /// albedo and shading normal), so that `marbre merge --denoise`
+    /// filters what it puts together.
+    #[arg(long)]
+    pub guides: bool,
 }
 
 /// The value of `all` called `s` by `name`, or the list of names.
@@ -229,6 +235,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         max_tile_pixels: args.max_tile_pixels,
         moments: args.moments,
+        guides: args.guides,
     };
     let frames = match &job.timing {
         Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,

@@ -150,37 +150,64 @@ pub fn save_exr(
     Ok(())
 }
 
-/// Writes [`encode_exr_with_variance`]'s file atomically.
-pub fn save_exr_with_variance(
+/// An extra layer of an EXR file beside its picture: a name and three
+/// channels (`variance.R`, `.G`, `.B`), in a fixed order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LayerName {
+    pub name: &'static str,
+    pub channels: [&'static str; 3],
+}
+
+/// Each pixel's estimated variance of its mean (`render --moments`), so
+/// that a merge of such files still knows its error.
+pub const VARIANCE: LayerName = LayerName {
+    name: "variance",
+    channels: ["R", "G", "B"],
+};
+/// The first hit's albedo plus emission, averaged over the pixel's samples
+/// (`render --guides`): a denoiser's guide, as Blender's and OIDN's.
+pub const ALBEDO: LayerName = LayerName {
+    name: "albedo",
+    channels: ["R", "G", "B"],
+};
+/// The first hit's shading normal, averaged over the pixel's samples
+/// (`render --guides`; not renormalised: a mean, as the other layers).
+pub const NORMAL: LayerName = LayerName {
+    name: "normal",
+    channels: ["X", "Y", "Z"],
+};
+
+/// Writes [`encode_exr_layers`]'s file atomically.
+pub fn save_exr_layers(
     width: u32,
     height: u32,
     pixels: &[[f32; 4]],
-    variance: &[[f32; 3]],
+    layers: &[(LayerName, &[[f32; 3]])],
     text: Option<(&str, &str)>,
     path: &Path,
 ) -> Result<()> {
     write_atomic(
         path,
-        &encode_exr_with_variance(width, height, pixels, variance, text)?,
+        &encode_exr_layers(width, height, pixels, layers, text)?,
     )?;
     Ok(())
 }
 
-/// The name of the layer [`encode_exr_with_variance`] writes.
-pub const VARIANCE_LAYER: &str = "variance";
-
-/// [`encode_exr`]'s file with a second layer, `variance.R`, `.G`, `.B`:
-/// each pixel's estimated variance of its mean (`render --moments`), so
-/// that a merge of such files still knows its error. Readers that want
-/// the picture read the unnamed layer, as compositors do.
-pub fn encode_exr_with_variance(
+/// [`encode_exr`]'s file with more layers beside the picture (`R`, `G`, `B`,
+/// `A`), each of three channels `name.channel`: readers that want the
+/// picture read the unnamed layer, as compositors do. Without layers, the
+/// bytes [`encode_exr`] writes.
+pub fn encode_exr_layers(
     width: u32,
     height: u32,
     pixels: &[[f32; 4]],
-    variance: &[[f32; 3]],
+    layers: &[(LayerName, &[[f32; 3]])],
     text: Option<(&str, &str)>,
 ) -> Result<Vec<u8>> {
     use exr::prelude::*;
+    if layers.is_empty() {
+        return encode_exr(width, height, pixels, text);
+    }
     let (w, h) = (width as usize, height as usize);
     let channel = |name: String, values: Vec<f32>| {
         AnyChannel::new(Text::new_or_panic(name), FlatSamples::F32(values))
@@ -192,11 +219,13 @@ pub fn encode_exr_with_variance(
             pixels.iter().map(|p| p[c]).collect(),
         ));
     }
-    for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        list.push(channel(
-            format!("{VARIANCE_LAYER}.{name}"),
-            variance.iter().map(|v| v[c]).collect(),
-        ));
+    for (layer, values) in layers {
+        for (c, name) in layer.channels.iter().enumerate() {
+            list.push(channel(
+                format!("{}.{name}", layer.name),
+                values.iter().map(|v| v[c]).collect(),
+            ));
+        }
     }
     let encoding = Encoding {
         line_order: LineOrder::Increasing,
@@ -219,9 +248,9 @@ pub fn encode_exr_with_variance(
     Ok(bytes.into_inner())
 }
 
-/// The `variance` layer of an EXR file ([`encode_exr_with_variance`]),
-/// if it has one.
-pub fn read_exr_variance(path: &Path) -> Result<Option<Vec<[f32; 3]>>> {
+/// The layers `names` of an EXR file ([`encode_exr_layers`]), each `None`
+/// where the file lacks one of its channels; the file decoded once.
+pub fn read_exr_layers(path: &Path, names: &[LayerName]) -> Result<Vec<Option<Vec<[f32; 3]>>>> {
     use exr::prelude::*;
     let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
         .with_context(|| format!("reading {}", path.display()))?;
@@ -234,22 +263,27 @@ pub fn read_exr_variance(path: &Path) -> Result<Option<Vec<[f32; 3]>>> {
         .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display()))?;
     let channels = &image.layer_data.channel_data.list;
-    let find = |base: &str| {
+    let find = |full: String| {
         channels
             .iter()
-            .find(|c| c.name.to_string() == format!("{VARIANCE_LAYER}.{base}"))
+            .find(|c| c.name.to_string() == full)
             .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
     };
-    let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) else {
-        return Ok(None);
-    };
-    Ok(Some(
-        r.into_iter()
-            .zip(g)
-            .zip(b)
-            .map(|((r, g), b)| [r, g, b])
-            .collect(),
-    ))
+    Ok(names
+        .iter()
+        .map(|layer| {
+            let [a, b, c] = layer
+                .channels
+                .map(|ch| find(format!("{}.{ch}", layer.name)));
+            Some(
+                a?.into_iter()
+                    .zip(b?)
+                    .zip(c?)
+                    .map(|((a, b), c)| [a, b, c])
+                    .collect(),
+            )
+        })
+        .collect())
 }
 
 /// `s` as EXR text, its characters beyond Latin-1 (which EXR text cannot
@@ -353,16 +387,21 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), bytes);
     }
 
-    /// A variance layer reads back beside the picture, which still decodes
-    /// as the file's RGBA; a file without one has none.
+    /// Layers read back beside the picture, which still decodes as the
+    /// file's RGBA; a layer the file lacks reads as none.
     #[test]
-    fn an_exr_variance_layer_reads_back() {
+    fn exr_layers_read_back() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("v.exr");
         let pixels = [[0.5, 1.0, 2.0, 1.0], [3.0, 4.0, 5.0, 1.0]];
         let variance = [[0.01, 0.02, 0.03], [0.04, 0.05, 0.06]];
-        save_exr_with_variance(2, 1, &pixels, &variance, Some(("k", "v")), &path).unwrap();
-        assert_eq!(read_exr_variance(&path).unwrap(), Some(variance.to_vec()));
+        let normal = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]];
+        let layers = [(VARIANCE, &variance[..]), (NORMAL, &normal[..])];
+        save_exr_layers(2, 1, &pixels, &layers, Some(("k", "v")), &path).unwrap();
+        assert_eq!(
+            read_exr_layers(&path, &[VARIANCE, ALBEDO, NORMAL]).unwrap(),
+            vec![Some(variance.to_vec()), None, Some(normal.to_vec())]
+        );
         let decoded =
             crate::image_decode::decode_file(&path, crate::image_decode::IntegerDecode::Linear)
                 .unwrap();
@@ -370,7 +409,7 @@ mod tests {
         assert_eq!(read_exr_attributes(&path).unwrap()["k"], "v");
         let plain = dir.path().join("p.exr");
         save_exr(2, 1, &pixels, None, &plain).unwrap();
-        assert_eq!(read_exr_variance(&plain).unwrap(), None);
+        assert_eq!(read_exr_layers(&plain, &[VARIANCE]).unwrap(), vec![None]);
     }
 
     /// A PNG's text chunk reads back by keyword, any character included,

@@ -23,7 +23,17 @@ pub struct Batch {
     /// Each pixel's estimated variance of its mean, when the file has the
     /// layer (`render --moments`).
     pub variance: Option<Vec<[f32; 3]>>,
+    /// The denoiser's guides, when the file has them (`render --guides`).
+    pub guides: Option<Guides>,
     pub record: RenderRecord,
+}
+
+/// A denoiser's guides: per pixel, the mean of its samples' first-hit
+/// albedo (plus emission) and shading normal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Guides {
+    pub albedo: Vec<[f32; 3]>,
+    pub normal: Vec<[f32; 3]>,
 }
 
 /// The merged image and its estimated error.
@@ -35,9 +45,13 @@ pub struct Merged {
     /// The record of the merged render: all the samples, from the first,
     /// of the whole image.
     pub record: RenderRecord,
-    /// Each pixel's estimated variance of its merged mean, when every
-    /// file has the layer: Σ (n_i / N)² v_i over its batches.
+    /// Each pixel's estimated variance of its merged mean, when every tile
+    /// has one: from the files' variance layers, Σ (n_i / N)² v_i over its
+    /// batches, else from the spread between its batches (two or more).
     pub variance: Option<Vec<[f32; 3]>>,
+    /// The guides' means weighted as the radiance's, when every file has
+    /// them.
+    pub guides: Option<Guides>,
     /// The error of the merged mean, from the files' variance layers
     /// where every batch of a tile has one, else from the spread between
     /// the batches of a tile; `None` when no tile has either.
@@ -150,19 +164,26 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
         ));
     }
     let count = image.0 as usize * image.1 as usize;
-    let mut pixels = vec![[0.0f32; 4]; count];
-    let with_moments = batches.iter().all(|b| b.variance.is_some());
-    let mut variance = with_moments.then(|| vec![[0.0f32; 3]; count]);
-    let mut spread = SpreadSum::default();
+    let mut out = Assembly {
+        width: image.0,
+        pixels: vec![[0.0f32; 4]; count],
+        variance: vec![[0.0f32; 3]; count],
+        guides: batches.iter().all(|b| b.guides.is_some()).then(|| Guides {
+            albedo: vec![[0.0; 3]; count],
+            normal: vec![[0.0; 3]; count],
+        }),
+        spread: SpreadSum::default(),
+    };
     for group in &groups {
-        group.assemble(image.0, &mut pixels, variance.as_deref_mut(), &mut spread);
+        group.assemble(&mut out);
     }
+    let every_tile_has_variance = groups.iter().all(TileGroup::has_variance);
     let kernels = distinct(batches.iter().map(|b| b.record.kernel.as_str()));
     let adapters = distinct(batches.iter().map(|b| b.record.adapter.as_str()));
     Ok(Merged {
         width: image.0,
         height: image.1,
-        pixels,
+        pixels: out.pixels,
         record: RenderRecord {
             spp: groups[0].samples.min(u64::from(u32::MAX)) as u32,
             sample_offset: groups[0].batches[0].record.sample_offset,
@@ -171,8 +192,9 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             adapter: adapters,
             ..first.record.clone()
         },
-        variance,
-        error: spread.error(),
+        variance: every_tile_has_variance.then_some(out.variance),
+        guides: out.guides,
+        error: out.spread.error(),
         tiles: groups.len(),
     })
 }
@@ -221,44 +243,43 @@ impl<'a> TileGroup<'a> {
         })
     }
 
-    /// Writes the tile's mean into `image` (rows of `width`), and its
-    /// variance into `variance` when the batches have their moments, and
-    /// adds the variance estimated (from the moments, else from the
-    /// spread between two or more batches) to `spread`.
-    fn assemble(
-        &self,
-        width: u32,
-        image: &mut [[f32; 4]],
-        mut variance: Option<&mut [[f32; 3]]>,
-        spread: &mut SpreadSum,
-    ) {
+    /// Whether the tile's variance is known: every batch has its moments,
+    /// or there are two batches or more to measure their spread.
+    fn has_variance(&self) -> bool {
+        self.with_moments() || self.batches.len() >= 2
+    }
+
+    fn with_moments(&self) -> bool {
+        self.batches.iter().all(|b| b.variance.is_some())
+    }
+
+    /// Writes the tile's mean, its variance where known and its guides
+    /// into `out`, and adds the variance to the error's sums.
+    fn assemble(&self, out: &mut Assembly) {
         let n = self.samples as f64;
         let (tile_width, _) = self.tile.size();
         let weight = |b: &Batch| f64::from(b.record.spp) / n;
+        let weighted = |p: usize, value: &dyn Fn(&Batch, usize) -> f64| -> f64 {
+            self.batches.iter().map(|b| weight(b) * value(b, p)).sum()
+        };
+        let moments = self.with_moments();
         for p in 0..self.tile.pixels() as usize {
             let (x, y) = (p as u32 % tile_width, p as u32 / tile_width);
-            let out = (self.tile.y0 + y) as usize * width as usize + (self.tile.x0 + x) as usize;
-            for (c, merged) in image[out].iter_mut().enumerate() {
-                let mean = self
-                    .batches
-                    .iter()
-                    .map(|b| weight(b) * f64::from(b.pixels[p][c]))
-                    .sum::<f64>();
-                *merged = mean as f32;
+            let at = (self.tile.y0 + y) as usize * out.width as usize + (self.tile.x0 + x) as usize;
+            for c in 0..4 {
+                let mean = weighted(p, &|b, p| f64::from(b.pixels[p][c]));
+                out.pixels[at][c] = mean as f32;
                 if c == 3 || !mean.is_finite() {
                     continue;
                 }
-                if let Some(variance) = variance.as_deref_mut() {
+                let variance = if moments {
                     // Independent batches: Var(Σ w_i x_i) = Σ w_i² Var(x_i).
-                    let v: f64 = self
-                        .batches
+                    self.batches
                         .iter()
                         .filter_map(|b| {
                             Some(weight(b).powi(2) * f64::from(b.variance.as_ref()?[p][c]))
                         })
-                        .sum();
-                    variance[out][c] = v as f32;
-                    spread.add(v, mean);
+                        .sum()
                 } else if self.batches.len() >= 2 {
                     // Each batch's mean x_i of n_i samples has variance
                     // σ²/n_i: Σ n_i (x_i − m)² / (K − 1) estimates σ², and
@@ -270,11 +291,35 @@ impl<'a> TileGroup<'a> {
                             f64::from(b.record.spp) * (f64::from(b.pixels[p][c]) - mean).powi(2)
                         })
                         .sum();
-                    spread.add(squares / ((self.batches.len() - 1) as f64 * n), mean);
+                    squares / ((self.batches.len() - 1) as f64 * n)
+                } else {
+                    continue;
+                };
+                out.variance[at][c] = variance as f32;
+                out.spread.add(variance, mean);
+            }
+            if let Some(guides) = out.guides.as_mut() {
+                for c in 0..3 {
+                    let guide = |pick: fn(&Guides) -> &Vec<[f32; 3]>| {
+                        weighted(p, &|b, p| {
+                            b.guides.as_ref().map_or(0.0, |g| f64::from(pick(g)[p][c]))
+                        }) as f32
+                    };
+                    guides.albedo[at][c] = guide(|g| &g.albedo);
+                    guides.normal[at][c] = guide(|g| &g.normal);
                 }
             }
         }
     }
+}
+
+/// The merged image under assembly, tile by tile.
+struct Assembly {
+    width: u32,
+    pixels: Vec<[f32; 4]>,
+    variance: Vec<[f32; 3]>,
+    guides: Option<Guides>,
+    spread: SpreadSum,
 }
 
 /// Sums of the per-channel variances of the merged means.
@@ -325,6 +370,7 @@ mod tests {
             height,
             pixels: vec![[value, value, value, 1.0]; tile.pixels() as usize],
             variance: None,
+            guides: None,
             record: RenderRecord {
                 spp,
                 sample_offset: offset,
@@ -354,6 +400,12 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(merged.pixels, vec![[2.0, 2.0, 2.0, 1.0]; 2]);
+        assert_eq!(
+            merged.variance,
+            Some(vec![[0.25; 3]; 2]),
+            "per pixel, from the spread"
+        );
+        assert_eq!(merged.guides, None);
         assert_eq!((merged.record.spp, merged.record.sample_offset), (4, 0));
         let error = merged.error.unwrap();
         assert!((error.rmse - 0.5).abs() < 1e-12, "{}", error.rmse);
@@ -392,6 +444,7 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(alone.error, None, "one batch a tile: no spread to measure");
+        assert_eq!(alone.variance, None);
     }
 
     /// Batches with their moments: the merged variance is Σ (n_i / N)²

@@ -15,9 +15,9 @@ use crate::session::{
 };
 use anyhow::{Context, Result, bail};
 use marbre_core::animated_image;
-use marbre_core::image_io::{self, ImageFormat};
+use marbre_core::image_io::{self, ImageFormat, LayerName};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, scene_hash};
-use marbre_core::scene::{Metering, Scene};
+use marbre_core::scene::{Metering, Scene, View};
 use marbre_core::texture::ImageSet;
 use marbre_core::tile::{self, Tile};
 use std::ops::ControlFlow;
@@ -102,6 +102,11 @@ pub struct FinalRender {
     /// the spread of its rounds: a merge of such files knows its error
     /// even with one batch a tile. Needs two rounds or more.
     pub moments: bool,
+    /// Write the denoiser's guides beside the radiance, the EXR's
+    /// `albedo` and `normal` layers (`render --guides`): the means of the
+    /// samples' first-hit albedo and shading normal, so that a merge can
+    /// denoise what it puts together.
+    pub guides: bool,
 }
 
 /// [`FinalRender::max_tile_pixels`] by default: a 4K UHD frame (3840 ×
@@ -272,9 +277,10 @@ pub fn check_job(job: &FinalRender) -> Result<(ImageFormat, Option<&PathBuf>)> {
             );
         }
     }
-    if job.moments && format != ImageFormat::Exr {
+    if (job.moments || job.guides) && format != ImageFormat::Exr {
         bail!(
-            "{}: --moments writes a variance layer, which only an .exr holds",
+            "{}: --moments and --guides write layers beside the picture, which only an .exr \
+             holds",
             job.output.display()
         );
     }
@@ -311,6 +317,18 @@ pub fn render_to_file(
         display.auto_exposure = true;
         display.metering = metering;
     }
+    if job.guides {
+        let render = &mut loaded.scene.render;
+        if render.view != View::Lit {
+            bail!(
+                "--guides records the lit image's first hits, not the {} view's",
+                render.view.name()
+            );
+        }
+        // The guides are accumulated while the display denoises; an EXR
+        // stays the raw accumulation (unless `denoise_exr`).
+        render.display.denoise = true;
+    }
     if let Some(problem) = loaded
         .scene
         .animation
@@ -345,10 +363,11 @@ pub fn render_to_file(
     let cropped = pieces != [Tile::whole(job.size)];
     if cropped {
         check_piecewise(&loaded.scene, job, format, pieces.len())?;
+    }
+    if pieces.len() > 1 {
         observer.note(&format!(
-            "traced in {} piece{} of at most {} × {} pixels",
+            "traced in {} pieces of at most {} × {} pixels",
             pieces.len(),
-            if pieces.len() == 1 { "" } else { "s" },
             pieces[0].size().0,
             pieces[0].size().1
         ));
@@ -381,7 +400,7 @@ pub fn render_to_file(
             continue;
         }
         let mut pixels = vec![[0.0f32; 4]; region.pixels() as usize];
-        let mut variance = job.moments.then(|| vec![[0.0f32; 3]; pixels.len()]);
+        let mut layers: Vec<(LayerName, Vec<[f32; 3]>)> = Vec::new();
         for piece in &pieces {
             renderer.set_crop(ctx, Some((*piece, job.size)));
             renderer.restart_at_sample(planned.frame, job.sample_offset);
@@ -390,14 +409,17 @@ pub fn render_to_file(
             }
             let (_, _, traced) = renderer.read_radiance(ctx)?;
             place(&mut pixels, region, *piece, &traced);
-            if let Some(variance) = variance.as_mut() {
-                place(variance, region, *piece, &read_variance(ctx, &renderer)?);
+            for (i, (name, values)) in read_layers(ctx, &renderer, job)?.into_iter().enumerate() {
+                if layers.len() == i {
+                    layers.push((name, vec![[0.0; 3]; pixels.len()]));
+                }
+                place(&mut layers[i].1, region, *piece, &values);
             }
         }
         let record = record_of(ctx, &renderer, job, planned, region);
         let assembled = Assembled {
             pixels: &pixels,
-            variance: variance.as_deref(),
+            layers: &layers,
             record: &record,
         };
         write_assembled(&renderer, &assembled, format, planned, observer)?;
@@ -438,16 +460,39 @@ fn check_piecewise(
     Ok(())
 }
 
-/// Each pixel's estimated variance of its mean: the spread of its rounds
-/// over their number less one (`shaders/trace.wgsl`'s weighted Welford:
-/// E[Σ n_i (x_i − m)²] = (F − 1) σ², and the spread is that over N).
-fn read_variance(ctx: &GpuContext, renderer: &Renderer) -> Result<Vec<[f32; 3]>> {
-    let (_, _, spread) = renderer.read_spread(ctx)?;
-    let rounds_less_one = renderer.accumulated_frames().saturating_sub(1).max(1) as f32;
-    Ok(spread
-        .iter()
-        .map(|s| [s[0], s[1], s[2]].map(|v| v / rounds_less_one))
-        .collect())
+/// The layers `job` asks for beside the radiance, of the region traced:
+/// each pixel's estimated variance of its mean (the spread of its rounds
+/// over their number less one: `shaders/trace.wgsl`'s weighted Welford
+/// keeps Σ n_i (x_i − m)² / N, whose expectation is (F − 1) σ² / N), and
+/// the guides (the normal decoded from the target's 0.5 + 0.5·n).
+fn read_layers(
+    ctx: &GpuContext,
+    renderer: &Renderer,
+    job: &FinalRender,
+) -> Result<Vec<(LayerName, Vec<[f32; 3]>)>> {
+    let mut layers = Vec::new();
+    if job.moments {
+        let (_, _, spread) = renderer.read_spread(ctx)?;
+        let rounds_less_one = renderer.accumulated_frames().saturating_sub(1).max(1) as f32;
+        let variance = spread
+            .iter()
+            .map(|s| [s[0], s[1], s[2]].map(|v| v / rounds_less_one))
+            .collect();
+        layers.push((image_io::VARIANCE, variance));
+    }
+    if job.guides {
+        let [albedo, normal] = renderer
+            .read_guides(ctx)?
+            .context("the renderer accumulated no guides")?;
+        let rgb = |p: &[f32; 4]| [p[0], p[1], p[2]];
+        layers.push((image_io::ALBEDO, albedo.iter().map(rgb).collect()));
+        let decoded = normal
+            .iter()
+            .map(|p| rgb(p).map(|v| 2.0 * v - 1.0))
+            .collect();
+        layers.push((image_io::NORMAL, decoded));
+    }
+    Ok(layers)
 }
 
 /// Copies `piece`'s pixels (`traced`, rows of its width) into `region`'s
@@ -487,12 +532,12 @@ fn record_of(
 /// An image traced in pieces, put together.
 struct Assembled<'a> {
     pixels: &'a [[f32; 4]],
-    variance: Option<&'a [[f32; 3]]>,
+    layers: &'a [(LayerName, Vec<[f32; 3]>)],
     record: &'a RenderRecord,
 }
 
 /// Writes an image traced in pieces: an EXR of its radiance (and its
-/// variance), or a PNG shown by the display pass's CPU twin (exposure
+/// layers), or a PNG shown by the display pass's CPU twin (exposure
 /// metered over the whole image).
 fn write_assembled(
     renderer: &Renderer,
@@ -505,12 +550,13 @@ fn write_assembled(
     let (w, h) = image.record.tile.size();
     let record = image.record.to_text();
     let text = Some((RECORD_ATTRIBUTE, record.as_str()));
-    match (format, image.variance) {
-        (ImageFormat::Exr, Some(variance)) => {
-            image_io::save_exr_with_variance(w, h, image.pixels, variance, text, output)
+    match format {
+        ImageFormat::Exr => {
+            let layers: Vec<(LayerName, &[[f32; 3]])> =
+                image.layers.iter().map(|(n, v)| (*n, &v[..])).collect();
+            image_io::save_exr_layers(w, h, image.pixels, &layers, text, output)
         }
-        (ImageFormat::Exr, None) => image_io::save_exr(w, h, image.pixels, text, output),
-        (ImageFormat::Png, _) => {
+        ImageFormat::Png => {
             let (shown, metered) = cpu_display::show(
                 image.pixels,
                 (w, h),
@@ -604,17 +650,15 @@ fn write_image(
             let (w, h, pixels) = if job.denoise_exr {
                 renderer.read_denoised(ctx)?
             } else {
-                if renderer.scene().render.display.denoise {
+                if renderer.scene().render.display.denoise && !job.guides {
                     observer.note("note: the EXR is the raw accumulation, not denoised");
                 }
                 renderer.read_radiance(ctx)?
             };
-            if job.moments {
-                let variance = read_variance(ctx, renderer)?;
-                image_io::save_exr_with_variance(w, h, &pixels, &variance, text, output)
-            } else {
-                image_io::save_exr(w, h, &pixels, text, output)
-            }
+            let layers = read_layers(ctx, renderer, job)?;
+            let layers: Vec<(LayerName, &[[f32; 3]])> =
+                layers.iter().map(|(n, v)| (*n, &v[..])).collect();
+            image_io::save_exr_layers(w, h, &pixels, &layers, text, output)
         }
     }
     .with_context(|| format!("saving {}", output.display()))?;

@@ -1030,6 +1030,7 @@ impl Viewer {
                     tile: None,
                     max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
                     moments: false,
+                    guides: false,
                 })
             }
         }

@@ -7,10 +7,7 @@
 
 use super::plan::{FarmPlan, Split, Task};
 use anyhow::{Context, Result, anyhow, bail};
-use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::merge::merge;
-use marbre_core::render_record::RECORD_ATTRIBUTE;
-use marbre_render::cpu_display;
 use marbre_render::final_render::{
     DEFAULT_MAX_TILE_PIXELS, FinalRender, Progress, RenderObserver, Stop, render_to_file,
 };
@@ -70,6 +67,7 @@ fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
         tile: task.tile,
         max_tile_pixels: DEFAULT_MAX_TILE_PIXELS,
         moments: false,
+        guides: false,
     };
     let ctx = GpuContext::headless()?;
     render_to_file(&ctx, loaded, &job, &mut Log)?;
@@ -130,18 +128,11 @@ pub fn merge_job(dir: &Path) -> Result<()> {
             .collect::<Result<_>>()?;
         let merged = merge(&parts).map_err(|e| anyhow!(e))?;
         let output = plan.frame_output(dir, frame);
-        let record = merged.record.to_text();
-        let text = Some((RECORD_ATTRIBUTE, record.as_str()));
-        match ImageFormat::from_path(&output)? {
-            ImageFormat::Exr => {
-                image_io::save_exr(merged.width, merged.height, &merged.pixels, text, &output)?
-            }
-            ImageFormat::Png => {
-                let (image, _) =
-                    cpu_display::show(&merged.pixels, (merged.width, merged.height), &display);
-                image_io::save_png_with_text(&image, text, &output)?
-            }
-        }
+        let how = crate::merge::MergedOutput {
+            display,
+            denoise: false,
+        };
+        crate::merge::write_merged(&merged, &output, &how)?;
         let error = merged.error.map_or(String::new(), |e| {
             format!(
                 "; estimated relative error {:.3} % (RMSE {:.5})",

@@ -97,6 +97,7 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         tile_index: None,
         max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
         moments: false,
+        guides: false,
     }
 }
 
@@ -114,6 +115,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         tile: None,
         max_tile_pixels: marbre_render::final_render::DEFAULT_MAX_TILE_PIXELS,
         moments: false,
+        guides: false,
     }
 }
 
