@@ -249,6 +249,20 @@ pub fn check_job(job: &FinalRender) -> Result<(ImageFormat, Option<&PathBuf>)> {
     {
         bail!("the target error must be a positive number, like 0.01 for 1 %");
     }
+    if job
+        .sample_offset
+        .checked_add(job.stop.max_samples())
+        .is_none()
+    {
+        bail!(
+            "--sample-offset {} is out of range: samples {}..{} pass the last one a render \
+             numbers, {}",
+            job.sample_offset,
+            job.sample_offset,
+            u64::from(job.sample_offset) + u64::from(job.stop.max_samples()),
+            u32::MAX
+        );
+    }
     let animation = match &job.timing {
         Timing::Sequence {
             animation: Some(path),

@@ -136,7 +136,8 @@ fn a_render_in_pieces_is_the_whole_render() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A PNG and an EXR say how they were made; a merged PNG too.
+/// A PNG and an EXR say how they were made; a merged PNG too. A
+/// truncated input is refused by name.
 #[test]
 fn outputs_record_their_render() {
     if gpu_or_skip("outputs_record_their_render").is_none() {
@@ -168,11 +169,23 @@ fn outputs_record_their_render() {
     let merged_record = RenderRecord::from_attributes(&text).unwrap().unwrap();
     assert_eq!((merged_record.spp, merged_record.scene), (4, record.scene));
     assert!(text.contains_key(RECORD_ATTRIBUTE));
+    // A truncated batch is named, and nothing is written.
+    let bytes = std::fs::read(&inputs[1]).unwrap();
+    let cut = dir.join("cut.exr");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let out = dir.join("from-cut.exr");
+    let e = merge_files(&[inputs[0].clone(), cut], &out, &[]).unwrap_err();
+    assert!(
+        format!("{e:#}").contains("cut.exr") && format!("{e:#}").contains("truncated"),
+        "{e:#}"
+    );
+    assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Bad tiles are refused before anything is traced, each naming its
-/// cause, and nothing is written.
+/// Bad tiles, an offset past the last sample and a denoised render in
+/// pieces are refused before anything is traced, each naming its cause,
+/// and nothing is written.
 #[test]
 fn bad_tiles_are_refused_by_name() {
     if gpu_or_skip("bad_tiles_are_refused_by_name").is_none() {
