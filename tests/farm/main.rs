@@ -3,7 +3,8 @@
 //! writes, with the marbre binary on lavapipe. A 4-batch sample array and
 //! its merge give the direct render of all the samples, a 4-tile array
 //! the direct render bit for bit; a 4-task frame
-//! array gives each frame as a direct render of it; a task that fails
+//! array gives each frame as a direct render of it (a task also takes its
+//! index from JOB_COMPLETION_INDEX, as a Kubernetes pod); a task that fails
 //! shows FAILED, the merge after it is cancelled, `farm merge` names it,
 //! and a rerun of that index alone completes the job. Without Slurm the
 //! test skips with a banner (a failure under MARBRE_REQUIRE_GPU=1).
@@ -198,6 +199,27 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
         pixels(&frames.join("frames/frame_0001.exr")) != pixels(&frame_2),
         "frames 1 and 2 traced the same samples"
     );
+
+    // A Kubernetes pod gives the index in JOB_COMPLETION_INDEX: frame 1
+    // is written, so the task does nothing. Without an index, an error.
+    let task = |env: &[(&str, &str)]| {
+        let mut command = Command::new(MARBRE);
+        command
+            .args(["farm", "task", frames.to_str().unwrap()])
+            .env_remove("JOB_COMPLETION_INDEX")
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .envs(env.iter().copied());
+        command.output().unwrap()
+    };
+    let indexed = task(&[("JOB_COMPLETION_INDEX", "1")]);
+    let said = String::from_utf8_lossy(&indexed.stdout);
+    assert!(
+        indexed.status.success() && said.contains("task 1: ") && said.contains("nothing to do"),
+        "{said}"
+    );
+    let unindexed = task(&[]);
+    assert!(!unindexed.status.success());
+    assert!(String::from_utf8_lossy(&unindexed.stderr).contains("no task index"));
 
     let mut expected = all("COMPLETED", 4);
     expected.insert(2, "FAILED".to_owned());

@@ -68,8 +68,10 @@ pub enum FarmCommand {
         cpus: u32,
     },
     /// Trace task INDEX of the job in DIR (what a node runs); a task whose
-    /// file is written already does nothing.
-    Task { dir: PathBuf, index: u32 },
+    /// file is written already does nothing. Without INDEX, the index the
+    /// scheduler gives: JOB_COMPLETION_INDEX (a Kubernetes Indexed Job's
+    /// pod) or SLURM_ARRAY_TASK_ID (a Slurm array's task).
+    Task { dir: PathBuf, index: Option<u32> },
     /// Check that every task of the job in DIR wrote its file (naming
     /// those that failed or never ran) and merge each frame's parts.
     Merge { dir: PathBuf },
@@ -168,9 +170,32 @@ pub fn run(args: &FarmArgs) -> Result<()> {
             );
             Ok(())
         }
-        FarmCommand::Task { dir, index } => task::run_task(dir, *index),
+        FarmCommand::Task { dir, index } => task::run_task(dir, task_index(*index)?),
         FarmCommand::Merge { dir } => task::merge_job(dir),
     }
+}
+
+/// The schedulers' variables that hold a task's index, in the order read.
+const INDEX_VARIABLES: [&str; 2] = ["JOB_COMPLETION_INDEX", "SLURM_ARRAY_TASK_ID"];
+
+/// The task index given, or the one the scheduler set.
+fn task_index(given: Option<u32>) -> Result<u32> {
+    if let Some(index) = given {
+        return Ok(index);
+    }
+    for name in INDEX_VARIABLES {
+        if let Ok(value) = std::env::var(name) {
+            return value
+                .trim()
+                .parse()
+                .with_context(|| format!("{name}={value:?} is not a task index"));
+        }
+    }
+    bail!(
+        "no task index: give it (`marbre farm task DIR 3`), or run under a Kubernetes Indexed \
+         Job or a Slurm array ({} unset)",
+        INDEX_VARIABLES.join(" and ")
+    )
 }
 
 /// The job's plan from the flags, checked (the preset read, batches that

@@ -2,8 +2,8 @@
 //! script, a merge script and a submit step that makes the merge wait for
 //! every task (`afterok`); for Kubernetes an Indexed Job, a merge Job and
 //! a submit step. Each task runs `marbre farm task DIR INDEX`, the array
-//! index coming from `SLURM_ARRAY_TASK_ID` or the Indexed Job's completion
-//! index (`JOB_COMPLETION_INDEX`, read from its pod annotation).
+//! index coming from `SLURM_ARRAY_TASK_ID` or the Indexed Job's
+//! `JOB_COMPLETION_INDEX`.
 
 use super::plan::FarmPlan;
 use serde_json::json;
@@ -139,14 +139,6 @@ pub fn kubernetes(
                 // lavapipe's threads follow the CPUs the pod may use.
                 "name": "LP_NUM_THREADS",
                 "valueFrom": { "resourceFieldRef": { "resource": "limits.cpu", "divisor": "1" } }
-            }, {
-                // The pod's index (what JOB_COMPLETION_INDEX holds), from
-                // the annotation the Job controller sets: declared here, so
-                // that `$(MARBRE_TASK_INDEX)` in the arguments expands.
-                "name": "MARBRE_TASK_INDEX",
-                "valueFrom": { "fieldRef": {
-                    "fieldPath": "metadata.annotations['batch.kubernetes.io/job-completion-index']"
-                } }
             }],
             "resources": { "limits": limits },
             "volumeMounts": [{ "name": "job", "mountPath": dir_text }]
@@ -170,7 +162,9 @@ pub fn kubernetes(
                 "restartPolicy": "Never",
                 "containers": [container(
                     "task",
-                    json!(["farm", "task", dir_text, "$(MARBRE_TASK_INDEX)"]),
+                    // The index: JOB_COMPLETION_INDEX, which the Job
+                    // controller sets in each pod.
+                    json!(["farm", "task", dir_text]),
                     options.gpus,
                 )],
                 "volumes": volumes
@@ -288,11 +282,8 @@ mod tests {
         assert_eq!(c["image"], "registry.example/marbre:0.1");
         assert_eq!(
             c["args"],
-            serde_json::json!(["farm", "task", "/jobs/a", "$(MARBRE_TASK_INDEX)"])
-        );
-        assert_eq!(
-            c["env"][1]["valueFrom"]["fieldRef"]["fieldPath"],
-            "metadata.annotations['batch.kubernetes.io/job-completion-index']"
+            serde_json::json!(["farm", "task", "/jobs/a"]),
+            "the index comes from JOB_COMPLETION_INDEX"
         );
         assert_eq!(c["resources"]["limits"]["nvidia.com/gpu"], "1");
         assert_eq!(c["env"][0]["name"], "LP_NUM_THREADS");
