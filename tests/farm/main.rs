@@ -25,18 +25,10 @@ const MARBRE: &str = env!("CARGO_BIN_EXE_marbre");
 const JOB_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// A diffuse ball under a point light and a constant sky: every pixel's
-/// estimate is noisy, so batches and frames differ.
-const BALL: &str = r#"(
-    format_version: 2,
-    scene: (
-        camera: (target: (0.0, 0.0, 0.0), distance: 4.0, yaw_degrees: 20.0, pitch_degrees: 10.0, fov_degrees: 40.0),
-        spheres: [(name: "ball", center: (0.0, 0.0, 0.0), radius: 1.0, material: (diffuse: (0.7, 0.5, 0.3)))],
-        ground: Some((height: -1.0, material: (diffuse: (0.5, 0.5, 0.5)))),
-        point_light: Some((position: (2.0, 3.0, 3.0), color: (1.0, 1.0, 1.0), intensity: 30.0)),
-        environment: (source: Constant(radiance: (0.3, 0.35, 0.4))),
-        render: (samples_per_frame: 2, max_bounces: 3),
-    ),
-)"#;
+/// estimate is noisy, so batches and frames differ. Two samples a frame.
+fn ball_preset() -> String {
+    include_str!("../data/noisy_ball.ron").replace("samples_per_frame: 1,", "samples_per_frame: 2,")
+}
 
 fn start_or_skip(test: &str) -> Option<SlurmCluster> {
     let cluster = SlurmCluster::start().unwrap_or_else(|e| panic!("[{test}] {e}"));
@@ -122,7 +114,7 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
     let root = cluster.folder().join("renders");
     std::fs::create_dir_all(&root).unwrap();
     let preset = root.join("ball.ron");
-    std::fs::write(&preset, BALL).unwrap();
+    std::fs::write(&preset, ball_preset()).unwrap();
     let preset = preset.to_str().unwrap();
     let job = |name: &str, flags: &[&str]| -> PathBuf {
         let dir = root.join(name);

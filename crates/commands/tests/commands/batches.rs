@@ -25,30 +25,22 @@ struct MergeCli {
     args: MergeArgs,
 }
 
-/// A diffuse ball on a ground, lit by a point light and a constant sky,
-/// paths of three bounces: every pixel's estimate is noisy. `{spf}`:
-/// the samples per frame.
-const BALL: &str = r#"(
-    format_version: 2,
-    scene: (
-        camera: (target: (0.0, 0.0, 0.0), distance: 4.0, yaw_degrees: 20.0, pitch_degrees: 10.0, fov_degrees: 40.0),
-        spheres: [(name: "ball", center: (0.0, 0.0, 0.0), radius: 1.0, material: (diffuse: (0.7, 0.5, 0.3)))],
-        ground: Some((height: -1.0, material: (diffuse: (0.5, 0.5, 0.5)))),
-        point_light: Some((position: (2.0, 3.0, 3.0), color: (1.0, 1.0, 1.0), intensity: 30.0)),
-        environment: (source: Constant(radiance: (0.3, 0.35, 0.4))),
-        render: (samples_per_frame: {spf}, max_bounces: 3),
-    ),
-)"#;
+/// A diffuse ball under a point light and a constant sky, whose every
+/// pixel's estimate is noisy, with `spf` samples per frame.
+fn ball_preset(spf: u32) -> String {
+    let text = include_str!("../../../../tests/data/noisy_ball.ron");
+    assert!(text.contains("samples_per_frame: 1,"));
+    text.replace(
+        "samples_per_frame: 1,",
+        &format!("samples_per_frame: {spf},"),
+    )
+}
 
 pub(crate) fn scratch(name: &str, spf: u32) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marbre-batch-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("ball.ron"),
-        BALL.replace("{spf}", &spf.to_string()),
-    )
-    .unwrap();
+    std::fs::write(dir.join("ball.ron"), ball_preset(spf)).unwrap();
     dir
 }
 

@@ -13,7 +13,22 @@ use marbre_core::image_io;
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord};
 use marbre_core::tile::Tile;
 use marbre_render::gpu::testing::gpu_or_skip;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// Renders every tile of a `grid` (`CxR`) of the ball with `flags`, to
+/// `{prefix}{i}.exr` in `dir`; their paths.
+fn render_tiles(dir: &Path, prefix: &str, grid: &str, flags: &[&str]) -> Vec<PathBuf> {
+    let count: u32 = marbre_core::tile::TileGrid::parse(grid).unwrap().count();
+    (0..count)
+        .map(|i| {
+            let name = format!("{prefix}{i}.exr");
+            let index = i.to_string();
+            let all = [flags, &["--tiles", grid, "--tile-index", &index]].concat();
+            render_ball_with(dir, &name, &all).unwrap();
+            dir.join(name)
+        })
+        .collect()
+}
 
 /// The six tiles of a 3x2 grid, merged, are the whole render bit for bit;
 /// so is a 2x2 grid whose tiles are each two batches of 2 samples (to
@@ -26,19 +41,7 @@ fn tiles_assemble_to_the_whole_render() {
     }
     let dir = scratch("tiles", 1);
     let whole = render_ball(&dir, "whole.exr", 4, 0).unwrap();
-    let tiles: Vec<PathBuf> = (0..6)
-        .map(|i| {
-            let name = format!("t{i}.exr");
-            let index = i.to_string();
-            render_ball_with(
-                &dir,
-                &name,
-                &["--spp", "4", "--tiles", "3x2", "--tile-index", &index],
-            )
-            .unwrap();
-            dir.join(name)
-        })
-        .collect();
+    let tiles = render_tiles(&dir, "t", "3x2", &["--spp", "4"]);
     let t4 = merge::read_batch(&tiles[4]).unwrap();
     assert_eq!(t4.record.tile, Tile::parse("13,12,26,24").unwrap());
     assert_eq!((t4.width, t4.height, t4.record.image), (13, 12, (40, 24)));
@@ -51,29 +54,16 @@ fn tiles_assemble_to_the_whole_render() {
     );
     assert_eq!(assembled.record.tile, Tile::whole((40, 24)));
 
-    let mut batches = Vec::new();
-    for i in 0..4 {
-        for offset in [0, 2] {
-            let name = format!("q{i}-{offset}.exr");
-            let (index, offset) = (i.to_string(), offset.to_string());
-            render_ball_with(
-                &dir,
-                &name,
-                &[
-                    "--spp",
-                    "2",
-                    "--sample-offset",
-                    &offset,
-                    "--tiles",
-                    "2x2",
-                    "--tile-index",
-                    &index,
-                ],
-            )
-            .unwrap();
-            batches.push(dir.join(name));
-        }
-    }
+    let batches = [
+        render_tiles(&dir, "q-first", "2x2", &["--spp", "2"]),
+        render_tiles(
+            &dir,
+            "q-second",
+            "2x2",
+            &["--spp", "2", "--sample-offset", "2"],
+        ),
+    ]
+    .concat();
     let merged = dir.join("batched.exr");
     merge_files(&batches, &merged, &[]).unwrap();
     let d = largest_relative_difference(&merge::read_batch(&merged).unwrap().pixels, &whole);
@@ -236,27 +226,7 @@ fn moments_let_a_merge_of_single_batches_know_its_error() {
         return;
     }
     let dir = scratch("moments", 1);
-    let tiles: Vec<PathBuf> = (0..4)
-        .map(|i| {
-            let name = format!("t{i}.exr");
-            let index = i.to_string();
-            render_ball_with(
-                &dir,
-                &name,
-                &[
-                    "--spp",
-                    "16",
-                    "--moments",
-                    "--tiles",
-                    "2x2",
-                    "--tile-index",
-                    &index,
-                ],
-            )
-            .unwrap();
-            dir.join(name)
-        })
-        .collect();
+    let tiles = render_tiles(&dir, "t", "2x2", &["--spp", "16", "--moments"]);
     let reference = render_ball(&dir, "reference.exr", 256, 4096).unwrap();
     let merged_path = dir.join("merged.exr");
     merge_files(&tiles, &merged_path, &[]).unwrap();
@@ -297,28 +267,7 @@ fn a_merge_denoises_with_the_files_guides() {
         return;
     }
     let dir = scratch("guides", 1);
-    let tiles: Vec<PathBuf> = (0..4)
-        .map(|i| {
-            let name = format!("t{i}.exr");
-            let index = i.to_string();
-            render_ball_with(
-                &dir,
-                &name,
-                &[
-                    "--spp",
-                    "8",
-                    "--moments",
-                    "--guides",
-                    "--tiles",
-                    "2x2",
-                    "--tile-index",
-                    &index,
-                ],
-            )
-            .unwrap();
-            dir.join(name)
-        })
-        .collect();
+    let tiles = render_tiles(&dir, "t", "2x2", &["--spp", "8", "--moments", "--guides"]);
     let whole = render_ball_with(
         &dir,
         "whole.exr",
