@@ -2,7 +2,8 @@
 //! cluster on 127.0.0.1 (`slurm_cluster`) runs the job arrays `farm slurm`
 //! writes, with the marbre binary on lavapipe. A 4-batch sample array and
 //! its merge give the direct render of all the samples, a 4-tile array
-//! the direct render bit for bit; a 4-task frame
+//! (with --moments) the direct render bit for bit and an error estimate;
+//! a 4-task frame
 //! array gives each frame as a direct render of it (a task also takes its
 //! index from JOB_COMPLETION_INDEX, as a Kubernetes pod); a task that fails
 //! shows FAILED, the merge after it is cancelled, `farm merge` names it,
@@ -145,7 +146,7 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
     let blocked = failing.join("parts/frame_0000_part_002.exr");
     std::fs::create_dir_all(&blocked).unwrap();
     let frames = job("frames", &["--spp", "4", "--frames", "0..3"]);
-    let tiles = job("tiles", &["--spp", "4", "--tiles", "2x2"]);
+    let tiles = job("tiles", &["--spp", "4", "--tiles", "2x2", "--moments"]);
     let (batch_tasks, batch_merge) = submit(&cluster, &batches);
     let (tile_tasks, tile_merge) = submit(&cluster, &tiles);
     let (failing_tasks, failing_merge) = submit(&cluster, &failing);
@@ -175,6 +176,11 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
     assert!(
         pixels(&tiles.join("image.exr")) == pixels(&four),
         "the assembled tiles differ from the direct render"
+    );
+    let merge_log = std::fs::read_to_string(tiles.join("logs/merge.out")).unwrap();
+    assert!(
+        merge_log.contains("estimated relative error"),
+        "single-batch tiles with --moments know their error: {merge_log}"
     );
 
     assert_eq!(cluster.states(frame_tasks).unwrap(), all("COMPLETED", 4));

@@ -70,13 +70,21 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let samples = merged.record.samples();
     let error = match merged.error {
         Some(e) => format!(
-            "estimated relative error {:.3} % (RMSE {:.5}), from {}",
+            "estimated relative error {:.3} % (RMSE {:.5}), from {}{}",
             100.0 * e.relative,
             e.rmse,
             if batches.iter().all(|b| b.variance.is_some()) {
                 "the files' variance layers"
             } else {
                 "the spread between each tile's batches"
+            },
+            if merged.measured_tiles < merged.tiles {
+                format!(
+                    ", over the {} of the {} tiles with two batches or more",
+                    merged.measured_tiles, merged.tiles
+                )
+            } else {
+                String::new()
             }
         ),
         None => "no error estimate: every tile is one batch (render two batches or more of a \
@@ -216,13 +224,31 @@ pub fn read_batch(path: &Path) -> Result<Batch> {
             )
         })?;
     let image = decode_file(path, IntegerDecode::Linear)?;
-    // Every channel of an EXR part has the picture's size.
     let [variance, albedo, normal]: [Option<Vec<[f32; 3]>>; 3] = image_io::read_exr_layers(
         path,
         &[image_io::VARIANCE, image_io::ALBEDO, image_io::NORMAL],
     )?
     .try_into()
     .expect("one answer a layer asked");
+    // A layer of another size (subsampled channels, another part) is not
+    // the picture's.
+    for (layer, values) in [
+        ("variance", &variance),
+        ("albedo", &albedo),
+        ("normal", &normal),
+    ] {
+        if let Some(values) = values
+            && values.len() != image.pixels.len()
+        {
+            bail!(
+                "{}: its {layer} layer has {} values, not one a pixel of its {}×{} picture",
+                path.display(),
+                values.len(),
+                image.width,
+                image.height
+            );
+        }
+    }
     Ok(Batch {
         path: path.to_path_buf(),
         width: image.width,

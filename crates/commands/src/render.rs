@@ -287,11 +287,7 @@ struct Bar {
 impl Bar {
     fn new(spp: u32, frames: u32, device: String) -> Self {
         let bar = indicatif::ProgressBar::new(u64::from(spp) * u64::from(frames));
-        let template = if frames > 1 {
-            "{msg} [{bar:40}] {prefix} {elapsed} (eta {eta})"
-        } else {
-            "{msg} [{bar:40}] {pos}/{len} spp, {elapsed} (eta {eta})"
-        };
+        let template = "{msg} [{bar:40}] {prefix} {elapsed} (eta {eta})";
         bar.set_style(indicatif::ProgressStyle::with_template(template).expect("a valid template"));
         bar.set_message(device);
         Self { bar, frames }
@@ -305,17 +301,21 @@ impl RenderObserver for Bar {
 
     fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {
         let per_frame = u64::from(progress.max_samples);
+        // A render traced in pieces reports them as it reports frames.
+        self.bar.set_length(u64::from(progress.frames) * per_frame);
         self.bar
             .set_position(u64::from(progress.frame) * per_frame + u64::from(progress.samples));
-        if self.frames > 1 {
-            self.bar.set_prefix(format!(
-                "frame {}/{}, {}/{} spp,",
+        let samples = format!("{}/{} spp,", progress.samples, progress.max_samples);
+        self.bar.set_prefix(if progress.frames > 1 {
+            let part = if self.frames > 1 { "frame" } else { "piece" };
+            format!(
+                "{part} {}/{}, {samples}",
                 progress.frame + 1,
-                progress.frames,
-                progress.samples,
-                progress.max_samples
-            ));
-        }
+                progress.frames
+            )
+        } else {
+            samples
+        });
         if let Some(e) = progress.relative_error {
             self.bar.set_message(format!("error {:.2} %", 100.0 * e));
         }

@@ -58,6 +58,9 @@ pub struct Merged {
     pub error: Option<MergeError>,
     /// How many tiles were assembled (1: batches of the whole image).
     pub tiles: usize,
+    /// How many of them have an estimated variance, which `error`
+    /// covers.
+    pub measured_tiles: usize,
 }
 
 /// An estimate of a merged image's error.
@@ -151,16 +154,23 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
         .map(|g| (name(g.batches[0]), g.tile))
         .collect();
     check_cover(image, &named)?;
-    if let Some(g) = groups.iter().find(|g| g.samples != groups[0].samples) {
+    let range = |g: &TileGroup| {
+        let start = g.batches[0].record.samples().start;
+        start..start + g.samples
+    };
+    if let Some(g) = groups.iter().find(|g| range(g) != range(&groups[0])) {
+        let (a, b) = (range(g), range(&groups[0]));
         return Err(format!(
-            "{} (tile {}) has {} samples per pixel, but {} (tile {}) {}: every tile of an \
+            "{} (tile {}) holds samples {}..{}, but {} (tile {}) {}..{}: every tile of an \
              image needs the same samples",
             name(g.batches[0]),
             g.tile,
-            g.samples,
+            a.start,
+            a.end,
             name(groups[0].batches[0]),
             groups[0].tile,
-            groups[0].samples
+            b.start,
+            b.end
         ));
     }
     let count = image.0 as usize * image.1 as usize;
@@ -177,7 +187,7 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
     for group in &groups {
         group.assemble(&mut out);
     }
-    let every_tile_has_variance = groups.iter().all(TileGroup::has_variance);
+    let measured_tiles = groups.iter().filter(|g| g.has_variance()).count();
     let kernels = distinct(batches.iter().map(|b| b.record.kernel.as_str()));
     let adapters = distinct(batches.iter().map(|b| b.record.adapter.as_str()));
     Ok(Merged {
@@ -192,7 +202,8 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             adapter: adapters,
             ..first.record.clone()
         },
-        variance: every_tile_has_variance.then_some(out.variance),
+        variance: (measured_tiles == groups.len()).then_some(out.variance),
+        measured_tiles,
         guides: out.guides,
         error: out.spread.error(),
         tiles: groups.len(),
@@ -218,10 +229,27 @@ struct TileGroup<'a> {
 }
 
 impl<'a> TileGroup<'a> {
-    /// Refused if two batches' sample ranges overlap.
+    /// Refused if two batches' sample ranges overlap or leave samples out
+    /// between them: the merged record says one range, from the first
+    /// sample to the last, which a later merge checks against (a gap
+    /// would let a merge of the merge count the missing samples twice).
     fn new(tile: Tile, batches: Vec<&'a Batch>) -> Result<Self, String> {
         for pair in batches.windows(2) {
             let (a, b) = (pair[0].record.samples(), pair[1].record.samples());
+            if b.start > a.end {
+                return Err(format!(
+                    "{} (samples {}..{}) and {} (samples {}..{}) leave samples {}..{} out: \
+                     merge batches whose samples follow one another (render the missing batch)",
+                    pair[0].path.display(),
+                    a.start,
+                    a.end,
+                    pair[1].path.display(),
+                    b.start,
+                    b.end,
+                    a.end,
+                    b.start
+                ));
+            }
             if b.start < a.end {
                 return Err(format!(
                     "{} (samples {}..{}) and {} (samples {}..{}) overlap: those samples would \
@@ -445,6 +473,7 @@ mod tests {
         .unwrap();
         assert_eq!(alone.error, None, "one batch a tile: no spread to measure");
         assert_eq!(alone.variance, None);
+        assert_eq!((merged.measured_tiles, alone.measured_tiles), (1, 0));
     }
 
     /// Batches with their moments: the merged variance is Σ (n_i / N)²
@@ -494,9 +523,15 @@ mod tests {
         let e = merge(&[a.clone(), later]).unwrap_err();
         assert!(e.contains("later.exr holds frame 7"), "{e}");
         let overlapping = batch("again.exr", 2, 4, 1.0);
-        let e = merge(&[a, overlapping]).unwrap_err();
+        let e = merge(&[a.clone(), overlapping]).unwrap_err();
         assert!(
             e.contains("a.exr (samples 0..4) and again.exr (samples 2..6) overlap"),
+            "{e}"
+        );
+        let far = batch("far.exr", 8, 4, 1.0);
+        let e = merge(&[a, far]).unwrap_err();
+        assert!(
+            e.contains("a.exr (samples 0..4) and far.exr (samples 8..12) leave samples 4..8 out"),
             "{e}"
         );
     }
@@ -529,6 +564,18 @@ mod tests {
             tile_batch("t1.exr", t("2,0,4,1"), image, 0, 8, 1.0),
         ])
         .unwrap_err();
-        assert!(e.contains("t1.exr (tile 2,0,4,1) has 8 samples"), "{e}");
+        assert!(
+            e.contains("t1.exr (tile 2,0,4,1) holds samples 0..8"),
+            "{e}"
+        );
+        let e = merge(&[
+            tile_batch("t0.exr", t("0,0,2,1"), image, 0, 4, 1.0),
+            tile_batch("t1.exr", t("2,0,4,1"), image, 4, 4, 1.0),
+        ])
+        .unwrap_err();
+        assert!(
+            e.contains("t1.exr (tile 2,0,4,1) holds samples 4..8"),
+            "{e}"
+        );
     }
 }

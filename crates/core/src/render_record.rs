@@ -137,8 +137,14 @@ pub fn scene_hash(scene: &Scene) -> String {
         ..scene.clone()
     };
     let text = ron::to_string(&traced).expect("a scene writes as RON");
-    let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    fnv1a_hex(text.as_bytes())
+}
+
+/// 16 hex digits of the 64-bit FNV-1a hash of `bytes`: the same on every
+/// machine and run.
+pub fn fnv1a_hex(bytes: &[u8]) -> String {
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
     });
     format!("{hash:016x}")
 }

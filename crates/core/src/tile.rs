@@ -5,7 +5,12 @@
 //! camera and per-pixel samples (`shaders/scene.wgsl`'s crop), so the
 //! tiles of an image assemble to its render exactly.
 
+use serde::{Deserialize, Serialize};
 use std::fmt;
+
+/// The most columns or rows a grid may have: an image's largest side
+/// (`render --size`), so that a grid's tile count fits a `u32`.
+pub const MAX_GRID_SIDE: u32 = 16384;
 
 /// The pixels [x0, x1) × [y0, y1) of an image.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -82,14 +87,14 @@ impl fmt::Display for Tile {
 /// A grid of `columns` × `rows` tiles (`--tiles CxR`), numbered row by
 /// row from the top left. Edges fall at ⌊i·W/C⌋, so tiles of a size the
 /// grid does not divide differ by a pixel at most.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct TileGrid {
     pub columns: u32,
     pub rows: u32,
 }
 
 impl TileGrid {
-    /// `CxR`, each at least 1.
+    /// `CxR`, each from 1 to [`MAX_GRID_SIDE`].
     pub fn parse(s: &str) -> Result<Self, String> {
         let (c, r) = s
             .split_once(['x', 'X'])
@@ -98,8 +103,10 @@ impl TileGrid {
             v.trim()
                 .parse::<u32>()
                 .ok()
-                .filter(|&n| n >= 1)
-                .ok_or_else(|| format!("`{s}` is not COLUMNSxROWS of whole numbers from 1"))
+                .filter(|&n| (1..=MAX_GRID_SIDE).contains(&n))
+                .ok_or_else(|| {
+                    format!("`{s}` is not COLUMNSxROWS of whole numbers from 1 to {MAX_GRID_SIDE}")
+                })
         };
         Ok(Self {
             columns: count(c)?,
@@ -147,27 +154,27 @@ impl TileGrid {
 
 /// The pieces `region` is traced in when one set of targets for it would
 /// exceed what a GPU holds: pieces at most `max_side` pixels on a side (a
-/// texture's largest size) and of at most `max_pixels` (the targets take
-/// about 160 bytes a pixel), as few as those allow, in rows from the top;
-/// `region` itself when it fits.
+/// texture's largest size) and, as far as whole rows allow, of at most
+/// `max_pixels` (the targets take about 160 bytes a pixel); as few as
+/// those allow, in rows from the top, all of the first's size but for the
+/// last row and column of pieces, which are smaller (so the renderer's
+/// targets, sized for the first, fit every piece); `region` itself when it
+/// fits.
 pub fn split(region: Tile, max_side: u32, max_pixels: u64) -> Vec<Tile> {
     let (w, h) = region.size();
     let max_side = max_side.max(1);
-    let columns = w.div_ceil(max_side);
-    let piece_width = w.div_ceil(columns);
-    let rows_fitting = (max_pixels / u64::from(piece_width)).clamp(1, u64::from(max_side)) as u32;
-    let grid = TileGrid {
-        columns,
-        rows: h.div_ceil(rows_fitting),
-    };
-    grid.tiles((w, h))
-        .expect("a grid no finer than the region's pixels")
-        .into_iter()
-        .map(|t| Tile {
-            x0: region.x0 + t.x0,
-            x1: region.x0 + t.x1,
-            y0: region.y0 + t.y0,
-            y1: region.y0 + t.y1,
+    let piece_width = w.div_ceil(w.div_ceil(max_side));
+    let piece_height =
+        (max_pixels / u64::from(piece_width)).clamp(1, u64::from(max_side.min(h))) as u32;
+    let starts = |len: u32, step: u32| (0..len.div_ceil(step)).map(move |i| i * step);
+    starts(h, piece_height)
+        .flat_map(|y| {
+            starts(w, piece_width).map(move |x| Tile {
+                x0: region.x0 + x,
+                x1: region.x0 + (x + piece_width).min(w),
+                y0: region.y0 + y,
+                y1: region.y0 + (y + piece_height).min(h),
+            })
         })
         .collect()
 }
@@ -190,25 +197,38 @@ pub fn check_cover(size: (u32, u32), tiles: &[(String, Tile)]) -> Result<(), Str
     let covered: u64 = tiles.iter().map(|(_, t)| t.pixels()).sum();
     let total = u64::from(size.0) * u64::from(size.1);
     if covered < total {
-        let first_missing = (0..size.1)
-            .flat_map(|y| (0..size.0).map(move |x| (x, y)))
-            .find(|&(x, y)| {
-                !tiles
-                    .iter()
-                    .any(|(_, t)| (t.x0..t.x1).contains(&x) && (t.y0..t.y1).contains(&y))
-            })
-            .unwrap_or((0, 0));
+        let (x, y) = first_uncovered(size, tiles).unwrap_or((0, 0));
         return Err(format!(
-            "the tiles leave {} of the {} × {} image's pixels out, the first at ({}, {}): \
+            "the tiles leave {} of the {} × {} image's pixels out, the first at ({x}, {y}): \
              a tile is missing",
             total - covered,
             size.0,
             size.1,
-            first_missing.0,
-            first_missing.1
         ));
     }
     Ok(())
+}
+
+/// The first pixel, row by row, that no tile covers: each row's tiles
+/// sorted by their left edge and walked once (not every pixel against
+/// every tile: a 16384² image has 2²⁸ pixels).
+fn first_uncovered(size: (u32, u32), tiles: &[(String, Tile)]) -> Option<(u32, u32)> {
+    (0..size.1).find_map(|y| {
+        let mut spans: Vec<(u32, u32)> = tiles
+            .iter()
+            .filter(|(_, t)| (t.y0..t.y1).contains(&y))
+            .map(|(_, t)| (t.x0, t.x1))
+            .collect();
+        spans.sort_unstable();
+        let mut x = 0;
+        for (x0, x1) in spans {
+            if x0 > x {
+                break;
+            }
+            x = x.max(x1);
+        }
+        (x < size.0).then_some((x, y))
+    })
 }
 
 #[cfg(test)]
@@ -240,6 +260,7 @@ mod tests {
         assert!(e.contains("0,0,9,4") && e.contains("8 × 8"), "{e}");
         assert!(TileGrid::parse("4").unwrap_err().contains("COLUMNSxROWS"));
         assert!(TileGrid::parse("0x2").is_err());
+        assert!(TileGrid::parse("16385x1").unwrap_err().contains("16384"));
         let grid = TileGrid::parse("2x2").unwrap();
         assert!(grid.tile((8, 8), 4).unwrap_err().contains("0 to 3"));
         let e = TileGrid::parse("9x1").unwrap().tile((8, 8), 0).unwrap_err();
@@ -274,7 +295,7 @@ mod tests {
     }
 
     /// A region that fits is one piece; a larger one is cut into pieces
-    /// within both limits, covering it once.
+    /// within both limits, none larger than the first, covering it once.
     #[test]
     fn pieces_stay_within_the_limits() {
         let whole = Tile::whole((100, 50));
@@ -282,26 +303,31 @@ mod tests {
         let pieces = split(whole, 4096, 1000);
         assert_eq!(pieces.len(), 5);
         assert_eq!(pieces[4], Tile::parse("0,40,100,50").unwrap());
+        let rows = split(Tile::whole((16384, 16384)), 16384, 3840 * 2160);
+        assert_eq!(
+            (rows.len(), rows[0].size(), rows[32].size()),
+            (33, (16384, 506), (16384, 192))
+        );
         let region = Tile::parse("10,20,110,70").unwrap();
-        for (max_side, max_pixels) in [(4096, 1000), (30, 1 << 20), (7, 20), (1, 1)] {
+        for (max_side, max_pixels) in [(4096, 1000), (30, 1 << 20), (7, 20), (1, 1), (64, 64)] {
             let pieces = split(region, max_side, max_pixels);
+            let (w0, h0) = pieces[0].size();
             for p in &pieces {
                 let (w, h) = p.size();
-                assert!(
-                    w <= max_side && h <= max_side && p.pixels() <= max_pixels.max(u64::from(w))
-                );
+                assert!(w <= max_side && h <= max_side, "{p}");
+                assert!(p.pixels() <= max_pixels.max(u64::from(w)), "{p}");
+                assert!(w <= w0 && h <= h0, "{p} is larger than the first piece");
             }
-            let named: Vec<_> = pieces.iter().map(|t| (t.to_string(), *t)).collect();
-            let shifted: Vec<_> = named
+            let shifted: Vec<_> = pieces
                 .iter()
-                .map(|(n, t)| {
+                .map(|t| {
                     let t = Tile {
                         x0: t.x0 - 10,
                         x1: t.x1 - 10,
                         y0: t.y0 - 20,
                         y1: t.y1 - 20,
                     };
-                    (n.clone(), t)
+                    (t.to_string(), t)
                 })
                 .collect();
             assert_eq!(

@@ -400,12 +400,12 @@ pub fn render_to_file(
         if index > 0 {
             renderer.set_scene(ctx, &base.at_time(planned.time))?;
         }
-        let mut in_sequence = InSequence {
-            observer: &mut *observer,
-            frame: index as u32,
-            frames: frames.len() as u32,
-        };
         if !cropped {
+            let mut in_sequence = InSequence {
+                observer: &mut *observer,
+                frame: index as u32,
+                frames: frames.len() as u32,
+            };
             renderer.restart_at_sample(planned.frame, job.sample_offset);
             if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
                 return Ok(Outcome::Cancelled);
@@ -415,8 +415,14 @@ pub fn render_to_file(
         }
         let mut pixels = vec![[0.0f32; 4]; region.pixels() as usize];
         let mut layers: Vec<(LayerName, Vec<[f32; 3]>)> = Vec::new();
-        for piece in &pieces {
-            renderer.set_crop(ctx, Some((*piece, job.size)));
+        for (p, piece) in pieces.iter().enumerate() {
+            // The progress counts pieces as it counts frames.
+            let mut in_sequence = InSequence {
+                observer: &mut *observer,
+                frame: (index * pieces.len() + p) as u32,
+                frames: (frames.len() * pieces.len()) as u32,
+            };
+            renderer.set_crop(ctx, *piece, job.size);
             renderer.restart_at_sample(planned.frame, job.sample_offset);
             if trace_to_stop(ctx, &mut renderer, job.stop, &mut in_sequence)?.is_break() {
                 return Ok(Outcome::Cancelled);

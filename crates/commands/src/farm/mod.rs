@@ -8,8 +8,8 @@ mod plan;
 mod scripts;
 mod task;
 
-pub use plan::{FarmPlan, Split};
-pub use scripts::{KubernetesOptions, SlurmOptions};
+use plan::{FarmPlan, Scheduler, Split};
+use scripts::{KubernetesOptions, SlurmOptions};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
@@ -53,10 +53,15 @@ pub enum FarmCommand {
         /// The container image with marbre on its PATH.
         #[arg(long)]
         image: String,
-        /// The persistent volume claim that holds the job's folder (mounted
-        /// at the same path in every pod).
+        /// The persistent volume claim that holds the job's folder and the
+        /// preset.
         #[arg(long)]
         claim: String,
+        /// Where the claim is mounted in the pods, the same path as on this
+        /// machine (default: the deepest folder holding both the job's
+        /// folder and the preset).
+        #[arg(long)]
+        mount: Option<PathBuf>,
         /// Tasks running at once.
         #[arg(long, default_value_t = 8)]
         parallelism: u32,
@@ -109,6 +114,14 @@ pub struct JobArgs {
     /// The finished images' format: exr (linear radiance) or png.
     #[arg(long, default_value = "exr", value_parser = ["exr", "png"])]
     pub format: String,
+    /// Each part records its variance (`render --moments`), so that the
+    /// merge of single-batch tiles knows its error.
+    #[arg(long)]
+    pub moments: bool,
+    /// Each part records the denoiser's guides (`render --guides`) and the
+    /// merge denoises each frame.
+    #[arg(long)]
+    pub denoise: bool,
     /// The job's folder, shared with the nodes: the plan, the scripts,
     /// the tasks' files, logs and the finished images go there.
     #[arg(short, long)]
@@ -125,7 +138,8 @@ pub fn run(args: &FarmArgs) -> Result<()> {
             cpus,
             marbre,
         } => {
-            let (plan, dir) = write_plan(job)?;
+            scripts::check_slurm_folder(&std::path::absolute(&job.output)?)?;
+            let (plan, dir) = write_plan(job, Scheduler::Slurm)?;
             let marbre = match marbre {
                 Some(path) => path.clone(),
                 None => std::env::current_exe().context("finding marbre's own path")?,
@@ -149,14 +163,34 @@ pub fn run(args: &FarmArgs) -> Result<()> {
             job,
             image,
             claim,
+            mount,
             parallelism,
             gpus,
             cpus,
         } => {
-            let (plan, dir) = write_plan(job)?;
+            // Checked before anything is written.
+            let (dir, preset) = (
+                std::path::absolute(&job.output)?,
+                std::path::absolute(&job.preset)?,
+            );
+            let mount = match mount {
+                Some(path) => std::path::absolute(path)?,
+                None => shared_folder(&dir, &preset)?,
+            };
+            for (what, path) in [("the job's folder", &dir), ("the preset", &preset)] {
+                if !path.starts_with(&mount) {
+                    bail!(
+                        "{what} {} is not under the claim's mount {}: the pods would not see it",
+                        path.display(),
+                        mount.display()
+                    );
+                }
+            }
+            let (plan, dir) = write_plan(job, Scheduler::Kubernetes)?;
             let options = KubernetesOptions {
                 image: image.clone(),
                 claim: claim.clone(),
+                mount,
                 parallelism: (*parallelism).max(1),
                 gpus: *gpus,
                 cpus: (*cpus).max(1),
@@ -198,10 +232,30 @@ fn task_index(given: Option<u32>) -> Result<u32> {
     )
 }
 
+/// The deepest folder holding both `dir` and `preset`, where a claim
+/// mounted serves both; refused when that is the root.
+fn shared_folder(dir: &Path, preset: &Path) -> Result<PathBuf> {
+    let shared: PathBuf = dir
+        .components()
+        .zip(preset.components())
+        .take_while(|(a, b)| a == b)
+        .map(|(a, _)| a)
+        .collect();
+    if shared.parent().is_none() {
+        bail!(
+            "the job's folder {} and the preset {} share no folder but the root: give \
+             --mount, the folder the claim holds",
+            dir.display(),
+            preset.display()
+        );
+    }
+    Ok(shared)
+}
+
 /// The job's plan from the flags, checked (the preset read, batches that
 /// start on a round of its samples) and written to its folder, made
 /// absolute so that the nodes find it.
-fn write_plan(job: &JobArgs) -> Result<(FarmPlan, PathBuf)> {
+fn write_plan(job: &JobArgs, scheduler: Scheduler) -> Result<(FarmPlan, PathBuf)> {
     let absolute = |p: &Path| -> Result<PathBuf> {
         std::path::absolute(p).with_context(|| format!("making {} absolute", p.display()))
     };
@@ -209,16 +263,16 @@ fn write_plan(job: &JobArgs) -> Result<(FarmPlan, PathBuf)> {
     let preset = marbre_core::preset::load(&preset_path)
         .with_context(|| format!("reading the preset {}", preset_path.display()))?
         .preset;
+    let bytes = std::fs::read(&preset_path)
+        .with_context(|| format!("reading the preset {}", preset_path.display()))?;
     let plan = FarmPlan {
+        preset_hash: marbre_core::render_record::fnv1a_hex(&bytes),
         preset: preset_path,
         size: job.size,
         spp: job.spp,
         split: match (job.batches, job.tiles) {
             (Some(batches), _) => Split::Batches { batches },
-            (None, Some(grid)) => Split::Tiles {
-                columns: grid.columns,
-                rows: grid.rows,
-            },
+            (None, Some(grid)) => Split::Tiles(grid),
             (None, None) => Split::Whole,
         },
         frames: job.frames.clone(),
@@ -228,16 +282,26 @@ fn write_plan(job: &JobArgs) -> Result<(FarmPlan, PathBuf)> {
             .unwrap_or(24.0),
         kernel: job.kernel.to_string(),
         format: job.format.clone(),
+        moments: job.moments,
+        denoise: job.denoise,
+        scheduler,
     };
     plan.check()?;
     let per_round = preset.scene.render.samples_per_frame.max(1);
-    if let Split::Batches { batches } = plan.split
-        && !(plan.spp / batches).is_multiple_of(per_round)
+    let per_task = plan.task(0)?.spp;
+    if let Split::Batches { .. } = plan.split
+        && !per_task.is_multiple_of(per_round)
     {
         bail!(
-            "each batch traces {} samples, not a multiple of the preset's samples_per_frame \
-             ({per_round}): a batch starts where a round of the long render starts",
-            plan.spp / batches
+            "each batch traces {per_task} samples, not a multiple of the preset's \
+             samples_per_frame ({per_round}): a batch starts where a round of the long render \
+             starts"
+        );
+    }
+    if plan.moments && per_task <= per_round {
+        bail!(
+            "--moments measures each part's spread over its rounds, and each part traces \
+             {per_task} samples, one round of the preset's {per_round}: give more --spp"
         );
     }
     let dir = absolute(&job.output)?;

@@ -21,15 +21,30 @@ pub enum Split {
     /// `batches` tasks each trace `spp / batches` samples from their own
     /// offset (`render --sample-offset`).
     Batches { batches: u32 },
-    /// One task per tile of a `columns` × `rows` grid (`render --tiles`).
-    Tiles { columns: u32, rows: u32 },
+    /// One task per tile of a grid (`render --tiles`).
+    Tiles(TileGrid),
 }
+
+/// Who runs the tasks: what `farm merge` tells to run again.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Scheduler {
+    Slurm,
+    Kubernetes,
+}
+
+/// The most tasks a job may have: far more than a scheduler runs at once
+/// (Slurm's default `MaxArraySize` is 1001), and few enough that every
+/// count fits a `u32`.
+pub const MAX_TASKS: u64 = 1 << 20;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FarmPlan {
     /// The preset, as an absolute path: the nodes read it from the shared
     /// folder.
     pub preset: PathBuf,
+    /// Its bytes' FNV-1a hash when the job was written: a preset edited
+    /// since is another job, whose folder must not hold this one's files.
+    pub preset_hash: String,
     pub size: (u32, u32),
     /// Samples per pixel of each frame, all its tasks together.
     pub spp: u32,
@@ -43,6 +58,13 @@ pub struct FarmPlan {
     pub kernel: String,
     /// The merged images' format: `exr` (linear radiance) or `png`.
     pub format: String,
+    /// Each part records its variance (`render --moments`), so that a
+    /// merge of single-batch tiles knows its error.
+    pub moments: bool,
+    /// Each part records the denoiser's guides (`render --guides`) and the
+    /// merge denoises.
+    pub denoise: bool,
+    pub scheduler: Scheduler,
 }
 
 /// What one array index traces.
@@ -60,8 +82,16 @@ pub struct Task {
 
 impl FarmPlan {
     /// An error if the plan cannot be cut as it says: batches that do not
-    /// divide the samples, a grid finer than the image, no frame.
+    /// divide the samples, a grid finer than the image or of one tile,
+    /// too many tasks, layers asked of a job without a merge.
     pub fn check(&self) -> Result<()> {
+        if !(1..=16384).contains(&self.size.0) || !(1..=16384).contains(&self.size.1) {
+            bail!(
+                "a {}×{} image: each side must be 1 to 16384",
+                self.size.0,
+                self.size.1
+            );
+        }
         match self.split {
             Split::Whole => {}
             Split::Batches { batches } => {
@@ -73,17 +103,46 @@ impl FarmPlan {
                     );
                 }
             }
-            Split::Tiles { columns, rows } => {
-                TileGrid { columns, rows }
-                    .tile(self.size, 0)
+            Split::Tiles(grid) => {
+                if grid.count() == 1 {
+                    bail!("--tiles 1x1 is the whole image: leave --tiles out");
+                }
+                grid.tile(self.size, 0)
                     .map_err(|e| anyhow::anyhow!("--tiles: {e}"))?;
             }
+        }
+        if self.task_count() > MAX_TASKS {
+            bail!(
+                "{} tasks ({} frames × {} parts) are more than a job may have ({MAX_TASKS}): \
+                 cut coarser or split the frames into several jobs",
+                self.task_count(),
+                self.frame_count(),
+                self.parts()
+            );
+        }
+        if (self.moments || self.denoise) && self.parts() == 1 {
+            bail!(
+                "--moments and --denoise act on the merge of a frame's parts: cut the frames \
+                 into --batches or --tiles"
+            );
         }
         if !(self.fps.is_finite() && self.fps > 0.0) {
             bail!("--fps must be a positive number of frames a second");
         }
+        self.kernel
+            .parse::<marbre_render::gpu::KernelChoice>()
+            .map_err(|e| anyhow::anyhow!("the kernel `{}`: {e}", self.kernel))?;
         ImageFormat::from_path(Path::new(&format!("x.{}", self.format)))?;
         Ok(())
+    }
+
+    fn frame_count(&self) -> u64 {
+        let frames = self.frame_numbers();
+        u64::from(frames.end() - frames.start()) + 1
+    }
+
+    fn task_count(&self) -> u64 {
+        self.frame_count() * u64::from(self.parts())
     }
 
     /// Tasks a frame is cut into.
@@ -91,7 +150,7 @@ impl FarmPlan {
         match self.split {
             Split::Whole => 1,
             Split::Batches { batches } => batches,
-            Split::Tiles { columns, rows } => columns * rows,
+            Split::Tiles(grid) => grid.count(),
         }
     }
 
@@ -100,10 +159,10 @@ impl FarmPlan {
         self.frames.clone().unwrap_or(0..=0)
     }
 
-    /// Tasks in all: the array's length.
+    /// Tasks in all: the array's length (at most [`MAX_TASKS`] in a
+    /// checked plan).
     pub fn tasks(&self) -> u32 {
-        let frames = self.frame_numbers();
-        (frames.end() - frames.start() + 1) * self.parts()
+        self.task_count().min(MAX_TASKS) as u32
     }
 
     /// What array index `index` traces: frame after frame, and each
@@ -123,10 +182,8 @@ impl FarmPlan {
                 let each = self.spp / batches;
                 (each, part * each, None)
             }
-            Split::Tiles { columns, rows } => {
-                let tile = TileGrid { columns, rows }
-                    .tile(self.size, part)
-                    .map_err(|e| anyhow::anyhow!(e))?;
+            Split::Tiles(grid) => {
+                let tile = grid.tile(self.size, part).map_err(|e| anyhow::anyhow!(e))?;
                 (self.spp, 0, Some(tile))
             }
         };
@@ -208,6 +265,7 @@ mod tests {
     fn plan(split: Split, frames: Option<RangeInclusive<u32>>) -> FarmPlan {
         FarmPlan {
             preset: PathBuf::from("/shared/p.ron"),
+            preset_hash: "0123456789abcdef".into(),
             size: (64, 48),
             spp: 64,
             split,
@@ -215,6 +273,9 @@ mod tests {
             fps: 24.0,
             kernel: "auto".into(),
             format: "exr".into(),
+            moments: false,
+            denoise: false,
+            scheduler: Scheduler::Slurm,
         }
     }
 
@@ -230,10 +291,10 @@ mod tests {
         let e = p.task(12).unwrap_err().to_string();
         assert!(e.contains("tasks 0 to 11"), "{e}");
         let p = plan(
-            Split::Tiles {
+            Split::Tiles(TileGrid {
                 columns: 2,
                 rows: 2,
-            },
+            }),
             None,
         );
         let t = p.task(3).unwrap();
@@ -257,10 +318,10 @@ mod tests {
             .unwrap_err();
         assert!(e.to_string().contains("divide --spp 64"), "{e}");
         let e = plan(
-            Split::Tiles {
+            Split::Tiles(TileGrid {
                 columns: 65,
                 rows: 1,
-            },
+            }),
             None,
         )
         .check()
@@ -269,16 +330,49 @@ mod tests {
         let mut p = plan(Split::Whole, None);
         p.format = "jpg".into();
         assert!(p.check().is_err());
+        let e = plan(
+            Split::Tiles(TileGrid {
+                columns: 1,
+                rows: 1,
+            }),
+            None,
+        )
+        .check()
+        .unwrap_err();
+        assert!(e.to_string().contains("1x1"), "{e}");
+        let e = plan(
+            Split::Tiles(TileGrid {
+                columns: 64,
+                rows: 48,
+            }),
+            Some(0..=999),
+        )
+        .check()
+        .unwrap_err();
+        assert!(e.to_string().contains("3072000 tasks"), "{e}");
+        let e = plan(Split::Whole, Some(0..=u32::MAX)).check().unwrap_err();
+        assert!(e.to_string().contains("more than a job may have"), "{e}");
+        let mut p = plan(Split::Whole, None);
+        p.moments = true;
+        assert!(
+            p.check()
+                .unwrap_err()
+                .to_string()
+                .contains("--batches or --tiles")
+        );
+        let mut p = plan(Split::Whole, None);
+        p.kernel = "fast".into();
+        assert!(p.check().unwrap_err().to_string().contains("fast"));
     }
 
     #[test]
     fn a_plan_reads_back() {
         let dir = tempfile::tempdir().unwrap();
         let p = plan(
-            Split::Tiles {
+            Split::Tiles(TileGrid {
                 columns: 4,
                 rows: 2,
-            },
+            }),
             Some(0..=9),
         );
         p.write(dir.path()).unwrap();

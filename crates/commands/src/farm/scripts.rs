@@ -6,8 +6,9 @@
 //! `JOB_COMPLETION_INDEX`.
 
 use super::plan::FarmPlan;
+use anyhow::{Result, bail};
 use serde_json::json;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What a Slurm job asks of the cluster (`marbre farm slurm`'s flags).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -41,9 +42,25 @@ fn sbatch_options(options: &SlurmOptions) -> String {
     lines
 }
 
-/// The Slurm files of the job in `dir`, by name: `tasks.sbatch` (the
-/// array), `merge.sbatch` and `submit.sh`. `marbre`: the binary's path
-/// on the nodes.
+/// Refuses a job folder whose path an `#SBATCH --output` line cannot
+/// carry: it is not shell-quoted there, and `%` is Slurm's pattern sign.
+pub fn check_slurm_folder(dir: &Path) -> Result<()> {
+    let text = dir.display().to_string();
+    if let Some(c) = text
+        .chars()
+        .find(|c| c.is_whitespace() || matches!(c, '%' | '\'' | '"' | '\\'))
+    {
+        bail!(
+            "{text}: a Slurm job's folder cannot hold {c:?} (its #SBATCH --output line would \
+             misread it); choose another folder"
+        );
+    }
+    Ok(())
+}
+
+/// The Slurm files of the job in `dir` ([`check_slurm_folder`]), by name:
+/// `tasks.sbatch` (the array), `merge.sbatch` and `submit.sh`. `marbre`:
+/// the binary's path on the nodes.
 pub fn slurm(
     plan: &FarmPlan,
     dir: &Path,
@@ -107,9 +124,12 @@ pub fn slurm(
 pub struct KubernetesOptions {
     /// The container image holding marbre.
     pub image: String,
-    /// The persistent volume claim holding the job's folder, mounted at
-    /// the same path in every pod.
+    /// The persistent volume claim holding the job's folder and the
+    /// preset.
     pub claim: String,
+    /// Where the claim is mounted in every pod: the path it has on the
+    /// machine that wrote the job, so that the plan's paths hold there.
+    pub mount: PathBuf,
     /// Tasks running at once.
     pub parallelism: u32,
     pub gpus: u32,
@@ -125,6 +145,13 @@ pub fn kubernetes(
     options: &KubernetesOptions,
 ) -> Vec<(&'static str, String)> {
     let dir_text = dir.display().to_string();
+    let mount = options.mount.display().to_string();
+    // Job names are unique in a namespace: two jobs' folders give two.
+    let suffix = job_suffix(dir);
+    let (tasks_name, merge_name) = (
+        format!("marbre-tasks-{suffix}"),
+        format!("marbre-merge-{suffix}"),
+    );
     let container = |name: &str, args: serde_json::Value, gpus: u32| {
         let mut limits = json!({ "cpu": options.cpus.to_string() });
         if gpus > 0 {
@@ -141,7 +168,7 @@ pub fn kubernetes(
                 "valueFrom": { "resourceFieldRef": { "resource": "limits.cpu", "divisor": "1" } }
             }],
             "resources": { "limits": limits },
-            "volumeMounts": [{ "name": "job", "mountPath": dir_text }]
+            "volumeMounts": [{ "name": "job", "mountPath": mount }]
         })
     };
     let volumes = json!([{
@@ -151,7 +178,7 @@ pub fn kubernetes(
     let tasks = json!({
         "apiVersion": "batch/v1",
         "kind": "Job",
-        "metadata": { "name": "marbre-tasks" },
+        "metadata": { "name": tasks_name },
         "spec": {
             "completionMode": "Indexed",
             "completions": plan.tasks(),
@@ -174,7 +201,7 @@ pub fn kubernetes(
     let merge = json!({
         "apiVersion": "batch/v1",
         "kind": "Job",
-        "metadata": { "name": "marbre-merge" },
+        "metadata": { "name": merge_name },
         "spec": {
             "backoffLimit": 0,
             "template": { "spec": {
@@ -189,19 +216,50 @@ pub fn kubernetes(
     };
     let submit = format!(
         "#!/bin/sh\n\
-         # Runs the tasks, waits for all of them, then the merge.\n\
+         # Runs the tasks and waits until every index has succeeded, then the\n\
+         # merge; stops if the Job fails (an index out of retries): `marbre\n\
+         # farm merge` names the tasks, and running this again reruns only\n\
+         # them (a finished index does nothing).\n\
          set -eu\n\
+         kubectl delete --ignore-not-found job/{tasks_name} job/{merge_name}\n\
          kubectl apply -f {tasks}\n\
-         kubectl wait --for=condition=complete --timeout=-1s job/marbre-tasks\n\
+         while ! kubectl wait --for=condition=complete --timeout=10s job/{tasks_name} >/dev/null 2>&1; do\n\
+         \x20   if kubectl wait --for=condition=failed --timeout=0s job/{tasks_name} >/dev/null 2>&1; then\n\
+         \x20       echo \"job/{tasks_name} failed: run marbre farm merge {dir} to see which tasks\" >&2\n\
+         \x20       exit 1\n\
+         \x20   fi\n\
+         done\n\
          kubectl apply -f {merge}\n",
         tasks = quoted(&dir.join("tasks-job.json").display().to_string()),
         merge = quoted(&dir.join("merge-job.json").display().to_string()),
+        dir = quoted(&dir_text),
     );
     vec![
         ("tasks-job.json", pretty(&tasks)),
         ("merge-job.json", pretty(&merge)),
         ("submit-k8s.sh", submit),
     ]
+}
+
+/// A suffix naming the job in `dir` within Kubernetes' name rules (lower
+/// case letters, digits and `-`): the folder's name, cut to 30
+/// characters, and 8 hex digits of its whole path's hash.
+fn job_suffix(dir: &Path) -> String {
+    let name: String = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_lowercase())
+        .unwrap_or_default()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .take(30)
+        .collect();
+    let hash = marbre_core::render_record::fnv1a_hex(dir.as_os_str().as_encoded_bytes());
+    let name = name.trim_matches('-');
+    if name.is_empty() {
+        hash[..8].to_owned()
+    } else {
+        format!("{name}-{}", &hash[..8])
+    }
 }
 
 #[cfg(test)]
@@ -215,11 +273,15 @@ mod tests {
             preset: PathBuf::from("/shared/p.ron"),
             size: (64, 64),
             spp: 64,
+            preset_hash: "0123456789abcdef".into(),
             split: Split::Batches { batches: 4 },
             frames: Some(0..=2),
             fps: 24.0,
             kernel: "auto".into(),
             format: "exr".into(),
+            moments: false,
+            denoise: false,
+            scheduler: crate::farm::plan::Scheduler::Slurm,
         }
     }
 
@@ -234,10 +296,14 @@ mod tests {
             time: Some("01:00:00".into()),
             cpus: Some(4),
         };
+        let e = check_slurm_folder(Path::new("/jobs/it's")).unwrap_err();
+        assert!(e.to_string().contains("cannot hold '\\''"), "{e}");
+        assert!(check_slurm_folder(Path::new("/jobs/50%")).is_err());
+        assert!(check_slurm_folder(Path::new("/jobs/a")).is_ok());
         let files = slurm(
             &plan(),
-            Path::new("/jobs/it's"),
-            Path::new("/opt/marbre"),
+            Path::new("/jobs/a"),
+            Path::new("/opt/o'marbre"),
             &options,
         );
         let text = |name: &str| files.iter().find(|(n, _)| *n == name).unwrap().1.clone();
@@ -248,8 +314,11 @@ mod tests {
         ));
         assert!(tasks.contains(r#"LP_NUM_THREADS="${SLURM_CPUS_PER_TASK:-1}""#));
         assert!(
-            tasks
-                .contains(r#"exec '/opt/marbre' farm task '/jobs/it'\''s' "$SLURM_ARRAY_TASK_ID""#),
+            tasks.contains("#SBATCH --output=/jobs/a/logs/task_%a.out\n"),
+            "{tasks}"
+        );
+        assert!(
+            tasks.contains(r#"exec '/opt/o'\''marbre' farm task '/jobs/a' "$SLURM_ARRAY_TASK_ID""#),
             "{tasks}"
         );
         let merge = text("merge.sbatch");
@@ -266,6 +335,7 @@ mod tests {
         let options = KubernetesOptions {
             image: "registry.example/marbre:0.1".into(),
             claim: "renders".into(),
+            mount: PathBuf::from("/jobs"),
             parallelism: 64,
             gpus: 1,
             cpus: 8,
@@ -287,7 +357,15 @@ mod tests {
         );
         assert_eq!(c["resources"]["limits"]["nvidia.com/gpu"], "1");
         assert_eq!(c["env"][0]["name"], "LP_NUM_THREADS");
-        assert_eq!(c["volumeMounts"][0]["mountPath"], "/jobs/a");
+        assert_eq!(c["volumeMounts"][0]["mountPath"], "/jobs");
+        let name = job["metadata"]["name"].as_str().unwrap();
+        assert!(name.starts_with("marbre-tasks-a-") && name.len() == "marbre-tasks-a-".len() + 8);
+        let other = kubernetes(&plan(), Path::new("/other/a"), &options);
+        let other: serde_json::Value = serde_json::from_str(&other[0].1).unwrap();
+        assert_ne!(
+            other["metadata"]["name"], job["metadata"]["name"],
+            "two folders, two names"
+        );
         assert_eq!(
             pod["volumes"][0]["persistentVolumeClaim"]["claimName"],
             "renders"
@@ -297,6 +375,13 @@ mod tests {
             merge["spec"]["template"]["spec"]["containers"][0]["args"][1],
             "merge"
         );
-        assert!(files[2].1.contains("kubectl wait --for=condition=complete"));
+        let submit = &files[2].1;
+        assert!(submit.contains(&format!(
+            "kubectl wait --for=condition=complete --timeout=10s job/{name}"
+        )));
+        assert!(
+            submit.contains("--for=condition=failed"),
+            "a failed Job ends the wait: {submit}"
+        );
     }
 }

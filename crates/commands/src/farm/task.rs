@@ -5,7 +5,7 @@
 //! a killed task leaves none). A task that fails leaves its error in
 //! `status/`, which the merge names.
 
-use super::plan::{FarmPlan, Split, Task};
+use super::plan::{FarmPlan, Scheduler, Split, Task};
 use anyhow::{Context, Result, anyhow, bail};
 use marbre_core::merge::merge;
 use marbre_render::final_render::{
@@ -66,8 +66,8 @@ fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
         sample_offset: task.sample_offset,
         tile: task.tile,
         max_tile_pixels: DEFAULT_MAX_TILE_PIXELS,
-        moments: false,
-        guides: false,
+        moments: plan.moments,
+        guides: plan.denoise,
     };
     let ctx = GpuContext::headless()?;
     render_to_file(&ctx, loaded, &job, &mut Log)?;
@@ -100,14 +100,22 @@ pub fn merge_job(dir: &Path) -> Result<()> {
         .filter(|t| !plan.task_output(dir, t).is_file())
         .collect();
     if !missing.is_empty() {
+        let indices = index_ranges(missing.iter().map(|t| t.index));
+        let rerun = match plan.scheduler {
+            Scheduler::Slurm => format!(
+                "with Slurm `sbatch --array={indices} {}`, then the merge again",
+                dir.join("tasks.sbatch").display()
+            ),
+            Scheduler::Kubernetes => format!(
+                "with Kubernetes `sh {}` again (the finished indices do nothing)",
+                dir.join("submit-k8s.sh").display()
+            ),
+        };
         bail!(
-            "{} of the {} tasks of {} have no file; run them again (a finished task is \
-             skipped), with Slurm `sbatch --array={} {}`:\n  {}",
+            "{} of the {} tasks of {} have no file; run them again, {rerun}:\n  {}",
             missing.len(),
             tasks.len(),
             dir.display(),
-            index_ranges(missing.iter().map(|t| t.index)),
-            dir.join("tasks.sbatch").display(),
             describe_missing(dir, &plan, &missing).join("\n  ")
         );
     }
@@ -130,7 +138,7 @@ pub fn merge_job(dir: &Path) -> Result<()> {
         let output = plan.frame_output(dir, frame);
         let how = crate::merge::MergedOutput {
             display,
-            denoise: false,
+            denoise: plan.denoise,
         };
         crate::merge::write_merged(&merged, &output, &how)?;
         let error = merged.error.map_or(String::new(), |e| {
@@ -202,7 +210,7 @@ fn describe_task(plan: &FarmPlan, t: &Task) -> String {
             t.sample_offset,
             t.sample_offset + t.spp
         ),
-        Split::Tiles { .. } => format!(
+        Split::Tiles(_) => format!(
             "frame {}, tile {}",
             t.frame,
             t.tile.map_or(String::new(), |tile| tile.to_string())

@@ -65,16 +65,14 @@ impl Renderer {
     /// Makes the targets hold `tile` of an image of `image` (resized to
     /// the tile), traced with that image's camera and per-pixel samples,
     /// so that tiles assemble to its render (`render --tile`, and a large
-    /// render traced a tile at a time); `None`: the whole image again.
-    /// Restarts the accumulation; no pipeline is built.
-    pub fn set_crop(&mut self, ctx: &GpuContext, crop: Option<(Tile, (u32, u32))>) {
-        if crop != self.crop {
-            self.crop = crop;
+    /// render traced a piece at a time). Restarts the accumulation; no
+    /// pipeline is built.
+    pub fn set_crop(&mut self, ctx: &GpuContext, tile: Tile, image: (u32, u32)) {
+        if self.crop != Some((tile, image)) {
+            self.crop = Some((tile, image));
             self.reset_accumulation();
         }
-        if let Some((tile, _)) = crop {
-            self.resize(ctx, tile.size());
-        }
+        self.resize(ctx, tile.size());
     }
 
     pub fn reset_accumulation(&mut self) {
