@@ -265,4 +265,22 @@ fn slurm_arrays_render_batches_tiles_and_frames_and_name_a_failed_task() {
         d < 1e-4,
         "the job completed by a rerun is {d} from the direct render"
     );
+
+    // The preset edited after the job was written: a task run again is
+    // refused rather than trace another scene beside the old one's parts.
+    std::fs::remove_file(batches.join("parts/frame_0000_part_001.exr")).unwrap();
+    std::fs::write(
+        root.join("ball.ron"),
+        ball_preset().replace("intensity: 30.0", "intensity: 31.0"),
+    )
+    .unwrap();
+    let out = Command::new(MARBRE)
+        .args(["farm", "task", batches.to_str().unwrap(), "1"])
+        .output()
+        .unwrap();
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && message.contains("changed since the job was written"),
+        "{message}"
+    );
 }

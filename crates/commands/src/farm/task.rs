@@ -45,8 +45,18 @@ pub fn run_task(dir: &Path, index: u32) -> Result<()> {
     }
 }
 
-/// Traces `task` of `plan` to `output`.
+/// Traces `task` of `plan` to `output`, refused if the preset changed
+/// since the job was written (its other tasks traced the old one).
 fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
+    let bytes = std::fs::read(&plan.preset)
+        .with_context(|| format!("reading the preset {}", plan.preset.display()))?;
+    if marbre_core::render_record::fnv1a_hex(&bytes) != plan.preset_hash {
+        bail!(
+            "the preset {} changed since the job was written: its tasks would trace two \
+             scenes; write the job again into a new folder",
+            plan.preset.display()
+        );
+    }
     let loaded = load_scene(&plan.preset, None)?;
     let job = FinalRender {
         size: plan.size,
