@@ -502,9 +502,12 @@ impl Viewer {
                 .collect()
         });
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames ({} kernel); window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
+            "quality: {spp} spp accumulated in {} frames ({} kernel); {} restarts; window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
             self.clock.frames,
             self.renderer.kernel(),
+            // Images thrown away since the start (an edit, a resize…),
+            // for the tests that an action keeps the image.
+            self.renderer.accumulation_generation(),
             self.clock.fps,
             if passes.is_empty() {
                 "not timed".to_owned()

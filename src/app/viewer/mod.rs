@@ -879,9 +879,12 @@ impl Viewer {
                 egui::Panel::right("marbre-panel")
                     .default_size(PANEL_WIDTH)
                     .show(ui, |ui| {
-                        // Not shrunk to the content: the panel keeps its
-                        // width as sections open and close.
-                        egui::ScrollArea::vertical()
+                        // Not shrunk to the content, and scrolled both
+                        // ways: a row wider than the panel (a colour
+                        // ramp's stop, an opened section) scrolls instead
+                        // of widening the panel, which would resize the
+                        // image and throw its samples away.
+                        egui::ScrollArea::both()
                             .auto_shrink([false; 2])
                             .show(ui, |ui| {
                                 actions = panel::draw(ui, scene, panel_state, &stats, timeline);

@@ -180,6 +180,17 @@ impl Accumulation {
         self.previewed = false;
     }
 
+    /// Drops the round under way, keeping the rounds traced: the next
+    /// trace starts the round again from its first row (its seeds are the
+    /// same), writing over the rows already in the write set.
+    pub fn restart_round(&mut self) {
+        if self.frames == 0 {
+            self.reset();
+        } else {
+            self.next_row = 0;
+        }
+    }
+
     /// The first row the round under way has yet to trace.
     pub fn next_row(&self) -> u32 {
         self.next_row

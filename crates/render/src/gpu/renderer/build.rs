@@ -287,17 +287,32 @@ impl Renderer {
         self.trace.pipeline = built.pipeline;
         self.trace.shader_bytes = built.shader_bytes;
         self.trace.last_build = Some(built.took);
+        // Another kernel for the same code traces the same image (the same
+        // samples into the same targets): the samples so far stay, as for
+        // any edit that keeps the image (the viewer's auto kernel choice
+        // lands a few seconds after the first image).
+        let same_image = self.trace.key.traces_as(&pending.key);
         self.trace.key = std::mem::take(&mut pending.key);
         self.trace.texture_plan = std::mem::take(&mut pending.plan);
+        let scene = std::mem::take(&mut pending.target.scene);
         // The installed scene may be several edits behind: everything is
-        // written. A new pipeline draws a new image even for the same scene
-        // (a feature compiled out): the samples of the old one must go.
-        let target = Target {
-            scene: std::mem::take(&mut pending.target.scene),
-            params: pending.target.params.take(),
-            change: Change::all(),
+        // written. A new pipeline otherwise draws a new image even for the
+        // same scene (a feature compiled out): the samples of the old one
+        // must go.
+        let change = if same_image {
+            // A round half traced by the other kernel is traced again
+            // whole by this one.
+            self.accumulation.restart_round();
+            scene.changes_from(&self.scene)
+        } else {
+            self.reset_accumulation();
+            Change::all()
         };
-        self.reset_accumulation();
+        let target = Target {
+            scene,
+            params: pending.target.params.take(),
+            change,
+        };
         self.apply(ctx, target);
     }
 
@@ -457,6 +472,24 @@ pub(super) struct PipelineKey {
     /// The shader files' generation (`marbre --dev` reloads them).
     pub(super) sources: u64,
     pub(super) kernel: Kernel,
+}
+
+impl PipelineKey {
+    /// Whether a pipeline of `other` traces what one of `self` does: the
+    /// same code, features, switches and sources, whatever the kernel.
+    pub(super) fn traces_as(&self, other: &PipelineKey) -> bool {
+        let PipelineKey {
+            features,
+            code,
+            switches,
+            sources,
+            kernel: _,
+        } = self;
+        *features == other.features
+            && *code == other.code
+            && *switches == other.switches
+            && *sources == other.sources
+    }
 }
 
 /// The render settings the trace shader reads as override constants
