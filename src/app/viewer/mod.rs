@@ -900,8 +900,21 @@ impl Viewer {
                         .resizable(true)
                         .default_size(QUALITY_HEIGHT)
                 };
+                let folded = panel_state.quality.folded;
                 quality.show(ui, |ui| {
-                    actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                    if folded {
+                        actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                    } else {
+                        // As the side panel's: content that grows (the
+                        // first estimates) scrolls instead of heightening
+                        // the strip, which would shrink the image and
+                        // throw its samples away.
+                        egui::ScrollArea::both()
+                            .auto_shrink([false; 2])
+                            .show(ui, |ui| {
+                                actions.extend(panel::draw_quality(ui, panel_state, &stats));
+                            });
+                    }
                 });
             }
             image_rect = ui.available_rect_before_wrap();

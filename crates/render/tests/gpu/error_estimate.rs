@@ -111,7 +111,9 @@ fn the_gpu_meter_matches_its_cpu_twin_and_falls_as_one_over_frames() {
     );
 }
 
-/// One frame has no spread, so no estimate; and a reset starts over.
+/// One frame has no spread, so no estimate; and a reset starts over, as
+/// does a resize (a new generation: the Quality strip's history of the
+/// old image must not go on as the new one's).
 #[test]
 fn no_estimate_before_two_frames_and_after_a_reset() {
     let Some(ctx) = gpu_or_skip("no_estimate_before_two_frames_and_after_a_reset") else {
@@ -128,4 +130,9 @@ fn no_estimate_before_two_frames_and_after_a_reset() {
     assert_ne!(renderer.accumulation_generation(), before.generation);
     accumulate(&ctx, &mut renderer, 1, |_| {}).unwrap();
     assert_eq!(renderer.estimate_error(&ctx).unwrap(), None);
+    accumulate(&ctx, &mut renderer, 2, |_| {}).unwrap();
+    let generation = renderer.accumulation_generation();
+    renderer.resize(&ctx, (SIZE.0 + 12, SIZE.1));
+    assert_eq!(renderer.accumulated_samples(), 0);
+    assert_ne!(renderer.accumulation_generation(), generation, "a resize starts over");
 }

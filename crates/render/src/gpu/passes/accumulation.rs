@@ -180,6 +180,18 @@ impl Accumulation {
         self.previewed = false;
     }
 
+    /// Targets of another `size`, empty: a new accumulation, the next
+    /// generation if this one showed a frame (so that what measured the
+    /// old one, the Quality strip's error history, starts over), its
+    /// shown images counted on.
+    pub fn resize(&mut self, device: &wgpu::Device, size: (u32, u32)) {
+        let generation = self.generation.wrapping_add(u32::from(self.frames > 0));
+        let shown_count = self.shown_count;
+        *self = Self::new(device, size, self.storage);
+        self.generation = generation;
+        self.shown_count = shown_count;
+    }
+
     /// Drops the round under way, keeping the rounds traced: the next
     /// trace starts the round again from its first row (its seeds are the
     /// same), writing over the rows already in the write set.

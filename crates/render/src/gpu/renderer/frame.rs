@@ -5,7 +5,6 @@
 use super::display_stage::DisplayUniform;
 use super::trace_stage::{FRAME_BYTES, FRAME_SLOTS, frame_stride};
 use super::{DisplayTarget, MeteredFrom, Renderer, TraceWork, bind, pixel_count, scaled};
-use crate::gpu::accumulation::Accumulation;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
@@ -48,8 +47,7 @@ impl Renderer {
         let size = (size.0.max(1), size.1.max(1));
         if size != self.size {
             self.size = size;
-            self.accumulation = Accumulation::new(&ctx.device, size, self.trace.compute_supported);
-            self.reset_accumulation();
+            self.accumulation.resize(&ctx.device, size);
         }
     }
 
