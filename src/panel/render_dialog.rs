@@ -35,6 +35,9 @@ pub struct RenderDialog {
     pub max_spp: u32,
     /// Auto exposure for the PNG (`None`: as the scene has it).
     pub auto_exposure: Option<Metering>,
+    /// Filter with the denoiser (`render --denoise`): the PNG, or the
+    /// EXR (`--denoise --denoise-exr`).
+    pub denoise: bool,
     /// The render under way, if any.
     pub running: Option<RunningView>,
     /// How the last render ended, or why the settings were refused.
@@ -71,6 +74,7 @@ impl Default for RenderDialog {
             target_percent: DEFAULT_TARGET_PERCENT,
             max_spp: DEFAULT_MAX_SPP,
             auto_exposure: None,
+            denoise: false,
             running: None,
             last_result: None,
             focus_output: false,
@@ -89,7 +93,7 @@ impl RenderDialog {
     /// kernel is the app's to choose.
     pub fn job(&self) -> Result<FinalRender, String> {
         let output = PathBuf::from(self.output.trim());
-        ImageFormat::from_path(&output).map_err(|e| format!("{e:#}"))?;
+        let format = ImageFormat::from_path(&output).map_err(|e| format!("{e:#}"))?;
         let size = parse_size(&self.size)?;
         let stop = if self.by_error {
             Stop::TargetError {
@@ -105,8 +109,10 @@ impl RenderDialog {
             auto_exposure: self.auto_exposure,
             kernel: KernelChoice::Auto,
             output,
-            // As `marbre render`: an EXR is the raw accumulation.
-            denoise_exr: false,
+            denoise: self.denoise,
+            // An EXR is filtered only when asked (`--denoise-exr`): here the
+            // box asks it of either format.
+            denoise_exr: self.denoise && format == ImageFormat::Exr,
             // The viewer shows the placeholder and its note: it renders
             // what it shows.
             allow_placeholders: true,
@@ -294,6 +300,14 @@ fn dialog_ui(ui: &mut Ui, dialog: &mut RenderDialog, actions: &mut Vec<PanelActi
                      scene's exposure becoming a compensation; an EXR stays unscaled radiance",
                     );
                 ui.end_row();
+                ui.label("denoise");
+                ui.checkbox(&mut dialog.denoise, "")
+                    .on_hover_text(
+                        "As `render --denoise`: filter the image with the viewer's denoiser \
+                         (an edge-avoiding à-trous filter guided by the first hit's albedo \
+                         and normal); an EXR is filtered too (`--denoise-exr`)",
+                    );
+                ui.end_row();
             });
     });
     match &dialog.running {
@@ -384,6 +398,24 @@ mod tests {
         );
         dialog.assemble = false;
         assert_eq!(dialog.animation_file(), None);
+    }
+
+    /// "denoise" asks the job to filter the image, a PNG's and, as
+    /// `--denoise-exr`, an EXR's.
+    #[test]
+    fn denoise_filters_either_format() {
+        let mut dialog = RenderDialog {
+            denoise: true,
+            ..RenderDialog::default()
+        };
+        let job = dialog.job().unwrap();
+        assert!(job.denoise && !job.denoise_exr);
+        dialog.output = "render.exr".to_owned();
+        let job = dialog.job().unwrap();
+        assert!(job.denoise && job.denoise_exr);
+        dialog.denoise = false;
+        let job = dialog.job().unwrap();
+        assert!(!job.denoise && !job.denoise_exr);
     }
 
     #[test]

@@ -195,15 +195,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let timing = timing(args, loaded.scene.animation.as_ref().map(|a| a.fps))?;
     let render = &mut loaded.scene.render;
     render.view = args.view.unwrap_or(render.view);
-    if args.denoise {
-        if render.view != View::Lit {
-            bail!(
-                "--denoise filters the lit image, not the {} view",
-                render.view.name()
-            );
-        }
-        render.display.denoise = true;
-    }
     render.transport.light_points = args.light_points.unwrap_or(render.transport.light_points);
     render.transport.strategy = args.strategy.unwrap_or(render.transport.strategy);
     let job = FinalRender {
@@ -221,6 +212,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }),
         kernel: args.kernel,
         output: args.output.clone(),
+        denoise: args.denoise,
         denoise_exr: args.denoise_exr,
         allow_placeholders: args.allow_placeholders,
         timing,

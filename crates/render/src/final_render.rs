@@ -70,9 +70,12 @@ pub struct FinalRender {
     pub kernel: KernelChoice,
     /// `.png` (tone-mapped, sRGB) or `.exr` (linear radiance, float).
     pub output: PathBuf,
-    /// Write the EXR denoised (the scene's display must have `denoise`
-    /// on); otherwise an EXR is the raw accumulation. A PNG is what the
-    /// display shows, denoised when the scene's display says so.
+    /// Filter the image with the denoiser (`render --denoise`, the Render
+    /// dialog's "denoise"), as the scene's display does when its
+    /// `denoise` is on: the PNG, and the EXR too with `denoise_exr`.
+    pub denoise: bool,
+    /// Write the EXR denoised (with `denoise`, or the scene's display's);
+    /// otherwise an EXR is the raw accumulation.
     pub denoise_exr: bool,
     /// Render even when a file the scene reads could not be loaded and was
     /// replaced (a placeholder image, a grey material): the viewer does,
@@ -330,6 +333,16 @@ pub fn render_to_file(
         let display = &mut loaded.scene.render.display;
         display.auto_exposure = true;
         display.metering = metering;
+    }
+    if job.denoise {
+        let render = &mut loaded.scene.render;
+        if render.view != View::Lit {
+            bail!(
+                "--denoise filters the lit image, not the {} view",
+                render.view.name()
+            );
+        }
+        render.display.denoise = true;
     }
     if job.guides {
         let render = &mut loaded.scene.render;

@@ -1039,6 +1039,7 @@ impl Viewer {
                     auto_exposure: None,
                     kernel: marbre_render::gpu::KernelChoice::Auto,
                     output,
+                    denoise: false,
                     denoise_exr: false,
                     allow_placeholders: true,
                     timing: Default::default(),

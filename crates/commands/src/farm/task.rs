@@ -67,6 +67,7 @@ fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
             .parse()
             .map_err(|e| anyhow!("the plan's kernel: {e}"))?,
         output: output.to_path_buf(),
+        denoise: false,
         denoise_exr: false,
         allow_placeholders: false,
         timing: Timing::Still {

@@ -108,6 +108,7 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         auto_exposure: auto_exposure.then_some(marbre_core::scene::Metering::Key),
         kernel: KernelChoice::Fragment,
         output,
+        denoise: false,
         denoise_exr: false,
         allow_placeholders: false,
         timing: Default::default(),

@@ -134,5 +134,9 @@ fn no_estimate_before_two_frames_and_after_a_reset() {
     let generation = renderer.accumulation_generation();
     renderer.resize(&ctx, (SIZE.0 + 12, SIZE.1));
     assert_eq!(renderer.accumulated_samples(), 0);
-    assert_ne!(renderer.accumulation_generation(), generation, "a resize starts over");
+    assert_ne!(
+        renderer.accumulation_generation(),
+        generation,
+        "a resize starts over"
+    );
 }
