@@ -27,6 +27,7 @@ use std::sync::mpsc;
 /// What the render thread sends the window.
 enum Event {
     Note(String),
+    Stage(String),
     Progress(Progress),
     Done(Result<Outcome>),
 }
@@ -47,6 +48,10 @@ pub struct RenderJob {
     cancel: Arc<AtomicBool>,
     events: mpsc::Receiver<Event>,
     progress: Option<Progress>,
+    /// What it prepares before its first sample.
+    stage: String,
+    /// When it started: the log says how long it prepared.
+    started: std::time::Instant,
     /// The render's thread, with its own device: joined on drop, after the
     /// cancel flag is set (it then stops after its current frame). Held
     /// only to be dropped.
@@ -81,6 +86,7 @@ impl RenderJob {
         };
         let thread_job = job.clone();
         let worker = Worker::spawn(names::RENDER_JOB, move || {
+            observer.stage("reading the scene's environment map");
             let result = snapshot(scene, images)
                 .and_then(|loaded| render_to_file(&device, loaded, &thread_job, &mut observer));
             let _ = sender.send(Event::Done(result));
@@ -90,6 +96,8 @@ impl RenderJob {
             cancel,
             events,
             progress: None,
+            stage: "starting a device".to_owned(),
+            started: std::time::Instant::now(),
             _worker: worker,
         })
     }
@@ -105,13 +113,28 @@ impl RenderJob {
         self.progress
     }
 
+    /// What the render prepares, until its first progress.
+    pub fn stage(&self) -> &str {
+        &self.stage
+    }
+
     /// What arrived since the last call; `Finished` comes last, once.
     pub fn poll(&mut self) -> Vec<Update> {
         let mut updates = Vec::new();
         loop {
             match self.events.try_recv() {
                 Ok(Event::Note(line)) => updates.push(Update::Note(line)),
-                Ok(Event::Progress(p)) => self.progress = Some(p),
+                Ok(Event::Stage(what)) => self.stage = what,
+                Ok(Event::Progress(p)) => {
+                    if self.progress.is_none() {
+                        eprintln!(
+                            "render: first round of {} traced {:.1} s after the start",
+                            self.job.output.display(),
+                            self.started.elapsed().as_secs_f64()
+                        );
+                    }
+                    self.progress = Some(p);
+                }
                 Ok(Event::Done(result)) => {
                     updates.push(Update::Finished(result.map_err(|e| format!("{e:#}"))));
                     return updates;
@@ -140,6 +163,10 @@ struct Sender {
 impl RenderObserver for Sender {
     fn note(&mut self, line: &str) {
         let _ = self.sender.send(Event::Note(line.to_owned()));
+    }
+
+    fn stage(&mut self, what: &str) {
+        let _ = self.sender.send(Event::Stage(what.to_owned()));
     }
 
     fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {

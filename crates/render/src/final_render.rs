@@ -145,6 +145,10 @@ impl Progress {
 /// each frame, whose answer can stop the render.
 pub trait RenderObserver {
     fn note(&mut self, line: &str);
+    /// What the render does before its first sample, as it starts it
+    /// ("building the trace shader"): a dialog shows it in place of its
+    /// progress. Nothing by default: a terminal shows the notes.
+    fn stage(&mut self, _what: &str) {}
     /// `Break` cancels the render: nothing is written.
     fn progress(&mut self, progress: &Progress) -> ControlFlow<()>;
 }
@@ -406,9 +410,14 @@ pub fn render_to_file(
             job.stop.max_samples()
         );
     }
+    if job.kernel == crate::gpu::KernelChoice::Auto {
+        observer.stage("timing the two trace kernels");
+    }
     let (kernel, timings) = pick_kernel(ctx, &loaded, pieces[0].size(), job.kernel)?;
     observer.note(&describe_pick(kernel, timings.as_ref()));
+    observer.stage(&format!("building the {kernel} trace shader"));
     let mut renderer = renderer_fitting(ctx, &loaded, pieces[0].size(), kernel)?;
+    observer.stage("tracing the first round");
     for (index, planned) in frames.iter().enumerate() {
         if index > 0 {
             renderer.set_scene(ctx, &base.at_time(planned.time))?;
@@ -619,6 +628,10 @@ struct InSequence<'a> {
 impl RenderObserver for InSequence<'_> {
     fn note(&mut self, line: &str) {
         self.observer.note(line);
+    }
+
+    fn stage(&mut self, what: &str) {
+        self.observer.stage(what);
     }
 
     fn progress(&mut self, progress: &Progress) -> ControlFlow<()> {

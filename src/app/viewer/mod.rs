@@ -600,7 +600,7 @@ impl Viewer {
         };
         let progress = job.progress();
         let line = match progress {
-            None => "preparing…".to_owned(),
+            None => format!("{}…", job.stage()),
             Some(p) => match p.relative_error {
                 Some(e) => format!(
                     "{} / {} spp, error {:.2} %",
