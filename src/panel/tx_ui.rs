@@ -59,6 +59,9 @@ impl TxEdit {
     }
 }
 
+/// The rows the TX box shows; a longer text scrolls in it.
+const TX_ROWS: usize = 5;
+
 /// The "as TX" section of `property`, folded by default.
 pub(super) fn tx_ui(ui: &mut Ui, material: &mut Material, property: Property) {
     let title = if property == Property::Opacity {
@@ -77,12 +80,23 @@ pub(super) fn tx_ui(ui: &mut Ui, material: &mut Material, property: Property) {
             if let Err(e) = &raised {
                 ui.label(egui::RichText::new(format!("no TX form: {e}")).weak());
             }
-            let field = ui.add(
-                TextEdit::multiline(&mut state.text)
-                    .code_editor()
-                    .desired_rows(2)
-                    .desired_width(f32::INFINITY),
-            );
+            // A box of a fixed height that scrolls: typing a line more does
+            // not push Apply down under the pointer.
+            let rows = TX_ROWS as f32;
+            let height = rows * ui.text_style_height(&egui::TextStyle::Monospace)
+                + 2.0 * ui.spacing().button_padding.y;
+            let field = egui::ScrollArea::vertical()
+                .id_salt("tx-scroll")
+                .max_height(height)
+                .show(ui, |ui| {
+                    ui.add(
+                        TextEdit::multiline(&mut state.text)
+                            .code_editor()
+                            .desired_rows(TX_ROWS)
+                            .desired_width(f32::INFINITY),
+                    )
+                })
+                .inner;
             if field.changed() {
                 state.edited = state.text != state.shown;
                 state.error = None;
