@@ -52,12 +52,13 @@ pub fn window(
     swatches: Swatches,
 ) {
     let Some(key) = *open else { return };
+    let title = scene.material_title(key).unwrap_or_else(|| key.to_string());
     let Some((material, layout)) = scene.material_and_layout_mut(key) else {
         *open = None;
         return;
     };
     let mut keep = true;
-    egui::Window::new(format!("node graph: {key}"))
+    egui::Window::new(format!("node graph: {title}"))
         .id(egui::Id::NULL.with("node graph window"))
         .open(&mut keep)
         .default_size([900.0, 560.0])

@@ -159,12 +159,54 @@ impl Scene {
         }?;
         Some((material, &mut self.graph_layout))
     }
+
+    /// The object whose material `key` names, as the panel titles it
+    /// (`sphere “marble”`, `mesh “box”, material “white”`), for the node
+    /// editor's window; `None` when there is no such object.
+    pub fn material_title(&self, key: MaterialKey) -> Option<String> {
+        Some(match key {
+            MaterialKey::Sphere(i) => format!("sphere “{}”", self.spheres.get(i)?.name),
+            MaterialKey::Cylinder(i) => format!("cylinder “{}”", self.cylinders.get(i)?.name),
+            MaterialKey::Polygon(i) => format!("polygon “{}”", self.polygons.get(i)?.name),
+            MaterialKey::Ground => {
+                self.ground.as_ref()?;
+                "ground".to_owned()
+            }
+            MaterialKey::Mesh { mesh, material } => {
+                let m = self.meshes.get(mesh)?;
+                format!(
+                    "mesh “{}”, material “{}”",
+                    m.name,
+                    m.materials.get(material)?.name
+                )
+            }
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::Sphere;
+
+    /// Titles name the object, not its index; a missing one has none.
+    #[test]
+    fn a_material_is_titled_by_its_object() {
+        let scene = Scene {
+            spheres: vec![Sphere {
+                name: "marble".into(),
+                ..Sphere::default()
+            }],
+            ground: None,
+            ..Scene::default()
+        };
+        assert_eq!(
+            scene.material_title(MaterialKey::Sphere(0)).as_deref(),
+            Some("sphere “marble”")
+        );
+        assert_eq!(scene.material_title(MaterialKey::Sphere(1)), None);
+        assert_eq!(scene.material_title(MaterialKey::Ground), None);
+    }
 
     fn path(text: &str) -> NodePath {
         text.parse().unwrap()
