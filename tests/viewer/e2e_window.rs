@@ -26,8 +26,8 @@
 use crate::xvfb;
 
 use crate::xvfb::{
-    TempDir, assert_success, display_or_skip, grab_window, marbre_log, request_close, serial,
-    spawn_marbre, wait_for_exit, xdotool,
+    TempDir, assert_success, display_or_skip, grab_window, marbre_log, number_before, quality_line,
+    request_close, serial, spawn_marbre, wait_for_exit, xdotool,
 };
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -586,25 +586,17 @@ fn sections_and_the_first_kernel_choice_keep_the_image() {
     std::thread::sleep(Duration::from_secs(3));
     request_close(&x, &session.window);
     assert_success(wait_for_exit(&mut child, &dir, STEP_TIMEOUT), &dir);
-    let log = marbre_log(&dir);
-    let line = log
-        .lines()
-        .find(|l| l.starts_with("quality: "))
-        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    let line = quality_line(&dir);
     eprintln!("{TEST}: {line}");
-    let words: Vec<&str> = line.split_whitespace().collect();
-    let number_before = |word: &str| -> u32 {
-        let at = words
-            .iter()
-            .position(|w| w.trim_end_matches(';') == word)
-            .unwrap();
-        words[at - 1].parse().unwrap()
-    };
-    assert!(number_before("spp") > 0, "nothing accumulated: {line}");
+    assert!(
+        number_before(&line, "spp") > 0,
+        "nothing accumulated: {line}"
+    );
     assert_eq!(
-        number_before("restarts"),
+        number_before(&line, "restarts"),
         0,
-        "an image was thrown away: {line}\n{log}"
+        "an image was thrown away: {line}\n{}",
+        marbre_log(&dir)
     );
     assert_clean_log(&dir);
 }

@@ -24,8 +24,8 @@
 
 use crate::REPO;
 use crate::xvfb::{
-    Guard, TempDir, Xvfb, assert_success, display_or_skip, marbre_log, serial, spawn_marbre,
-    wait_for_exit, xdotool,
+    Guard, TempDir, Xvfb, assert_success, display_or_skip, marbre_log, number_before, quality_line,
+    serial, spawn_marbre, wait_for_exit, xdotool,
 };
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -204,11 +204,7 @@ fn window_shows_panel_and_render() {
         quality.mean_luma < 0.25 && quality.light_fraction > 0.01,
         "no Quality strip under the image: {quality:?}"
     );
-    let log = marbre_log(&dir);
-    let line = log
-        .lines()
-        .find(|l| l.starts_with("quality: "))
-        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    let line = quality_line(&dir);
     assert!(
         line.contains("estimated error 0.") && line.contains("relative"),
         "no error estimate after 10 frames: {line}"
@@ -622,18 +618,9 @@ fn the_panel_keeps_drawing_while_a_slow_scene_accumulates() {
         ],
     );
     assert_success(wait_for_exit(&mut child, &dir, CHILD_TIMEOUT), &dir);
-    let log = marbre_log(&dir);
-    let line = log
-        .lines()
-        .find(|l| l.starts_with("quality: "))
-        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    let line = quality_line(&dir);
     eprintln!("{TEST}: {line}");
-    let number_before = |word: &str| -> u32 {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        let at = words.iter().position(|w| *w == word).unwrap();
-        words[at - 1].parse().unwrap()
-    };
-    let (spp, frames) = (number_before("spp"), number_before("frames"));
+    let (spp, frames) = (number_before(&line, "spp"), number_before(&line, "frames"));
     assert_eq!(frames, 60, "{line}");
     assert!(
         spp < frames / 2,

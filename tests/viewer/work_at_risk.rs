@@ -24,8 +24,8 @@
 use crate::REPO;
 use crate::e2e_window::{Look, PANEL_LEFT, STEP_TIMEOUT, assert_clean_log, open};
 use crate::xvfb::{
-    TempDir, assert_success, display_or_skip, grab_window, marbre_log, request_close, serial,
-    wait_for_exit,
+    TempDir, assert_success, display_or_skip, grab_window, marbre_log, number_before, quality_line,
+    request_close, serial, wait_for_exit,
 };
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -256,15 +256,9 @@ fn frames_on_the_cornell_box(test: &str, offer: bool, seconds: u64) -> (u64, ima
     let window = grab_window(&x, &session.window);
     request_close(&x, &session.window);
     assert_success(wait_for_exit(&mut child, &dir, STEP_TIMEOUT), &dir);
-    let log = marbre_log(&dir);
-    let line = log
-        .lines()
-        .find(|l| l.starts_with("quality: "))
-        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"));
+    let line = quality_line(&dir);
     eprintln!("{test} (offer: {offer}): {line}");
-    let words: Vec<&str> = line.split_whitespace().collect();
-    let at = words.iter().position(|w| *w == "frames").unwrap();
-    (words[at - 1].parse().unwrap(), window)
+    (number_before(&line, "frames").into(), window)
 }
 
 #[test]

@@ -219,6 +219,30 @@ pub fn marbre_log(dir: &TempDir) -> String {
     std::fs::read_to_string(dir.path().join("marbre.log")).unwrap_or_default()
 }
 
+/// The viewer's closing line (`quality: …`, written when it ends
+/// cleanly): what the Quality strip showed, the frames drawn, the images
+/// thrown away. Fails, with the log, if there is none.
+pub fn quality_line(dir: &TempDir) -> String {
+    let log = marbre_log(dir);
+    log.lines()
+        .find(|l| l.starts_with("quality: "))
+        .map(str::to_owned)
+        .unwrap_or_else(|| panic!("no quality line in the log:\n{log}"))
+}
+
+/// The number written just before `word` (`12 spp`, `0 restarts;`) in
+/// `line`.
+pub fn number_before(line: &str, word: &str) -> u32 {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = words
+        .iter()
+        .position(|w| w.trim_end_matches(';') == word)
+        .unwrap_or_else(|| panic!("no `{word}` in: {line}"));
+    words[at - 1]
+        .parse()
+        .unwrap_or_else(|_| panic!("no number before `{word}` in: {line}"))
+}
+
 /// Waits for the viewer to exit; fails (and kills it) after `timeout`.
 pub fn wait_for_exit(child: &mut Guard, dir: &TempDir, timeout: Duration) -> ExitStatus {
     let start = Instant::now();
