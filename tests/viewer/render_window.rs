@@ -17,8 +17,8 @@ use std::time::{Duration, Instant};
 
 /// Where the dialog's Cancel button is while a render runs: the dialog is
 /// anchored 12 points from the window's top-left corner, at scale 1 (under
-/// its fields, the time row's included).
-const CANCEL_BUTTON: (i32, i32) = (46, 225);
+/// its fields, the time and denoise rows included).
+const CANCEL_BUTTON: (i32, i32) = (46, 248);
 
 /// How long a render of the small image may take on lavapipe, the window
 /// tracing beside it.
