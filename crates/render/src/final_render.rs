@@ -17,7 +17,7 @@ use anyhow::{Context, Result, bail};
 use marbre_core::animated_image;
 use marbre_core::image_io::{self, ImageFormat, LayerName};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, scene_hash};
-use marbre_core::scene::{Metering, Scene, View};
+use marbre_core::scene::{Metering, RenderSettings, Scene, View};
 use marbre_core::texture::ImageSet;
 use marbre_core::tile::{self, Tile};
 use std::ops::ControlFlow;
@@ -333,33 +333,7 @@ pub fn render_to_file(
             written[0].output.display()
         ));
     }
-    if let Some(metering) = job.auto_exposure {
-        let display = &mut loaded.scene.render.display;
-        display.auto_exposure = true;
-        display.metering = metering;
-    }
-    if job.denoise {
-        let render = &mut loaded.scene.render;
-        if render.view != View::Lit {
-            bail!(
-                "--denoise filters the lit image, not the {} view",
-                render.view.name()
-            );
-        }
-        render.display.denoise = true;
-    }
-    if job.guides {
-        let render = &mut loaded.scene.render;
-        if render.view != View::Lit {
-            bail!(
-                "--guides records the lit image's first hits, not the {} view's",
-                render.view.name()
-            );
-        }
-        // The guides are accumulated while the display denoises; an EXR
-        // stays the raw accumulation (unless `denoise_exr`).
-        render.display.denoise = true;
-    }
+    show_as_asked(&mut loaded.scene.render, job)?;
     if let Some(problem) = loaded
         .scene
         .animation
@@ -614,6 +588,30 @@ fn write_assembled(
     }
     .with_context(|| format!("saving {}", output.display()))?;
     observer.note(&format!("wrote {}", output.display()));
+    Ok(())
+}
+
+/// The display settings `job` asks of the render on top of the scene's:
+/// auto exposure (the scene's exposure becoming a compensation), and the
+/// denoiser, whose guides the trace then accumulates (`denoise`, and
+/// `guides` for the EXR's layers), on the lit image only.
+fn show_as_asked(render: &mut RenderSettings, job: &FinalRender) -> Result<()> {
+    if let Some(metering) = job.auto_exposure {
+        render.display.auto_exposure = true;
+        render.display.metering = metering;
+    }
+    if job.denoise || job.guides {
+        if render.view != View::Lit {
+            let what = if job.denoise {
+                "--denoise filters the lit image"
+            } else {
+                "--guides records the lit image's first hits"
+            };
+            bail!("{what}, not the {} view", render.view.name());
+        }
+        // An EXR stays the raw accumulation unless `denoise_exr`.
+        render.display.denoise = true;
+    }
     Ok(())
 }
 

@@ -131,7 +131,8 @@ impl Accumulation {
 
     /// Allocates the guides' targets, or frees them: whether the trace
     /// pipeline writes them. Call it before recording a band; a pipeline
-    /// change restarts the accumulation, so new targets start empty.
+    /// change that adds them (new features) restarts the accumulation, so
+    /// new targets start empty.
     pub fn set_guides(&mut self, device: &wgpu::Device, on: bool) {
         if on && self.guides.is_none() {
             self.guides = Some(Guides {

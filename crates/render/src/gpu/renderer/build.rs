@@ -301,9 +301,11 @@ impl Renderer {
         // must go.
         let change = if same_image {
             // A round half traced by the other kernel is traced again
-            // whole by this one.
+            // whole by this one. The edits that waited for the build are
+            // the target's change, joined as they came: the scenes are
+            // not compared again.
             self.accumulation.restart_round();
-            scene.changes_from(&self.scene)
+            pending.target.change
         } else {
             self.reset_accumulation();
             Change::all()
