@@ -73,7 +73,7 @@ pub(super) fn canvas(
     layout: &mut GraphLayout,
     swatches: Swatches,
 ) {
-    let id = Id::NULL.with(("node canvas", key.to_string()));
+    let id = canvas_id(key);
     let mut view: View = ui.data(|d| d.get_temp(id)).unwrap_or_default();
     match &view.message {
         Some(message) => ui.colored_label(ui.visuals().error_fg_color, message),
@@ -130,7 +130,7 @@ pub(super) fn canvas(
         let swatch = swatches(key, &node.path, texture);
         let drawn = texture_node(
             ui,
-            rect,
+            (rect, id),
             top_left,
             (key, &node.path),
             texture,
@@ -205,6 +205,12 @@ pub(super) fn canvas(
         }
     }
     ui.data_mut(|d| d.insert_temp(id, view));
+}
+
+/// The canvas's id for `key`'s material: its view, its nodes' heights and
+/// the nodes' ids are named under it.
+pub(super) fn canvas_id(key: MaterialKey) -> Id {
+    Id::NULL.with(("node canvas", key.to_string()))
 }
 
 /// A link from an output to an input, leaving and entering horizontally.
@@ -315,7 +321,7 @@ struct DrawnNode {
 /// texture is linked.
 fn texture_node(
     ui: &mut Ui,
-    canvas: Rect,
+    (canvas, canvas_id): (Rect, Id),
     top_left: Pos2,
     (key, path): (MaterialKey, &NodePath),
     texture: &mut Texture,
@@ -323,7 +329,7 @@ fn texture_node(
     sockets: &mut Sockets,
 ) -> DrawnNode {
     let mut child = place(ui, canvas, top_left, NODE_WIDTH, ("node", path.to_string()));
-    let id = child.scope_id();
+    let id = node_id(canvas_id, path);
     let inner = node_frame(&child).show(&mut child, |ui| {
         ui.set_width(NODE_WIDTH - 12.0);
         let header = ui
@@ -396,7 +402,9 @@ fn texture_node(
         header
     });
     let frame = inner.response.rect;
-    let header = ui.interact(inner.inner, id.with("header"), Sense::drag());
+    // The whole top row grabs the node, not only its swatch and title.
+    let header = Rect::from_x_y_ranges(frame.x_range(), inner.inner.y_range());
+    let header = ui.interact(header, id.with("header"), Sense::drag());
     let output_at = pos2(frame.right(), inner.inner.center().y);
     socket(ui, output_at, path, true);
     let output = ui.interact(
@@ -409,6 +417,12 @@ fn texture_node(
         output,
         height: frame.height(),
     }
+}
+
+/// The id a node's header and output are named under, from the canvas's
+/// id and the node's path (tests find a node's header by it).
+pub(super) fn node_id(canvas: Id, path: &NodePath) -> Id {
+    canvas.with(("node", path.to_string()))
 }
 
 fn input_socket(

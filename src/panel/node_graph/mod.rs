@@ -138,6 +138,107 @@ mod tests {
         }
     }
 
+    /// Runs one frame of the window with `events` as input.
+    fn frame(
+        ctx: &Context,
+        scene: &mut Scene,
+        open: &mut Option<MaterialKey>,
+        events: Vec<egui::Event>,
+    ) {
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(1280.0, 720.0),
+            )),
+            events,
+            ..Default::default()
+        };
+        ctx.run_ui(input, |ui| {
+            window(ui.ctx(), scene, open, &|_, _, _| {
+                Some(egui::TextureId::Managed(0))
+            });
+        })
+        .drop_without_applying_deltas();
+    }
+
+    fn pointer(pos: egui::Pos2, pressed: Option<bool>) -> Vec<egui::Event> {
+        let mut events = vec![egui::Event::PointerMoved(pos)];
+        if let Some(pressed) = pressed {
+            events.push(egui::Event::PointerButton {
+                pos,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::NONE,
+            });
+        }
+        events
+    }
+
+    /// A press at `from`, moves in steps to `to`, a release there.
+    fn drag(
+        ctx: &Context,
+        scene: &mut Scene,
+        open: &mut Option<MaterialKey>,
+        from: egui::Pos2,
+        to: egui::Pos2,
+    ) {
+        frame(ctx, scene, open, pointer(from, None));
+        frame(ctx, scene, open, pointer(from, Some(true)));
+        for k in 1..=5 {
+            let at = from + (to - from) * (k as f32 / 5.0);
+            frame(ctx, scene, open, pointer(at, None));
+        }
+        frame(ctx, scene, open, pointer(to, Some(false)));
+        frame(ctx, scene, open, vec![]);
+    }
+
+    /// Where a node's part (`header`, `output`) was drawn last frame.
+    fn drawn_rect(ctx: &Context, key: MaterialKey, path: &str, part: &str) -> egui::Rect {
+        let id = canvas::node_id(canvas::canvas_id(key), &path.parse().unwrap()).with(part);
+        ctx.read_response(id).expect("the node was drawn").rect
+    }
+
+    fn header_rect(ctx: &Context, key: MaterialKey, path: &str) -> egui::Rect {
+        drawn_rect(ctx, key, path, "header")
+    }
+
+    /// Dragging a node's header, anywhere along its top row, moves that
+    /// node by the drag and nothing else: not the other nodes, not the
+    /// view.
+    #[test]
+    fn dragging_a_header_moves_its_node_alone() {
+        let mut scene = scene();
+        let key = MaterialKey::Sphere(0);
+        let mut open = Some(key);
+        let ctx = Context::default();
+        for _ in 0..3 {
+            frame(&ctx, &mut scene, &mut open, vec![]);
+        }
+        let header = header_rect(&ctx, key, "diffuse.a");
+        let other = header_rect(&ctx, key, "diffuse");
+        // Right of the title, where the row is empty, short of the output
+        // socket at the node's right edge.
+        let output = drawn_rect(&ctx, key, "diffuse.a", "output");
+        let from = egui::pos2(output.center().x - 40.0, header.center().y);
+        drag(
+            &ctx,
+            &mut scene,
+            &mut open,
+            from,
+            from + egui::vec2(-60.0, 40.0),
+        );
+        let moved = header_rect(&ctx, key, "diffuse.a");
+        assert_eq!(
+            moved.min - header.min,
+            egui::vec2(-60.0, 40.0),
+            "{header:?} → {moved:?}"
+        );
+        assert_eq!(header_rect(&ctx, key, "diffuse"), other);
+        let layout = scene.graph_layout.get(key).expect("a position was saved");
+        assert!(layout.position(&"diffuse.a".parse().unwrap()).is_some());
+        assert!(layout.position(&"diffuse".parse().unwrap()).is_none());
+    }
+
     /// A material that is gone closes the window rather than panicking.
     #[test]
     fn a_missing_material_closes_the_window() {
