@@ -7,11 +7,14 @@
 //!
 //! The graph is a view of the tree, not a second model: the viewer's node
 //! editor reads it, and edits the [`Material`] itself through the paths
-//! here ([`texture_at_mut`], [`move_subtree`], [`detach`]), so the tree
+//! here ([`texture_at_mut`], [`move_subtree`], [`detach`], [`add_node`],
+//! [`duplicate`]), so the tree
 //! panel and the graph always show one scene and share its undo history.
 
 use super::graph_layout::MaterialLayout;
 use super::material::{Material, Property};
+use super::pattern::Pattern;
+use super::pattern_table::PatternKind;
 pub use super::node_path::{NodePath, Root, Socket};
 use super::texture_tree::{Child, Texture};
 use glam::{Vec2, Vec3};
@@ -406,6 +409,64 @@ pub fn detach(
     layout.rename(|path| {
         (!path.starts_with(from) || (path == from && keeps_node)).then(|| path.clone())
     });
+    Ok(())
+}
+
+/// Puts a new node of `kind` on the input `at` (the node editor's Add
+/// menu: a tree has no unlinked nodes, so a new one is linked where it is
+/// added). What `at` held becomes the new node's `a`, so nothing is lost,
+/// and its `b` a contrasting value (as a pattern switched from a constant
+/// gets), so the new node shows at once. The layout moves the positions
+/// under `at` one level down, to `at.a`.
+pub fn add_node(
+    material: &mut Material,
+    layout: &mut MaterialLayout,
+    at: &NodePath,
+    kind: PatternKind,
+) -> Result<(), GraphEditError> {
+    let held = match read(material, at) {
+        Some(Content::Node(t)) => Child::Texture(t),
+        Some(Content::Value(v)) => v,
+        None => return Err(GraphEditError::NoInput(at.to_string())),
+    };
+    let node = Texture::blend(Pattern::Constant, held.clone(), held)
+        .with_pattern_contrasting(Pattern::fresh(kind, None));
+    let node = Content::Node(Box::new(node));
+    if node.depth_at(at) > Texture::MAX_DEPTH {
+        return Err(GraphEditError::TooDeep);
+    }
+    write(material, at, node);
+    let below = at.child(Socket::A);
+    layout.rename(|path| {
+        Some(if path.starts_with(at) {
+            path.moved(at, &below)
+        } else {
+            path.clone()
+        })
+    });
+    Ok(())
+}
+
+/// Puts a copy of the node at `from`, with its subtree, on the input `at`
+/// (the node editor's Duplicate). What `at` held is replaced, and the
+/// layout forgets its positions; `from` itself is left as it was.
+pub fn duplicate(
+    material: &mut Material,
+    layout: &mut MaterialLayout,
+    from: &NodePath,
+    at: &NodePath,
+) -> Result<(), GraphEditError> {
+    let Some(copy @ Content::Node(_)) = read(material, from) else {
+        return Err(GraphEditError::NoNode(from.to_string()));
+    };
+    if read(material, at).is_none() {
+        return Err(GraphEditError::NoInput(at.to_string()));
+    }
+    if copy.depth_at(at) > Texture::MAX_DEPTH {
+        return Err(GraphEditError::TooDeep);
+    }
+    write(material, at, copy);
+    layout.rename(|path| (!path.starts_with(at)).then(|| path.clone()));
     Ok(())
 }
 

@@ -374,3 +374,85 @@ proptest! {
         }
     }
 }
+
+/// A node added on a linked input takes the subtree there as its `a`
+/// (nothing is lost), with a contrasting `b`, and the positions below
+/// move one level down with it.
+#[test]
+fn an_added_node_nests_what_its_input_held() {
+    let mut m = material();
+    let mut layout = MaterialLayout::default();
+    layout.set(&path("diffuse.a"), Vec2::new(-600.0, 0.0));
+    let marble = m.diffuse.a.clone();
+    add_node(&mut m, &mut layout, &path("diffuse.a"), PatternKind::Waves).unwrap();
+    let added = texture_at(&m, &path("diffuse.a")).unwrap();
+    assert_eq!(added.pattern.kind(), PatternKind::Waves);
+    assert_eq!(added.a, marble);
+    assert!(matches!(added.b, Child::Color(_)), "{:?}", added.b);
+    assert_eq!(
+        layout.position(&path("diffuse.a.a")),
+        Some(Vec2::new(-600.0, 0.0))
+    );
+    assert_eq!(layout.position(&path("diffuse.a")), None);
+    // The rest of the tree is as it was.
+    assert_eq!(m.diffuse.b, Child::Color(Vec3::Z));
+    assert_eq!(m.roughness, material().roughness);
+}
+
+/// On a value input the value becomes the new node's `a`; on a root the
+/// property's whole tree does.
+#[test]
+fn an_added_node_on_a_value_or_a_root_keeps_it() {
+    let mut m = material();
+    let mut layout = MaterialLayout::default();
+    add_node(&mut m, &mut layout, &path("diffuse.b"), PatternKind::Checker).unwrap();
+    let added = texture_at(&m, &path("diffuse.b")).unwrap();
+    assert_eq!(added.a, Child::Color(Vec3::Z));
+    assert_ne!(added.b, added.a);
+    let roughness = m.roughness.clone();
+    add_node(&mut m, &mut layout, &path("roughness"), PatternKind::Fbm).unwrap();
+    assert_eq!(m.roughness.a, Child::Texture(Box::new(roughness)));
+}
+
+#[test]
+fn an_added_node_is_refused_past_the_depth_limit_or_on_no_input() {
+    let before = material();
+    let mut m = before.clone();
+    let mut layout = MaterialLayout::default();
+    let mut deep = path("diffuse");
+    for _ in 0..Texture::MAX_DEPTH {
+        deep = deep.child(Socket::A);
+    }
+    assert_eq!(
+        add_node(&mut m, &mut layout, &deep, PatternKind::Fbm),
+        Err(GraphEditError::NoInput(deep.to_string()))
+    );
+    // Nest until the limit refuses, then the tree holds at the limit.
+    let mut refused = None;
+    for _ in 0..=Texture::MAX_DEPTH {
+        if let Err(e) = add_node(&mut m, &mut layout, &path("diffuse"), PatternKind::Fbm) {
+            refused = Some(e);
+            break;
+        }
+    }
+    assert_eq!(refused, Some(GraphEditError::TooDeep));
+    assert_eq!(m.diffuse.depth(), Texture::MAX_DEPTH);
+}
+
+/// A duplicate is a copy: the original stays, the input it lands on
+/// holds an equal subtree, and that input's old positions are forgotten.
+#[test]
+fn a_duplicate_copies_the_subtree_onto_the_input() {
+    let mut m = material();
+    let mut layout = MaterialLayout::default();
+    layout.set(&path("roughness.factor"), Vec2::new(5.0, 5.0));
+    let marble = texture_at(&m, &path("diffuse.a")).unwrap().clone();
+    duplicate(&mut m, &mut layout, &path("diffuse.a"), &path("roughness")).unwrap();
+    assert_eq!(texture_at(&m, &path("diffuse.a")), Some(&marble));
+    assert_eq!(m.roughness, marble);
+    assert_eq!(layout.position(&path("roughness.factor")), None);
+    assert_eq!(
+        duplicate(&mut m, &mut layout, &path("diffuse.b"), &path("roughness")),
+        Err(GraphEditError::NoNode("diffuse.b".into()))
+    );
+}
