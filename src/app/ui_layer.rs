@@ -17,11 +17,14 @@
 //! hardly accumulated (issue 28).
 //!
 //! While an animation plays the panel changes every frame, but only in a
-//! few rows (the play head, the frame and time, keyed fields). A copied
+//! few rows (the play head, the frame and time, keyed fields). The kept
 //! layer is compared with the new output in bands of [`BAND`] pixel rows
-//! ([`band_fingerprints`]), and only the bands that differ are cleared and
-//! drawn again, egui's clip rectangles cut to them: egui's pass then costs
-//! what those rows cost, not the whole panel's (issue 29).
+//! ([`band_fingerprints`]), and only the bands that differ are cleared (to
+//! the background, or to transparency for a blended layer) and drawn
+//! again, egui's clip rectangles cut to them: egui's pass then costs what
+//! those rows cost, not the whole panel's (issue 29). A blended layer is
+//! drawn in bands too since issue 31: with the node editor open over the
+//! image, every refresh of the Stats figures drew the whole graph again.
 
 use std::hash::{Hash, Hasher};
 
@@ -288,7 +291,7 @@ pub struct UiLayer {
     bind_group: wgpu::BindGroup,
     /// The output the texture holds, and how it was drawn, if any.
     key: Option<(u64, Mode)>,
-    /// Its bands' fingerprints, when it was copied and has them.
+    /// Its bands' fingerprints, when it has them.
     bands: Option<Vec<u64>>,
 }
 
@@ -355,16 +358,12 @@ impl UiLayer {
             return Redraw::Nothing;
         }
         let held = self.key.map(|(_, m)| m);
-        let bands = match mode {
-            Mode::Copied => bands(),
-            Mode::Blended => None,
-        };
-        let before = std::mem::replace(&mut self.bands, bands);
+        let before = std::mem::replace(&mut self.bands, bands());
         self.key = Some((key, mode));
         let height = self.texture.height();
         match (held, before, &self.bands) {
-            (Some(Mode::Copied), Some(before), Some(after))
-                if mode == Mode::Copied && before.len() == after.len() =>
+            (Some(held), Some(before), Some(after))
+                if held == mode && before.len() == after.len() =>
             {
                 let rows = changed_rows(&before, after, height);
                 let changed: u32 = rows.iter().map(|r| r.end - r.start).sum();
@@ -753,22 +752,29 @@ mod tests {
         let mut after = panel(Color32::from_rgba_unmultiplied(255, 200, 0, 160), 52.5);
         let draw = |layer: &mut UiLayer,
                     renderer: &mut egui_wgpu::Renderer,
-                    jobs: &mut [egui::ClippedPrimitive]| {
+                    jobs: &mut [egui::ClippedPrimitive],
+                    (mode, clear): (Mode, wgpu::Color)| {
             let mut encoder = device.create_command_encoder(&Default::default());
             let extra = renderer.update_buffers(device, queue, &mut encoder, jobs, &screen);
             let key = output_key(jobs, &screen);
-            let drew_rows = match layer
-                .redraw(key, Mode::Copied, || band_fingerprints(jobs, &screen))
-            {
+            let drew_rows = match layer.redraw(key, mode, || band_fingerprints(jobs, &screen)) {
                 Redraw::Nothing => None,
                 Redraw::Whole(view) => {
-                    let mut pass = begin_pass(&mut encoder, view, wgpu::LoadOp::Clear(GREY), None);
+                    let mut pass = begin_pass(&mut encoder, view, wgpu::LoadOp::Clear(clear), None);
                     renderer.render(&mut pass, jobs, &screen);
                     Some(false)
                 }
                 Redraw::Rows(view, rows) => {
                     let mut pass = begin_pass(&mut encoder, view, wgpu::LoadOp::Load, None);
-                    draw_rows(renderer, &compositor, &mut pass, jobs, &screen, &rows, GREY);
+                    draw_rows(
+                        renderer,
+                        &compositor,
+                        &mut pass,
+                        jobs,
+                        &screen,
+                        &rows,
+                        clear,
+                    );
                     Some(true)
                 }
             };
@@ -778,19 +784,30 @@ mod tests {
                     .unwrap();
             (drew_rows, pixels)
         };
-        let mut kept = UiLayer::new(device, &config, &compositor);
-        assert_eq!(draw(&mut kept, &mut renderer, &mut before).0, Some(false));
-        let (drew_rows, by_rows) = draw(&mut kept, &mut renderer, &mut after);
-        assert_eq!(drew_rows, Some(true), "a small change draws rows only");
-        let mut fresh = UiLayer::new(device, &config, &compositor);
-        let (_, whole) = draw(&mut fresh, &mut renderer, &mut after);
-        let differing = by_rows.iter().zip(&whole).filter(|(a, b)| a != b).count();
-        assert_eq!(
-            differing, 0,
-            "bytes that differ from the output drawn whole"
-        );
-        let (_, before_whole) = draw(&mut fresh, &mut renderer, &mut before);
-        assert_ne!(before_whole, whole, "the two outputs differ");
+        // Over the background (a panel beside the image) and over
+        // transparency (the node editor's window over the image).
+        for drawn_over in [
+            (Mode::Copied, GREY),
+            (Mode::Blended, wgpu::Color::TRANSPARENT),
+        ] {
+            let mut kept = UiLayer::new(device, &config, &compositor);
+            assert_eq!(
+                draw(&mut kept, &mut renderer, &mut before, drawn_over).0,
+                Some(false)
+            );
+            let (drew_rows, by_rows) = draw(&mut kept, &mut renderer, &mut after, drawn_over);
+            assert_eq!(drew_rows, Some(true), "a small change draws rows only");
+            let mut fresh = UiLayer::new(device, &config, &compositor);
+            let (_, whole) = draw(&mut fresh, &mut renderer, &mut after, drawn_over);
+            let differing = by_rows.iter().zip(&whole).filter(|(a, b)| a != b).count();
+            assert_eq!(
+                differing, 0,
+                "bytes that differ from the output drawn whole, over {:?}",
+                drawn_over.0
+            );
+            let (_, before_whole) = draw(&mut fresh, &mut renderer, &mut before, drawn_over);
+            assert_ne!(before_whole, whole, "the two outputs differ");
+        }
     }
 
     const GREY: wgpu::Color = wgpu::Color {

@@ -66,6 +66,12 @@ struct Node {
     /// Whether `shows` changed since it was last sent to render.
     unsent: bool,
     image: Option<TextureHandle>,
+    /// The subtree `image` was rendered from, so that a subtree that
+    /// moves to another place (a link dragged, an undo) takes its image
+    /// along at once rather than wait for a render.
+    image_of: Option<Texture>,
+    /// The subtree last sent to render, which the next delivery shows.
+    sent: Option<Texture>,
     last_asked: u64,
 }
 
@@ -90,6 +96,8 @@ pub fn swatch(ctx: &Context, place: SwatchPlace) -> Option<TextureId> {
         read: false,
         unsent: false,
         image: None,
+        image_of: None,
+        sent: None,
         last_asked: frame,
     });
     node.last_asked = frame;
@@ -101,11 +109,24 @@ impl SwatchBook {
     /// by the viewer): reads the subtree of each place asked for the first
     /// time, and of every place when `change` touches a material or moves
     /// the objects (a key may then name another material); a subtree that
-    /// differs from what the node shows is to be rendered.
+    /// differs from what the node shows takes the image of a node that
+    /// showed the same subtree before (of the same kind, colour or
+    /// scalar), if there is one, or else is to be rendered.
     pub fn observe(&mut self, scene: &Scene, change: Change) {
         let materials_changed = change.intersects(
             Change::MATERIAL_PARAMETERS | Change::MATERIAL_STRUCTURE | Change::GEOMETRY,
         );
+        let rendered: Vec<(bool, Texture, TextureHandle)> = self
+            .nodes
+            .iter()
+            .filter_map(|(place, node)| {
+                Some((
+                    place.path.is_color(),
+                    node.image_of.clone()?,
+                    node.image.clone()?,
+                ))
+            })
+            .collect();
         for (place, node) in &mut self.nodes {
             if node.read && !materials_changed {
                 continue;
@@ -114,9 +135,20 @@ impl SwatchBook {
             let now = scene
                 .material(place.key)
                 .and_then(|material| texture_at(material, &place.path));
-            if now != node.shows.as_ref() {
-                node.shows = now.cloned();
-                node.unsent = node.shows.is_some();
+            if now == node.shows.as_ref() {
+                continue;
+            }
+            node.shows = now.cloned();
+            let same = rendered.iter().find(|(color, texture, _)| {
+                *color == place.path.is_color() && Some(texture) == node.shows.as_ref()
+            });
+            match same {
+                Some((_, texture, image)) => {
+                    node.image = Some(image.clone());
+                    node.image_of = Some(texture.clone());
+                    node.unsent = false;
+                }
+                None => node.unsent = node.shows.is_some(),
             }
         }
     }
@@ -131,6 +163,7 @@ impl SwatchBook {
             }
             if let (true, Some(texture)) = (node.unsent, &node.shows) {
                 node.unsent = false;
+                node.sent = Some(texture.clone());
                 out.push(SwatchRequest {
                     place: place.clone(),
                     texture: texture.clone(),
@@ -146,6 +179,7 @@ impl SwatchBook {
     pub fn deliver(&mut self, place: &SwatchPlace, image: TextureHandle) {
         if let Some(node) = self.nodes.get_mut(place) {
             node.image = Some(image);
+            node.image_of = node.sent.clone();
         }
     }
 
@@ -228,5 +262,68 @@ mod tests {
             book.lock().unwrap().end_frame();
         }
         assert_eq!(book.lock().unwrap().shown(), 0);
+    }
+
+    /// A link dragged from one input to another swaps two subtrees: each
+    /// node's swatch follows its subtree in the same frame, with nothing
+    /// to render, where it used to show the old subtree until a render.
+    #[test]
+    fn swatches_follow_a_subtree_that_moves() {
+        use marbre_core::scene::texture_graph::move_subtree;
+        let ctx = Context::default();
+        let book = SharedSwatchBook::default();
+        install(&ctx, book.clone());
+        let marble = Texture::blend(
+            Pattern::fresh(marbre_core::scene::PatternKind::Marble, None),
+            Vec3::ZERO,
+            Vec3::ONE,
+        );
+        let mut sphere = marbre_core::scene::Sphere::default();
+        sphere.material.diffuse = Texture::blend(
+            Pattern::fresh(marbre_core::scene::PatternKind::Checker, None),
+            marble,
+            Texture::color(Vec3::X),
+        );
+        let mut scene = Scene {
+            spheres: vec![sphere],
+            ..Scene::default()
+        };
+        let key = MaterialKey::Sphere(0);
+        let at = |text: &str| SwatchPlace {
+            key,
+            path: text.parse().unwrap(),
+        };
+        let (a, b) = (at("diffuse.a"), at("diffuse.b"));
+        swatch(&ctx, a.clone());
+        swatch(&ctx, b.clone());
+        book.lock().unwrap().observe(&scene, Change::empty());
+        let sent = book.lock().unwrap().take_requests(8);
+        assert_eq!(sent.len(), 2);
+        let images: Vec<_> = (0..2)
+            .map(|i| {
+                ctx.load_texture(
+                    format!("s{i}"),
+                    egui::ColorImage::example(),
+                    Default::default(),
+                )
+            })
+            .collect();
+        for (request, image) in sent.iter().zip(&images) {
+            book.lock().unwrap().deliver(&request.place, image.clone());
+        }
+        let before = (swatch(&ctx, a.clone()), swatch(&ctx, b.clone()));
+
+        let (material, layout) = scene.material_and_layout_mut(key).unwrap();
+        layout
+            .edit(key, |l| move_subtree(material, l, &a.path, &b.path))
+            .unwrap();
+        book.lock()
+            .unwrap()
+            .observe(&scene, Change::MATERIAL_STRUCTURE);
+        assert!(book.lock().unwrap().take_requests(8).is_empty());
+        assert_eq!(
+            (swatch(&ctx, a.clone()), swatch(&ctx, b.clone())),
+            (before.1, before.0)
+        );
     }
 }

@@ -409,6 +409,10 @@ impl Viewer {
             Redraw::Rows(view, rows) => {
                 extra = self.update_egui_buffers(encoder, paint_jobs, screen);
                 let mut pass = self.egui_pass(encoder, view, wgpu::LoadOp::Load);
+                let clear = match mode {
+                    Mode::Copied => BACKGROUND,
+                    Mode::Blended => wgpu::Color::TRANSPARENT,
+                };
                 ui_layer::draw_rows(
                     &self.egui_renderer,
                     &compositor,
@@ -416,7 +420,7 @@ impl Viewer {
                     paint_jobs,
                     screen,
                     &rows,
-                    BACKGROUND,
+                    clear,
                 );
             }
         }

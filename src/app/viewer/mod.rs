@@ -799,9 +799,13 @@ impl Viewer {
                 Shortcut::SaveAs => self.open_dialog(DialogPurpose::SavePresetAs),
                 Shortcut::Open => self.open_dialog(DialogPurpose::OpenPreset),
                 Shortcut::Help => self.show_help = !self.show_help,
-                // The help first: it is drawn over Save as.
+                // The help first: it is drawn over Save as, and Save as
+                // over the node editor's Add menu.
                 Shortcut::Close if self.show_help => self.show_help = false,
-                Shortcut::Close => self.panel.save_as = None,
+                Shortcut::Close if self.panel.save_as.is_some() => self.panel.save_as = None,
+                Shortcut::Close => {
+                    panel::node_graph::close_menu(&self.egui_ctx, self.panel.node_graph);
+                }
                 Shortcut::HideUi => self.ui_hidden = !self.ui_hidden,
                 Shortcut::PlayPause => self.timeline.toggle(Instant::now()),
                 Shortcut::RecallView(index) => {

@@ -1,36 +1,58 @@
-//! Drawing the graph and what the pointer does to it: a pannable canvas,
-//! the material's node on the right with a socket per tree, a node per
-//! texture (its swatch slot, pattern, parameters and inputs), bezier links,
-//! and the link or node being dragged.
+//! Drawing the graph and what the pointer and keys do to it: a canvas that
+//! pans (drag the background) and zooms (wheel, pinch) as `egui::Scene`
+//! does, the material's node at the origin with a socket per tree, a node
+//! per texture (its swatch, pattern, parameters and inputs), bezier links,
+//! the link or node being dragged, a selected node, and the Add menu.
+//!
+//! Keys act on the canvas under the pointer, as in Blender's editors, and
+//! never while a text field has the keyboard: Shift+A adds, X or Delete
+//! deletes the selected node (its subtree becomes a constant), Shift+D
+//! duplicates it onto the input nearest the pointer, Home frames all.
 
 use super::Swatches;
+use super::add_menu::{self, AddMenu};
 use super::layout::{NODE_WIDTH, UNMEASURED_HEIGHT, auto_positions};
 use crate::panel::keying;
 use crate::panel::material_editor::{image_source_ui, mapping_ui, math_ui, pattern_ui, ramp_ui};
 use crate::panel::widgets::{color_button, slider};
+use egui::emath::TSTransform;
 use egui::epaint::CubicBezierShape;
 use egui::{
-    CollapsingHeader, Color32, Frame, Id, Label, Pos2, Rect, Sense, Shape, Stroke, Ui, UiBuilder,
-    Vec2, pos2, vec2,
+    CollapsingHeader, Color32, Frame, Id, Key, Label, Modifiers, Pos2, Rect, Sense, Shape, Stroke,
+    Ui, UiBuilder, Vec2, pos2, vec2,
 };
 use marbre_core::animation::ParamPath;
 use marbre_core::scene::texture_graph::{
-    NodePath, Root, Socket, TextureGraph, detach, move_subtree, roots, texture_at_mut,
+    NodePath, Root, Socket, TextureGraph, add_node, detach, duplicate, move_subtree, roots,
+    texture_at_mut,
 };
-use marbre_core::scene::{Child, GraphLayout, Material, MaterialKey, Pattern, Texture};
+use marbre_core::scene::{
+    Child, GraphLayout, Material, MaterialKey, Pattern, PatternKind, Texture,
+};
 
 const SOCKET_RADIUS: f32 = 5.0;
 /// How near the pointer must be to a socket to grab or drop on it.
 const SOCKET_REACH: f32 = 12.0;
 /// The material node's width.
 const MATERIAL_WIDTH: f32 = 170.0;
+/// How far the view zooms out and in.
+const ZOOM: std::ops::RangeInclusive<f32> = 0.1..=2.0;
+/// How much one notch of the wheel zooms.
+const WHEEL_STEP: f32 = 1.2;
+/// The space Home leaves around the nodes.
+const FRAME_MARGIN: f32 = 30.0;
 
 /// What the canvas keeps between frames (egui memory, not the scene): the
-/// pan, the link being dragged and the last refused link's reason.
+/// part of the graph shown, the link being dragged, the selected node, the
+/// open Add menu and the last refused edit's reason.
 #[derive(Clone, Default)]
-struct View {
-    pan: Option<Vec2>,
+pub(super) struct View {
+    /// The graph-space rectangle the canvas shows (`egui::Scene`'s): pan
+    /// and zoom.
+    pub shown: Option<Rect>,
     dragging: Option<NodePath>,
+    pub selected: Option<NodePath>,
+    pub adding: Option<AddMenu>,
     message: Option<String>,
 }
 
@@ -38,11 +60,24 @@ struct View {
 /// is drawn (parameters are edited in place while drawing).
 enum Edit {
     Place(NodePath, glam::Vec2),
-    Move { from: NodePath, to: NodePath },
+    Move {
+        from: NodePath,
+        to: NodePath,
+    },
     Detach(NodePath),
+    Add {
+        at: NodePath,
+        kind: PatternKind,
+        place: glam::Vec2,
+    },
+    Duplicate {
+        from: NodePath,
+        at: NodePath,
+        place: glam::Vec2,
+    },
 }
 
-/// Where sockets were drawn this frame, in screen space.
+/// Where sockets were drawn this frame, in graph space.
 #[derive(Default)]
 struct Sockets {
     /// Each input that may take a link: the path a texture linked there has.
@@ -57,12 +92,63 @@ impl Sockets {
             .map(|(_, at)| *at)
     }
 
-    fn nearest(&self, at: Pos2) -> Option<&NodePath> {
+    /// The input nearest `at`, within `reach`.
+    fn nearest(&self, at: Pos2, reach: f32) -> Option<&NodePath> {
         self.inputs
             .iter()
-            .filter(|(_, p)| p.distance(at) <= SOCKET_REACH)
+            .filter(|(_, p)| p.distance(at) <= reach)
             .min_by(|a, b| a.1.distance(at).total_cmp(&b.1.distance(at)))
             .map(|(p, _)| p)
+    }
+}
+
+/// The canvas's id for `key`'s material: its view, its nodes' heights and
+/// the nodes' ids are named under it.
+pub(super) fn canvas_id(key: MaterialKey) -> Id {
+    Id::NULL.with(("node canvas", key.to_string()))
+}
+
+/// The id a node's header and output are named under, from the canvas's
+/// id and the node's path (tests find a node's header by it).
+pub(super) fn node_id(canvas: Id, path: &NodePath) -> Id {
+    canvas.with(("node", path.to_string()))
+}
+
+/// The canvas's view of `key`'s material as last drawn.
+pub(super) fn view(ctx: &egui::Context, key: MaterialKey) -> View {
+    ctx.data(|d| d.get_temp(canvas_id(key))).unwrap_or_default()
+}
+
+impl View {
+    /// Closes the Add menu; whether it was open.
+    pub fn close_menu(&mut self) -> bool {
+        self.adding.take().is_some()
+    }
+}
+
+/// What the keys asked of the canvas this frame.
+#[derive(Default)]
+struct Keys {
+    add: bool,
+    delete: bool,
+    duplicate: bool,
+    frame_all: bool,
+}
+
+impl Keys {
+    /// The canvas's keys, taken only with the pointer over it and no text
+    /// field holding the keyboard.
+    fn read(ui: &Ui, over_canvas: bool) -> Keys {
+        if !over_canvas || ui.ctx().memory(|m| m.focused().is_some()) {
+            return Keys::default();
+        }
+        ui.input_mut(|i| Keys {
+            add: i.consume_key(Modifiers::SHIFT, Key::A),
+            delete: i.consume_key(Modifiers::NONE, Key::X)
+                || i.consume_key(Modifiers::NONE, Key::Delete),
+            duplicate: i.consume_key(Modifiers::SHIFT, Key::D),
+            frame_all: i.consume_key(Modifiers::NONE, Key::Home),
+        })
     }
 }
 
@@ -74,30 +160,21 @@ pub(super) fn canvas(
     swatches: Swatches,
 ) {
     let id = canvas_id(key);
-    let mut view: View = ui.data(|d| d.get_temp(id)).unwrap_or_default();
+    let mut view = view(ui.ctx(), key);
     match &view.message {
         Some(message) => ui.colored_label(ui.visuals().error_fg_color, message),
         None => ui.weak(
-            "Drag a link's end onto another input to move the subtree (what the input held \
-             takes its place), onto nothing to leave a constant; drag a header to move a node, \
-             the background to pan.",
+            "Drag a header to move a node, the background to pan; the wheel zooms, Home frames \
+             all. Shift+A or right-click adds a node on the input nearest the pointer; click a \
+             header to select, X deletes (a constant stays), Shift+D duplicates. Drag a link's \
+             end onto another input to move the subtree, onto nothing to leave a constant.",
         ),
     };
-    let (rect, background) = ui.allocate_exact_size(ui.available_size(), Sense::drag());
-    let pan = view
-        .pan
-        .get_or_insert(vec2(rect.width() - MATERIAL_WIDTH - 20.0, 20.0));
-    if background.dragged() {
-        *pan += background.drag_delta();
-    }
-    let origin = rect.min + *pan;
-    let painter = ui.painter_at(rect);
-    painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
-    let links_slot = painter.add(Shape::Noop);
-
-    let mut sockets = Sockets::default();
-    let roots = roots(material);
-    let root_ys = material_node(ui, rect, origin, material, &roots, &mut sockets);
+    let outer = ui.available_rect_before_wrap();
+    ui.painter()
+        .rect_filled(outer, 0.0, ui.visuals().extreme_bg_color);
+    let over_canvas = ui.rect_contains_pointer(outer);
+    let keys = Keys::read(ui, over_canvas);
 
     let graph = TextureGraph::of(material);
     let height_id = |path: &NodePath| id.with(("height", path.to_string()));
@@ -107,6 +184,8 @@ pub(super) fn canvas(
         .map(|n| ui.data(|d| d.get_temp(height_id(&n.path))))
         .map(|h| h.unwrap_or(UNMEASURED_HEIGHT))
         .collect();
+    let root_ys_id = id.with("root ys");
+    let root_ys: Vec<f32> = ui.data(|d| d.get_temp(root_ys_id)).unwrap_or_default();
     let auto = auto_positions(
         &graph,
         |i| heights[i],
@@ -120,77 +199,182 @@ pub(super) fn canvas(
         .map(|(n, a)| saved.and_then(|l| l.position(&n.path)).unwrap_or(*a))
         .collect();
 
+    // The material's node on the right, as the view opens.
+    let shown = view.shown.get_or_insert(Rect::from_min_size(
+        pos2(MATERIAL_WIDTH + 20.0 - outer.width(), -20.0),
+        outer.size(),
+    ));
+    if keys.frame_all {
+        let mut all = Rect::from_min_size(
+            Pos2::ZERO,
+            vec2(MATERIAL_WIDTH, 30.0 + 16.0 * root_ys.len() as f32),
+        );
+        for (p, h) in positions.iter().zip(&heights) {
+            all = all.union(Rect::from_min_size(pos2(p.x, p.y), vec2(NODE_WIDTH, *h)));
+        }
+        *shown = all.expand(FRAME_MARGIN);
+    }
+
+    if over_canvas {
+        wheel_zoom(ui, outer, shown);
+    }
+
     let mut edits = Vec::new();
-    let mut outputs = Vec::with_capacity(graph.nodes.len());
-    for (node, position) in graph.nodes.iter().zip(&positions) {
-        let Some(texture) = texture_at_mut(material, &node.path) else {
-            continue;
-        };
-        let top_left = origin + vec2(position.x, position.y);
-        let swatch = swatches(key, &node.path, texture);
-        let drawn = texture_node(
-            ui,
-            (rect, id),
-            top_left,
-            (key, &node.path),
-            texture,
-            swatch,
-            &mut sockets,
-        );
-        if drawn.header.dragged() && drawn.header.drag_delta() != Vec2::ZERO {
-            let d = drawn.header.drag_delta();
-            edits.push(Edit::Place(
-                node.path.clone(),
-                *position + glam::Vec2::new(d.x, d.y),
-            ));
+    let mut sockets = Sockets::default();
+    let roots = roots(material);
+    let scene = egui::Scene::new().zoom_range(ZOOM);
+    let drawn = scene.show(ui, shown, |ui| {
+        let links_slot = ui.painter().add(Shape::Noop);
+        let from_global = ui
+            .ctx()
+            .layer_transform_from_global(ui.layer_id())
+            .unwrap_or(TSTransform::IDENTITY);
+        let pointer = ui
+            .input(|i| i.pointer.latest_pos())
+            .map(|p| from_global * p);
+
+        let root_ys_now = material_node(ui, material, &roots, &mut sockets);
+        if root_ys_now != root_ys {
+            ui.data_mut(|d| d.insert_temp(root_ys_id, root_ys_now));
         }
-        if drawn.output.drag_started() {
-            view.dragging = Some(node.path.clone());
+
+        let mut outputs = Vec::with_capacity(graph.nodes.len());
+        for (i, (node, position)) in graph.nodes.iter().zip(&positions).enumerate() {
+            let Some(texture) = texture_at_mut(material, &node.path) else {
+                continue;
+            };
+            let top_left = pos2(position.x, position.y);
+            let swatch = swatches(key, &node.path, texture);
+            let selected = view.selected.as_ref() == Some(&node.path);
+            let drawn = texture_node(
+                ui,
+                (id, top_left, selected),
+                (key, &node.path),
+                texture,
+                swatch,
+                &mut sockets,
+            );
+            if drawn.header.dragged() && drawn.header.drag_delta() != Vec2::ZERO {
+                let d = drawn.header.drag_delta();
+                edits.push(Edit::Place(
+                    node.path.clone(),
+                    *position + glam::Vec2::new(d.x, d.y),
+                ));
+            }
+            if drawn.header.clicked() || drawn.header.drag_started() {
+                view.selected = Some(node.path.clone());
+            }
+            drawn.header.context_menu(|ui| {
+                if ui.button("Duplicate (Shift+D)").clicked() {
+                    let at = pointer.unwrap_or(top_left);
+                    if let Some(to) = sockets.nearest(at, f32::INFINITY) {
+                        edits.push(Edit::Duplicate {
+                            from: node.path.clone(),
+                            at: to.clone(),
+                            place: glam::Vec2::new(at.x, at.y),
+                        });
+                    }
+                }
+                if ui.button("Delete (X): a constant stays").clicked() {
+                    edits.push(Edit::Detach(node.path.clone()));
+                }
+            });
+            if drawn.output.drag_started() {
+                view.dragging = Some(node.path.clone());
+            }
+            if (drawn.height - heights[i]).abs() > 0.5 {
+                ui.data_mut(|d| d.insert_temp(height_id(&node.path), drawn.height));
+            }
+            outputs.push((node.path.clone(), drawn.output.rect.center()));
         }
-        if (drawn.height - heights[outputs.len()]).abs() > 0.5 {
-            ui.data_mut(|d| d.insert_temp(height_id(&node.path), drawn.height));
+
+        // An input holding a texture gives up its link when dragged.
+        for (path, at) in &sockets.inputs {
+            let grab = ui.interact(
+                Rect::from_center_size(*at, Vec2::splat(2.0 * SOCKET_REACH)),
+                id.with(("input", path.to_string())),
+                Sense::drag(),
+            );
+            if grab.drag_started() && outputs.iter().any(|(p, _)| p == path) {
+                view.dragging = Some(path.clone());
+            }
         }
-        outputs.push((node.path.clone(), drawn.output.rect.center()));
+
+        let mut links = Vec::new();
+        for (path, from) in &outputs {
+            let to = if view.dragging.as_ref() == Some(path) {
+                pointer
+            } else {
+                sockets.input(path)
+            };
+            if let Some(to) = to {
+                links.push(link(*from, to, link_color(ui, path)));
+            }
+        }
+        ui.painter().set(links_slot, Shape::Vec(links));
+
+        if ui.input(|i| i.pointer.any_released())
+            && let Some(from) = view.dragging.take()
+        {
+            match pointer.and_then(|at| sockets.nearest(at, SOCKET_REACH)) {
+                Some(to) if *to == from => {}
+                Some(to) => edits.push(Edit::Move {
+                    from,
+                    to: to.clone(),
+                }),
+                None => edits.push(Edit::Detach(from)),
+            }
+        }
+        pointer
+    });
+    let pointer = drawn.inner;
+    let background = drawn.response;
+    if background.clicked() {
+        view.selected = None;
     }
 
-    // An input holding a texture gives up its link when dragged.
-    for (path, at) in &sockets.inputs {
-        let grab = ui.interact(
-            Rect::from_center_size(*at, Vec2::splat(2.0 * SOCKET_REACH)),
-            id.with(("input", path.to_string())),
-            Sense::drag(),
-        );
-        if grab.drag_started() && outputs.iter().any(|(p, _)| p == path) {
-            view.dragging = Some(path.clone());
-        }
-    }
-
-    let pointer = ui.input(|i| i.pointer.latest_pos());
-    let mut links = Vec::new();
-    for (path, from) in &outputs {
-        let to = if view.dragging.as_ref() == Some(path) {
-            pointer
-        } else {
-            sockets.input(path)
-        };
-        if let Some(to) = to {
-            links.push(link(*from, to, link_color(ui, path)));
-        }
-    }
-    ui.painter_at(rect).set(links_slot, Shape::Vec(links));
-
-    if ui.input(|i| i.pointer.any_released())
-        && let Some(from) = view.dragging.take()
+    let nearest_input = |at: Pos2| sockets.nearest(at, f32::INFINITY).cloned();
+    if (keys.add || background.secondary_clicked())
+        && let Some(at) = pointer
+        && let Some(input) = nearest_input(at)
     {
-        match pointer.and_then(|at| sockets.nearest(at)) {
-            Some(to) if *to == from => {}
-            Some(to) => edits.push(Edit::Move {
-                from,
-                to: to.clone(),
-            }),
-            None => edits.push(Edit::Detach(from)),
+        view.adding = Some(AddMenu::new(
+            input,
+            at,
+            ui.input(|i| i.pointer.latest_pos())
+                .unwrap_or(outer.center()),
+        ));
+    }
+    if keys.delete
+        && let Some(selected) = view.selected.take()
+    {
+        edits.push(Edit::Detach(selected));
+    }
+    if keys.duplicate
+        && let (Some(from), Some(at)) = (view.selected.clone(), pointer)
+        && let Some(input) = nearest_input(at)
+    {
+        edits.push(Edit::Duplicate {
+            from,
+            at: input,
+            place: glam::Vec2::new(at.x, at.y),
+        });
+    }
+    if let Some(menu) = &mut view.adding {
+        match add_menu::show(ui.ctx(), id.with("add menu"), menu) {
+            add_menu::Outcome::Open => {}
+            add_menu::Outcome::Closed => view.adding = None,
+            add_menu::Outcome::Chosen(kind) => {
+                edits.push(Edit::Add {
+                    at: menu.input.clone(),
+                    kind,
+                    place: glam::Vec2::new(menu.place.x, menu.place.y),
+                });
+                view.adding = None;
+            }
         }
     }
+
     for edit in edits {
         let result = layout.edit(key, |l| match &edit {
             Edit::Place(path, at) => {
@@ -199,18 +383,49 @@ pub(super) fn canvas(
             }
             Edit::Move { from, to } => move_subtree(material, l, from, to),
             Edit::Detach(from) => detach(material, l, from),
+            Edit::Add { at, kind, place } => add_node(material, l, at, *kind).map(|()| {
+                l.set(at, *place);
+            }),
+            Edit::Duplicate { from, at, place } => {
+                duplicate(material, l, from, at).map(|()| l.set(at, *place))
+            }
         });
-        if !matches!(edit, Edit::Place(..)) {
-            view.message = result.err().map(|e| e.to_string());
+        match &edit {
+            Edit::Place(..) => {}
+            Edit::Add { at, .. } | Edit::Duplicate { at, .. } if result.is_ok() => {
+                view.selected = Some(at.clone());
+                view.message = None;
+            }
+            _ => view.message = result.err().map(|e| e.to_string()),
         }
     }
     ui.data_mut(|d| d.insert_temp(id, view));
 }
 
-/// The canvas's id for `key`'s material: its view, its nodes' heights and
-/// the nodes' ids are named under it.
-pub(super) fn canvas_id(key: MaterialKey) -> Id {
-    Id::NULL.with(("node canvas", key.to_string()))
+/// The wheel zooms about the pointer, [`WHEEL_STEP`] a notch (Blender's
+/// wheel; `egui::Scene`'s own wheel zoom takes about 1.7× a notch). The
+/// scroll is taken, so the scene does not pan with it too; a pinch is left
+/// to the scene.
+fn wheel_zoom(ui: &Ui, outer: Rect, shown: &mut Rect) {
+    let scroll = ui
+        .input_mut(|i| std::mem::take(&mut i.smooth_scroll_delta))
+        .y;
+    let Some(pointer) = ui.input(|i| i.pointer.latest_pos()) else {
+        return;
+    };
+    if scroll == 0.0 || !shown.is_positive() {
+        return;
+    }
+    let line = ui.ctx().options(|o| o.input_options.line_scroll_speed);
+    // The scene fits `shown` in `outer` at one scale, centred.
+    let scale = (outer.size() / shown.size()).min_elem();
+    let wanted = scale * WHEEL_STEP.powf(scroll / line);
+    let factor = ZOOM.start().max(wanted.min(*ZOOM.end())) / scale;
+    let fixed = shown.center() + (pointer - outer.center()) / scale;
+    *shown = Rect::from_min_max(
+        fixed + (shown.min - fixed) / factor,
+        fixed + (shown.max - fixed) / factor,
+    );
 }
 
 /// A link from an output to an input, leaving and entering horizontally.
@@ -243,29 +458,33 @@ fn socket(ui: &Ui, at: Pos2, path: &NodePath, linked: bool) {
     }
 }
 
-fn node_frame(ui: &Ui) -> Frame {
+/// A node's box; the selected node's outline in the selection colour, as
+/// Blender outlines the active node.
+fn node_frame(ui: &Ui, selected: bool) -> Frame {
+    let stroke = if selected {
+        Stroke::new(2.0, ui.visuals().selection.stroke.color)
+    } else {
+        ui.visuals().window_stroke
+    };
     Frame::new()
         .fill(ui.visuals().window_fill)
-        .stroke(ui.visuals().window_stroke)
+        .stroke(stroke)
         .corner_radius(4.0)
         .inner_margin(6.0)
 }
 
-/// A child Ui at `top_left`, clipped to the canvas.
+/// A child Ui at `top_left` (graph space).
 fn place(
     ui: &mut Ui,
-    canvas: Rect,
     top_left: Pos2,
     width: f32,
     salt: impl std::hash::Hash + std::fmt::Debug,
 ) -> Ui {
-    let mut child = ui.new_child(
+    ui.new_child(
         UiBuilder::new()
             .id_salt(salt)
             .max_rect(Rect::from_min_size(top_left, vec2(width, 4000.0))),
-    );
-    child.set_clip_rect(canvas.intersect(ui.clip_rect()));
-    child
+    )
 }
 
 fn root_label(material: &Material, root: Root) -> String {
@@ -279,29 +498,27 @@ fn root_label(material: &Material, root: Root) -> String {
 }
 
 /// The material's node at the graph's origin: a socket per tree. Returns
-/// each socket's y in graph space, for the automatic layout.
+/// each socket's y, for the automatic layout.
 fn material_node(
     ui: &mut Ui,
-    canvas: Rect,
-    origin: Pos2,
     material: &Material,
     roots: &[Root],
     sockets: &mut Sockets,
 ) -> Vec<f32> {
-    let mut child = place(ui, canvas, origin, MATERIAL_WIDTH, "material node");
+    let mut child = place(ui, Pos2::ZERO, MATERIAL_WIDTH, "material node");
     let mut ys = Vec::new();
-    node_frame(&child).show(&mut child, |ui| {
+    node_frame(&child, false).show(&mut child, |ui| {
         ui.set_width(MATERIAL_WIDTH - 12.0);
         ui.add(Label::new(egui::RichText::new("material").strong()).selectable(false));
         for &root in roots {
             let row = ui
                 .add(Label::new(root_label(material, root)).selectable(false))
                 .rect;
-            let at = pos2(origin.x, row.center().y);
+            let at = pos2(0.0, row.center().y);
             let path = NodePath::root(root);
             socket(ui, at, &path, true);
             sockets.inputs.push((path, at));
-            ys.push(row.top() - origin.y);
+            ys.push(row.top());
         }
     });
     ys
@@ -314,23 +531,22 @@ struct DrawnNode {
     height: f32,
 }
 
-/// A texture node: the header (swatch slot, pattern name; drag it to move
-/// the node; its output socket on the right), the pattern and its
-/// parameters, the image, mapping, ramp and math steps folded, and the
-/// inputs the pattern reads, each a socket with its value inline when no
-/// texture is linked.
+/// A texture node: the header (swatch, pattern name; drag it to move the
+/// node, click it to select; its output socket on the right), the pattern
+/// and its parameters, the image, mapping, ramp and math steps folded, and
+/// the inputs the pattern reads, each a socket with its value inline when
+/// no texture is linked.
 fn texture_node(
     ui: &mut Ui,
-    (canvas, canvas_id): (Rect, Id),
-    top_left: Pos2,
+    (canvas_id, top_left, selected): (Id, Pos2, bool),
     (key, path): (MaterialKey, &NodePath),
     texture: &mut Texture,
     swatch: Option<egui::TextureId>,
     sockets: &mut Sockets,
 ) -> DrawnNode {
-    let mut child = place(ui, canvas, top_left, NODE_WIDTH, ("node", path.to_string()));
+    let mut child = place(ui, top_left, NODE_WIDTH, ("node", path.to_string()));
     let id = node_id(canvas_id, path);
-    let inner = node_frame(&child).show(&mut child, |ui| {
+    let inner = node_frame(&child, selected).show(&mut child, |ui| {
         ui.set_width(NODE_WIDTH - 12.0);
         let header = ui
             .horizontal(|ui| {
@@ -404,7 +620,7 @@ fn texture_node(
     let frame = inner.response.rect;
     // The whole top row grabs the node, not only its swatch and title.
     let header = Rect::from_x_y_ranges(frame.x_range(), inner.inner.y_range());
-    let header = ui.interact(header, id.with("header"), Sense::drag());
+    let header = ui.interact(header, id.with("header"), Sense::click_and_drag());
     let output_at = pos2(frame.right(), inner.inner.center().y);
     socket(ui, output_at, path, true);
     let output = ui.interact(
@@ -417,12 +633,6 @@ fn texture_node(
         output,
         height: frame.height(),
     }
-}
-
-/// The id a node's header and output are named under, from the canvas's
-/// id and the node's path (tests find a node's header by it).
-pub(super) fn node_id(canvas: Id, path: &NodePath) -> Id {
-    canvas.with(("node", path.to_string()))
 }
 
 fn input_socket(

@@ -16,6 +16,7 @@
 //! egui-snarl 0.12.0 needs egui 0.36, egui-graph-edit 0.9.1 egui 0.35,
 //! egui_node_graph2 0.7.0 egui 0.29), and a tree needs little of them.
 
+mod add_menu;
 mod canvas;
 mod layout;
 
@@ -41,6 +42,18 @@ pub fn toggle(ui: &mut Ui, open: &mut Option<MaterialKey>, key: MaterialKey) {
     {
         *open = shown.then_some(key);
     }
+}
+
+/// Closes the node editor's Add menu if it is open (Escape, which the
+/// viewer's shortcuts take before the widgets); whether it was.
+pub fn close_menu(ctx: &Context, open: Option<MaterialKey>) -> bool {
+    let Some(key) = open else { return false };
+    let mut view = canvas::view(ctx, key);
+    let closed = view.close_menu();
+    if closed {
+        ctx.data_mut(|d| d.insert_temp(canvas::canvas_id(key), view));
+    }
+    closed
 }
 
 /// The node editor's window for the material `open` names, if any; closing
@@ -75,7 +88,8 @@ pub fn window(
 mod tests {
     use super::*;
     use glam::{Vec2, Vec3};
-    use marbre_core::scene::{Child, Ground, Pattern, Sphere, Texture};
+    use marbre_core::scene::texture_graph::texture_at;
+    use marbre_core::scene::{Child, Ground, Pattern, PatternKind, Sphere, Texture};
 
     fn scene() -> Scene {
         let checker = |a: Child, b: Child| {
@@ -192,10 +206,15 @@ mod tests {
         frame(ctx, scene, open, vec![]);
     }
 
-    /// Where a node's part (`header`, `output`) was drawn last frame.
+    /// Where a node's part (`header`, `output`) was drawn last frame, on
+    /// the screen (the canvas's layer is panned and zoomed).
     fn drawn_rect(ctx: &Context, key: MaterialKey, path: &str, part: &str) -> egui::Rect {
         let id = canvas::node_id(canvas::canvas_id(key), &path.parse().unwrap()).with(part);
-        ctx.read_response(id).expect("the node was drawn").rect
+        let response = ctx.read_response(id).expect("the node was drawn");
+        let to_screen = ctx
+            .layer_transform_to_global(response.layer_id)
+            .unwrap_or_default();
+        to_screen * response.rect
     }
 
     fn header_rect(ctx: &Context, key: MaterialKey, path: &str) -> egui::Rect {
@@ -228,15 +247,216 @@ mod tests {
             from + egui::vec2(-60.0, 40.0),
         );
         let moved = header_rect(&ctx, key, "diffuse.a");
-        assert_eq!(
-            moved.min - header.min,
-            egui::vec2(-60.0, 40.0),
+        // Within a point: the canvas's layer transform rounds.
+        let moved_by = moved.min - header.min;
+        assert!(
+            (moved_by - egui::vec2(-60.0, 40.0)).length() <= 1.5,
             "{header:?} → {moved:?}"
         );
-        assert_eq!(header_rect(&ctx, key, "diffuse"), other);
+        assert_eq!(header_rect(&ctx, key, "diffuse").min, other.min);
         let layout = scene.graph_layout.get(key).expect("a position was saved");
         assert!(layout.position(&"diffuse.a".parse().unwrap()).is_some());
         assert!(layout.position(&"diffuse".parse().unwrap()).is_none());
+    }
+
+    fn key_event(key: egui::Key, modifiers: egui::Modifiers) -> egui::Event {
+        egui::Event::Key {
+            key,
+            physical_key: None,
+            pressed: true,
+            repeat: false,
+            modifiers,
+        }
+    }
+
+    /// A context with `key`'s graph open and settled (egui sizes windows
+    /// over the first frames).
+    fn opened(scene: &mut Scene, key: MaterialKey) -> (Context, Option<MaterialKey>) {
+        let ctx = Context::default();
+        let mut open = Some(key);
+        for _ in 0..3 {
+            frame(&ctx, scene, &mut open, vec![]);
+        }
+        (ctx, open)
+    }
+
+    /// The wheel zooms about the pointer, as does a pinch: the nodes grow
+    /// on screen and the graph shows less of itself.
+    #[test]
+    fn the_wheel_and_a_pinch_zoom_the_canvas() {
+        let mut scene = scene();
+        let key = MaterialKey::Sphere(0);
+        let (ctx, mut open) = opened(&mut scene, key);
+        let before = header_rect(&ctx, key, "diffuse").width();
+        let shown = canvas::view(&ctx, key).shown.expect("a view").width();
+        let at = header_rect(&ctx, key, "diffuse").center();
+        frame(&ctx, &mut scene, &mut open, pointer(at, None));
+        for _ in 0..10 {
+            let wheel = egui::Event::MouseWheel {
+                unit: egui::MouseWheelUnit::Line,
+                delta: egui::vec2(0.0, 1.0),
+                phase: egui::TouchPhase::Move,
+                source: egui::MouseWheelSource::Unknown,
+                modifiers: egui::Modifiers::NONE,
+            };
+            frame(&ctx, &mut scene, &mut open, vec![wheel]);
+        }
+        frame(&ctx, &mut scene, &mut open, vec![]);
+        let wheeled = header_rect(&ctx, key, "diffuse").width();
+        assert!(wheeled > 1.2 * before, "{before} → {wheeled}");
+        assert!(canvas::view(&ctx, key).shown.unwrap().width() < shown / 1.2);
+        frame(&ctx, &mut scene, &mut open, vec![egui::Event::Zoom(0.5)]);
+        frame(&ctx, &mut scene, &mut open, vec![]);
+        let pinched = header_rect(&ctx, key, "diffuse").width();
+        assert!(pinched < 0.7 * wheeled, "{wheeled} → {pinched}");
+        // Nothing in the scene moved: the view is not the scene's.
+        assert_eq!(scene, self::scene());
+    }
+
+    /// Shift+A over the canvas opens the Add menu on the input nearest
+    /// the pointer; typing filters it and Enter adds the first match
+    /// there, nesting what the input held.
+    #[test]
+    fn shift_a_adds_the_searched_node_on_the_nearest_input() {
+        let mut scene = scene();
+        let key = MaterialKey::Sphere(0);
+        let (ctx, mut open) = opened(&mut scene, key);
+        // Just left of the diffuse node's `b` input: its header's left
+        // edge, some rows down.
+        let node = header_rect(&ctx, key, "diffuse");
+        let near_b = egui::pos2(node.left() - 20.0, node.bottom() + 1.0);
+        frame(&ctx, &mut scene, &mut open, pointer(near_b, None));
+        let shift = egui::Modifiers::SHIFT;
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![key_event(egui::Key::A, shift)],
+        );
+        let view = canvas::view(&ctx, key);
+        let menu_input = view
+            .adding
+            .as_ref()
+            .map(|m| &m.input)
+            .expect("the menu opened")
+            .to_string();
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![egui::Event::Text("wave".into())],
+        );
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![key_event(egui::Key::Enter, egui::Modifiers::NONE)],
+        );
+        let added = texture_at(&scene.spheres[0].material, &menu_input.parse().unwrap())
+            .expect("a node on the menu's input");
+        assert_eq!(added.pattern.kind(), PatternKind::Waves);
+        assert!(
+            canvas::view(&ctx, key)
+                .adding
+                .as_ref()
+                .map(|m| &m.input)
+                .is_none()
+        );
+        assert_eq!(
+            canvas::view(&ctx, key).selected.map(|p| p.to_string()),
+            Some(menu_input)
+        );
+    }
+
+    /// A click on a header selects the node; X deletes it, leaving a
+    /// constant of its value in its place; Shift+D puts a copy of the
+    /// selected node on the input nearest the pointer.
+    #[test]
+    fn x_deletes_the_selected_node_and_shift_d_duplicates_it() {
+        let mut scene = scene();
+        let key = MaterialKey::Sphere(0);
+        let (ctx, mut open) = opened(&mut scene, key);
+        let inner = header_rect(&ctx, key, "diffuse.a");
+        let click_at = inner.center();
+        frame(&ctx, &mut scene, &mut open, pointer(click_at, Some(true)));
+        frame(&ctx, &mut scene, &mut open, pointer(click_at, Some(false)));
+        assert_eq!(
+            canvas::view(&ctx, key).selected.map(|p| p.to_string()),
+            Some("diffuse.a".into())
+        );
+        // Duplicate with the pointer left of the roughness node.
+        let roughness = header_rect(&ctx, key, "roughness");
+        let at = egui::pos2(roughness.left() - 2.0, roughness.center().y);
+        frame(&ctx, &mut scene, &mut open, pointer(at, None));
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![key_event(egui::Key::D, egui::Modifiers::SHIFT)],
+        );
+        let checker = texture_at(&scene.spheres[0].material, &"diffuse.a".parse().unwrap())
+            .unwrap()
+            .clone();
+        // The copy is selected, on an input near the pointer, outside the
+        // original's tree.
+        let copy = canvas::view(&ctx, key)
+            .selected
+            .expect("the copy is selected");
+        assert!(!copy.to_string().starts_with("diffuse"), "{copy}");
+        assert_eq!(
+            texture_at(&scene.spheres[0].material, &copy),
+            Some(&checker)
+        );
+        // Select the original again and delete it.
+        frame(&ctx, &mut scene, &mut open, pointer(click_at, Some(true)));
+        frame(&ctx, &mut scene, &mut open, pointer(click_at, Some(false)));
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![key_event(egui::Key::X, egui::Modifiers::NONE)],
+        );
+        let m = &scene.spheres[0].material;
+        assert!(texture_at(m, &"diffuse.a".parse().unwrap()).is_none());
+        assert_eq!(
+            m.diffuse.a,
+            Child::Color(checker.eval(Vec3::ZERO, Vec2::ZERO))
+        );
+    }
+
+    /// Home frames every node: the shown rectangle holds each node's
+    /// place, and the nodes are all on screen.
+    #[test]
+    fn home_frames_all() {
+        let mut scene = scene();
+        let key = MaterialKey::Sphere(0);
+        let (ctx, mut open) = opened(&mut scene, key);
+        let window = ctx.read_response(egui::Id::NULL.with("node graph window"));
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 720.0));
+        let bump = header_rect(&ctx, key, "bump");
+        assert!(!screen.contains_rect(bump), "bump at {bump:?} before");
+        let inside = header_rect(&ctx, key, "diffuse").center();
+        frame(&ctx, &mut scene, &mut open, pointer(inside, None));
+        frame(
+            &ctx,
+            &mut scene,
+            &mut open,
+            vec![key_event(egui::Key::Home, egui::Modifiers::NONE)],
+        );
+        frame(&ctx, &mut scene, &mut open, vec![]);
+        for path in [
+            "diffuse",
+            "diffuse.a",
+            "roughness",
+            "roughness.factor",
+            "bump",
+        ] {
+            let r = header_rect(&ctx, key, path);
+            assert!(
+                screen.contains_rect(r),
+                "{path} at {r:?}, window {window:?}"
+            );
+        }
     }
 
     /// A material that is gone closes the window rather than panicking.

@@ -13,9 +13,9 @@
 
 use super::graph_layout::MaterialLayout;
 use super::material::{Material, Property};
+pub use super::node_path::{NodePath, Root, Socket};
 use super::pattern::Pattern;
 use super::pattern_table::PatternKind;
-pub use super::node_path::{NodePath, Root, Socket};
 use super::texture_tree::{Child, Texture};
 use glam::{Vec2, Vec3};
 use std::fmt;

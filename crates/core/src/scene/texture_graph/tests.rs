@@ -405,7 +405,13 @@ fn an_added_node_nests_what_its_input_held() {
 fn an_added_node_on_a_value_or_a_root_keeps_it() {
     let mut m = material();
     let mut layout = MaterialLayout::default();
-    add_node(&mut m, &mut layout, &path("diffuse.b"), PatternKind::Checker).unwrap();
+    add_node(
+        &mut m,
+        &mut layout,
+        &path("diffuse.b"),
+        PatternKind::Checker,
+    )
+    .unwrap();
     let added = texture_at(&m, &path("diffuse.b")).unwrap();
     assert_eq!(added.a, Child::Color(Vec3::Z));
     assert_ne!(added.b, added.a);
