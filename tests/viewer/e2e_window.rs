@@ -43,12 +43,14 @@ const HEADER_STEP: i32 = 23;
 /// (seconds on lavapipe), and each frame takes about a second.
 pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(60);
 
-/// Mean luma (0..1) and mean blue-minus-red of the image's central
-/// quarter, the luma of its top-left corner (background), and the mean
-/// luma of its top sixth (which view of a scene is shown).
+/// Mean luma (0..1), its standard deviation (a pattern) and mean
+/// blue-minus-red of the image's central quarter, the luma of its top-left
+/// corner (background), and the mean luma of its top sixth (which view of
+/// a scene is shown).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Look {
     pub(crate) centre_luma: f64,
+    pub(crate) centre_spread: f64,
     pub(crate) centre_blue_excess: f64,
     pub(crate) corner_luma: f64,
     pub(crate) top_luma: f64,
@@ -59,6 +61,7 @@ fn look(path: &Path) -> Look {
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .to_rgb8();
     let (w, h) = image.dimensions();
+    let luma = |rgb: [f64; 3]| 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
     let mean = |xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
         let (mut n, mut rgb) = (0.0, [0.0f64; 3]);
         for y in ys {
@@ -72,12 +75,23 @@ fn look(path: &Path) -> Look {
         }
         rgb.map(|c| c / n)
     };
-    let luma = |rgb: [f64; 3]| 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-    let centre = mean(w * 3 / 8..w * 5 / 8, h * 3 / 8..h * 5 / 8);
+    let (xs, ys) = (w * 3 / 8..w * 5 / 8, h * 3 / 8..h * 5 / 8);
+    let centre = mean(xs.clone(), ys.clone());
+    let lumas: Vec<f64> = ys
+        .flat_map(|y| xs.clone().map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let p = image.get_pixel(x, y);
+            luma(p.0.map(|c| f64::from(c) / 255.0))
+        })
+        .collect();
+    let centre_mean = lumas.iter().sum::<f64>() / lumas.len() as f64;
+    let centre_spread =
+        (lumas.iter().map(|l| (l - centre_mean).powi(2)).sum::<f64>() / lumas.len() as f64).sqrt();
     let corner = mean(0..w / 10, 0..h / 10);
     let top = mean(0..w, 0..h / 6);
     Look {
         centre_luma: luma(centre),
+        centre_spread,
         centre_blue_excess: centre[2] - centre[0],
         corner_luma: luma(corner),
         top_luma: luma(top),

@@ -1,5 +1,5 @@
 //! The viewer's tests under Xvfb: the window (`window`), a user's session
-//! driven end to end (`e2e_window`), OBJ files opened as scenes
+//! driven end to end (`e2e_window`), the node editor (`node_window`), OBJ files opened as scenes
 //! (`obj_window`), the guards on the user's work (`work_at_risk`) and the
 //! soak (`soak`), each running the `marbre` binary
 //! on lavapipe. `xvfb` starts the display and drives it. `render_cli` runs
@@ -9,6 +9,7 @@
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
 mod e2e_window;
+mod node_window;
 mod obj_window;
 mod render_cli;
 mod render_window;
