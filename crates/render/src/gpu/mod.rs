@@ -20,7 +20,7 @@ pub(crate) mod twin_layout;
 
 pub use passes::{
     accumulation, auto_exposure, bake, denoise, error_meter, metering_grid, non_finite, pass_timer,
-    swatch, trace_bands, trace_pass,
+    preview_ladder, swatch, trace_bands, trace_pass,
 };
 pub use shader::{
     features, pipeline_build, pipelines, preprocess, shader_source, texture_codegen, texture_params,

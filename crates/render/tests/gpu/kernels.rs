@@ -532,6 +532,65 @@ fn a_preview_shows_first_and_the_full_image_follows() {
     }
 }
 
+/// With a budget of a 64th of a round, a fresh accumulation refines: an
+/// eighth-scale preview after the first call, then a quarter, then a half
+/// (each traced in bands and shown when whole, never samples), then the
+/// full image, which equals a whole-pass accumulation of the same rounds
+/// (the previews leave the seeds alone) on both kernels.
+#[test]
+fn previews_refine_in_steps_before_the_first_round() {
+    let Some(ctx) = gpu_with_compute("previews_refine_in_steps_before_the_first_round") else {
+        return;
+    };
+    let loaded = preset("default.ron");
+    let full = SIZE;
+    let round = u64::from(full.0) * u64::from(full.1);
+    for kernel in Kernel::ALL {
+        let mut r = renderer_with(&ctx, &loaded, full, kernel).unwrap();
+        let mut shown = vec![];
+        let mut rounds = 0;
+        for _ in 0..400 {
+            rounds += trace_within(&ctx, &mut r, round / 64).rounds;
+            if rounds > 0 {
+                break;
+            }
+            assert_eq!(
+                r.accumulated_samples(),
+                0,
+                "{kernel}: a preview is not samples"
+            );
+            let size = r.shown_size();
+            if shown.last() != Some(&size) {
+                let preview = read(&ctx, &r);
+                assert_eq!(preview.size, size, "{kernel}");
+                assert!(
+                    preview.mean.iter().all(|p| p.iter().all(|c| c.is_finite())),
+                    "{kernel}: non-finite preview at {size:?}"
+                );
+                assert!(
+                    preview.mean.iter().any(|p| p[..3].iter().any(|&c| c > 0.0)),
+                    "{kernel}: black preview at {size:?}"
+                );
+                shown.push(size);
+            }
+        }
+        assert_eq!(shown, [(8, 6), (15, 11), (30, 22)], "{kernel}");
+        assert_eq!(r.shown_size(), full, "{kernel}");
+        while rounds < 2 {
+            rounds += trace_within(&ctx, &mut r, round / 64).rounds;
+        }
+        let banded = read(&ctx, &r);
+        let whole = whole_pass_from_frame(&ctx, &loaded, kernel, 0, rounds);
+        let inexact = assert_same_image(
+            &format!("{kernel}, after the previews"),
+            &banded,
+            &whole,
+            |_| 0.0,
+        );
+        assert_eq!(inexact, 0, "{kernel}");
+    }
+}
+
 /// Switching the kernel mid-accumulation (mid-round, even) keeps the
 /// rounds traced, as the viewer's auto kernel choice lands a few seconds
 /// after the first image (which it must not throw away), and traces the

@@ -17,6 +17,7 @@
 //! is complete. So the window always shows a whole image: the last
 //! complete round, or the preview of a new accumulation at a reduced size.
 
+use super::preview_ladder::Previews;
 use std::time::{Duration, Instant};
 
 /// The format of both targets: linear radiance needs floats, and the
@@ -94,8 +95,8 @@ pub struct Accumulation {
     /// The size of the traced region the latest set holds: the display's
     /// source, which may be a preview at a reduced size.
     shown_size: (u32, u32),
-    /// Whether this accumulation's preview is done (or was not needed).
-    previewed: bool,
+    /// Where this accumulation's previews stand (`preview_ladder`).
+    previews: Previews,
     /// Images shown so far (rounds and previews): what auto exposure
     /// metered is compared with it.
     shown_count: u32,
@@ -122,7 +123,7 @@ impl Accumulation {
             frames: 0,
             next_row: 0,
             shown_size: (size.0.max(1), size.1.max(1)),
-            previewed: false,
+            previews: Previews::default(),
             shown_count: 0,
             started: Instant::now(),
             generation: 0,
@@ -178,7 +179,7 @@ impl Accumulation {
         self.samples = 0;
         self.frames = 0;
         self.next_row = 0;
-        self.previewed = false;
+        self.previews = Previews::default();
     }
 
     /// Targets of another `size`, empty: a new accumulation, the next
@@ -227,25 +228,25 @@ impl Accumulation {
         self.shown_size
     }
 
-    /// Whether the next round should first show a preview: a new
-    /// accumulation that has neither a round nor its preview yet.
-    pub fn wants_preview(&self) -> bool {
-        !self.previewed && self.frames == 0 && self.next_row == 0
+    /// Where the previews stand: none are due once a round is done.
+    pub fn previews(&self) -> Previews {
+        self.previews
+    }
+
+    /// Where the previews stand after a call's passes.
+    pub fn set_previews(&mut self, previews: Previews) {
+        self.previews = previews;
     }
 
     /// Records that the write set now holds a preview of `size` (a whole
-    /// round at a reduced size, not counted as samples): it becomes the
-    /// latest, what the display shows until the first real round is done.
+    /// image at a reduced size, not counted as samples): it becomes the
+    /// latest, what the display shows until a finer preview or the first
+    /// real round is done.
     pub fn show_preview(&mut self, size: (u32, u32)) {
         self.shown_count = self.shown_count.wrapping_add(1);
         self.latest = 1 - self.latest;
         self.shown_size = size;
-        self.previewed = true;
-    }
-
-    /// Skips the preview: the first round fits in one frame.
-    pub fn skip_preview(&mut self) {
-        self.previewed = true;
+        self.next_row = 0;
     }
 
     pub fn generation(&self) -> u32 {
@@ -336,7 +337,7 @@ impl Accumulation {
         self.latest = 1 - self.latest;
         self.shown_size = size;
         self.next_row = 0;
-        self.previewed = true;
+        self.previews.done = true;
         self.samples = self.samples.saturating_add(samples);
         self.frames = self.frames.saturating_add(1);
     }

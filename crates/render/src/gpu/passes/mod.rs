@@ -12,6 +12,7 @@ pub mod error_meter;
 pub mod metering_grid;
 pub mod non_finite;
 pub mod pass_timer;
+pub mod preview_ladder;
 pub mod swatch;
 pub mod trace_bands;
 pub mod trace_pass;

@@ -4,15 +4,16 @@
 
 use super::display_stage::DisplayUniform;
 use super::trace_stage::{FRAME_BYTES, FRAME_SLOTS, frame_stride};
-use super::{DisplayTarget, MeteredFrom, Renderer, TraceWork, bind, pixel_count, scaled};
+use super::{DisplayTarget, MeteredFrom, Renderer, TraceWork, bind};
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
 use crate::gpu::pipelines::fullscreen_pipeline;
+use crate::gpu::preview_ladder;
 use crate::gpu::scene_gpu::Frame;
 use crate::gpu::trace_bands::TraceBudget;
 use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
-use crate::gpu::{non_finite, scene_gpu, trace_bands};
+use crate::gpu::{non_finite, scene_gpu};
 use anyhow::Result;
 use marbre_core::scene::{Metering, ToneMap};
 use marbre_core::tile::Tile;
@@ -128,12 +129,13 @@ impl Renderer {
         self.trace_within(ctx, encoder, TraceBudget::Round, timestamps)
     }
 
-    /// Records about `budget` of tracing (see [`trace_bands::plan`]): the
+    /// Records about `budget` of tracing (see [`crate::gpu::trace_bands::plan`]): the
     /// round under way continues where it stopped, and a round completed
     /// becomes the image. A new accumulation whose first round does not
-    /// fit in the budget first traces a preview whole, at the size that
-    /// fits (at most the interactive scale): the window shows the edit at
-    /// once, at a reduced resolution, then the full one.
+    /// fit in the budget first shows previews ([`preview_ladder`]): the
+    /// largest that fits at once, then finer ones, each twice the scale
+    /// (at most the interactive scale): the window shows the edit at once
+    /// and refines it, then the full resolution follows.
     pub fn trace_within(
         &mut self,
         ctx: &GpuContext,
@@ -142,51 +144,45 @@ impl Renderer {
         timestamps: Option<PassTimestamps<'_>>,
     ) -> TraceWork {
         if !self.scene.render.accumulate && self.accumulation.next_row() == 0 {
-            // Each round starts anew; the preview was for the first.
-            let previewed = !self.accumulation.wants_preview();
+            // Each round starts anew; the previews were for the first.
+            let previews = self.accumulation.previews();
             self.accumulation.reset();
-            if previewed {
-                self.accumulation.skip_preview();
-            }
+            self.accumulation.set_previews(previews);
         }
-        let full = self.render_size();
-        // Each pass: the region's size, the band's rows, whether a preview.
-        let mut passes: Vec<((u32, u32), std::ops::Range<u32>, bool)> = Vec::new();
-        let mut budget = budget;
-        if let TraceBudget::Pixels(pixels) = budget
-            && self.accumulation.wants_preview()
-        {
-            let round = u64::from(full.0) * u64::from(full.1);
-            if round > pixels {
-                let scale = ((pixels as f64 / round as f64).sqrt() as f32)
-                    .min(self.scene.render.interactive_scale);
-                let size = scaled(full, scale);
-                passes.push((size, 0..size.1, true));
-                budget = TraceBudget::Pixels(pixels.saturating_sub(pixel_count(size)));
-            } else {
-                self.accumulation.skip_preview();
-            }
-        }
-        let bands = trace_bands::plan(full.0, full.1, self.accumulation.next_row(), budget);
-        passes.extend(bands.into_iter().map(|rows| (full, rows, false)));
+        let plan = preview_ladder::plan(
+            self.render_size(),
+            self.accumulation.next_row(),
+            budget,
+            self.accumulation.previews(),
+            self.scene.render.interactive_scale,
+        );
         let mut work = TraceWork::default();
-        let count = passes.len();
-        for (index, (size, rows, preview)) in passes.into_iter().enumerate() {
-            if index > 0 && !preview && rows.start == 0 && !self.scene.render.accumulate {
+        let count = plan.passes.len();
+        for (index, pass) in plan.passes.into_iter().enumerate() {
+            let (size, rows) = (pass.size, pass.rows);
+            if index > 0
+                && pass.preview.is_none()
+                && rows.start == 0
+                && !self.scene.render.accumulate
+            {
                 // A later round of this call: it too starts anew.
                 self.accumulation.reset();
-                self.accumulation.skip_preview();
+                self.accumulation.set_previews(plan.previews);
             }
             if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
                 self.non_finite.clear(encoder);
             }
             self.record_band(ctx, encoder, size, rows.clone(), (index, count), timestamps);
             work.pixels += u64::from(size.0) * u64::from(rows.end - rows.start);
-            if preview {
-                // The preview draws the first round's samples at its own
+            if pass.preview.is_some() {
+                // A preview draws the first round's samples at its own
                 // size: the frame index (the seed) stays, so the image
                 // that follows is the one a whole pass gives.
-                self.accumulation.show_preview(size);
+                if rows.end == size.1 {
+                    self.accumulation.show_preview(size);
+                } else {
+                    self.accumulation.traced_to(rows.end);
+                }
                 continue;
             }
             self.accumulation.traced_to(rows.end);
@@ -195,6 +191,9 @@ impl Renderer {
                 self.frame_index = self.frame_index.wrapping_add(1);
                 work.rounds += 1;
             }
+        }
+        if self.accumulation.frames() == 0 {
+            self.accumulation.set_previews(plan.previews);
         }
         self.non_finite
             .record_readback(encoder, self.accumulation.generation());

@@ -200,7 +200,7 @@ impl Renderer {
 
     /// The size actually traced: the target size times the render scale.
     pub fn render_size(&self) -> (u32, u32) {
-        scaled(self.size, self.render_scale)
+        crate::gpu::preview_ladder::scaled(self.size, self.render_scale)
     }
 
     /// The size of the image on show: the last complete round's traced
@@ -219,16 +219,6 @@ impl Renderer {
     pub fn accumulation_generation(&self) -> u32 {
         self.accumulation.generation()
     }
-}
-
-/// `size` scaled by `scale`, at least one pixel a side.
-fn scaled(size: (u32, u32), scale: f32) -> (u32, u32) {
-    let s = |v: u32| ((v as f32 * scale).ceil() as u32).clamp(1, v.max(1));
-    (s(size.0), s(size.1))
-}
-
-fn pixel_count(size: (u32, u32)) -> u64 {
-    u64::from(size.0) * u64::from(size.1)
 }
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {

@@ -59,7 +59,7 @@ pub(super) struct TraceStage {
 }
 
 /// Frame uniforms in the ring: more than the passes of one submit
-/// ([`trace_bands::MAX_PASSES`] and a preview).
+/// ([`trace_bands::MAX_PASSES`] and the previews, a few).
 pub(super) const FRAME_SLOTS: u64 = 2 * trace_bands::MAX_PASSES as u64;
 
 /// The bytes of one frame-uniform slot: two copies of the settings (see
