@@ -5,12 +5,19 @@
 //! frame of a drag takes in the viewer. The GPU is not waited on: this is
 //! the render thread's own cost, which a timeline animating a parameter
 //! would pay every frame.
+//!
+//! `--structural` times instead what a user waits for after a structural
+//! edit (a pattern switched, as the node editor's Add or the tree panel's
+//! pattern list do): the new pipeline built on its worker thread, then
+//! frames of the viewer's budget traced until the first preview, a
+//! preview at 0.4 of the render size or finer (`preview_ladder`'s last
+//! steps) and the full round show.
 
 use anyhow::{Result, ensure};
 use clap::Args;
-use marbre_core::scene::{Child, Scene, Texture};
-use marbre_render::gpu::Kernel;
+use marbre_core::scene::{Child, PatternKind, Scene, Texture};
 use marbre_render::gpu::{GpuContext, Renderer};
+use marbre_render::gpu::{Kernel, TraceBudget};
 use marbre_render::session::{load_scene, renderer_with};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,6 +30,17 @@ pub struct EditBenchArgs {
     /// Edits timed per kind, interleaved.
     #[arg(long, default_value_t = 300)]
     pub steps: u32,
+    /// Time structural edits to their previews instead (this many edits,
+    /// at the render size `--size`).
+    #[arg(long)]
+    pub structural: bool,
+    /// The render size of `--structural`: the viewer's default image.
+    #[arg(long, default_value = "884x575", value_parser = crate::render::parse_size)]
+    pub size: (u32, u32),
+    /// The trace time per frame of `--structural`, as the viewer's
+    /// `--frame-budget-ms`.
+    #[arg(long, default_value_t = 12.0)]
+    pub frame_budget_ms: f32,
 }
 
 /// The edits a drag makes, one step at a time.
@@ -96,6 +114,9 @@ fn edit_first_texture(scene: &mut Scene, edit: &mut dyn FnMut(&mut Texture) -> b
 
 pub fn run(args: &EditBenchArgs) -> Result<()> {
     ensure!(args.steps > 0, "--steps must be at least 1");
+    if args.structural {
+        return structural(args);
+    }
     let ctx = GpuContext::headless()?;
     let loaded = load_scene(&args.preset, None)?;
     let mut renderer = renderer_with(&ctx, &loaded, (64, 36), Kernel::Fragment)?;
@@ -139,4 +160,105 @@ fn hand_over(ctx: &GpuContext, renderer: &mut Renderer, scene: &Scene) -> Result
         result?;
     }
     Ok(())
+}
+
+/// Milliseconds from a structural edit to each stage the window shows.
+#[derive(Debug, Default, Clone, Copy)]
+struct Waited {
+    build: f64,
+    first_preview: f64,
+    fine_preview: f64,
+    full_round: f64,
+}
+
+/// `--structural`: switches the first pattern between two kinds, each
+/// switch a new pipeline, and traces the viewer's frames until the full
+/// round shows, noting when each stage appeared.
+fn structural(args: &EditBenchArgs) -> Result<()> {
+    let ctx = GpuContext::headless()?;
+    let loaded = load_scene(&args.preset, None)?;
+    let mut renderer = renderer_with(&ctx, &loaded, args.size, Kernel::Fragment)?;
+    println!("adapter: {}", ctx.describe());
+    println!(
+        "preset: {}, {}x{}, {} ms of tracing a frame",
+        args.preset.display(),
+        args.size.0,
+        args.size.1,
+        args.frame_budget_ms
+    );
+    // A whole round, for the cost of a pixel (the viewer learns it from
+    // its frames' timestamps).
+    let start = Instant::now();
+    frame(&ctx, &mut renderer, TraceBudget::Round);
+    let round_ms = start.elapsed().as_secs_f64() * 1000.0;
+    let pixels = u64::from(args.size.0) * u64::from(args.size.1);
+    let budget = (pixels as f64 * f64::from(args.frame_budget_ms) / round_ms).max(1.0) as u64;
+    println!("one round: {round_ms:.0} ms, so {budget} pixels a frame");
+    let mut scene = loaded.scene.clone();
+    let kinds = [PatternKind::Waves, PatternKind::Checker];
+    let mut waits = Vec::new();
+    for i in 0..args.steps as usize {
+        ensure!(
+            edit_first_texture(&mut scene, &mut |t| {
+                t.pattern = t.pattern.with_kind(kinds[i % 2]);
+                true
+            }),
+            "{}: no texture node to switch",
+            args.preset.display()
+        );
+        let edited = Instant::now();
+        let ms = || edited.elapsed().as_secs_f64() * 1000.0;
+        hand_over(&ctx, &mut renderer, &scene)?;
+        let mut waited = Waited::default();
+        while renderer.is_building() {
+            if let Some(result) = renderer.poll_build(&ctx) {
+                result?;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        waited.build = ms();
+        let full = renderer.render_size();
+        while renderer.accumulated_samples() == 0 {
+            frame(&ctx, &mut renderer, TraceBudget::Pixels(budget));
+            let shown = renderer.shown_size();
+            if waited.first_preview == 0.0 {
+                waited.first_preview = ms();
+            }
+            if waited.fine_preview == 0.0 && 5 * shown.0 >= 2 * full.0 {
+                waited.fine_preview = ms();
+            }
+        }
+        waited.full_round = ms();
+        waits.push(waited);
+    }
+    let median = |f: fn(&Waited) -> f64| {
+        let mut v: Vec<f64> = waits.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    println!(
+        "{:<44} {:>10}",
+        format!("structural edit, median of {}", waits.len()),
+        "ms"
+    );
+    for (what, f) in [
+        (
+            "new pipeline built",
+            (|w: &Waited| w.build) as fn(&Waited) -> f64,
+        ),
+        ("first preview shown", |w| w.first_preview),
+        ("a preview at 0.4 scale or finer shown", |w| w.fine_preview),
+        ("the full round shown", |w| w.full_round),
+    ] {
+        println!("{what:<44} {:>10.0}", median(f));
+    }
+    Ok(())
+}
+
+/// Traces one frame of `budget` and waits for the GPU.
+fn frame(ctx: &GpuContext, renderer: &mut Renderer, budget: TraceBudget) {
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    renderer.trace_within(ctx, &mut encoder, budget, None);
+    ctx.queue.submit([encoder.finish()]);
+    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
 }
