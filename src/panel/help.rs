@@ -68,13 +68,30 @@ pub const SHORTCUTS: &[Shortcut] = &[
     },
     Shortcut {
         keys: "Esc",
-        action: "Close this help, Save as, or a question (its cautious answer)",
+        action: "Close this help, Save as, the node editor's Add menu, or a question (its cautious answer)",
+    },
+    Shortcut {
+        keys: "Shift+A",
+        action: "Node editor (pointer over it): add a node, searched by name, on the nearest input",
+    },
+    Shortcut {
+        keys: "X / Delete",
+        action: "Node editor: delete the selected node (a constant of its value stays)",
+    },
+    Shortcut {
+        keys: "Shift+D",
+        action: "Node editor: put a copy of the selected node on the input nearest the pointer",
+    },
+    Shortcut {
+        keys: "Home",
+        action: "Node editor: frame every node",
     },
 ];
 
 /// What the mouse does over the image (see `app::camera_input`).
-const MOUSE_CONTROLS: &str =
-    "Mouse over the image: left drag orbits, right or middle drag pans, the wheel zooms.";
+const MOUSE_CONTROLS: &str = "Mouse over the image: left drag orbits, right or middle drag pans, \
+     the wheel zooms. In the node editor: drag a header to move a node, the background to pan; \
+     the wheel or a pinch zooms; right-click adds a node.";
 
 /// Why some keys do nothing at times (see `app::shortcuts`).
 const TYPING_NOTE: &str = "While a text field has the keyboard, only the F keys, Esc and the \
@@ -137,8 +154,8 @@ mod tests {
                 );
             }
         }
-        // Redo's two combinations count separately.
-        assert_eq!(seen.len(), SHORTCUTS.len() + 1);
+        // Redo's and delete's two combinations count separately.
+        assert_eq!(seen.len(), SHORTCUTS.len() + 2);
     }
 
     /// The text of every text shape in a frame's output.
