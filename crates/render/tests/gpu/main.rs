@@ -13,6 +13,7 @@ mod bake;
 mod bvh;
 mod chi2;
 mod common;
+mod course_looks;
 mod cubemap;
 mod denoise;
 mod diffuse_transmission;
