@@ -4,8 +4,8 @@
 //! that the command and the fuzz targets read the same way.
 
 use crate::scene::{
-    Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere, Texture,
-    ToneMap,
+    Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere,
+    Texture, ToneMap,
 };
 use crate::tx;
 use glam::Vec3;

@@ -458,7 +458,10 @@ mod tests {
                 .sum::<f32>()
                 / n as f32;
             let want = mean_abs_noise(kind);
-            assert!((mean - want).abs() < 0.01, "{kind:?}: measured {mean}, constant {want}");
+            assert!(
+                (mean - want).abs() < 0.01,
+                "{kind:?}: measured {mean}, constant {want}"
+            );
         }
     }
 

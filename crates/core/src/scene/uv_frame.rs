@@ -67,7 +67,9 @@ mod tests {
         };
         assert_eq!(frame.problem(), None);
         assert_eq!(frame.problem_on_plane(Vec3::Y), None);
-        let problem = frame.problem_on_plane(Vec3::Z).expect("degenerate on z = const");
+        let problem = frame
+            .problem_on_plane(Vec3::Z)
+            .expect("degenerate on z = const");
         assert!(problem.contains("one colour"), "{problem}");
     }
 }
