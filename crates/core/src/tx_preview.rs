@@ -38,6 +38,7 @@ pub fn preview_scene(doc: &tx::Document, base_dir: &Path) -> Result<Scene, tx::T
             yaw_degrees: 0.0,
             pitch_degrees: 12.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         spheres: vec![Sphere {
             name: "sphere".into(),

@@ -26,7 +26,7 @@ mod time;
 pub mod transport;
 pub mod uv_frame;
 
-pub use camera::{OrbitCamera, SavedView};
+pub use camera::{OrbitCamera, Projection, SavedView};
 pub use change::Change;
 pub use color_encoding::ColorEncoding;
 pub use environment::{EnvSource, Environment};

@@ -30,6 +30,7 @@ mod light_transport;
 mod noise_stability;
 mod non_finite;
 mod offscreen;
+mod orthographic;
 mod presets;
 mod report_frames;
 mod sampling_stability;
