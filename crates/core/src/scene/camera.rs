@@ -223,6 +223,28 @@ impl OrbitCamera {
 mod tests {
     use super::*;
 
+    /// A perspective ray leaves the camera through its pixel; orthographic
+    /// rays run along the view, parallel, from the pixel's place on a
+    /// plane through the camera as high as the view at the target.
+    #[test]
+    fn camera_rays_by_projection() {
+        let mut camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 4.0,
+            pitch_degrees: 0.0,
+            fov_degrees: 90.0,
+            ..OrbitCamera::default()
+        };
+        let corner = glam::Vec2::new(1.0, 1.0);
+        let (o, d) = camera.frame().ray(corner, 2.0);
+        assert_eq!(o, Vec3::new(0.0, 0.0, 4.0));
+        assert!((d - Vec3::new(2.0, 1.0, -1.0).normalize()).length() < 1e-6);
+        camera.projection = Projection::Orthographic;
+        let (o, d) = camera.frame().ray(corner, 2.0);
+        assert!((o - Vec3::new(8.0, 4.0, 4.0)).length() < 1e-5, "{o}");
+        assert!((d - Vec3::NEG_Z).length() < 1e-6);
+    }
+
     #[test]
     fn frame_is_orthonormal_and_looks_at_the_target() {
         let mut c = OrbitCamera::default();

@@ -145,8 +145,15 @@ fn massal_page3_shows_the_environment_as_one_colour() {
         accumulate(&ctx, &mut r, 4, |_| {}).unwrap();
         let (_, _, pixels) = r.read_radiance(&ctx).unwrap();
         let (w, h) = size;
-        [(0, 0), (w - 1, 0), (0, h - 1), (w - 1, h - 1), (w / 2, 0), (0, h / 2)]
-            .map(|(x, y)| pixels[(y * w + x) as usize])
+        [
+            (0, 0),
+            (w - 1, 0),
+            (0, h - 1),
+            (w - 1, h - 1),
+            (w / 2, 0),
+            (0, h / 2),
+        ]
+        .map(|(x, y)| pixels[(y * w + x) as usize])
     };
     let ortho = background(Projection::Orthographic);
     for p in &ortho[1..] {
