@@ -32,7 +32,8 @@ struct Frame {
     has_ground: u32,
     cylinder_count: u32,
     polygon_count: u32,
-    // The angle a pixel subtends at the camera: the spread of ray cones.
+    // The angle a pixel subtends at the camera: the spread of ray cones (0
+    // for an orthographic camera, whose rays are parallel).
     pixel_spread: f32,
     // Non-zero: sample the environment map by its luminance (MIS).
     env_sampling: u32,
@@ -70,6 +71,8 @@ struct Frame {
     // The ground's (u, v) frame (Rust: Ground::frame): world (x, z) is the
     // frame at the origin on +x and +z.
     ground_uv_origin: vec3f,
+    // An orthographic camera's half-height in scene units; 0: perspective.
+    ortho_half_height: f32,
     ground_uv_u: vec3f,
     ground_uv_v: vec3f,
     // A crop of a larger image (render --tile): the targets hold the

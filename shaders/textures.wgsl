@@ -83,12 +83,14 @@ fn material_signals(material: u32, p: vec3f, pw: vec3f, width: f32) -> vec4f {
     let first_perlin = min(materials[material].first_perlin, count);
 #if NOISE_GRADIENT
     for (var k = 0u; k < first_perlin; k++) {
-        values[k] = fractal_sum_gradient(signal_point(material, k, p, pw), signal_params(material, k, width));
+        let n = signal_params(material, k, width);
+        values[k] = fractal_sum_gradient(signal_point(material, k, p, pw), n) + dropped_mean(material, k, n);
     }
 #endif
 #if NOISE_PERLIN
     for (var k = first_perlin; k < count; k++) {
-        values[k] = fractal_sum_perlin(signal_point(material, k, p, pw), signal_params(material, k, width));
+        let n = signal_params(material, k, width);
+        values[k] = fractal_sum_perlin(signal_point(material, k, p, pw), n) + dropped_mean(material, k, n);
     }
 #endif
     return values;
@@ -104,6 +106,16 @@ fn signal_params(material: u32, k: u32, width: f32) -> NoiseParams {
     }
 #endif
     return n;
+}
+
+// What signal k's octaves dropped by `signal_params` (leaving `kept`'s)
+// add on average.
+fn dropped_mean(material: u32, k: u32, kept: NoiseParams) -> f32 {
+#if FOOTPRINT
+    return dropped_octaves_mean(materials[material].signals[k], kept.octaves);
+#else
+    return 0.0;
+#endif
 }
 
 // Where signal k of a material is taken: its mapping of the object point p

@@ -67,13 +67,25 @@ var<private> sample_albedo: vec3f;
 var<private> sample_normal: vec3f;
 #endif
 
-// `pixel`: a position in the whole image (a crop's target pixel plus its
-// origin).
-fn camera_ray(pixel: vec2f) -> vec3f {
+struct CameraRay {
+    origin: vec3f,
+    d: vec3f,
+}
+
+// The camera ray through `pixel`, a position in the whole image (a crop's
+// target pixel plus its origin): from the camera through the pixel, or
+// for an orthographic camera along the view from the pixel's place on the
+// camera's plane. CPU twin: CameraFrame::ray.
+fn camera_ray(pixel: vec2f) -> CameraRay {
     let ndc = vec2f(pixel.x / frame.image_size.x * 2.0 - 1.0, 1.0 - pixel.y / frame.image_size.y * 2.0);
+    if frame.ortho_half_height > 0.0 {
+        let h = frame.ortho_half_height;
+        let origin = frame.cam_pos + ndc.x * h * frame.aspect * frame.cam_right + ndc.y * h * frame.cam_up;
+        return CameraRay(origin, frame.cam_forward);
+    }
     let x = ndc.x * frame.tan_half_fov * frame.aspect;
     let y = ndc.y * frame.tan_half_fov;
-    return normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up);
+    return CameraRay(frame.cam_pos, normalize(frame.cam_forward + x * frame.cam_right + y * frame.cam_up));
 }
 
 // Which side of the surface a direction `wi` leaves on: 1 along the
@@ -199,8 +211,9 @@ const FINAL_VERTEX_PASS: u32 = 0u;
 // would cost one more pass, under an empty mask, after the last bounce
 // (measured: 11 % of the default preset's frame).
 fn trace_path(pixel: vec2f) -> vec3f {
-    var d = camera_ray(pixel);
-    var hit = intersect_scene(frame.cam_pos, d);
+    let camera = camera_ray(pixel);
+    var d = camera.d;
+    var hit = intersect_scene(camera.origin, d);
     var throughput = vec3f(1.0);
     var radiance = vec3f(0.0);
     // Whether the path is still going: it ends by escaping or by absorption.
@@ -210,15 +223,17 @@ fn trace_path(pixel: vec2f) -> vec3f {
     var crossings = 0u;
     // The ray cone's width where the current ray starts: it grows by the
     // pixel's spread per unit of distance, bounce after bounce (no
-    // curvature term, so a mirror keeps it as the camera made it).
-    var cone_width = 0.0;
+    // curvature term, so a mirror keeps it as the camera made it). A
+    // perspective cone starts at a point; an orthographic one, whose rays
+    // do not spread, as wide as a pixel on the camera's plane.
+    var cone_width = 2.0 * frame.ortho_half_height / frame.image_size.y;
     // The continuous density of the last bounce's direction (0 for the
     // camera ray and mirror bounces): an escape or an emitter reached
     // weighs it against light sampling.
     var last_bsdf_pdf = 0.0;
     // Where the path last scattered: light sampling's density for the
     // emitter a bounce reaches is measured from there.
-    var scatter_point = frame.cam_pos;
+    var scatter_point = camera.origin;
 #if DENOISE_GUIDES
     sample_albedo = vec3f(0.0);
     sample_normal = vec3f(0.0);

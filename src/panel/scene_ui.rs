@@ -9,7 +9,7 @@ use super::widgets::{labelled_color, slider, uv_frame_ui, vec3_field, vec3_ui};
 use egui::{CollapsingHeader, Ui};
 use marbre_core::animation::ParamPath;
 use marbre_core::bake::{BakeProperty, ObjectRef};
-use marbre_core::scene::{Ground, MaterialKey, OrbitCamera, PointLight, Scene};
+use marbre_core::scene::{Ground, MaterialKey, OrbitCamera, PointLight, Projection, Scene};
 
 /// One collapsible block per object (spheres, cylinders, polygons), then
 /// the ground. Only the first is open at start, so a scene with many
@@ -257,6 +257,21 @@ pub(super) fn camera_ui(ui: &mut Ui, scene: &mut Scene, actions: &mut Vec<PanelA
         ui.add(slider(v, 10.0..=120.0, "field of view").suffix("°"))
     })
     .on_hover_text("Vertical field of view");
+    egui::ComboBox::new("projection", "projection")
+        .selected_text(camera.projection.label())
+        .show_ui(ui, |ui| {
+            for p in Projection::ALL {
+                ui.selectable_value(&mut camera.projection, p, p.label())
+                    .on_hover_text(match p {
+                        Projection::Perspective => "Rays from the camera: far things look smaller",
+                        Projection::Orthographic => {
+                            "Parallel rays (Massal's figures): size does not change with \
+                             depth; the view is as high as the perspective one at the \
+                             target, and the distance zooms"
+                        }
+                    });
+            }
+        });
     if ui
         .button("Reset")
         .on_hover_text("Back to the preset's camera")

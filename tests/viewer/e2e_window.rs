@@ -45,15 +45,15 @@ pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// Mean luma (0..1), its standard deviation (a pattern) and mean
 /// blue-minus-red of the image's central quarter, the luma of its top-left
-/// corner (background), and the mean luma of its top sixth (which view of
-/// a scene is shown).
+/// corner (background), and the mean blue-minus-red of its top sixth
+/// (which view of a scene is shown).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Look {
     pub(crate) centre_luma: f64,
     pub(crate) centre_spread: f64,
     pub(crate) centre_blue_excess: f64,
     pub(crate) corner_luma: f64,
-    pub(crate) top_luma: f64,
+    pub(crate) top_blue_excess: f64,
 }
 
 fn look(path: &Path) -> Look {
@@ -94,7 +94,7 @@ fn look(path: &Path) -> Look {
         centre_spread,
         centre_blue_excess: centre[2] - centre[0],
         corner_luma: luma(corner),
-        top_luma: luma(top),
+        top_blue_excess: top[2] - top[0],
     }
 }
 

@@ -300,11 +300,12 @@ fn keys_typed_for_the_panel_fire_no_shortcut() {
     let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
         return;
     };
-    // The default preset's own camera shows the evening sky at the top of
-    // the image (luma 0.41); its saved view 3 looks down at the pale
-    // ground (0.68), as `number_keys_recall_saved_views` measured.
+    // The default preset's own camera shows the warm evening sky at the
+    // top of the image (blue − red −0.07); its saved view 3 looks down at
+    // the ground, whose polished cells mirror the blue sky (0.19), as
+    // `number_keys_recall_saved_views` says.
     let preset = Path::new(REPO).join("presets/default.ron");
-    let own_view = |l: &Look| l.top_luma < 0.55;
+    let own_view = |l: &Look| l.top_blue_excess < 0.05;
     let (_child, session) = open(&x, &dir, &preset);
     session.wait_for("default.ron from its own camera", own_view);
     // The panel is the right of the window from x = 820 or so on (the

@@ -62,6 +62,7 @@ pub fn grazing_ground(diffuse: Texture) -> Scene {
             yaw_degrees: 0.0,
             pitch_degrees: 8.0,
             fov_degrees: 30.0,
+            ..Default::default()
         },
         ..Scene::default()
     };

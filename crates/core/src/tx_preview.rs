@@ -4,7 +4,8 @@
 //! that the command and the fuzz targets read the same way.
 
 use crate::scene::{
-    Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere, Texture,
+    Cylinder, EnvSource, Ground, Material, OrbitCamera, PointLight, Polygon, Scene, Sphere,
+    Texture, ToneMap,
 };
 use crate::tx;
 use glam::Vec3;
@@ -37,6 +38,7 @@ pub fn preview_scene(doc: &tx::Document, base_dir: &Path) -> Result<Scene, tx::T
             yaw_degrees: 0.0,
             pitch_degrees: 12.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         spheres: vec![Sphere {
             name: "sphere".into(),
@@ -84,6 +86,10 @@ pub fn preview_scene(doc: &tx::Document, base_dir: &Path) -> Result<Scene, tx::T
     scene.environment.source = EnvSource::Constant {
         radiance: Vec3::splat(0.5),
     };
+    // The course display: no tone curve, so that a colour the text types
+    // shows as typed where the polygon is lit about evenly (ACES showed
+    // BOIS's FONCE 0.54 0.27 0.074 as 0.48 0.21 0.09).
+    scene.render.display.tone_map = ToneMap::Clamp;
     Ok(scene)
 }
 
@@ -136,6 +142,29 @@ pub fn parse_gallery(text: &str) -> Result<Vec<GalleryEntry>, GalleryError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The report's ATX example typed literally (u = (1, 0, 0), v = (1, 0,
+    /// 1), axes of its horizontal polygon) spans one line of the upright
+    /// preview polygon: the scene's notes, which `marbre tx` prints, warn
+    /// of it; the shipped example, whose axes lie in the polygon's plane,
+    /// draws no warning.
+    #[test]
+    fn the_literal_atx_example_warns_that_its_frame_is_flat_on_the_preview_polygon() {
+        let notes = |text: &str| {
+            let doc = tx::parse(text).unwrap();
+            preview_scene(&doc, Path::new("")).unwrap().sanitize()
+        };
+        let quad = "TX QUAD UNI CD 0.8 0 0 FTX UNI CD 0 0 0.8 FTX GU 0.25 GV 0.25 FTX";
+        let literal = notes(&format!("ATX 0 0 0 1 0 0 1 0 1 FATX {quad}"));
+        assert!(
+            literal
+                .iter()
+                .any(|n| n.contains("polygon `polygon`: warning") && n.contains("one colour")),
+            "{literal:?}"
+        );
+        let shipped = notes(&format!("ATX -1.4 0 -1.2 2.8 0 0 2.8 2.8 0 FATX {quad}"));
+        assert!(shipped.is_empty(), "{shipped:?}");
+    }
 
     #[test]
     fn gallery_entries_read_in_order() {

@@ -156,8 +156,13 @@ fn finish_scene(
     report: &mut dyn FnMut(LoadStage),
 ) -> Result<LoadedScene> {
     // The meshes' materials arrive with their files: clamp them as the
-    // preset's own were.
-    notes.extend(scene.sanitize());
+    // preset's own were. A warning that changes nothing (a polygon's flat
+    // frame) comes again: it is said once.
+    for note in scene.sanitize() {
+        if !notes.contains(&note) {
+            notes.push(note);
+        }
+    }
     report(LoadStage::Images);
     let images = load_images(&scene, &mut notes)?;
     substitutes.extend_from_slice(images.placeholders());

@@ -122,6 +122,32 @@ fn footprint_octaves(n: NoiseParams, width: f32) -> f32 {
 }
 #endif
 
+#if FOOTPRINT
+// What the octaves past `kept` add on average: for turbulence (shape 1)
+// each dropped octave its amplitude times the mean |noise|, so a far
+// turbulence fades to its mean rather than to 0 (pbrt's Turbulence); other
+// shapes nothing. Twin of noise::dropped_octaves_mean.
+fn dropped_octaves_mean(n: NoiseParams, kept: f32) -> f32 {
+    if n.shape != 1u {
+        return 0.0;
+    }
+    let octaves = clamp(n.octaves, 0.0, MAX_OCTAVES);
+    var frequency = n.frequency;
+    var amplitude = n.amplitude;
+    var sum = 0.0;
+    for (var i = 0u; i < u32(ceil(octaves)); i++) {
+        let scales = octave_scales(n, i, frequency, amplitude);
+        let full = min(octaves - f32(i), 1.0);
+        let shown = clamp(kept - f32(i), 0.0, 1.0);
+        sum += (full - shown) * scales.y;
+        frequency = scales.x * n.lacunarity;
+        amplitude = scales.y * n.persistence;
+    }
+    // The mean |noise| of the gradient noise and of Perlin's (fractal.rs).
+    return sum * select(0.146, 0.220, n.kind == 1u);
+}
+#endif
+
 // Octave i's frequency and amplitude, given the geometric progression's
 // running ones: the linear progression replaces them by frequency · k and
 // amplitude / k, k = i + 1.

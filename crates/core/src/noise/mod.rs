@@ -16,8 +16,9 @@ pub mod rebase;
 
 pub use evolution::Evolution;
 pub use fractal::{
-    FractalParams, FractalShape, NoiseSettings, Progression, fbm, footprint_octaves, fractal_sum,
-    marble, noise, noise4, noise4_f64, ridged, turbulence, warped,
+    FractalParams, FractalShape, NoiseSettings, Progression, dropped_octaves_mean, fbm,
+    footprint_octaves, fractal_sum, marble, mean_abs_noise, noise, noise4, noise4_f64, ridged,
+    turbulence, warped,
 };
 pub use gradient::{gradient_noise, gradient_noise4};
 pub use hash::HashKind;

@@ -15,6 +15,35 @@ pub struct OrbitCamera {
     pub pitch_degrees: f32,
     /// Vertical field of view, degrees.
     pub fov_degrees: f32,
+    /// How the image is projected: perspective, or orthographic (Massal's
+    /// figures). Old presets, which have no such field, are perspective.
+    pub projection: Projection,
+}
+
+/// How camera rays leave the camera.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Projection {
+    /// Every ray leaves the camera's position through its pixel: far
+    /// things look smaller.
+    #[default]
+    Perspective,
+    /// Parallel rays along the view direction, each from its pixel's place
+    /// on a plane through the camera: size does not change with depth.
+    /// The view is as high as the perspective view's at the target,
+    /// 2·distance·tan(fov/2), so switching keeps the target's framing and
+    /// the distance zooms.
+    Orthographic,
+}
+
+impl Projection {
+    pub const ALL: [Projection; 2] = [Projection::Perspective, Projection::Orthographic];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Projection::Perspective => "perspective",
+            Projection::Orthographic => "orthographic",
+        }
+    }
 }
 
 impl Default for OrbitCamera {
@@ -25,6 +54,7 @@ impl Default for OrbitCamera {
             yaw_degrees: 0.0,
             pitch_degrees: 15.0,
             fov_degrees: 40.0,
+            projection: Projection::Perspective,
         }
     }
 }
@@ -60,6 +90,26 @@ pub struct CameraFrame {
     pub forward: Vec3,
     /// tan(fov/2): the half-height of the image plane at distance 1.
     pub tan_half_fov: f32,
+    /// An orthographic view's half-height in scene units (distance ·
+    /// tan(fov/2)); 0 for a perspective one.
+    pub ortho_half_height: f32,
+}
+
+impl CameraFrame {
+    /// The camera ray through `ndc` (x right, y up, each -1 to 1 across an
+    /// image of width / height `aspect`): its origin and unit direction.
+    /// CPU twin of `camera_ray` in shaders/trace.wgsl.
+    pub fn ray(&self, ndc: glam::Vec2, aspect: f32) -> (Vec3, Vec3) {
+        if self.ortho_half_height > 0.0 {
+            let h = self.ortho_half_height;
+            let origin = self.position + ndc.x * h * aspect * self.right + ndc.y * h * self.up;
+            return (origin, self.forward);
+        }
+        let d = self.forward
+            + ndc.x * self.tan_half_fov * aspect * self.right
+            + ndc.y * self.tan_half_fov * self.up;
+        (self.position, d.normalize())
+    }
 }
 
 impl OrbitCamera {
@@ -74,12 +124,17 @@ impl OrbitCamera {
         let forward = -back;
         let right = (rotation * Vec3::X).normalize();
         let up = right.cross(forward).normalize();
+        let tan_half_fov = (self.fov_degrees.clamp(1.0, 170.0).to_radians() * 0.5).tan();
         CameraFrame {
             position: self.target + back * self.distance,
             right,
             up,
             forward,
-            tan_half_fov: (self.fov_degrees.clamp(1.0, 170.0).to_radians() * 0.5).tan(),
+            tan_half_fov,
+            ortho_half_height: match self.projection {
+                Projection::Perspective => 0.0,
+                Projection::Orthographic => self.distance * tan_half_fov,
+            },
         }
     }
 
@@ -167,6 +222,28 @@ impl OrbitCamera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A perspective ray leaves the camera through its pixel; orthographic
+    /// rays run along the view, parallel, from the pixel's place on a
+    /// plane through the camera as high as the view at the target.
+    #[test]
+    fn camera_rays_by_projection() {
+        let mut camera = OrbitCamera {
+            target: Vec3::ZERO,
+            distance: 4.0,
+            pitch_degrees: 0.0,
+            fov_degrees: 90.0,
+            ..OrbitCamera::default()
+        };
+        let corner = glam::Vec2::new(1.0, 1.0);
+        let (o, d) = camera.frame().ray(corner, 2.0);
+        assert_eq!(o, Vec3::new(0.0, 0.0, 4.0));
+        assert!((d - Vec3::new(2.0, 1.0, -1.0).normalize()).length() < 1e-6);
+        camera.projection = Projection::Orthographic;
+        let (o, d) = camera.frame().ray(corner, 2.0);
+        assert!((o - Vec3::new(8.0, 4.0, 4.0)).length() < 1e-5, "{o}");
+        assert!((d - Vec3::NEG_Z).length() < 1e-6);
+    }
 
     #[test]
     fn frame_is_orthonormal_and_looks_at_the_target() {

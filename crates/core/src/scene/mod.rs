@@ -26,7 +26,7 @@ mod time;
 pub mod transport;
 pub mod uv_frame;
 
-pub use camera::{OrbitCamera, SavedView};
+pub use camera::{OrbitCamera, Projection, SavedView};
 pub use change::Change;
 pub use color_encoding::ColorEncoding;
 pub use environment::{EnvSource, Environment};
@@ -388,6 +388,13 @@ impl Scene {
             self.polygons.truncate(MAX_POLYGONS);
         }
         for p in &mut self.polygons {
+            let flat = p
+                .uv_frame
+                .zip(p.normal())
+                .and_then(|(frame, n)| frame.problem_on_plane(n));
+            if let Some(problem) = flat {
+                notes.push(format!("polygon `{}`: warning: {problem}", p.name));
+            }
             p.material.sanitize(&format!("polygon `{}`", p.name), notes);
         }
     }

@@ -29,4 +29,47 @@ impl UvFrame {
         }
         None
     }
+
+    /// Why the frame, sound in space, spans nothing on a plane of unit
+    /// normal `normal`, if it does not: its axes project there onto one
+    /// line, so every point of the plane gets the same (u, v) and the
+    /// texture shows one colour (the report's ATX u = (1, 0, 0), v = (1, 0,
+    /// 1) on an upright polygon).
+    pub fn problem_on_plane(&self, normal: Vec3) -> Option<String> {
+        let flat = |a: Vec3| a - a.dot(normal) * normal;
+        let on_plane = UvFrame {
+            u_axis: flat(self.u_axis),
+            v_axis: flat(self.v_axis),
+            ..*self
+        };
+        on_plane.problem()?;
+        Some(format!(
+            "its frame's axes u = {} and v = {} lie along one line on its plane (normal {normal}), \
+             so (u, v) does not vary there and the texture shows one colour; give axes in the \
+             polygon's plane",
+            self.u_axis, self.v_axis
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report's literal ATX vectors span the ground's plane but only one
+    /// line of an upright polygon's.
+    #[test]
+    fn a_frame_flat_on_the_ground_is_degenerate_on_an_upright_plane() {
+        let frame = UvFrame {
+            origin: Vec3::ZERO,
+            u_axis: Vec3::new(1.0, 0.0, 0.0),
+            v_axis: Vec3::new(1.0, 0.0, 1.0),
+        };
+        assert_eq!(frame.problem(), None);
+        assert_eq!(frame.problem_on_plane(Vec3::Y), None);
+        let problem = frame
+            .problem_on_plane(Vec3::Z)
+            .expect("degenerate on z = const");
+        assert!(problem.contains("one colour"), "{problem}");
+    }
 }

@@ -366,8 +366,8 @@ pub fn approx_same(a: &Texture, b: &Texture) -> bool {
 /// The report's examples also ship as presets (`presets/report/*.ron`), each
 /// property written as its `.tx` text: every one loads without a note, and
 /// each object's material and the polygon's frame are what lowering the
-/// `.tx` file onto their neutral base gives, so the preset shows what
-/// `marbre tx` renders.
+/// `.tx` file onto their neutral base gives, and the display is the
+/// preview's, so the preset shows what `marbre tx` renders.
 #[test]
 fn the_report_presets_are_their_tx_files() {
     // Spelt without `..`: the preset loader normalises the paths it reads.
@@ -419,6 +419,13 @@ fn the_report_presets_are_their_tx_files() {
             assert_eq!(material.bump_height, lowered.material.bump_height);
         }
         assert_eq!(scene.polygons[0].uv_frame, lowered.polygon_frame);
+        let preview = marbre_core::tx_preview::preview_scene(&doc, &dir).unwrap();
+        assert_eq!(
+            scene.render.display,
+            preview.render.display,
+            "{}: the course display, as `marbre tx` shows it",
+            ron_path.display()
+        );
         count += 1;
     }
     assert_eq!(count, 20, "every example has its preset");

@@ -212,6 +212,7 @@ pub fn spheres_in_constant_light(radiance: f32) -> Scene {
         yaw_degrees: 0.0,
         pitch_degrees: 15.0,
         fov_degrees: 45.0,
+        ..Default::default()
     };
     scene
 }
@@ -308,6 +309,7 @@ pub fn assert_sphere_shows_its_diffuse(ctx: &GpuContext, diffuse: Texture) {
             yaw_degrees: 30.0,
             pitch_degrees: 20.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         ..Scene::default()
     };

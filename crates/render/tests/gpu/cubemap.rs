@@ -872,6 +872,7 @@ fn the_cross_as_background_renders_what_the_cube_samples() {
                 yaw_degrees: yaw,
                 pitch_degrees: pitch,
                 fov_degrees: 20.0,
+                ..Default::default()
             },
             ..Scene::default()
         };

@@ -39,6 +39,7 @@ fn sheet_scene(material: Material) -> Scene {
             yaw_degrees: 0.0,
             pitch_degrees: 89.0,
             fov_degrees: 10.0,
+            ..Default::default()
         },
         ..Scene::default()
     }

@@ -123,6 +123,7 @@ fn a_ground_under_the_esplanade_sun_gets_the_closed_form_radiance() {
             yaw_degrees: 0.0,
             pitch_degrees: 89.0,
             fov_degrees: 30.0,
+            ..Default::default()
         },
         ..Scene::default()
     };
@@ -178,6 +179,7 @@ fn an_emitter_of_a_million_lights_the_ground_as_the_closed_form_says() {
             yaw_degrees: 0.0,
             pitch_degrees: 60.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         ..Scene::default()
     };

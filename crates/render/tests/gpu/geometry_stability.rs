@@ -980,6 +980,7 @@ fn a_sphere_in_a_white_furnace_has_no_dark_silhouette_ring() {
         yaw_degrees: 30.0,
         pitch_degrees: 10.0,
         fov_degrees: 40.0,
+        ..Default::default()
     };
     scene.render.max_bounces = 1;
     let (size, spp) = ((64, 64), 256);
@@ -1074,6 +1075,7 @@ fn a_grazingly_lit_ground_matches_the_closed_form_and_keeps_its_shadow() {
             yaw_degrees: -90.0,
             pitch_degrees: 50.0,
             fov_degrees: 50.0,
+            ..Default::default()
         };
         scene.render.max_bounces = 1;
         let pixels = render_scene(&ctx, scene.clone(), size, 4);
@@ -1494,6 +1496,7 @@ fn emitters_too_small_to_sample_render_finite() {
             yaw_degrees: 0.0,
             pitch_degrees: 30.0,
             fov_degrees: 50.0,
+            ..Default::default()
         };
         let loaded = prepare_scene(scene, Vec::new()).unwrap();
         let (renderer, _) = render_loaded(&ctx, &loaded, (32, 32), 4);

@@ -525,6 +525,7 @@ fn on_two_panels_choosing_by_power_beats_uniform() {
         yaw_degrees: 0.0,
         pitch_degrees: 60.0,
         fov_degrees: 60.0,
+        ..Default::default()
     };
     let (uniform, power) = selection_errors(&ctx, scene, (40, 30));
     eprintln!("two-panels, 16 spp: RMSE uniform {uniform:.5}, by power {power:.5}");

@@ -311,6 +311,7 @@ fn infinite_emitter() -> LoadedScene {
         yaw_degrees: 0.0,
         pitch_degrees: 0.0,
         fov_degrees: 50.0,
+        ..Default::default()
     };
     scene.render.samples_per_frame = 2;
     // Unsanitised: `prepare_scene` would clamp the infinite strength.

@@ -54,6 +54,7 @@ fn lat_long_scene(importance: bool) -> Scene {
             yaw_degrees: 0.0,
             pitch_degrees: 10.0,
             fov_degrees: 35.0,
+            ..Default::default()
         },
         ..Scene::default()
     };

@@ -43,6 +43,7 @@ fn emitter_filling_the_view(strength: f32) -> Scene {
         yaw_degrees: 0.0,
         pitch_degrees: 0.0,
         fov_degrees: 45.0,
+        ..Default::default()
     };
     scene.render.samples_per_frame = SPP_PER_FRAME;
     scene

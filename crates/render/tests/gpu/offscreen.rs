@@ -41,6 +41,7 @@ fn diffuse_sphere_in_a_white_environment_reads_its_albedo() {
             yaw_degrees: 30.0,
             pitch_degrees: 10.0,
             fov_degrees: 40.0,
+            ..Default::default()
         };
         scene.render.max_bounces = bounces;
         let (w, h) = (64, 64);
@@ -91,6 +92,7 @@ fn point_light_on_a_diffuse_plane_matches_the_closed_form() {
         yaw_degrees: 0.0,
         pitch_degrees: 89.0,
         fov_degrees: 10.0,
+        ..Default::default()
     };
     let (w, h) = (33, 33);
     let pixels = render(&ctx, &scene, (w, h), 16);
@@ -140,6 +142,7 @@ fn integrating_sphere_counts_one_light_sample_per_bounce() {
             yaw_degrees: 20.0,
             pitch_degrees: 10.0,
             fov_degrees: 60.0,
+            ..Default::default()
         };
         scene.render.max_bounces = bounces;
         // Russian roulette would add variance (not bias): off here.
@@ -222,6 +225,7 @@ fn generated_texture_code_renders_the_cpu_reference() {
         yaw_degrees: 20.0,
         pitch_degrees: 70.0,
         fov_degrees: 40.0,
+        ..Default::default()
     };
     let (w, h) = (96, 64);
     let pixels = render(&ctx, &scene, (w, h), 4);
@@ -267,6 +271,7 @@ fn generated_ramp_renders_the_cpu_reference() {
         yaw_degrees: 0.0,
         pitch_degrees: 89.0,
         fov_degrees: 20.0,
+        ..Default::default()
     };
     let (w, h) = (64, 32);
     let pixels = render(&ctx, &scene, (w, h), 16);
@@ -368,6 +373,7 @@ fn waves_bump_tilts_the_shading_normal_as_the_closed_form() {
             yaw_degrees: 0.0,
             pitch_degrees: 89.0,
             fov_degrees: 4.0,
+            ..Default::default()
         };
         let (w, h) = (33, 33);
         let pixels = render(&ctx, &scene, (w, h), 16);

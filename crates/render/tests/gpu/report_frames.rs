@@ -41,6 +41,7 @@ fn a_checker_on_the_framed_ground_renders_the_cpu_reference() {
         yaw_degrees: 20.0,
         pitch_degrees: 60.0,
         fov_degrees: 50.0,
+        ..Default::default()
     };
     let ground = scene.ground.clone().unwrap();
     let (w, h) = (64, 64);

@@ -69,6 +69,7 @@ fn layers_mix_and_math_render_the_cpu_reference() {
         yaw_degrees: 20.0,
         pitch_degrees: 70.0,
         fov_degrees: 40.0,
+        ..Default::default()
     };
     let material = scene.ground.as_ref().unwrap().material.clone();
     let (w, h) = (96, 64);
@@ -109,6 +110,7 @@ fn massal_marble_renders_the_cpu_reference() {
         yaw_degrees: 10.0,
         pitch_degrees: 75.0,
         fov_degrees: 50.0,
+        ..Default::default()
     };
     let material = scene.ground.as_ref().unwrap().material.clone();
     let (w, h) = (96, 64);
@@ -159,6 +161,7 @@ fn every_pattern_of_the_table_renders_its_cpu_reference() {
             yaw_degrees: 10.0,
             pitch_degrees: 75.0,
             fov_degrees: 50.0,
+            ..Default::default()
         };
         let (w, h) = (64, 48);
         // The threshold: halfway between the least and the greatest t at
@@ -225,6 +228,7 @@ fn opacity_and_emission_match_the_closed_form() {
             yaw_degrees: 0.0,
             pitch_degrees: 0.0,
             fov_degrees: 10.0,
+            ..Default::default()
         },
         ..Scene::default()
     };
@@ -276,6 +280,7 @@ fn a_half_opaque_sphere_lets_a_quarter_of_the_light_through() {
             yaw_degrees: 0.0,
             pitch_degrees: 60.0,
             fov_degrees: 6.0,
+            ..Default::default()
         },
         ..Scene::default()
     };
@@ -347,6 +352,7 @@ fn noise_bump_renders_the_cpu_finite_difference_normal() {
             yaw_degrees: 0.0,
             pitch_degrees: 89.0,
             fov_degrees: 20.0,
+            ..Default::default()
         },
         ..Scene::default()
     };
@@ -442,6 +448,7 @@ fn polygon_and_cylinder_map_uv_as_the_cpu() {
         yaw_degrees: 15.0,
         pitch_degrees: 10.0,
         fov_degrees: 40.0,
+        ..Default::default()
     };
     let mut scene = Scene {
         polygons: vec![polygon.clone()],
@@ -611,6 +618,7 @@ fn image_texture_renders_the_cpu_reference() {
             yaw_degrees: 0.0,
             pitch_degrees: 0.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         ..Scene::default()
     };
@@ -734,6 +742,7 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
         yaw_degrees: 0.0,
         pitch_degrees: 89.0,
         fov_degrees: 10.0,
+        ..Default::default()
     };
     let size = (16, 16);
     let mut renderer = marbre_render::gpu::Renderer::new(&ctx, &scene, None, size).unwrap();

@@ -40,6 +40,7 @@ fn the_reports_4x4_checker_renders_its_16_cells_on_a_polygon() {
             yaw_degrees: 0.0,
             pitch_degrees: 0.0,
             fov_degrees: 40.0,
+            ..Default::default()
         },
         polygons: vec![Polygon {
             vertices: vec![

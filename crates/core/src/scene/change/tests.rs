@@ -40,6 +40,16 @@ fn the_same_scene_changed_nothing() {
     assert_eq!(edited(|_| {}), Change::empty());
 }
 
+/// The projection is the camera's: switching to orthographic restarts
+/// the image through the frame uniform, no new shader.
+#[test]
+fn a_projection_switch_is_a_camera_change_without_new_code() {
+    let change = edited(|s| s.camera.projection = crate::scene::Projection::Orthographic);
+    assert_eq!(change, Change::CAMERA);
+    assert!(change.resets_accumulation());
+    assert!(!change.regenerates_code());
+}
+
 #[test]
 fn a_camera_move_resets_the_image_but_is_no_edit() {
     let change = edited(|s| s.camera.yaw_degrees += 10.0);

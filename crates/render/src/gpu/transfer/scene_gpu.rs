@@ -74,7 +74,10 @@ pub struct Frame {
     pub depth_scale: f32,
     /// The ground's (u, v) frame (`Ground::frame`; world x, z without one).
     pub ground_uv_origin: [f32; 3],
-    pub _pad_ground0: f32,
+    /// An orthographic camera's half-height in scene units
+    /// (`CameraFrame::ortho_half_height`); 0 for perspective. In the
+    /// padding after the ground's origin.
+    pub ortho_half_height: f32,
     pub ground_uv_u: [f32; 3],
     pub _pad_ground1: f32,
     pub ground_uv_v: [f32; 3],
@@ -384,7 +387,13 @@ pub fn frame_uniform(
         has_ground: u32::from(scene.ground.is_some()),
         cylinder_count: scene.cylinders.len().min(MAX_CYLINDERS) as u32,
         polygon_count: scene.polygons.len().min(MAX_POLYGONS) as u32,
-        pixel_spread: 2.0 * cam.tan_half_fov / image_size[1],
+        // Parallel rays do not spread: an orthographic cone keeps the
+        // width a pixel has on the camera's plane (trace.wgsl).
+        pixel_spread: if cam.ortho_half_height > 0.0 {
+            0.0
+        } else {
+            2.0 * cam.tan_half_fov / image_size[1]
+        },
         env_sampling: u32::from(env.source.is_map() && scene.render.env_importance),
         // Filled in by the renderer, which holds the distribution and the
         // light table.
@@ -407,7 +416,7 @@ pub fn frame_uniform(
         light_points: scene.render.transport.light_points.id(),
         depth_scale: scene.camera.distance.max(f32::MIN_POSITIVE),
         ground_uv_origin: ground_frame.origin.to_array(),
-        _pad_ground0: 0.0,
+        ortho_half_height: cam.ortho_half_height,
         ground_uv_u: ground_frame.u_axis.to_array(),
         _pad_ground1: 0.0,
         ground_uv_v: ground_frame.v_axis.to_array(),
@@ -491,6 +500,7 @@ mod tests {
                 light_points,
                 depth_scale,
                 ground_uv_origin,
+                ortho_half_height,
                 ground_uv_u,
                 ground_uv_v,
                 crop_origin,
