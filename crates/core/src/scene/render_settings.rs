@@ -10,6 +10,8 @@ pub enum ToneMap {
     /// `x / (1 + x)`.
     Reinhard,
     /// Clamp to [0, 1]: what the linear radiance looks like untouched.
+    /// The course display: the report's presets and `marbre tx` show
+    /// their typed colours as typed through it (no curve, sRGB out).
     Clamp,
     /// `1 − exp(−x)`: Massal's photographic exposure curve. His tutorial
     /// computes `1 − exp(e · c)` with a negative exposure `e` (−1 by
@@ -30,7 +32,7 @@ impl ToneMap {
         match self {
             ToneMap::Aces => "ACES (filmic)",
             ToneMap::Reinhard => "Reinhard",
-            ToneMap::Clamp => "clamp",
+            ToneMap::Clamp => "clamp (course: colours as typed)",
             ToneMap::Exponential => "1 − exp (Massal)",
         }
     }
