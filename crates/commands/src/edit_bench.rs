@@ -9,9 +9,8 @@
 //! `--structural` times instead what a user waits for after a structural
 //! edit (a pattern switched, as the node editor's Add or the tree panel's
 //! pattern list do): the new pipeline built on its worker thread, then
-//! frames of the viewer's budget traced until the first preview, a
-//! preview at 0.4 of the render size or finer (`preview_ladder`'s last
-//! steps) and the full round show.
+//! frames of the viewer's budget traced until each preview
+//! (`preview_ladder`) and the full round show.
 
 use anyhow::{Result, ensure};
 use clap::Args;
@@ -162,12 +161,13 @@ fn hand_over(ctx: &GpuContext, renderer: &mut Renderer, scene: &Scene) -> Result
     Ok(())
 }
 
-/// Milliseconds from a structural edit to each stage the window shows.
-#[derive(Debug, Default, Clone, Copy)]
+/// Milliseconds from a structural edit to each stage the window shows:
+/// the new pipeline, each preview (its width as a fraction of the
+/// render's), the full round.
+#[derive(Debug, Default, Clone)]
 struct Waited {
     build: f64,
-    first_preview: f64,
-    fine_preview: f64,
+    previews: Vec<(f32, f64)>,
     full_round: f64,
 }
 
@@ -220,38 +220,40 @@ fn structural(args: &EditBenchArgs) -> Result<()> {
         let full = renderer.render_size();
         while renderer.accumulated_samples() == 0 {
             frame(&ctx, &mut renderer, TraceBudget::Pixels(budget));
-            let shown = renderer.shown_size();
-            if waited.first_preview == 0.0 {
-                waited.first_preview = ms();
-            }
-            if waited.fine_preview == 0.0 && 5 * shown.0 >= 2 * full.0 {
-                waited.fine_preview = ms();
+            let shown = renderer.shown_size().0 as f32 / full.0 as f32;
+            if renderer.accumulated_samples() == 0
+                && waited.previews.last().is_none_or(|(s, _)| *s != shown)
+            {
+                waited.previews.push((shown, ms()));
             }
         }
         waited.full_round = ms();
         waits.push(waited);
     }
-    let median = |f: fn(&Waited) -> f64| {
-        let mut v: Vec<f64> = waits.iter().map(f).collect();
+    let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
+    println!("structural edit, median of {} (ms)", waits.len());
     println!(
-        "{:<44} {:>10}",
-        format!("structural edit, median of {}", waits.len()),
-        "ms"
+        "{:<36} {:>8.0}",
+        "new pipeline built",
+        median(waits.iter().map(|w| w.build).collect())
     );
-    for (what, f) in [
-        (
-            "new pipeline built",
-            (|w: &Waited| w.build) as fn(&Waited) -> f64,
-        ),
-        ("first preview shown", |w| w.first_preview),
-        ("a preview at 0.4 scale or finer shown", |w| w.fine_preview),
-        ("the full round shown", |w| w.full_round),
-    ] {
-        println!("{what:<44} {:>10.0}", median(f));
+    let steps = waits.iter().map(|w| w.previews.len()).min().unwrap_or(0);
+    for k in 0..steps {
+        let scale = waits[0].previews[k].0;
+        println!(
+            "{:<36} {:>8.0}",
+            format!("preview {} shown ({scale:.2} scale)", k + 1),
+            median(waits.iter().map(|w| w.previews[k].1).collect())
+        );
     }
+    println!(
+        "{:<36} {:>8.0}",
+        "the full round shown",
+        median(waits.iter().map(|w| w.full_round).collect())
+    );
     Ok(())
 }
 
