@@ -118,7 +118,8 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
             )]
         }
         Knob::LightSelection => {
-            let panels = scenes::preset(root, "two_panels")?;
+            let mut panels = scenes::preset(root, "two_panels")?;
+            scenes::hide_the_panels(&mut panels.scene);
             let base = panels.scene.clone();
             let variants = LightSelection::ALL
                 .iter()
@@ -132,7 +133,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
             });
             vec![Sweep::new(
                 knob,
-                "two_panels",
+                "two_panels (panels out of view)",
                 panels,
                 against(&reference, variants),
                 scale,
