@@ -116,6 +116,10 @@ impl SwatchBook {
         let materials_changed = change.intersects(
             Change::MATERIAL_PARAMETERS | Change::MATERIAL_STRUCTURE | Change::GEOMETRY,
         );
+        if !materials_changed && self.nodes.values().all(|node| node.read) {
+            // Most frames: nothing to read, so no images to gather either.
+            return;
+        }
         let rendered: Vec<(bool, Texture, TextureHandle)> = self
             .nodes
             .iter()
