@@ -28,8 +28,17 @@ pub struct Api {
     pub release_buffer: unsafe extern "C" fn(Handle),
     pub new_filter: unsafe extern "C" fn(Handle, *const c_char) -> Handle,
     #[allow(clippy::type_complexity)]
-    pub set_filter_image:
-        unsafe extern "C" fn(Handle, *const c_char, Handle, c_int, usize, usize, usize, usize, usize),
+    pub set_filter_image: unsafe extern "C" fn(
+        Handle,
+        *const c_char,
+        Handle,
+        c_int,
+        usize,
+        usize,
+        usize,
+        usize,
+        usize,
+    ),
     pub set_filter_bool: unsafe extern "C" fn(Handle, *const c_char, bool),
     pub set_filter_int: unsafe extern "C" fn(Handle, *const c_char, c_int),
     pub commit_filter: unsafe extern "C" fn(Handle),

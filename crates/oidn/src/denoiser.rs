@@ -155,21 +155,27 @@ impl Denoiser {
         }
         let guided = images.guides.is_some();
         let (colour_in, pw, ph) = border::pad(
-            &images.colour.iter().map(|&c| sanitise::colour(c)).collect::<Vec<_>>(),
+            &images
+                .colour
+                .iter()
+                .map(|&c| sanitise::colour(c))
+                .collect::<Vec<_>>(),
             w as usize,
             h as usize,
         );
         let padded_size = (pw as u32, ph as u32);
-        let fits = self.filters.as_ref().is_some_and(|f| {
-            f.size == padded_size && f.quality == quality && f.guided == guided
-        });
+        let fits = self
+            .filters
+            .as_ref()
+            .is_some_and(|f| f.size == padded_size && f.quality == quality && f.guided == guided);
         if !fits {
             self.release_filters();
             let filters = self.make_filters(padded_size, quality, guided)?;
             self.filters = Some(filters);
         }
         let f = self.filters.as_ref().expect("made above");
-        let (colour, albedo, normal, output, main) = (f.colour, f.albedo, f.normal, f.output, f.main);
+        let (colour, albedo, normal, output, main) =
+            (f.colour, f.albedo, f.normal, f.output, f.main);
         let prefilters = f.prefilters.clone();
         self.write(colour, &colour_in);
         if let Some((a, nrm)) = images.guides {
@@ -230,8 +236,16 @@ impl Denoiser {
             main: std::ptr::null_mut(),
             prefilters: Vec::new(),
             colour: new_buffer(),
-            albedo: if guided { new_buffer() } else { std::ptr::null_mut() },
-            normal: if guided { new_buffer() } else { std::ptr::null_mut() },
+            albedo: if guided {
+                new_buffer()
+            } else {
+                std::ptr::null_mut()
+            },
+            normal: if guided {
+                new_buffer()
+            } else {
+                std::ptr::null_mut()
+            },
             output: new_buffer(),
         };
         if let Err(e) = self.check("oidnNewBuffer") {
@@ -308,7 +322,9 @@ impl Denoiser {
         } else {
             // SAFETY: OIDN returns a NUL-terminated string valid until the
             // next call on this device.
-            unsafe { CStr::from_ptr(message) }.to_string_lossy().into_owned()
+            unsafe { CStr::from_ptr(message) }
+                .to_string_lossy()
+                .into_owned()
         };
         Err(OidnError { call, message })
     }

@@ -39,7 +39,9 @@ pub struct Library {
 
 impl fmt::Debug for Library {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Library").field("origin", &self.origin).finish()
+        f.debug_struct("Library")
+            .field("origin", &self.origin)
+            .finish()
     }
 }
 

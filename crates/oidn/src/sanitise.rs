@@ -41,10 +41,20 @@ mod tests {
 
     #[test]
     fn every_value_comes_out_finite_and_in_range() {
-        let bad = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -3.0, 1e30, f32::MAX];
+        let bad = [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -3.0,
+            1e30,
+            f32::MAX,
+        ];
         for &v in &bad {
             let c = colour([v; 3]);
-            assert!(c.iter().all(|x| x.is_finite() && (0.0..=COLOUR_LIMIT).contains(x)));
+            assert!(
+                c.iter()
+                    .all(|x| x.is_finite() && (0.0..=COLOUR_LIMIT).contains(x))
+            );
             assert!(albedo([v; 3]).iter().all(|x| (0.0..=1.0).contains(x)));
             assert!(normal([v; 3]).iter().all(|x| (-1.0..=1.0).contains(x)));
         }

@@ -8,10 +8,11 @@ fn cpu(test: &str) -> Option<Denoiser> {
 }
 
 /// A flat grey wall, its guides flat too: nothing to remove. The image's
-/// mean stays within 1e-3 (2e-3 for the fast network), and every pixel, at the edges too, within 0.5 %:
-/// OIDN's network itself ripples by up to 0.34 % on a flat image (its
-/// `oidnDenoise` alike), and without the mirrored borders its outer 16
-/// pixels came back 5 % (high) to 17 % (fast) off.
+/// mean stays within 1e-3, and every pixel, at the edges too, within 0.4 %
+/// (the fast network: 2e-3 and 1 %): OIDN's network itself ripples by up
+/// to 0.5 % on a flat image (its `oidnDenoise` alike), and without the
+/// mirrored borders its outer 16 pixels came back 5 % (high) to 17 %
+/// (fast) off.
 #[test]
 fn a_constant_image_stays_constant() {
     let Some(mut oidn) = cpu("a_constant_image_stays_constant") else {
@@ -36,15 +37,21 @@ fn a_constant_image_stays_constant() {
                 .unwrap();
             let relative = |v: f32| (v / value - 1.0).abs();
             let mean = out.iter().flatten().sum::<f32>() / (3 * n) as f32;
-            let tolerance = if quality == Quality::Fast { 2e-3 } else { 1e-3 };
-            assert!(relative(mean) < tolerance, "{quality:?}, {value}: mean {mean}");
+            let (mean_tolerance, pixel_tolerance) = match quality {
+                Quality::Fast => (2e-3, 1e-2),
+                _ => (1e-3, 4e-3),
+            };
+            assert!(
+                relative(mean) < mean_tolerance,
+                "{quality:?}, {value}: mean {mean}"
+            );
             let (worst, at) = out
                 .iter()
                 .enumerate()
                 .map(|(i, p)| (relative(p[0]).max(relative(p[1])).max(relative(p[2])), i))
                 .fold((0.0f32, 0), |a, b| if b.0 > a.0 { b } else { a });
             assert!(
-                worst < 5e-3,
+                worst < pixel_tolerance,
                 "{quality:?}, {value}: pixel ({}, {}) off by {worst}",
                 at % w,
                 at / w
@@ -61,8 +68,17 @@ fn bad_values_give_finite_output() {
         return;
     };
     let size = (32, 32);
-    let bad = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -5.0, 1e30, f32::MAX];
-    let colour: Vec<[f32; 3]> = (0..1024).map(|i| [bad[i % 6], 0.5, bad[(i / 7) % 6]]).collect();
+    let bad = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -5.0,
+        1e30,
+        f32::MAX,
+    ];
+    let colour: Vec<[f32; 3]> = (0..1024)
+        .map(|i| [bad[i % 6], 0.5, bad[(i / 7) % 6]])
+        .collect();
     let albedo: Vec<[f32; 3]> = (0..1024).map(|i| [bad[(i / 3) % 6], 0.5, 0.5]).collect();
     let normal: Vec<[f32; 3]> = (0..1024).map(|i| [0.0, bad[(i / 5) % 6], 1.0]).collect();
     for guides in [Some((&albedo[..], &normal[..])), None] {
