@@ -6,7 +6,7 @@
 use super::PanelAction;
 use egui::{ComboBox, Ui};
 use marbre_core::image_io::ImageFormat;
-use marbre_core::scene::Metering;
+use marbre_core::scene::{DenoiseQuality, Denoiser, Metering};
 use marbre_render::final_render::{FinalRender, Stop, parse_size};
 use marbre_render::gpu::KernelChoice;
 use std::path::PathBuf;
@@ -35,9 +35,9 @@ pub struct RenderDialog {
     pub max_spp: u32,
     /// Auto exposure for the PNG (`None`: as the scene has it).
     pub auto_exposure: Option<Metering>,
-    /// Filter with the denoiser (`render --denoise`): the PNG, or the
-    /// EXR (`--denoise --denoise-exr`).
-    pub denoise: bool,
+    /// Filter with this denoiser (`render --denoise oidn|atrous`): the
+    /// PNG, or the EXR (`--denoise --denoise-exr`); `None`: raw.
+    pub denoise: Option<Denoiser>,
     /// The render under way, if any.
     pub running: Option<RunningView>,
     /// How the last render ended, or why the settings were refused.
@@ -74,7 +74,7 @@ impl Default for RenderDialog {
             target_percent: DEFAULT_TARGET_PERCENT,
             max_spp: DEFAULT_MAX_SPP,
             auto_exposure: None,
-            denoise: false,
+            denoise: None,
             running: None,
             last_result: None,
             focus_output: false,
@@ -110,9 +110,11 @@ impl RenderDialog {
             kernel: KernelChoice::Auto,
             output,
             denoise: self.denoise,
+            // A final frame: OIDN's best network.
+            denoise_quality: DenoiseQuality::High,
             // An EXR is filtered only when asked (`--denoise-exr`): here the
             // box asks it of either format.
-            denoise_exr: self.denoise && format == ImageFormat::Exr,
+            denoise_exr: self.denoise.is_some() && format == ImageFormat::Exr,
             // The viewer shows the placeholder and its note: it renders
             // what it shows.
             allow_placeholders: true,
@@ -301,11 +303,22 @@ fn dialog_ui(ui: &mut Ui, dialog: &mut RenderDialog, actions: &mut Vec<PanelActi
                     );
                 ui.end_row();
                 ui.label("denoise");
-                ui.checkbox(&mut dialog.denoise, "")
+                let label = dialog.denoise.map_or("off", Denoiser::label);
+                ComboBox::from_id_salt("render denoiser")
+                    .selected_text(label)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut dialog.denoise, None, "off");
+                        for d in Denoiser::ALL {
+                            ui.selectable_value(&mut dialog.denoise, Some(d), d.label());
+                        }
+                    })
+                    .response
                     .on_hover_text(
-                        "As `render --denoise`: filter the image with the viewer's denoiser \
-                         (an edge-avoiding à-trous filter guided by the first hit's albedo \
-                         and normal); an EXR is filtered too (`--denoise-exr`)",
+                        "As `render --denoise oidn|atrous`: filter the image, guided by the \
+                         first hit's albedo and normal, with Intel Open Image Denoise (its \
+                         high-quality network; the à-trous filter where its library is not \
+                         found) or the viewer's à-trous filter; an EXR is filtered too \
+                         (`--denoise-exr`)",
                     );
                 ui.end_row();
             });
@@ -405,17 +418,19 @@ mod tests {
     #[test]
     fn denoise_filters_either_format() {
         let mut dialog = RenderDialog {
-            denoise: true,
+            denoise: Some(Denoiser::Oidn),
             ..RenderDialog::default()
         };
         let job = dialog.job().unwrap();
-        assert!(job.denoise && !job.denoise_exr);
+        assert!(job.denoise == Some(Denoiser::Oidn) && !job.denoise_exr);
+        assert_eq!(job.denoise_quality, DenoiseQuality::High);
         dialog.output = "render.exr".to_owned();
+        dialog.denoise = Some(Denoiser::Atrous);
         let job = dialog.job().unwrap();
-        assert!(job.denoise && job.denoise_exr);
-        dialog.denoise = false;
+        assert!(job.denoise == Some(Denoiser::Atrous) && job.denoise_exr);
+        dialog.denoise = None;
         let job = dialog.job().unwrap();
-        assert!(!job.denoise && !job.denoise_exr);
+        assert!(job.denoise.is_none() && !job.denoise_exr);
     }
 
     #[test]

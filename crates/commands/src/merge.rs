@@ -11,8 +11,10 @@ use marbre_core::image_io::LayerName;
 use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::merge::{Batch, Guides, Merged, merge};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord};
-use marbre_core::scene::{DisplaySettings, Metering};
+use marbre_core::scene::{DenoiseQuality, Denoiser, DisplaySettings, Metering};
+use marbre_oidn::DeviceKind;
 use marbre_render::cpu_display;
+use marbre_render::denoiser::{GuidedImage, Running, oidn_for};
 use marbre_render::gpu::denoise::{DenoiseImage, DenoiseSettings, denoise_cpu};
 use std::path::{Path, PathBuf};
 
@@ -35,12 +37,23 @@ pub struct MergeArgs {
     /// default) or Massal's RMS (`massal`).
     #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "key", value_name = "METERING")]
     pub auto_exposure: Option<crate::render::MeteringArg>,
-    /// Filter the merged image with the denoiser (the viewer's: an
-    /// edge-avoiding à-trous filter), guided by the files' albedo and
-    /// normal (`render --guides`) and weighted by the merged variance
-    /// where known; before tone mapping, for a PNG or an EXR.
-    #[arg(long)]
-    pub denoise: bool,
+    /// Filter the merged image with a denoiser, guided by the files'
+    /// albedo and normal (`render --guides`), before tone mapping, for a
+    /// PNG or an EXR: oidn (Intel Open Image Denoise on the CPU, the
+    /// default; where its library is not found, atrous runs instead and a
+    /// line says why) or atrous (the viewer's edge-avoiding filter, its CPU
+    /// twin, weighted by the merged variance where known).
+    #[arg(
+        long,
+        num_args = 0..=1,
+        default_missing_value = "oidn",
+        value_name = "oidn|atrous",
+        value_parser = crate::render::parse_denoiser
+    )]
+    pub denoise: Option<Denoiser>,
+    /// OIDN's network: high (the default), balanced or fast.
+    #[arg(long, default_value = "high", value_parser = crate::render::parse_denoise_quality)]
+    pub denoise_quality: DenoiseQuality,
 }
 
 pub fn run(args: &MergeArgs) -> Result<()> {
@@ -62,7 +75,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let merged = merge(&batches).map_err(|e| anyhow!(e))?;
     let how = MergedOutput {
         display,
-        denoise: args.denoise,
+        denoise: args.denoise.map(|d| (d, args.denoise_quality)),
     };
     for line in write_merged(&merged, &args.output, &how)? {
         println!("{line}");
@@ -113,8 +126,8 @@ pub fn run(args: &MergeArgs) -> Result<()> {
 pub struct MergedOutput {
     /// How a PNG is shown.
     pub display: DisplaySettings,
-    /// Filter it with the denoiser first.
-    pub denoise: bool,
+    /// Filter it with this denoiser (and OIDN's network) first.
+    pub denoise: Option<(Denoiser, DenoiseQuality)>,
 }
 
 /// Writes `merged` to `output` as `how` says: an EXR of its radiance with
@@ -124,18 +137,20 @@ pub struct MergedOutput {
 pub fn write_merged(merged: &Merged, output: &Path, how: &MergedOutput) -> Result<Vec<String>> {
     let mut lines = Vec::new();
     let size = (merged.width, merged.height);
-    let pixels = if how.denoise {
-        lines.push("denoised after the merge".to_owned());
-        denoise_merged(merged, output)?
-    } else {
-        merged.pixels.clone()
+    let pixels = match how.denoise {
+        Some((denoiser, quality)) => {
+            let (pixels, by) = denoise_merged(merged, output, denoiser, quality)?;
+            lines.push(format!("denoised after the merge by {by}"));
+            pixels
+        }
+        None => merged.pixels.clone(),
     };
     let record = merged.record.to_text();
     let text = Some((RECORD_ATTRIBUTE, record.as_str()));
     match ImageFormat::from_path(output)? {
         ImageFormat::Exr => {
             let mut layers: Vec<(LayerName, &[[f32; 3]])> = Vec::new();
-            if let Some(variance) = merged.variance.as_ref().filter(|_| !how.denoise) {
+            if let Some(variance) = merged.variance.as_ref().filter(|_| how.denoise.is_none()) {
                 layers.push((image_io::VARIANCE, variance));
             }
             if let Some(guides) = &merged.guides {
@@ -157,17 +172,58 @@ pub fn write_merged(merged: &Merged, output: &Path, how: &MergedOutput) -> Resul
     Ok(lines)
 }
 
-/// The merged image through the denoiser's CPU twin, guided by the files'
-/// guides; each pixel's variance of its mean, where known, weighs its
-/// neighbours (the filter's two-frame form: spread / (F − 1) with F = 2),
-/// else the filter estimates it from the pixel's neighbourhood.
-fn denoise_merged(merged: &Merged, output: &Path) -> Result<Vec<[f32; 4]>> {
+/// The merged image denoised, guided by the files' guides, and what
+/// denoised it: OIDN on the CPU, or (asked, or OIDN not found) the à-trous
+/// filter's CPU twin.
+fn denoise_merged(
+    merged: &Merged,
+    output: &Path,
+    denoiser: Denoiser,
+    quality: DenoiseQuality,
+) -> Result<(Vec<[f32; 4]>, String)> {
     let Some(guides) = &merged.guides else {
         bail!(
             "{}: --denoise needs the files' guides; render them with --guides",
             output.display()
         );
     };
+    let instead_of_oidn = match oidn_for(denoiser) {
+        Ok(None) => None,
+        Ok(Some(library)) => {
+            let mut oidn =
+                marbre_oidn::Denoiser::new(library, DeviceKind::Cpu).map_err(|e| anyhow!("{e}"))?;
+            let image = GuidedImage {
+                size: (merged.width, merged.height),
+                mean: merged.pixels.clone(),
+                albedo: guides
+                    .albedo
+                    .iter()
+                    .map(|a| [a[0], a[1], a[2], 1.0])
+                    .collect(),
+                normal: guides
+                    .normal
+                    .iter()
+                    .map(|n| [0.5 + 0.5 * n[0], 0.5 + 0.5 * n[1], 0.5 + 0.5 * n[2], 1.0])
+                    .collect(),
+            };
+            let running = Running::Oidn {
+                device: DeviceKind::Cpu,
+                version: oidn.version(),
+                quality,
+            };
+            return Ok((image.denoise(&mut oidn, quality)?, running.describe()));
+        }
+        Err(why) => Some(why),
+    };
+    let by = Running::Atrous { instead_of_oidn }.describe();
+    Ok((atrous_merged(merged, guides)?, by))
+}
+
+/// The merged image through the à-trous filter's CPU twin; each pixel's
+/// variance of its mean, where known, weighs its neighbours (the filter's
+/// two-frame form: spread / (F − 1) with F = 2), else the filter estimates
+/// it from the pixel's neighbourhood.
+fn atrous_merged(merged: &Merged, guides: &Guides) -> Result<Vec<[f32; 4]>> {
     let with_alpha = |v: &[f32; 3]| [v[0], v[1], v[2], 1.0];
     let spread: Vec<[f32; 4]> = merged.variance.as_ref().map_or_else(
         || vec![[0.0; 4]; merged.pixels.len()],

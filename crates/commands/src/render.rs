@@ -6,7 +6,7 @@
 
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
-use marbre_core::scene::{LightPoints, Metering, Strategy, View};
+use marbre_core::scene::{DenoiseQuality, Denoiser, LightPoints, Metering, Strategy, View};
 use marbre_core::tile::{Tile, TileGrid};
 pub use marbre_render::final_render::parse_size;
 use marbre_render::final_render::{
@@ -68,12 +68,24 @@ pub struct RenderArgs {
     /// diffuse lobe uniform over the hemisphere).
     #[arg(long, value_parser = parse_strategy)]
     pub strategy: Option<Strategy>,
-    /// Filter the PNG with the denoiser (the viewer's "denoise"): an
-    /// edge-avoiding à-trous filter guided by the first hit's albedo and
-    /// normal, accumulated beside the radiance. An EXR stays the raw
+    /// Filter the PNG with a denoiser (the viewer's "denoise"), guided by
+    /// the first hit's albedo and normal, accumulated beside the radiance:
+    /// oidn (Intel Open Image Denoise, the default; where its library is
+    /// not found, atrous runs instead and a note says why) or atrous
+    /// (marbre's edge-avoiding filter, on the GPU). An EXR stays the raw
     /// accumulation unless --denoise-exr is given too.
-    #[arg(long)]
-    pub denoise: bool,
+    #[arg(
+        long,
+        num_args = 0..=1,
+        default_missing_value = "oidn",
+        value_name = "oidn|atrous",
+        value_parser = parse_denoiser
+    )]
+    pub denoise: Option<Denoiser>,
+    /// OIDN's network: high (for final frames, the default), balanced or
+    /// fast.
+    #[arg(long, default_value = "high", value_parser = parse_denoise_quality)]
+    pub denoise_quality: DenoiseQuality,
     /// With --denoise, filter an EXR output as well (biased: it trades the
     /// noise for some blur).
     #[arg(long, requires = "denoise")]
@@ -166,6 +178,14 @@ fn parse_strategy(s: &str) -> Result<Strategy, String> {
     parse_named(s, &Strategy::ALL, Strategy::name)
 }
 
+pub(crate) fn parse_denoiser(s: &str) -> Result<Denoiser, String> {
+    parse_named(s, &Denoiser::ALL, Denoiser::name)
+}
+
+pub(crate) fn parse_denoise_quality(s: &str) -> Result<DenoiseQuality, String> {
+    parse_named(s, &DenoiseQuality::ALL, DenoiseQuality::label)
+}
+
 /// `--auto-exposure`'s metering.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum MeteringArg {
@@ -213,6 +233,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         kernel: args.kernel,
         output: args.output.clone(),
         denoise: args.denoise,
+        denoise_quality: args.denoise_quality,
         denoise_exr: args.denoise_exr,
         allow_placeholders: args.allow_placeholders,
         timing,

@@ -118,8 +118,8 @@ impl Library {
         // SAFETY: opening runs the library's initialisers; OIDN's only set
         // up its C++ runtime. A file of that name that is not OIDN 2 fails
         // `Api::read` below.
-        let library = unsafe { libloading::Library::new(path) }
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        // The loader's message names the file.
+        let library = unsafe { libloading::Library::new(path) }.map_err(|e| e.to_string())?;
         // SAFETY: a library named libOpenImageDenoise.so.2 exporting these
         // symbols is OIDN 2, whose signatures `Api` declares.
         let api = unsafe { Api::read(&library) }.map_err(|e| format!("{}: {e}", path.display()))?;

@@ -17,7 +17,7 @@ use anyhow::{Context, Result, bail};
 use marbre_core::animated_image;
 use marbre_core::image_io::{self, ImageFormat, LayerName};
 use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, scene_hash};
-use marbre_core::scene::{Metering, RenderSettings, Scene, View};
+use marbre_core::scene::{DenoiseQuality, Denoiser, Metering, RenderSettings, Scene, View};
 use marbre_core::texture::ImageSet;
 use marbre_core::tile::{self, Tile};
 use std::ops::ControlFlow;
@@ -70,10 +70,15 @@ pub struct FinalRender {
     pub kernel: KernelChoice,
     /// `.png` (tone-mapped, sRGB) or `.exr` (linear radiance, float).
     pub output: PathBuf,
-    /// Filter the image with the denoiser (`render --denoise`, the Render
+    /// Filter the image with this denoiser (`render --denoise`, the Render
     /// dialog's "denoise"), as the scene's display does when its
-    /// `denoise` is on: the PNG, and the EXR too with `denoise_exr`.
-    pub denoise: bool,
+    /// `denoise` is on: the PNG, and the EXR too with `denoise_exr`. OIDN
+    /// falls back to the à-trous filter, with a note, where its library is
+    /// not found.
+    pub denoise: Option<Denoiser>,
+    /// OIDN's network for this render (`render --denoise-quality`; high,
+    /// for final frames, unless asked).
+    pub denoise_quality: DenoiseQuality,
     /// Write the EXR denoised (with `denoise`, or the scene's display's);
     /// otherwise an EXR is the raw accumulation.
     pub denoise_exr: bool,
@@ -600,9 +605,9 @@ fn show_as_asked(render: &mut RenderSettings, job: &FinalRender) -> Result<()> {
         render.display.auto_exposure = true;
         render.display.metering = metering;
     }
-    if job.denoise || job.guides {
+    if job.denoise.is_some() || job.guides {
         if render.view != View::Lit {
-            let what = if job.denoise {
+            let what = if job.denoise.is_some() {
                 "--denoise filters the lit image"
             } else {
                 "--guides records the lit image's first hits"
@@ -612,6 +617,10 @@ fn show_as_asked(render: &mut RenderSettings, job: &FinalRender) -> Result<()> {
         // An EXR stays the raw accumulation unless `denoise_exr`.
         render.display.denoise = true;
     }
+    if let Some(denoiser) = job.denoise {
+        render.display.denoiser = denoiser;
+    }
+    render.display.denoise_quality = job.denoise_quality;
     Ok(())
 }
 
@@ -687,11 +696,17 @@ fn write_image(
     let text = Some((RECORD_ATTRIBUTE, record.as_str()));
     match format {
         ImageFormat::Png => {
+            if let Some(running) = renderer.finish_denoise(ctx)? {
+                observer.note(&format!("denoised by {}", running.describe()));
+            }
             let image = renderer.read_display(ctx)?;
             image_io::save_png_with_text(&image, text, output)
         }
         ImageFormat::Exr => {
             let (w, h, pixels) = if job.denoise_exr {
+                if let Some(running) = renderer.finish_denoise(ctx)? {
+                    observer.note(&format!("denoised by {}", running.describe()));
+                }
                 renderer.read_denoised(ctx)?
             } else {
                 if renderer.scene().render.display.denoise && !job.guides {

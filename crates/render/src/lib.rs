@@ -4,6 +4,7 @@
 
 pub mod bake_file;
 pub mod cpu_display;
+pub mod denoiser;
 pub mod final_render;
 pub mod frame_sequence;
 pub mod gpu;

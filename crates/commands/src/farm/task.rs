@@ -8,6 +8,7 @@
 use super::plan::{FarmPlan, Scheduler, Split, Task};
 use anyhow::{Context, Result, anyhow, bail};
 use marbre_core::merge::merge;
+use marbre_core::scene::{DenoiseQuality, Denoiser};
 use marbre_render::final_render::{
     DEFAULT_MAX_TILE_PIXELS, FinalRender, Progress, RenderObserver, Stop, render_to_file,
 };
@@ -67,7 +68,8 @@ fn trace(plan: &FarmPlan, task: &Task, output: &Path) -> Result<()> {
             .parse()
             .map_err(|e| anyhow!("the plan's kernel: {e}"))?,
         output: output.to_path_buf(),
-        denoise: false,
+        denoise: None,
+        denoise_quality: DenoiseQuality::High,
         denoise_exr: false,
         allow_placeholders: false,
         timing: Timing::Still {
@@ -149,7 +151,9 @@ pub fn merge_job(dir: &Path) -> Result<()> {
         let output = plan.frame_output(dir, frame);
         let how = crate::merge::MergedOutput {
             display,
-            denoise: plan.denoise,
+            denoise: plan
+                .denoise
+                .then_some((Denoiser::Oidn, DenoiseQuality::High)),
         };
         crate::merge::write_merged(&merged, &output, &how)?;
         let error = merged.error.map_or(String::new(), |e| {

@@ -5,6 +5,7 @@
 //! cancelled render and one into a missing folder write nothing.
 
 use marbre_commands::render::{self, RenderArgs};
+use marbre_core::scene::{DenoiseQuality, Denoiser};
 use marbre_render::final_render::{
     FinalRender, Outcome, Progress, RenderObserver, Stop, render_to_file, snapshot,
 };
@@ -83,7 +84,8 @@ fn cli_args(output: PathBuf, auto_exposure: bool) -> RenderArgs {
         view: None,
         light_points: None,
         strategy: None,
-        denoise: false,
+        denoise: None,
+        denoise_quality: DenoiseQuality::High,
         denoise_exr: false,
         allow_placeholders: false,
         frames: None,
@@ -108,7 +110,8 @@ fn dialog_job(output: PathBuf, auto_exposure: bool) -> FinalRender {
         auto_exposure: auto_exposure.then_some(marbre_core::scene::Metering::Key),
         kernel: KernelChoice::Fragment,
         output,
-        denoise: false,
+        denoise: None,
+        denoise_quality: DenoiseQuality::High,
         denoise_exr: false,
         allow_placeholders: false,
         timing: Default::default(),
@@ -226,7 +229,7 @@ fn denoise_filters_the_png_and_the_exr_only_when_asked() {
     let run = |name: &str, denoise: bool, denoise_exr: bool| {
         let output = dir.0.join(name);
         render::run(&RenderArgs {
-            denoise,
+            denoise: denoise.then_some(Denoiser::Atrous),
             denoise_exr,
             ..cli_args(output.clone(), false)
         })

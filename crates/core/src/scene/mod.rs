@@ -36,7 +36,9 @@ pub use mesh::{Mesh, MeshMaterial, MeshPlacement, TriangleMesh};
 pub use pattern::{MappingSpace, Pattern, Signal, SurfacePoint, TextureMapping};
 pub use pattern_table::{PATTERNS, PatternCode, PatternInfo, PatternKind};
 pub use primitives::{Cylinder, MAX_CYLINDERS, MAX_POLYGONS, Polygon};
-pub use render_settings::{DisplaySettings, Metering, RenderSettings, ToneMap};
+pub use render_settings::{
+    DenoiseQuality, Denoiser, DisplaySettings, Metering, RenderSettings, ToneMap,
+};
 pub use render_view::View;
 pub use texture_tree::{Child, MathOp, Texture};
 pub use transport::{Integrator, LightPoints, Strategy, TransportSettings};

@@ -38,6 +38,64 @@ impl ToneMap {
     }
 }
 
+/// Which filter the display's `denoise` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum Denoiser {
+    /// Intel Open Image Denoise, where its library is found (the render
+    /// crate's `denoiser`); the à-trous filter otherwise, with a note.
+    #[default]
+    Oidn,
+    /// marbre's edge-avoiding à-trous filter, on the GPU.
+    Atrous,
+}
+
+impl Denoiser {
+    pub const ALL: [Denoiser; 2] = [Denoiser::Oidn, Denoiser::Atrous];
+
+    /// The name `render --denoise` and `merge --denoise` take.
+    pub fn name(self) -> &'static str {
+        match self {
+            Denoiser::Oidn => "oidn",
+            Denoiser::Atrous => "atrous",
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Denoiser::Oidn => "OIDN",
+            Denoiser::Atrous => "à-trous",
+        }
+    }
+}
+
+/// OIDN's three networks (its `quality`), slowest and best first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum DenoiseQuality {
+    /// For final frames: `marbre render` and `merge` use it.
+    High,
+    /// For interactive rendering: the viewer's default.
+    #[default]
+    Balanced,
+    /// For real-time previews.
+    Fast,
+}
+
+impl DenoiseQuality {
+    pub const ALL: [DenoiseQuality; 3] = [
+        DenoiseQuality::High,
+        DenoiseQuality::Balanced,
+        DenoiseQuality::Fast,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            DenoiseQuality::High => "high",
+            DenoiseQuality::Balanced => "balanced",
+            DenoiseQuality::Fast => "fast",
+        }
+    }
+}
+
 /// How auto exposure meters the image.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum Metering {
@@ -117,12 +175,15 @@ pub struct DisplaySettings {
     /// Debug view: pixels where a path gave a NaN or infinite sample (which
     /// the accumulation drops and counts) are painted magenta.
     pub show_non_finite: bool,
-    /// Show the accumulation through the denoiser (`gpu::denoise`): an
-    /// edge-avoiding filter guided by the first hit's albedo and normal,
-    /// which the trace pass then accumulates beside the radiance (a
-    /// specialised shader). Biased; off by default, and saved EXRs stay the
-    /// raw accumulation.
+    /// Show the accumulation through the denoiser, guided by the first
+    /// hit's albedo and normal, which the trace pass then accumulates
+    /// beside the radiance (a specialised shader). Biased; off by default,
+    /// and saved EXRs stay the raw accumulation.
     pub denoise: bool,
+    /// Which denoiser, when `denoise` is on.
+    pub denoiser: Denoiser,
+    /// OIDN's network.
+    pub denoise_quality: DenoiseQuality,
 }
 
 impl Default for DisplaySettings {
@@ -134,6 +195,8 @@ impl Default for DisplaySettings {
             tone_map: ToneMap::Aces,
             show_non_finite: false,
             denoise: false,
+            denoiser: Denoiser::Oidn,
+            denoise_quality: DenoiseQuality::Balanced,
         }
     }
 }
@@ -161,6 +224,10 @@ struct RenderSettingsFile {
     auto_exposure_metering: Metering,
     view: super::render_view::View,
     denoise: bool,
+    /// Presets written before it denoise with OIDN, as ones written after
+    /// it do by default.
+    denoiser: Denoiser,
+    denoise_quality: DenoiseQuality,
 }
 
 impl From<RenderSettingsFile> for RenderSettings {
@@ -182,6 +249,8 @@ impl From<RenderSettingsFile> for RenderSettings {
                 tone_map: f.tone_map,
                 show_non_finite: f.show_non_finite,
                 denoise: f.denoise,
+                denoiser: f.denoiser,
+                denoise_quality: f.denoise_quality,
             },
         }
     }
@@ -205,6 +274,8 @@ impl From<RenderSettings> for RenderSettingsFile {
             auto_exposure_metering: r.display.metering,
             view: r.view,
             denoise: r.display.denoise,
+            denoiser: r.display.denoiser,
+            denoise_quality: r.display.denoise_quality,
         }
     }
 }
@@ -273,6 +344,7 @@ impl RenderSettings {
                 show_non_finite: self.display.show_non_finite,
                 metering: self.display.metering,
                 denoise: false,
+                ..self.display
             }
         } else {
             self.display
@@ -402,6 +474,8 @@ mod tests {
             // Its guides come with a new pipeline, which restarts the
             // accumulation by itself.
             denoise: true,
+            denoiser: Denoiser::Atrous,
+            denoise_quality: DenoiseQuality::Fast,
         };
         assert!(base.traces_like(&shown));
         let mut traced = base;

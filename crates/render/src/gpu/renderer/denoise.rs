@@ -1,14 +1,17 @@
-//! The denoised preview (`gpu::denoise`): while the scene's display asks
-//! for it and the trace pipeline accumulates the guides, the display pass
-//! shows the latest image filtered, filtered again only when a new image is
-//! shown.
+//! The denoised display: while the scene's display asks for it and the
+//! trace pipeline accumulates the guides, the display pass shows the
+//! latest image filtered, by OIDN (`oidn_stage.rs`) or by the à-trous
+//! filter (`gpu::denoise`), which runs where OIDN's library is not found
+//! and is filtered again only when a new image is shown.
 
 use super::{MeteredFrom, Renderer};
+use crate::denoiser::{DenoiseReport, Running};
 use crate::gpu::context::GpuContext;
 use crate::gpu::denoise::{DenoiseSettings, DenoiseSources, Denoiser};
 use crate::gpu::features::Feature;
 use crate::gpu::readback::read_texture;
 use anyhow::{Result, bail};
+use marbre_core::scene::Denoiser as Choice;
 
 impl Renderer {
     /// Whether the display shows the denoised image: the scene asks for it
@@ -19,21 +22,43 @@ impl Renderer {
             && self.trace.key.features.contains(Feature::DenoiseGuides)
     }
 
-    /// Records the filter of the latest image if it has not been filtered
-    /// yet, and returns the view of the filtered image; `None` when not
-    /// denoising.
+    /// Records this frame's step of the denoiser and returns the view of
+    /// the denoised image to show; `None` when not denoising, or before
+    /// OIDN's first image of this accumulation.
     pub(super) fn record_denoise(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
     ) -> Result<Option<wgpu::TextureView>> {
-        if !self.denoises() {
+        if !self.denoises() || self.accumulation.latest_guides().is_none() {
+            // Not denoising, or no band traced with the guides yet.
             return Ok(None);
         }
-        let Some((albedo, normal)) = self.accumulation.latest_guides() else {
-            // No band traced with the guides yet.
-            return Ok(None);
+        let instead_of_oidn = match self.scene.render.display.denoiser {
+            Choice::Atrous => None,
+            Choice::Oidn => match self.oidn_library() {
+                Ok(library) => return self.record_oidn(ctx, encoder, library),
+                Err(why) => Some(why),
+            },
         };
+        self.display.oidn.report = Some(DenoiseReport {
+            running: Running::Atrous { instead_of_oidn },
+            last: None,
+        });
+        self.record_atrous(ctx, encoder).map(Some)
+    }
+
+    /// The à-trous filter of the latest image, recorded if it has not
+    /// been filtered yet; the view of its output.
+    fn record_atrous(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<wgpu::TextureView> {
+        let (albedo, normal) = self
+            .accumulation
+            .latest_guides()
+            .expect("checked by record_denoise");
         let from = MeteredFrom {
             shown: self.accumulation.shown_count(),
             size: self.size,
@@ -57,7 +82,10 @@ impl Renderer {
             denoiser.record(ctx, encoder, &sources, &settings);
             self.display.denoised_from = Some(from);
         }
-        Ok(denoiser.output(&settings).map(|(_, view)| view.clone()))
+        Ok(denoiser
+            .output(&settings)
+            .map(|(_, view)| view.clone())
+            .expect("recorded above"))
     }
 
     /// The guides the trace pass accumulated over the shown region: the
@@ -74,21 +102,31 @@ impl Renderer {
     }
 
     /// The denoised linear image of the shown region (alpha 1), waiting for
-    /// the GPU: for `render --denoise-exr`, the bench and tests. An error
-    /// unless the scene's display has `denoise` on.
+    /// the GPU and for OIDN: for `render --denoise-exr`, the bench and
+    /// tests. An error unless the scene's display has `denoise` on.
     pub fn read_denoised(&mut self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+        if !self.denoises() {
+            bail!("no denoised image: the scene's display does not have denoise on");
+        }
+        if let Some(Running::Oidn { .. }) = self.finish_denoise(ctx)? {
+            let texture = self.oidn_texture_now().expect("denoised above");
+            let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
+            let (w, h) = (texture.width(), texture.height());
+            return Ok((w, h, bytemuck::cast_slice(&bytes).to_vec()));
+        }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let recorded = self.record_denoise(ctx, &mut encoder)?.is_some();
+        let Some(view) = self.record_denoise(ctx, &mut encoder)? else {
+            bail!("no denoised image: no band was traced with the guides");
+        };
+        drop(view);
+        ctx.queue.submit([encoder.finish()]);
         let settings = DenoiseSettings::default();
-        let output = self
+        let (texture, _) = self
             .display
             .denoiser
             .as_ref()
-            .and_then(|d| d.output(&settings));
-        let (true, Some((texture, _))) = (recorded, output) else {
-            bail!("no denoised image: the scene's display does not have denoise on");
-        };
-        ctx.queue.submit([encoder.finish()]);
+            .and_then(|d| d.output(&settings))
+            .expect("recorded above");
         let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
         let mut pixels: Vec<[f32; 4]> = bytemuck::cast_slice(&bytes).to_vec();
         for p in &mut pixels {

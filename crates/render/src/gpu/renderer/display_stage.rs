@@ -1,7 +1,9 @@
 //! The display stage: the pass that turns the accumulation into an image
 //! on any colour target (exposure, tone map, encoding), its uniform, the
-//! auto-exposure metering it reads and the denoiser (`denoise.rs`).
+//! auto-exposure metering it reads and the denoisers (`denoise.rs`, and
+//! OIDN's `oidn_stage.rs`).
 
+use super::oidn_stage::OidnStage;
 use crate::gpu::auto_exposure::AutoExposure;
 use crate::gpu::denoise::Denoiser;
 use crate::gpu::features::FeatureSet;
@@ -28,6 +30,8 @@ pub(super) struct DisplayStage {
     pub(super) denoiser: Option<Denoiser>,
     /// What the denoiser's output was filtered from.
     pub(super) denoised_from: Option<MeteredFrom>,
+    /// OIDN: its read-back, thread and output.
+    pub(super) oidn: OidnStage,
 }
 
 impl DisplayStage {
@@ -55,6 +59,7 @@ impl DisplayStage {
             metered_from: None,
             denoiser: None,
             denoised_from: None,
+            oidn: OidnStage::default(),
         })
     }
 }

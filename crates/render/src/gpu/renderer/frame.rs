@@ -460,5 +460,6 @@ impl Renderer {
     pub fn after_submit(&self) {
         self.error_meter.after_submit();
         self.non_finite.after_submit();
+        self.display.oidn.after_submit();
     }
 }

@@ -16,6 +16,7 @@ mod build;
 mod denoise;
 mod display_stage;
 mod frame;
+mod oidn_stage;
 mod readback;
 mod scene_bindings;
 mod trace_stage;

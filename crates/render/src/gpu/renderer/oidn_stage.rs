@@ -1,0 +1,413 @@
+//! The renderer's OIDN stage (`crate::denoiser`): when to denoise, the
+//! read-back of the accumulation and its guides, and the uploaded result
+//! the display pass shows.
+//!
+//! In the viewer nothing here waits: the copy is recorded in a frame's
+//! encoder and mapped after its submit ([`OidnStage::after_submit`]); a
+//! later frame hands the bytes to the OIDN thread; a later one still
+//! uploads the result. Meanwhile the display shows the last denoised image
+//! of the same accumulation, or the raw mean before the first. A denoise
+//! is due at 1, 2, 4, 8… rounds (every few samples at first, ever rarer),
+//! and once more when the accumulation settles (nothing traced between two
+//! displays). `marbre render` and the tests denoise in place instead
+//! ([`Renderer::finish_denoise`]).
+
+use super::Renderer;
+use crate::denoiser::{DenoiseReport, GuidedImage, Job, OidnWorker, Running, device_for, oidn_for};
+use crate::gpu::accumulation::ACCUMULATION_FORMAT;
+use crate::gpu::context::GpuContext;
+use anyhow::{Result, anyhow};
+use marbre_oidn::Library;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::time::Instant;
+
+/// What a denoised image was filtered from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct DenoisedFrom {
+    generation: u32,
+    frames: u32,
+    size: (u32, u32),
+}
+
+const IDLE: u8 = 0;
+const RECORDED: u8 = 1;
+const IN_FLIGHT: u8 = 2;
+const MAPPED: u8 = 3;
+
+/// The copy of the mean and both guides into one mappable buffer.
+struct GuideReadback {
+    buffer: wgpu::Buffer,
+    state: Arc<AtomicU8>,
+    from: DenoisedFrom,
+    /// Bytes per row, padded to wgpu's copy alignment.
+    row_bytes: u32,
+}
+
+#[derive(Default)]
+pub(super) struct OidnStage {
+    /// The last denoised image and what it was filtered from.
+    image: Option<(wgpu::Texture, wgpu::TextureView, DenoisedFrom)>,
+    readback: Option<GuideReadback>,
+    worker: Option<OidnWorker<DenoisedFrom>>,
+    /// For `finish_denoise`: a device on the calling thread.
+    in_place: Option<marbre_oidn::Denoiser>,
+    /// The rounds of the last image sent to be denoised, and its
+    /// accumulation.
+    requested: Option<(u32, u32)>,
+    /// The rounds seen by the previous display, for "settled".
+    last_seen: Option<(u32, u32)>,
+    /// OIDN's library, looked for once.
+    library: Option<Result<Arc<Library>, String>>,
+    pub(super) report: Option<DenoiseReport>,
+}
+
+impl OidnStage {
+    /// Whether a round-`frames` image of accumulation `generation` is due:
+    /// at 1, 2, 4, 8… rounds, or when nothing was traced since the last
+    /// display (the accumulation has settled).
+    fn due(&mut self, generation: u32, frames: u32) -> bool {
+        let settled = self.last_seen == Some((generation, frames));
+        self.last_seen = Some((generation, frames));
+        if frames == 0 {
+            return false;
+        }
+        match self.requested {
+            Some((g, f)) if g == generation => f != frames && (frames >= 2 * f || settled),
+            _ => true,
+        }
+    }
+
+    /// Starts mapping the copy recorded in the encoder just submitted.
+    pub(super) fn after_submit(&self) {
+        let Some(r) = &self.readback else { return };
+        if r.state.load(Ordering::Acquire) != RECORDED {
+            return;
+        }
+        r.state.store(IN_FLIGHT, Ordering::Release);
+        let state = r.state.clone();
+        r.buffer.map_async(wgpu::MapMode::Read, .., move |result| {
+            state.store(
+                if result.is_ok() { MAPPED } else { IDLE },
+                Ordering::Release,
+            );
+        });
+    }
+}
+
+impl Renderer {
+    /// What denoises the display now, when it is denoising and the scene
+    /// asks for OIDN: its library, or why the à-trous filter runs instead.
+    pub(super) fn oidn_library(&mut self) -> Result<Arc<Library>, String> {
+        let choice = self.scene.render.display.denoiser;
+        self.display
+            .oidn
+            .library
+            .get_or_insert_with(|| oidn_for(choice).map(|l| l.expect("asked for OIDN")))
+            .clone()
+    }
+
+    /// What filters the display, and the last denoise's time: `None` when
+    /// not denoising.
+    pub fn denoise_report(&self) -> Option<&DenoiseReport> {
+        self.denoises()
+            .then_some(self.display.oidn.report.as_ref())
+            .flatten()
+    }
+
+    /// What the display's denoised image would be filtered from now.
+    fn denoise_source(&self) -> DenoisedFrom {
+        DenoisedFrom {
+            generation: self.accumulation.generation(),
+            frames: self.accumulation.frames(),
+            size: self.shown_size(),
+        }
+    }
+
+    /// The viewer's step of OIDN, in a frame's encoder: collects what came
+    /// back, starts what is due, and returns the view to show (the latest
+    /// denoised image of this accumulation), if any.
+    pub(super) fn record_oidn(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        library: Arc<Library>,
+    ) -> Result<Option<wgpu::TextureView>> {
+        let now = self.denoise_source();
+        self.collect_oidn(ctx);
+        let full_round = self.shown_size() == self.render_size();
+        let stage = &mut self.display.oidn;
+        let idle = stage
+            .readback
+            .as_ref()
+            .is_none_or(|r| r.state.load(Ordering::Acquire) == IDLE)
+            && stage.worker.as_ref().is_none_or(|w| !w.is_busy());
+        if stage.due(now.generation, now.frames) && full_round && idle {
+            if stage.worker.is_none() {
+                let device = device_for(ctx, &library);
+                stage.worker = Some(OidnWorker::start(library, device)?);
+            }
+            self.record_guide_copy(ctx, encoder, now);
+            self.display.oidn.requested = Some((now.generation, now.frames));
+        }
+        Ok(self.shown_oidn(now))
+    }
+
+    /// The denoised view to show for `now`: one of the same accumulation
+    /// and size, however many rounds behind.
+    fn shown_oidn(&self, now: DenoisedFrom) -> Option<wgpu::TextureView> {
+        let (_, view, from) = self.display.oidn.image.as_ref()?;
+        (from.generation == now.generation && from.size == now.size).then(|| view.clone())
+    }
+
+    /// Hands a mapped read-back to the OIDN thread, and uploads a result
+    /// that came back.
+    fn collect_oidn(&mut self, ctx: &GpuContext) {
+        let stage = &mut self.display.oidn;
+        if let Some(r) = &stage.readback
+            && r.state.load(Ordering::Acquire) == MAPPED
+        {
+            let image = r
+                .buffer
+                .get_mapped_range(..)
+                .map(|bytes| guided_image(&bytes, r.from.size, r.row_bytes));
+            r.buffer.unmap();
+            r.state.store(IDLE, Ordering::Release);
+            let (tag, quality) = (r.from, self.scene.render.display.denoise_quality);
+            if let (Ok(image), Some(worker)) = (image, &mut stage.worker) {
+                worker.submit(Job {
+                    tag,
+                    image,
+                    quality,
+                });
+            }
+        }
+        let Some(done) = stage.worker.as_mut().and_then(OidnWorker::take) else {
+            return;
+        };
+        let device = stage.worker.as_ref().map(OidnWorker::device);
+        match done.pixels {
+            Ok(pixels) => {
+                let samples = done.tag.frames * self.scene.render.samples_per_frame;
+                self.upload_denoised(ctx, done.tag, &pixels);
+                self.display.oidn.report = Some(DenoiseReport {
+                    running: Running::Oidn {
+                        device: device.unwrap_or(marbre_oidn::DeviceKind::Cpu),
+                        version: done.version,
+                        quality: self.scene.render.display.denoise_quality,
+                    },
+                    last: Some((done.took, samples)),
+                });
+            }
+            Err(why) => log::warn!("OIDN: {why}"),
+        }
+    }
+
+    /// Records the copy of the mean and both guides of the shown region.
+    fn record_guide_copy(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        from: DenoisedFrom,
+    ) {
+        let Some([albedo, normal]) = self.accumulation.latest_guide_textures() else {
+            return;
+        };
+        let (w, h) = from.size;
+        let row_bytes = (w * 16).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let size = 3 * u64::from(row_bytes) * u64::from(h);
+        let stage = &mut self.display.oidn;
+        if stage
+            .readback
+            .as_ref()
+            .is_none_or(|r| r.buffer.size() != size)
+        {
+            stage.readback = Some(GuideReadback {
+                buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("OIDN read-back"),
+                    size,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                }),
+                state: Arc::new(AtomicU8::new(IDLE)),
+                from,
+                row_bytes,
+            });
+        }
+        let r = stage.readback.as_mut().expect("made above");
+        r.from = from;
+        r.row_bytes = row_bytes;
+        let mean = self.accumulation.latest_mean_texture();
+        for (i, texture) in [mean, albedo, normal].into_iter().enumerate() {
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &r.buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: i as u64 * u64::from(row_bytes) * u64::from(h),
+                        bytes_per_row: Some(row_bytes),
+                        rows_per_image: Some(h),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        r.state.store(RECORDED, Ordering::Release);
+    }
+
+    /// Denoises the latest image with OIDN now, on this thread, if the
+    /// display denoises with OIDN and has not this image yet: for `marbre
+    /// render`, the bench and tests, before [`Self::read_display`] or
+    /// [`Self::read_denoised`]. Returns what filters the display (`None`
+    /// when not denoising).
+    pub fn finish_denoise(&mut self, ctx: &GpuContext) -> Result<Option<Running>> {
+        if !self.denoises() {
+            return Ok(None);
+        }
+        let library = match self.scene.render.display.denoiser {
+            marbre_core::scene::Denoiser::Atrous => {
+                return Ok(Some(Running::Atrous {
+                    instead_of_oidn: None,
+                }));
+            }
+            marbre_core::scene::Denoiser::Oidn => match self.oidn_library() {
+                Ok(library) => library,
+                Err(why) => {
+                    return Ok(Some(Running::Atrous {
+                        instead_of_oidn: Some(why),
+                    }));
+                }
+            },
+        };
+        let now = self.denoise_source();
+        let quality = self.scene.render.display.denoise_quality;
+        let device = device_for(ctx, &library);
+        let stage = &mut self.display.oidn;
+        if stage.in_place.is_none() {
+            stage.in_place =
+                Some(marbre_oidn::Denoiser::new(library, device).map_err(|e| anyhow!("{e}"))?);
+        }
+        let version = stage.in_place.as_ref().expect("made above").version();
+        let running = Running::Oidn {
+            device,
+            version,
+            quality,
+        };
+        if self.shown_oidn(now).is_some()
+            && self
+                .display
+                .oidn
+                .image
+                .as_ref()
+                .is_some_and(|(_, _, f)| *f == now)
+        {
+            return Ok(Some(running));
+        }
+        let Some([albedo, normal]) = self.read_guides(ctx)? else {
+            return Err(anyhow!(
+                "no guides to denoise with: the trace has not accumulated them"
+            ));
+        };
+        let (w, h, mean) = self.read_radiance(ctx)?;
+        let image = GuidedImage {
+            size: (w, h),
+            mean,
+            albedo,
+            normal,
+        };
+        let start = Instant::now();
+        let oidn = self.display.oidn.in_place.as_mut().expect("made above");
+        let pixels = image.denoise(oidn, quality)?;
+        let took = start.elapsed();
+        self.upload_denoised(ctx, now, &pixels);
+        self.display.oidn.requested = Some((now.generation, now.frames));
+        self.display.oidn.report = Some(DenoiseReport {
+            running: running.clone(),
+            last: Some((took, self.accumulation.samples())),
+        });
+        Ok(Some(running))
+    }
+
+    /// Puts a denoised image where the display pass reads it.
+    fn upload_denoised(&mut self, ctx: &GpuContext, from: DenoisedFrom, pixels: &[[f32; 4]]) {
+        let (w, h) = from.size;
+        let stage = &mut self.display.oidn;
+        let fits = stage
+            .image
+            .as_ref()
+            .is_some_and(|(t, _, _)| (t.width(), t.height()) == (w, h));
+        if !fits {
+            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("OIDN output"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ACCUMULATION_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&Default::default());
+            stage.image = Some((texture, view, from));
+        }
+        let (texture, _, tag) = stage.image.as_mut().expect("made above");
+        *tag = from;
+        ctx.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(pixels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 16),
+                rows_per_image: Some(h),
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// The OIDN output texture, when it holds the latest image.
+    pub(super) fn oidn_texture_now(&self) -> Option<&wgpu::Texture> {
+        let now = self.denoise_source();
+        let (texture, _, from) = self.display.oidn.image.as_ref()?;
+        (*from == now).then_some(texture)
+    }
+}
+
+/// The mean and guides out of the read-back's bytes: three images of
+/// `size`, one after the other, rows `row_bytes` apart.
+fn guided_image(bytes: &[u8], size: (u32, u32), row_bytes: u32) -> GuidedImage {
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let plane = row_bytes as usize * h;
+    let read = |i: usize| {
+        let mut out = Vec::with_capacity(w * h);
+        for y in 0..h {
+            let start = i * plane + y * row_bytes as usize;
+            out.extend(
+                bytes[start..start + w * 16]
+                    .chunks_exact(16)
+                    .map(bytemuck::pod_read_unaligned::<[f32; 4]>),
+            );
+        }
+        out
+    };
+    GuidedImage {
+        size,
+        mean: read(0),
+        albedo: read(1),
+        normal: read(2),
+    }
+}
