@@ -194,6 +194,8 @@ pub struct Stats {
     /// The fraction of the sample round under way already traced (a slow
     /// adapter traces a round over several frames).
     pub round_progress: f32,
+    /// What denoises the display and its last time, when denoising.
+    pub denoise: Option<marbre_render::denoiser::DenoiseReport>,
 }
 
 /// A button press the app must act on: these need files, the GPU or the

@@ -6,7 +6,7 @@ use super::widgets::slider;
 use super::{PanelAction, Stats};
 use egui::{ComboBox, Ui};
 use marbre_core::animation::ParamPath;
-use marbre_core::scene::{Metering, RenderSettings, ToneMap, View};
+use marbre_core::scene::{DenoiseQuality, Denoiser, Metering, RenderSettings, ToneMap, View};
 
 pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut Vec<PanelAction>) {
     ComboBox::new("view", "view")
@@ -98,16 +98,9 @@ pub(super) fn render_ui(ui: &mut Ui, render: &mut RenderSettings, actions: &mut 
         );
     ui.checkbox(&mut render.clamp_octaves, "clamp octaves to footprint")
         .on_hover_text("Stop fractal sums at the finest octave a pixel resolves (pbrt's rule)");
-    ui.add_enabled_ui(render.view == View::Lit, |ui| {
-        ui.checkbox(&mut render.display.denoise, "denoise")
-            .on_hover_text(
-                "Show the image through an edge-avoiding filter guided by the first surface's \
-                 albedo and normal (à-trous wavelets, SVGF's variance weight): a clean preview \
-                 from few samples, slightly blurred. PNG screenshots are filtered; EXRs stay \
-                 the raw accumulation. Turning it on restarts the accumulation",
-            )
-            .on_disabled_hover_text("Filters the lit image only");
-    });
+    ui.add_enabled_ui(render.view == View::Lit, |ui| denoise_ui(ui, render))
+        .response
+        .on_disabled_hover_text("Filters the lit image only");
     ui.checkbox(
         &mut render.display.show_non_finite,
         "show non-finite pixels",
@@ -185,5 +178,45 @@ pub(super) fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelActio
         );
     if choice != stats.kernel_choice {
         actions.push(PanelAction::SetKernel(choice));
+    }
+}
+
+/// The denoiser: off, OIDN or à-trous, and OIDN's network.
+fn denoise_ui(ui: &mut Ui, render: &mut RenderSettings) {
+    let display = &mut render.display;
+    let mut choice = display.denoise.then_some(display.denoiser);
+    ComboBox::from_label("denoiser")
+        .selected_text(choice.map_or("off", Denoiser::label))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut choice, None, "off");
+            for d in Denoiser::ALL {
+                ui.selectable_value(&mut choice, Some(d), d.label());
+            }
+        })
+        .response
+        .on_hover_text(
+            "Show the image denoised, guided by the first surface's albedo and normal. OIDN \
+             (Intel Open Image Denoise, as Blender uses) runs on the CPU off the render \
+             thread, where its library is found (Stats says which runs); à-trous is marbre's \
+             edge-avoiding filter on the GPU. PNG screenshots are filtered; EXRs stay the raw \
+             accumulation. Turning it on restarts the accumulation",
+        );
+    display.denoise = choice.is_some();
+    if let Some(d) = choice {
+        display.denoiser = d;
+    }
+    if choice == Some(Denoiser::Oidn) {
+        ComboBox::from_label("OIDN quality")
+            .selected_text(display.denoise_quality.label())
+            .show_ui(ui, |ui| {
+                for q in DenoiseQuality::ALL {
+                    ui.selectable_value(&mut display.denoise_quality, q, q.label());
+                }
+            })
+            .response
+            .on_hover_text(
+                "OIDN's network: high for final frames, balanced for interactive use, fast for \
+                 real-time previews",
+            );
     }
 }

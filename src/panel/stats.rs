@@ -3,6 +3,7 @@
 
 use super::Stats;
 use egui::{Color32, Ui};
+use marbre_render::denoiser::DenoiseReport;
 use marbre_render::gpu::NonFiniteCounts;
 
 /// The live figures for the first line of the panel (the Preset
@@ -54,6 +55,9 @@ pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {
         stats.kernel, stats.kernel_reason
     ));
     non_finite_ui(ui, &stats.non_finite);
+    if let Some(report) = &stats.denoise {
+        denoise_ui(ui, report);
+    }
     let (w, h) = stats.resolution;
     ui.label(format!("{w} × {h}"));
     ui.label(format!("{} ({})", stats.adapter, stats.backend));
@@ -81,6 +85,23 @@ pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {
 
 /// The NaN and Inf counters: red as soon as one sample was dropped, since a
 /// correct renderer never produces one.
+/// Which denoiser runs, on which device, and its last time.
+fn denoise_ui(ui: &mut Ui, report: &DenoiseReport) {
+    let time = match report.last {
+        Some((took, samples)) => format!(
+            ", {:.0} ms for the {samples}-spp image",
+            took.as_secs_f64() * 1e3
+        ),
+        None => String::new(),
+    };
+    ui.label(format!("denoiser: {}{time}", report.running.describe()))
+        .on_hover_text(
+            "OIDN filters a copy of the accumulation off the render thread: the image shown \
+             is the last one filtered (at 1, 2, 4, 8… rounds and when the image settles), or \
+             the raw one before the first",
+        );
+}
+
 fn non_finite_ui(ui: &mut Ui, counts: &NonFiniteCounts) {
     let text = format!(
         "non-finite samples: {} NaN, {} Inf ({} pixels)",

@@ -86,6 +86,7 @@ impl Viewer {
             kernel_choice: self.kernels.choice(),
             kernel_reason: self.kernels.reason().to_owned(),
             round_progress: self.renderer.round_progress(),
+            denoise: self.renderer.denoise_report().cloned(),
             samples: self.renderer.accumulated_samples(),
             adapter: info.name,
             backend: format!("{:?}", info.backend),

@@ -17,6 +17,7 @@ use crate::denoiser::{DenoiseReport, GuidedImage, Job, OidnWorker, Running, devi
 use crate::gpu::accumulation::ACCUMULATION_FORMAT;
 use crate::gpu::context::GpuContext;
 use anyhow::{Result, anyhow};
+use marbre_core::scene::DenoiseQuality;
 use marbre_oidn::Library;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -52,9 +53,9 @@ pub(super) struct OidnStage {
     worker: Option<OidnWorker<DenoisedFrom>>,
     /// For `finish_denoise`: a device on the calling thread.
     in_place: Option<marbre_oidn::Denoiser>,
-    /// The rounds of the last image sent to be denoised, and its
-    /// accumulation.
-    requested: Option<(u32, u32)>,
+    /// The accumulation, rounds and network of the last image sent to be
+    /// denoised.
+    requested: Option<(u32, u32, DenoiseQuality)>,
     /// The rounds seen by the previous display, for "settled".
     last_seen: Option<(u32, u32)>,
     /// OIDN's library, looked for once.
@@ -64,16 +65,18 @@ pub(super) struct OidnStage {
 
 impl OidnStage {
     /// Whether a round-`frames` image of accumulation `generation` is due:
-    /// at 1, 2, 4, 8… rounds, or when nothing was traced since the last
-    /// display (the accumulation has settled).
-    fn due(&mut self, generation: u32, frames: u32) -> bool {
+    /// at 1, 2, 4, 8… rounds, when nothing was traced since the last
+    /// display (the accumulation has settled), or for another network.
+    fn due(&mut self, generation: u32, frames: u32, quality: DenoiseQuality) -> bool {
         let settled = self.last_seen == Some((generation, frames));
         self.last_seen = Some((generation, frames));
         if frames == 0 {
             return false;
         }
         match self.requested {
-            Some((g, f)) if g == generation => f != frames && (frames >= 2 * f || settled),
+            Some((g, f, q)) if g == generation && q == quality => {
+                f != frames && (frames >= 2 * f || settled)
+            }
             _ => true,
         }
     }
@@ -142,13 +145,14 @@ impl Renderer {
             .as_ref()
             .is_none_or(|r| r.state.load(Ordering::Acquire) == IDLE)
             && stage.worker.as_ref().is_none_or(|w| !w.is_busy());
-        if stage.due(now.generation, now.frames) && full_round && idle {
+        let quality = self.scene.render.display.denoise_quality;
+        if stage.due(now.generation, now.frames, quality) && full_round && idle {
             if stage.worker.is_none() {
                 let device = device_for(ctx, &library);
                 stage.worker = Some(OidnWorker::start(library, device)?);
             }
             self.record_guide_copy(ctx, encoder, now);
-            self.display.oidn.requested = Some((now.generation, now.frames));
+            self.display.oidn.requested = Some((now.generation, now.frames, quality));
         }
         Ok(self.shown_oidn(now))
     }
@@ -325,7 +329,7 @@ impl Renderer {
         let pixels = image.denoise(oidn, quality)?;
         let took = start.elapsed();
         self.upload_denoised(ctx, now, &pixels);
-        self.display.oidn.requested = Some((now.generation, now.frames));
+        self.display.oidn.requested = Some((now.generation, now.frames, quality));
         self.display.oidn.report = Some(DenoiseReport {
             running: running.clone(),
             last: Some((took, self.accumulation.samples())),
