@@ -83,3 +83,64 @@ fn render_through_a_file_names_the_file() {
     );
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "a file");
 }
+
+/// `render --denoise` says what denoised the image: OIDN where its library
+/// is found; with `MARBRE_OIDN_DIR` pointing at an empty folder, the
+/// à-trous filter, and why (the folder named), the render still written.
+#[test]
+fn render_denoise_says_which_denoiser_ran_and_falls_back_without_oidn() {
+    const TEST: &str = "render_denoise_says_which_denoiser_ran_and_falls_back_without_oidn";
+    let dir = TempDir::new("render-cli-denoise");
+    if gpu_or_skip(TEST).is_none() {
+        return;
+    }
+    let empty = dir.path().join("no-oidn");
+    std::fs::create_dir(&empty).unwrap();
+    let output = dir.path().join("fallback.png");
+    let run = Command::new(BIN)
+        .args([
+            "render",
+            "--preset",
+            "presets/default.ron",
+            "--size",
+            "16x16",
+        ])
+        .args(["--spp", "2", "--kernel", "fragment", "--denoise", "-o"])
+        .arg(&output)
+        .current_dir(REPO)
+        .env("MARBRE_OIDN_DIR", &empty)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{}: {stderr}", run.status);
+    assert!(output.is_file(), "{stderr}");
+    assert!(
+        stderr.contains("denoised by à-trous, as OIDN's library")
+            && stderr.contains(&empty.display().to_string()),
+        "{stderr}"
+    );
+    if marbre_oidn::library_or_skip(TEST).is_none() {
+        return;
+    }
+    let output = dir.path().join("oidn.png");
+    let run = Command::new(BIN)
+        .args([
+            "render",
+            "--preset",
+            "presets/default.ron",
+            "--size",
+            "16x16",
+        ])
+        .args(["--spp", "2", "--kernel", "fragment", "--denoise", "-o"])
+        .arg(&output)
+        .current_dir(REPO)
+        .env_remove("MARBRE_OIDN_DIR")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{}: {stderr}", run.status);
+    assert!(
+        stderr.contains("denoised by OIDN 2.") && stderr.contains("(high)"),
+        "{stderr}"
+    );
+}

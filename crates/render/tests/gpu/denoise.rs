@@ -4,7 +4,7 @@
 //! a higher-spp reference.
 
 use crate::common::{assert_kernels_agree, kernels, root};
-use marbre_core::scene::{Scene, View};
+use marbre_core::scene::{Denoiser as Choice, Scene, View};
 use marbre_render::gpu::denoise::{DenoiseImage, DenoiseSettings, Denoiser, denoise_cpu};
 use marbre_render::gpu::testing::gpu_or_skip;
 use marbre_render::gpu::{GpuContext, Kernel, Renderer};
@@ -158,8 +158,8 @@ fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
     (sum / (3 * a.len()) as f64).sqrt()
 }
 
-/// `name`'s preset at one sample a frame, with the denoised display if
-/// `denoise`.
+/// `name`'s preset at one sample a frame, with the à-trous filter's
+/// display if `denoise`.
 fn preset(name: &str, denoise: bool) -> LoadedScene {
     let path = root().join("presets").join(format!("{name}.ron"));
     let mut loaded = load_scene(&path, None).unwrap_or_else(|e| panic!("{name}: {e:#}"));
@@ -167,6 +167,7 @@ fn preset(name: &str, denoise: bool) -> LoadedScene {
     render.samples_per_frame = 1;
     render.accumulate = true;
     render.display.denoise = denoise;
+    render.display.denoiser = Choice::Atrous;
     loaded
 }
 

@@ -30,6 +30,7 @@ mod light_transport;
 mod noise_stability;
 mod non_finite;
 mod offscreen;
+mod oidn;
 mod orthographic;
 mod presets;
 mod report_frames;

@@ -108,8 +108,10 @@ impl Renderer {
         self.error_meter.measure(ctx, &self.accumulated())
     }
 
-    /// The displayed (tone-mapped, sRGB) image at the trace resolution.
+    /// The displayed (tone-mapped, sRGB) image at the trace resolution;
+    /// denoised, when denoising, from the latest round (OIDN waited for).
     pub fn read_display(&mut self, ctx: &GpuContext) -> Result<image::RgbaImage> {
+        self.finish_denoise(ctx)?;
         let (w, h) = self.shown_size();
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let target = ctx.device.create_texture(&wgpu::TextureDescriptor {
