@@ -418,6 +418,23 @@ mod tests {
     use super::super::View;
     use super::*;
 
+    /// A preset written before the denoiser could be chosen denoises with
+    /// OIDN's balanced network, as a new one does by default; a choice
+    /// round-trips.
+    #[test]
+    fn the_denoiser_reads_oidn_from_old_presets_and_round_trips() {
+        let old: RenderSettings = ron::from_str("(denoise: true)").unwrap();
+        assert!(old.display.denoise);
+        assert_eq!(old.display.denoiser, Denoiser::Oidn);
+        assert_eq!(old.display.denoise_quality, DenoiseQuality::Balanced);
+        let mut chosen = old;
+        chosen.display.denoiser = Denoiser::Atrous;
+        chosen.display.denoise_quality = DenoiseQuality::Fast;
+        let text = ron::to_string(&chosen).unwrap();
+        assert!(text.contains("denoiser:Atrous"), "{text}");
+        assert_eq!(ron::from_str::<RenderSettings>(&text).unwrap(), chosen);
+    }
+
     #[test]
     fn auto_exposure_reads_off_from_old_presets_and_on_when_set() {
         let old: RenderSettings = ron::from_str("(exposure: 1.5, tone_map: Reinhard)").unwrap();
