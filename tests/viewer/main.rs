@@ -8,6 +8,7 @@
 /// The repository's root: the presets and the test data.
 const REPO: &str = env!("CARGO_MANIFEST_DIR");
 
+mod denoise_window;
 mod e2e_window;
 mod node_window;
 mod obj_window;

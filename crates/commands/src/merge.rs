@@ -208,7 +208,7 @@ fn denoise_merged(
             };
             let running = Running::Oidn {
                 device: DeviceKind::Cpu,
-                version: oidn.version(),
+                version: Some(oidn.version()),
                 quality,
             };
             return Ok((image.denoise(&mut oidn, quality)?, running.describe()));

@@ -520,6 +520,16 @@ impl Viewer {
                 passes.join(", ")
             }
         );
+        if let Some(report) = self.renderer.denoise_report() {
+            let meanwhile = report.fewest_frames_meanwhile.map_or(String::new(), |n| {
+                format!("; each while {n} frames or more were drawn")
+            });
+            eprintln!(
+                "denoise: {}; {} images{meanwhile}",
+                report.running.describe(),
+                report.images
+            );
+        }
     }
 
     /// Whether the trace is timed on the CPU clock, submitted alone and

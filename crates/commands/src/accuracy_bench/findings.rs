@@ -52,31 +52,46 @@ pub fn findings(knob: Knob, points: &[Point]) -> Vec<String> {
     }
 }
 
-/// For each scene and sample count, the denoised image's RMSE against the
-/// raw one's (the same accumulation, filtered), and what the filter cost.
+/// For each scene, sample count and denoiser, the denoised image's RMSE
+/// against the raw one's (the same accumulation, filtered) and what the
+/// filter cost; then, for OIDN, the sample count at which raw reaches its
+/// RMSE at 16 spp.
 fn denoised(curves: &[Curve]) -> Vec<String> {
     let mut lines = Vec::new();
     for raw in curves.iter().filter(|c| c.variant == "raw") {
-        let Some(filtered) = curves
+        let filtered = curves
             .iter()
-            .find(|c| c.scene == raw.scene && c.variant == "denoised")
-        else {
-            continue;
-        };
-        for point in &raw.points {
-            let Some(f) = filtered.at_spp(point.spp) else {
-                continue;
-            };
-            let change = f.errors.rmse / point.errors.rmse - 1.0;
-            lines.push(format!(
-                "{} at {} spp: RMSE {:.4} raw, {:.4} denoised ({:+.0} %), the filter {:.1} ms.",
-                raw.scene,
-                point.spp,
-                point.errors.rmse,
-                f.errors.rmse,
-                100.0 * change,
-                f.filter_ms.unwrap_or(0.0),
-            ));
+            .filter(|c| c.scene == raw.scene && c.variant != "raw");
+        for f in filtered {
+            for point in &raw.points {
+                let Some(d) = f.at_spp(point.spp) else {
+                    continue;
+                };
+                lines.push(format!(
+                    "{} at {} spp: RMSE {:.4} raw, {:.4} {} ({:.2}× raw), the filter {:.1} ms.",
+                    raw.scene,
+                    point.spp,
+                    point.errors.rmse,
+                    d.errors.rmse,
+                    f.variant,
+                    d.errors.rmse / point.errors.rmse,
+                    d.filter_ms.unwrap_or(0.0),
+                ));
+            }
+            if let Some(at16) = f.at_spp(16) {
+                let matched = raw
+                    .points
+                    .iter()
+                    .find(|p| p.errors.rmse <= at16.errors.rmse)
+                    .map_or_else(
+                        || "none of the raw counts measured".to_owned(),
+                        |p| format!("raw at {} spp", p.spp),
+                    );
+                lines.push(format!(
+                    "{}: {} at 16 spp (RMSE {:.4}) is reached by {matched}.",
+                    raw.scene, f.variant, at16.errors.rmse
+                ));
+            }
         }
     }
     lines
@@ -283,18 +298,27 @@ mod tests {
         }
     }
 
-    /// The denoise knob compares the two variants at each sample count.
+    /// The denoise knob compares each filter with raw at each sample
+    /// count, and finds the raw count matching the filter at 16 spp.
     #[test]
     fn denoise_findings_compare_raw_and_filtered_at_equal_samples() {
         let mut points = vec![
             point(Knob::Denoise, "raw", 4, 1.0, 0.2),
-            point(Knob::Denoise, "denoised", 4, 1.1, 0.1),
+            point(Knob::Denoise, "raw", 16, 4.0, 0.1),
+            point(Knob::Denoise, "raw", 64, 16.0, 0.05),
+            point(Knob::Denoise, "OIDN", 4, 1.5, 0.05),
+            point(Knob::Denoise, "OIDN", 16, 4.5, 0.04),
         ];
-        points[1].filter_ms = Some(12.0);
+        points[3].filter_ms = Some(12.0);
+        points[4].filter_ms = Some(12.0);
         let lines = findings(Knob::Denoise, &points);
         assert_eq!(
             lines,
-            ["scene at 4 spp: RMSE 0.2000 raw, 0.1000 denoised (-50 %), the filter 12.0 ms."]
+            [
+                "scene at 4 spp: RMSE 0.2000 raw, 0.0500 OIDN (0.25× raw), the filter 12.0 ms.",
+                "scene at 16 spp: RMSE 0.1000 raw, 0.0400 OIDN (0.40× raw), the filter 12.0 ms.",
+                "scene: OIDN at 16 spp (RMSE 0.0400) is reached by none of the raw counts measured.",
+            ]
         );
     }
 

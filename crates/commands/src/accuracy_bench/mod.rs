@@ -15,6 +15,7 @@ mod findings;
 mod frame_timer;
 mod knob;
 mod measure;
+mod oidn_timing;
 mod plot;
 mod report;
 mod scale;
@@ -181,8 +182,14 @@ pub fn run_on(
         kernels,
         findings: knobs
             .iter()
-            .map(|&k| (k, findings::findings(k, &points)))
-            .collect(),
+            .map(|&k| {
+                let mut lines = findings::findings(k, &points);
+                if k == Knob::Denoise && !args.quick {
+                    lines.extend(oidn_timing::measure(ctx, &args.root)?);
+                }
+                Ok((k, lines))
+            })
+            .collect::<Result<_>>()?,
         points,
     };
     write(args, &scale, &results)?;

@@ -50,7 +50,9 @@ impl Scale {
             reference_spp: 2048,
             bounces: (1..=8).collect(),
             octaves: (1..=12).collect(),
-            denoise_spp: vec![1, 4, 16, 64],
+            // 256 too: the target is OIDN at 16 spp against raw at
+            // 256.
+            denoise_spp: vec![1, 4, 16, 64, 256],
             denoise_reference_spp: 4096,
         }
     }

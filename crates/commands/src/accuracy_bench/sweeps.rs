@@ -9,7 +9,7 @@ use anyhow::Result;
 use marbre_core::envmap::EnvImage;
 use marbre_core::lights::LightSelection;
 use marbre_core::noise::HashKind;
-use marbre_core::scene::{Scene, Strategy};
+use marbre_core::scene::{DenoiseQuality, Denoiser, Scene, Strategy};
 use marbre_core::texture::{ImageFilter, ImageSet};
 use marbre_render::gpu::FeatureSet;
 use marbre_render::session::{LoadedScene, prepare_scene};
@@ -324,15 +324,25 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
             .map(|name| {
                 let loaded = scenes::preset(root, name)?;
                 let scene = loaded.scene.clone();
+                let denoised = |denoiser: Denoiser| {
+                    with(&scene, |s| {
+                        let display = &mut s.render.display;
+                        display.denoise = true;
+                        display.denoiser = denoiser;
+                        display.denoise_quality = DenoiseQuality::High;
+                    })
+                };
                 let mut variants = against(
                     &scene,
                     vec![
                         ("raw".into(), scene.clone()),
-                        ("denoised".into(), scene.clone()),
+                        ("à-trous".into(), denoised(Denoiser::Atrous)),
+                        ("OIDN".into(), denoised(Denoiser::Oidn)),
                     ],
                 );
-                variants[1].denoise = true;
-                variants[1].scene.render.display.denoise = true;
+                for v in &mut variants[1..] {
+                    v.denoise = true;
+                }
                 let mut sweep = Sweep::new(knob, name, loaded, variants, scale);
                 sweep.spp = scale.denoise_spp.clone();
                 sweep.reference_spp = scale.denoise_reference_spp;

@@ -24,7 +24,8 @@ use std::time::Duration;
 pub enum Running {
     Oidn {
         device: DeviceKind,
-        version: String,
+        /// OIDN's version, once its device reported it.
+        version: Option<String>,
         quality: DenoiseQuality,
     },
     /// The à-trous filter; `instead_of_oidn` says why OIDN does not run
@@ -42,7 +43,8 @@ impl Running {
                 version,
                 quality,
             } => format!(
-                "OIDN {version} on the {} ({})",
+                "OIDN{} on the {} ({})",
+                version.as_ref().map_or(String::new(), |v| format!(" {v}")),
                 device.name(),
                 quality.label()
             ),
@@ -56,13 +58,27 @@ impl Running {
     }
 }
 
-/// The last denoise: what ran, for how long, on how many samples.
-#[derive(Debug, Clone, PartialEq)]
+/// What denoises, its last time, and how the viewer kept drawing.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct DenoiseReport {
     pub running: Running,
     /// The last OIDN filter's wall time (the CPU's, or CUDA's with the
     /// copies through host memory), and the samples per pixel it filtered.
     pub last: Option<(Duration, u32)>,
+    /// OIDN images shown since the renderer started.
+    pub images: u32,
+    /// The fewest frames the display drew while one of them was read back
+    /// and filtered: the viewer never waits for OIDN, so it is several
+    /// whenever the filter takes several frames' time.
+    pub fewest_frames_meanwhile: Option<u32>,
+}
+
+impl Default for Running {
+    fn default() -> Self {
+        Running::Atrous {
+            instead_of_oidn: None,
+        }
+    }
 }
 
 /// OIDN's library for a scene that asks for `choice`: `Ok(None)` when it

@@ -43,7 +43,7 @@ impl Renderer {
         };
         self.display.oidn.report = Some(DenoiseReport {
             running: Running::Atrous { instead_of_oidn },
-            last: None,
+            ..DenoiseReport::default()
         });
         self.record_atrous(ctx, encoder).map(Some)
     }

@@ -60,6 +60,8 @@ pub(super) struct OidnStage {
     last_seen: Option<(u32, u32)>,
     /// OIDN's library, looked for once.
     library: Option<Result<Arc<Library>, String>>,
+    /// Displays recorded since the image in flight was copied.
+    frames_meanwhile: u32,
     pub(super) report: Option<DenoiseReport>,
 }
 
@@ -138,6 +140,9 @@ impl Renderer {
     ) -> Result<Option<wgpu::TextureView>> {
         let now = self.denoise_source();
         self.collect_oidn(ctx);
+        if self.display.oidn.requested.is_some() {
+            self.display.oidn.frames_meanwhile += 1;
+        }
         let full_round = self.shown_size() == self.render_size();
         let stage = &mut self.display.oidn;
         let idle = stage
@@ -150,9 +155,18 @@ impl Renderer {
             if stage.worker.is_none() {
                 let device = device_for(ctx, &library);
                 stage.worker = Some(OidnWorker::start(library, device)?);
+                stage.report.get_or_insert_with(|| DenoiseReport {
+                    running: Running::Oidn {
+                        device,
+                        version: None,
+                        quality,
+                    },
+                    ..DenoiseReport::default()
+                });
             }
             self.record_guide_copy(ctx, encoder, now);
             self.display.oidn.requested = Some((now.generation, now.frames, quality));
+            self.display.oidn.frames_meanwhile = 0;
         }
         Ok(self.shown_oidn(now))
     }
@@ -194,13 +208,22 @@ impl Renderer {
             Ok(pixels) => {
                 let samples = done.tag.frames * self.scene.render.samples_per_frame;
                 self.upload_denoised(ctx, done.tag, &pixels);
-                self.display.oidn.report = Some(DenoiseReport {
+                let stage = &mut self.display.oidn;
+                let previous = stage.report.take().unwrap_or_default();
+                let meanwhile = stage.frames_meanwhile;
+                stage.report = Some(DenoiseReport {
                     running: Running::Oidn {
                         device: device.unwrap_or(marbre_oidn::DeviceKind::Cpu),
-                        version: done.version,
+                        version: Some(done.version),
                         quality: self.scene.render.display.denoise_quality,
                     },
                     last: Some((done.took, samples)),
+                    images: previous.images + 1,
+                    fewest_frames_meanwhile: Some(
+                        previous
+                            .fewest_frames_meanwhile
+                            .map_or(meanwhile, |f| f.min(meanwhile)),
+                    ),
                 });
             }
             Err(why) => log::warn!("OIDN: {why}"),
@@ -296,7 +319,7 @@ impl Renderer {
             stage.in_place =
                 Some(marbre_oidn::Denoiser::new(library, device).map_err(|e| anyhow!("{e}"))?);
         }
-        let version = stage.in_place.as_ref().expect("made above").version();
+        let version = Some(stage.in_place.as_ref().expect("made above").version());
         let running = Running::Oidn {
             device,
             version,
@@ -330,9 +353,12 @@ impl Renderer {
         let took = start.elapsed();
         self.upload_denoised(ctx, now, &pixels);
         self.display.oidn.requested = Some((now.generation, now.frames, quality));
+        let previous = self.display.oidn.report.take().unwrap_or_default();
         self.display.oidn.report = Some(DenoiseReport {
             running: running.clone(),
             last: Some((took, self.accumulation.samples())),
+            images: previous.images + 1,
+            ..previous
         });
         Ok(Some(running))
     }
