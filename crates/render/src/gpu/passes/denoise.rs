@@ -3,12 +3,10 @@
 //! SVGF's luminance-variance weight (Schied et al. 2017), run as a compute
 //! pass (`denoise.wgsl`), and its CPU twin ([`denoise_cpu`]) for tests.
 //!
-//! Why not Intel Open Image Denoise (the `oidn` crate): it binds the OIDN
-//! C++ library, which Debian 12 (this project's machines and CI) does not
-//! package (`apt-cache search openimagedenoise` finds nothing), and
-//! building it from source needs ISPC and oneTBB and its trained weights,
-//! none of which the package registries the project may use provide. The
-//! filter here needs nothing but wgpu and runs wherever the renderer does.
+//! It is the fallback where Intel Open Image Denoise's library is not
+//! found (`crate::denoiser`), and the choice where a filter on the GPU,
+//! with no read-back, matters more than OIDN's quality: it needs nothing
+//! but wgpu and runs wherever the renderer does.
 //!
 //! The input is the accumulated mean with the variance of each pixel's
 //! luminance in its alpha ([`filter_input`]: from the accumulation's spread

@@ -67,10 +67,18 @@ pub(super) struct OidnStage {
 
 impl OidnStage {
     /// Whether a round-`frames` image of accumulation `generation` is due:
-    /// at 1, 2, 4, 8… rounds, when nothing was traced since the last
-    /// display (the accumulation has settled), or for another network.
-    fn due(&mut self, generation: u32, frames: u32, quality: DenoiseQuality) -> bool {
-        let settled = self.last_seen == Some((generation, frames));
+    /// at 1, 2, 4, 8… rounds, when the accumulation has settled (the same
+    /// rounds as at the last display, and no round under way: a slow
+    /// adapter traces a round in bands over many displays), or for
+    /// another network.
+    fn due(
+        &mut self,
+        generation: u32,
+        frames: u32,
+        round_under_way: bool,
+        quality: DenoiseQuality,
+    ) -> bool {
+        let settled = self.last_seen == Some((generation, frames)) && !round_under_way;
         self.last_seen = Some((generation, frames));
         if frames == 0 {
             return false;
@@ -144,6 +152,7 @@ impl Renderer {
             self.display.oidn.frames_meanwhile += 1;
         }
         let full_round = self.shown_size() == self.render_size();
+        let round_under_way = self.accumulation.next_row() > 0;
         let stage = &mut self.display.oidn;
         let idle = stage
             .readback
@@ -151,7 +160,7 @@ impl Renderer {
             .is_none_or(|r| r.state.load(Ordering::Acquire) == IDLE)
             && stage.worker.as_ref().is_none_or(|w| !w.is_busy());
         let quality = self.scene.render.display.denoise_quality;
-        if stage.due(now.generation, now.frames, quality) && full_round && idle {
+        if stage.due(now.generation, now.frames, round_under_way, quality) && full_round && idle {
             if stage.worker.is_none() {
                 let device = device_for(ctx, &library);
                 stage.worker = Some(OidnWorker::start(library, device)?);
@@ -439,5 +448,46 @@ fn guided_image(bytes: &[u8], size: (u32, u32), row_bytes: u32) -> GuidedImage {
         mean: read(0),
         albedo: read(1),
         normal: read(2),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Asks `due` as the display does each frame and records a request
+    /// when due, as `record_oidn` does.
+    fn ask(stage: &mut OidnStage, generation: u32, frames: u32, under_way: bool) -> bool {
+        let quality = DenoiseQuality::Balanced;
+        let due = stage.due(generation, frames, under_way, quality);
+        if due {
+            stage.requested = Some((generation, frames, quality));
+        }
+        due
+    }
+
+    /// Due at the first round, then at twice the rounds last denoised,
+    /// once more when the image settles, and at once for a new
+    /// accumulation or another network; never while rounds are traced in
+    /// bands at the same count.
+    #[test]
+    fn denoises_fall_due_at_doubling_rounds_and_when_settled() {
+        let mut stage = OidnStage::default();
+        assert!(!ask(&mut stage, 0, 0, true), "nothing traced yet");
+        assert!(ask(&mut stage, 0, 1, true));
+        assert!(!ask(&mut stage, 0, 1, true));
+        assert!(ask(&mut stage, 0, 2, true), "twice the rounds");
+        for _ in 0..5 {
+            assert!(!ask(&mut stage, 0, 3, true), "round 4 under way in bands");
+        }
+        assert!(ask(&mut stage, 0, 4, false), "twice the rounds again");
+        assert!(!ask(&mut stage, 0, 5, false), "a round just completed");
+        assert!(ask(&mut stage, 0, 5, false), "settled: nothing traced since");
+        assert!(!ask(&mut stage, 0, 5, false), "already denoised");
+        assert!(!ask(&mut stage, 0, 9, true));
+        assert!(ask(&mut stage, 0, 10, true));
+        assert!(ask(&mut stage, 1, 1, true), "a new accumulation");
+        let quality = DenoiseQuality::High;
+        assert!(stage.due(1, 1, true, quality), "another network");
     }
 }
