@@ -47,7 +47,6 @@ pub struct Measured {
 /// What a sweep needs besides itself.
 pub struct Bench<'a> {
     pub ctx: &'a GpuContext,
-    pub size: (u32, u32),
     pub cache: &'a ReferenceCache,
     pub timer: &'a FrameTimer,
     /// The trace kernel: the one named, or for `auto` the faster on each
@@ -134,7 +133,7 @@ impl Bench<'_> {
             .get_or_render(
                 self.ctx,
                 &with_scene(sweep, scene.clone()),
-                self.size,
+                sweep.size,
                 sweep.reference_spp,
                 |done| self.progress.set_position(start + u64::from(done)),
             )
@@ -156,7 +155,7 @@ impl Bench<'_> {
         let mut renderer = renderer_with(
             self.ctx,
             &with_scene(sweep, measured(variant)),
-            self.size,
+            sweep.size,
             kernel,
         )?;
         if variant.features.is_some() {
@@ -181,7 +180,7 @@ impl Bench<'_> {
         self.progress
             .set_message(format!("{}: {} kernel", sweep.knob.id(), sweep.scene_name));
         let loaded = with_scene(sweep, measured(first));
-        Ok(pick_kernel(self.ctx, &loaded, self.size, self.kernel)?.0)
+        Ok(pick_kernel(self.ctx, &loaded, sweep.size, self.kernel)?.0)
     }
 }
 

@@ -157,7 +157,6 @@ pub fn run_on(
     let cache = ReferenceCache::new(&args.cache);
     let bench = Bench {
         ctx,
-        size: scale.size,
         cache: &cache,
         timer: &timer,
         progress: &progress,

@@ -92,6 +92,20 @@ pub fn write_markdown(path: &Path, run: &RunInfo, knobs: &[KnobReport]) -> Resul
             .join(", "),
         run.scale.reference_spp,
     );
+    if knobs.iter().any(|k| k.knob == Knob::Denoise) {
+        let (w, h) = run.scale.denoise_size;
+        let _ = writeln!(
+            md,
+            "* the denoise knob: {w}×{h} pixels at {} spp (reference {})",
+            run.scale
+                .denoise_spp
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            run.scale.denoise_reference_spp,
+        );
+    }
     let _ = writeln!(
         md,
         "* the run took {:.0} s, with {} references rendered and {} read from the cache",

@@ -19,9 +19,12 @@ pub struct Scale {
     pub bounces: Vec<u32>,
     /// The octave counts swept (against 16).
     pub octaves: Vec<u32>,
-    /// The denoise knob's counts, raw and filtered, and its reference.
+    /// The denoise knob's counts, raw and filtered, its reference and its
+    /// size: OIDN's network was trained on images of ordinary sizes, and a
+    /// thumbnail's pixels each average much of the scene.
     pub denoise_spp: Vec<u32>,
     pub denoise_reference_spp: u32,
+    pub denoise_size: (u32, u32),
 }
 
 impl Scale {
@@ -37,10 +40,12 @@ impl Scale {
             octaves: vec![1, 2, 4, 8, 12],
             denoise_spp: vec![1, 4, 16],
             denoise_reference_spp: 256,
+            denoise_size: (48, 48),
         }
     }
 
-    /// Eight minutes in a release build, three with the references cached.
+    /// Eight minutes in a release build, three with the references cached
+    /// (the denoise knob: about 40 more, its references at 160 × 90).
     pub fn full() -> Self {
         Self {
             size: (64, 64),
@@ -54,6 +59,7 @@ impl Scale {
             // 256.
             denoise_spp: vec![1, 4, 16, 64, 256],
             denoise_reference_spp: 4096,
+            denoise_size: (160, 90),
         }
     }
 }

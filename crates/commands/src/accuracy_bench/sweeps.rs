@@ -36,6 +36,8 @@ pub struct Sweep {
     pub variants: Vec<Variant>,
     pub spp: Vec<u32>,
     pub reference_spp: u32,
+    /// The image's size: the scale's, or the denoise knob's own.
+    pub size: (u32, u32),
 }
 
 impl Sweep {
@@ -55,6 +57,7 @@ impl Sweep {
             variants,
             spp: scale.variant_spp.clone(),
             reference_spp: scale.reference_spp,
+            size: scale.size,
         }
     }
 }
@@ -346,6 +349,7 @@ pub fn sweeps(knob: Knob, scale: &Scale, root: &Path) -> Result<Vec<Sweep>> {
                 let mut sweep = Sweep::new(knob, name, loaded, variants, scale);
                 sweep.spp = scale.denoise_spp.clone();
                 sweep.reference_spp = scale.denoise_reference_spp;
+                sweep.size = scale.denoise_size;
                 Ok(sweep)
             })
             .collect::<Result<_>>()?,
