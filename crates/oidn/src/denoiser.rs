@@ -54,9 +54,15 @@ pub struct Images<'a> {
     pub size: (u32, u32),
     /// Linear HDR radiance.
     pub colour: &'a [[f32; 3]],
-    /// The first hit's albedo and its normal in [−1, 1] (world or camera
-    /// space, not necessarily normalised).
-    pub guides: Option<(&'a [[f32; 3]], &'a [[f32; 3]])>,
+    pub guides: Option<Guides<'a>>,
+}
+
+/// The first hit's albedo, and its normal in [−1, 1] (world or camera
+/// space, not necessarily normalised), row by row.
+#[derive(Debug, Clone, Copy)]
+pub struct Guides<'a> {
+    pub albedo: &'a [[f32; 3]],
+    pub normal: &'a [[f32; 3]],
 }
 
 /// An OIDN device and the filters of the last image's size and quality.
@@ -146,7 +152,7 @@ impl Denoiser {
         let lengths_agree = images.colour.len() == n
             && images
                 .guides
-                .is_none_or(|(a, nrm)| a.len() == n && nrm.len() == n);
+                .is_none_or(|g| g.albedo.len() == n && g.normal.len() == n);
         if n == 0 || !lengths_agree {
             return Err(OidnError {
                 call: "denoise",
@@ -178,9 +184,9 @@ impl Denoiser {
             (f.colour, f.albedo, f.normal, f.output, f.main);
         let prefilters = f.prefilters.clone();
         self.write(colour, &colour_in);
-        if let Some((a, nrm)) = images.guides {
-            let a: Vec<[f32; 3]> = a.iter().map(|&c| sanitise::albedo(c)).collect();
-            let nrm: Vec<[f32; 3]> = nrm.iter().map(|&c| sanitise::normal(c)).collect();
+        if let Some(guides) = images.guides {
+            let a: Vec<[f32; 3]> = guides.albedo.iter().map(|&c| sanitise::albedo(c)).collect();
+            let nrm: Vec<[f32; 3]> = guides.normal.iter().map(|&c| sanitise::normal(c)).collect();
             self.write(albedo, &border::pad(&a, w as usize, h as usize).0);
             self.write(normal, &border::pad(&nrm, w as usize, h as usize).0);
         }

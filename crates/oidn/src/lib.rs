@@ -22,7 +22,7 @@ mod denoiser;
 pub mod library;
 pub mod sanitise;
 
-pub use denoiser::{Denoiser, DeviceKind, Images, Quality};
+pub use denoiser::{Denoiser, DeviceKind, Guides, Images, Quality};
 pub use library::{Library, NotFound};
 
 /// What went wrong inside OIDN: the call and the device's own message.

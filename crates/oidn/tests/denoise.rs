@@ -1,6 +1,6 @@
 //! OIDN itself, on images whose answer is known.
 
-use marbre_oidn::{Denoiser, DeviceKind, Images, Quality, library_or_skip};
+use marbre_oidn::{Denoiser, DeviceKind, Guides, Images, Quality, library_or_skip};
 
 fn cpu(test: &str) -> Option<Denoiser> {
     let lib = library_or_skip(test)?;
@@ -30,7 +30,10 @@ fn a_constant_image_stays_constant() {
                     &Images {
                         size: (w as u32, h as u32),
                         colour: &colour,
-                        guides: Some((&albedo, &normal)),
+                        guides: Some(Guides {
+                            albedo: &albedo,
+                            normal: &normal,
+                        }),
                     },
                     quality,
                 )
@@ -81,7 +84,13 @@ fn bad_values_give_finite_output() {
         .collect();
     let albedo: Vec<[f32; 3]> = (0..1024).map(|i| [bad[(i / 3) % 6], 0.5, 0.5]).collect();
     let normal: Vec<[f32; 3]> = (0..1024).map(|i| [0.0, bad[(i / 5) % 6], 1.0]).collect();
-    for guides in [Some((&albedo[..], &normal[..])), None] {
+    for guides in [
+        Some(Guides {
+            albedo: &albedo,
+            normal: &normal,
+        }),
+        None,
+    ] {
         let out = oidn
             .denoise(
                 &Images {
@@ -133,7 +142,10 @@ fn noise_on_a_ramp_is_removed() {
             &Images {
                 size: (w as u32, h as u32),
                 colour: &noisy,
-                guides: Some((&albedo, &normal)),
+                guides: Some(Guides {
+                    albedo: &albedo,
+                    normal: &normal,
+                }),
             },
             Quality::High,
         )
@@ -164,7 +176,10 @@ fn mismatched_lengths_are_refused() {
             &Images {
                 size: (4, 4),
                 colour: &colour,
-                guides: Some((&short, &colour)),
+                guides: Some(Guides {
+                    albedo: &short,
+                    normal: &colour,
+                }),
             },
             Quality::Fast,
         )

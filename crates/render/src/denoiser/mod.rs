@@ -15,7 +15,7 @@ pub use oidn_worker::{Done, Job, OidnWorker};
 use crate::gpu::context::GpuContext;
 use anyhow::{Result, anyhow};
 use marbre_core::scene::{DenoiseQuality, Denoiser as Choice};
-use marbre_oidn::{DeviceKind, Images, Library, Quality};
+use marbre_oidn::{DeviceKind, Guides, Images, Library, Quality};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -139,7 +139,10 @@ impl GuidedImage {
                 &Images {
                     size: self.size,
                     colour: &colour,
-                    guides: Some((&albedo, &normal)),
+                    guides: Some(Guides {
+                        albedo: &albedo,
+                        normal: &normal,
+                    }),
                 },
                 quality(q),
             )

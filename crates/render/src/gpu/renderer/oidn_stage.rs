@@ -482,7 +482,10 @@ mod tests {
         }
         assert!(ask(&mut stage, 0, 4, false), "twice the rounds again");
         assert!(!ask(&mut stage, 0, 5, false), "a round just completed");
-        assert!(ask(&mut stage, 0, 5, false), "settled: nothing traced since");
+        assert!(
+            ask(&mut stage, 0, 5, false),
+            "settled: nothing traced since"
+        );
         assert!(!ask(&mut stage, 0, 5, false), "already denoised");
         assert!(!ask(&mut stage, 0, 9, true));
         assert!(ask(&mut stage, 0, 10, true));
