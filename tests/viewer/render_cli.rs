@@ -84,6 +84,30 @@ fn render_through_a_file_names_the_file() {
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "a file");
 }
 
+/// `render --denoise` of the default preset, tiny, to `output`, with
+/// `MARBRE_OIDN_DIR` set to `oidn_dir` or unset.
+fn render_denoised(output: &Path, oidn_dir: Option<&Path>) -> Output {
+    let mut command = Command::new(BIN);
+    command
+        .args([
+            "render",
+            "--preset",
+            "presets/default.ron",
+            "--size",
+            "16x16",
+        ])
+        .args(["--spp", "2", "--kernel", "fragment", "--denoise", "-o"])
+        .arg(output)
+        .current_dir(REPO);
+    match oidn_dir {
+        Some(dir) => command.env("MARBRE_OIDN_DIR", dir),
+        None => command.env_remove("MARBRE_OIDN_DIR"),
+    };
+    command
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"))
+}
+
 /// `render --denoise` says what denoised the image: OIDN where its library
 /// is found; with `MARBRE_OIDN_DIR` pointing at an empty folder, the
 /// à-trous filter, and why (the folder named), the render still written.
@@ -97,20 +121,7 @@ fn render_denoise_says_which_denoiser_ran_and_falls_back_without_oidn() {
     let empty = dir.path().join("no-oidn");
     std::fs::create_dir(&empty).unwrap();
     let output = dir.path().join("fallback.png");
-    let run = Command::new(BIN)
-        .args([
-            "render",
-            "--preset",
-            "presets/default.ron",
-            "--size",
-            "16x16",
-        ])
-        .args(["--spp", "2", "--kernel", "fragment", "--denoise", "-o"])
-        .arg(&output)
-        .current_dir(REPO)
-        .env("MARBRE_OIDN_DIR", &empty)
-        .output()
-        .unwrap();
+    let run = render_denoised(&output, Some(&empty));
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{}: {stderr}", run.status);
     assert!(output.is_file(), "{stderr}");
@@ -122,21 +133,7 @@ fn render_denoise_says_which_denoiser_ran_and_falls_back_without_oidn() {
     if marbre_oidn::library_or_skip(TEST).is_none() {
         return;
     }
-    let output = dir.path().join("oidn.png");
-    let run = Command::new(BIN)
-        .args([
-            "render",
-            "--preset",
-            "presets/default.ron",
-            "--size",
-            "16x16",
-        ])
-        .args(["--spp", "2", "--kernel", "fragment", "--denoise", "-o"])
-        .arg(&output)
-        .current_dir(REPO)
-        .env_remove("MARBRE_OIDN_DIR")
-        .output()
-        .unwrap();
+    let run = render_denoised(&dir.path().join("oidn.png"), None);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{}: {stderr}", run.status);
     assert!(

@@ -335,3 +335,14 @@ pub fn assert_sphere_shows_its_diffuse(ctx: &GpuContext, diffuse: Texture) {
         })
     });
 }
+
+/// The root-mean-square difference of two images' RGB, over every pixel
+/// and channel.
+pub fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (0..3).map(|c| f64::from(x[c] - y[c]).powi(2)).sum::<f64>())
+        .sum();
+    (sum / (3 * a.len()) as f64).sqrt()
+}

@@ -3,7 +3,7 @@
 //! accumulates, with both kernels; and the shipped presets at 4 spp against
 //! a higher-spp reference.
 
-use crate::common::{assert_kernels_agree, kernels, root};
+use crate::common::{assert_kernels_agree, kernels, rmse, root};
 use marbre_core::scene::{Denoiser as Choice, Scene, View};
 use marbre_render::gpu::denoise::{DenoiseImage, DenoiseSettings, Denoiser, denoise_cpu};
 use marbre_render::gpu::testing::gpu_or_skip;
@@ -147,15 +147,6 @@ fn the_gpu_filter_keeps_a_constant_image_constant() {
             }
         }
     }
-}
-
-fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| f64::from(x[c] - y[c]).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * a.len()) as f64).sqrt()
 }
 
 /// `name`'s preset at one sample a frame, with the à-trous filter's

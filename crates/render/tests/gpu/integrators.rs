@@ -74,15 +74,6 @@ fn mean_and_standard_error(xs: &[f64]) -> (f64, f64) {
     (mean, (var / n).sqrt())
 }
 
-fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| f64::from(x[c] - y[c]).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * a.len()) as f64).sqrt()
-}
-
 /// A white furnace: a sphere of albedo 1 inside a constant environment of
 /// radiance 1 reads 1 at every pixel, for every strategy and bounce count
 /// (the environment is found by BSDF sampling alone here, and the sphere

@@ -3,7 +3,7 @@
 //! filter; what the display shows, in place and in the viewer's way (a
 //! background thread, nothing waited for).
 
-use crate::common::root;
+use crate::common::{rmse, root};
 use marbre_core::scene::{DenoiseQuality, Denoiser};
 use marbre_render::denoiser::Running;
 use marbre_render::gpu::readback::read_texture;
@@ -11,15 +11,6 @@ use marbre_render::gpu::testing::gpu_or_skip;
 use marbre_render::gpu::{DisplayTarget, GpuContext, Kernel, Renderer, Viewport};
 use marbre_render::session::{LoadedScene, accumulate, load_scene, renderer_with};
 use std::time::{Duration, Instant};
-
-fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| f64::from(x[c] - y[c]).powi(2)).sum::<f64>())
-        .sum();
-    (sum / (3 * a.len()) as f64).sqrt()
-}
 
 /// `name`'s preset at one sample a frame, denoised by `denoiser`.
 fn preset(name: &str, denoiser: Option<Denoiser>) -> LoadedScene {
