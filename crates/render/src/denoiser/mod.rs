@@ -124,7 +124,8 @@ pub struct GuidedImage {
 }
 
 impl GuidedImage {
-    /// OIDN's output for it (alpha 1), with `oidn`'s device.
+    /// OIDN's output for it (alpha 1), with `oidn`'s device; the pixels
+    /// that see an emitter keep their raw radiance ([`sees_an_emitter`]).
     pub fn denoise(
         &self,
         oidn: &mut marbre_oidn::Denoiser,
@@ -147,8 +148,32 @@ impl GuidedImage {
                 quality(q),
             )
             .map_err(|e| anyhow!("{e}"))?;
-        Ok(out.into_iter().map(|[r, g, b]| [r, g, b, 1.0]).collect())
+        Ok(out
+            .into_iter()
+            .zip(&self.mean)
+            .zip(&self.albedo)
+            .map(|((d, m), a)| {
+                if sees_an_emitter(*a) {
+                    [m[0], m[1], m[2], 1.0]
+                } else {
+                    [d[0], d[1], d[2], 1.0]
+                }
+            })
+            .collect())
     }
+}
+
+/// Whether a pixel's samples met an emitter first: its albedo guide
+/// (albedo plus emission) exceeds 1, which no reflectance does. Such a
+/// pixel keeps its raw radiance. OIDN takes albedo within [0, 1], so a
+/// light reaches it as a white surface barely brighter than a white wall,
+/// and its network spread the light into the ceiling around it: on the
+/// Cornell box at 320 × 180 and 16 spp, OIDN's RMSE was 1.31× the raw
+/// one's, 91 % of it in the light's pixels (which lost a third of their
+/// radiance), though it halved the walls' error; with the light's pixels
+/// kept, 0.85×.
+fn sees_an_emitter(albedo_guide: [f32; 4]) -> bool {
+    albedo_guide[..3].iter().any(|&v| v > 1.0)
 }
 
 /// The normal guide decoded: 2g − 1, except where every sample escaped
@@ -164,6 +189,14 @@ pub fn decode_normal(g: [f32; 4]) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_a_guide_above_any_reflectance_sees_an_emitter() {
+        assert!(!sees_an_emitter([1.0, 1.0, 1.0, 1.0]));
+        assert!(!sees_an_emitter([0.0, 0.0, 0.0, 1.0]));
+        assert!(sees_an_emitter([0.2, 1.5, 0.2, 1.0]));
+        assert!(sees_an_emitter([17.0, 12.0, 4.0, 1.0]));
+    }
 
     #[test]
     fn normals_decode_and_an_escaped_pixel_has_none() {
