@@ -10,6 +10,7 @@ pub const DEVICE_TYPE_CPU: c_int = 1;
 pub const DEVICE_TYPE_CUDA: c_int = 3;
 pub const FORMAT_FLOAT3: c_int = 3;
 pub const ERROR_NONE: c_int = 0;
+pub const ERROR_CANCELLED: c_int = 6;
 pub const QUALITY_FAST: c_int = 4;
 pub const QUALITY_BALANCED: c_int = 5;
 pub const QUALITY_HIGH: c_int = 6;
@@ -44,7 +45,13 @@ pub struct Api {
     pub commit_filter: unsafe extern "C" fn(Handle),
     pub execute_filter: unsafe extern "C" fn(Handle),
     pub release_filter: unsafe extern "C" fn(Handle),
+    pub set_filter_progress_monitor:
+        unsafe extern "C" fn(Handle, Option<ProgressMonitor>, *mut c_void),
 }
+
+/// `OIDNProgressMonitorFunction`: called as a filter runs; returning false
+/// cancels it.
+pub type ProgressMonitor = unsafe extern "C" fn(*mut c_void, f64) -> bool;
 
 impl Api {
     /// Reads every function from `lib`; the name of the first one missing
@@ -80,6 +87,7 @@ impl Api {
             commit_filter: symbol!("oidnCommitFilter"),
             execute_filter: symbol!("oidnExecuteFilter"),
             release_filter: symbol!("oidnReleaseFilter"),
+            set_filter_progress_monitor: symbol!("oidnSetFilterProgressMonitorFunction"),
         })
     }
 }

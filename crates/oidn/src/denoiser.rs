@@ -5,8 +5,9 @@
 use crate::api::{self, Handle};
 use crate::library::Library;
 use crate::{OidnError, border, sanitise};
-use std::ffi::{CStr, c_char};
+use std::ffi::{CStr, c_char, c_void};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Which OIDN device runs the network.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,6 +72,18 @@ pub struct Denoiser {
     device: Handle,
     kind: DeviceKind,
     filters: Option<Filters>,
+    /// Set, a running filter stops at its next progress report (OIDN
+    /// reports many times a second) and [`Denoiser::denoise`] returns
+    /// [`OidnError::cancelled`]: a window closing or an image gone stale
+    /// need not wait seconds for a 1080p denoise on a CPU.
+    cancel: Arc<AtomicBool>,
+}
+
+/// OIDN's progress callback: carry on unless the flag (`user`) is set.
+unsafe extern "C" fn carry_on(user: *mut c_void, _done: f64) -> bool {
+    // SAFETY: `user` is the `AtomicBool` of the denoiser's `cancel`,
+    // which the denoiser keeps alive for as long as its filters.
+    !unsafe { &*user.cast::<AtomicBool>() }.load(Ordering::Relaxed)
 }
 
 // SAFETY: OIDN's objects may be used from any thread, one at a time; a
@@ -107,13 +120,14 @@ impl Denoiser {
             device,
             kind,
             filters: None,
+            cancel: Arc::new(AtomicBool::new(false)),
         };
         denoiser.check("oidnNewDevice")?;
         if denoiser.device.is_null() {
-            return Err(OidnError {
-                call: "oidnNewDevice",
-                message: format!("no {} device", kind.name()),
-            });
+            return Err(OidnError::new(
+                "oidnNewDevice",
+                format!("no {} device", kind.name()),
+            ));
         }
         // SAFETY: a device just made.
         unsafe { (denoiser.library.api.commit_device)(denoiser.device) };
@@ -130,6 +144,19 @@ impl Denoiser {
 
     pub fn kind(&self) -> DeviceKind {
         self.kind
+    }
+
+    /// The flag that cancels a running (or the next) denoise when set;
+    /// clear it before a denoise that should run.
+    pub fn cancel_flag(&self) -> Arc<AtomicBool> {
+        self.cancel.clone()
+    }
+
+    /// Makes `flag` this denoiser's cancel flag (its filters are made
+    /// again, with the new flag).
+    pub fn share_cancel_flag(&mut self, flag: Arc<AtomicBool>) {
+        self.release_filters();
+        self.cancel = flag;
     }
 
     /// OIDN's version, as "2.5.1".
@@ -154,10 +181,10 @@ impl Denoiser {
                 .guides
                 .is_none_or(|g| g.albedo.len() == n && g.normal.len() == n);
         if n == 0 || !lengths_agree {
-            return Err(OidnError {
-                call: "denoise",
-                message: format!("a {w}×{h} image needs {n} pixels of colour and of each guide"),
-            });
+            return Err(OidnError::new(
+                "denoise",
+                format!("a {w}×{h} image needs {n} pixels of colour and of each guide"),
+            ));
         }
         let guided = images.guides.is_some();
         let (colour_in, pw, ph) = border::pad(
@@ -195,6 +222,9 @@ impl Denoiser {
             // buffers of the right size.
             unsafe { (self.library.api.execute_filter)(filter) };
             self.check("oidnExecuteFilter")?;
+            if self.cancel.load(Ordering::Relaxed) {
+                return Err(OidnError::cancelled());
+            }
         }
         let mut padded = vec![[0.0f32; 3]; pw * ph];
         // SAFETY: `padded` holds exactly the output buffer's bytes.
@@ -275,7 +305,16 @@ impl Denoiser {
                 )
             }
         };
-        let new_filter = || unsafe { (api.new_filter)(self.device, c"RT".as_ptr()) };
+        let user = Arc::as_ptr(&self.cancel).cast_mut().cast::<c_void>();
+        let new_filter = || {
+            // SAFETY: OIDN's API on a committed device; the monitor's
+            // `user` outlives the filter (see `cancel`).
+            unsafe {
+                let filter = (api.new_filter)(self.device, c"RT".as_ptr());
+                (api.set_filter_progress_monitor)(filter, Some(carry_on), user);
+                filter
+            }
+        };
         // SAFETY (below): parameters of oidn.h on filters just made.
         let set_int = |filter: Handle, name: &CStr, v: i32| unsafe {
             (api.set_filter_int)(filter, name.as_ptr() as *const c_char, v)
@@ -323,6 +362,9 @@ impl Denoiser {
         if code == api::ERROR_NONE {
             return Ok(());
         }
+        if code == api::ERROR_CANCELLED {
+            return Err(OidnError::cancelled());
+        }
         let message = if message.is_null() {
             format!("error {code}")
         } else {
@@ -332,7 +374,7 @@ impl Denoiser {
                 .to_string_lossy()
                 .into_owned()
         };
-        Err(OidnError { call, message })
+        Err(OidnError::new(call, message))
     }
 
     fn release(&self, f: &Filters) {

@@ -31,6 +31,26 @@ pub use library::{Library, NotFound};
 pub struct OidnError {
     pub call: &'static str,
     pub message: String,
+    /// Stopped by its cancel flag ([`Denoiser::cancel_flag`]), not failed.
+    pub cancelled: bool,
+}
+
+impl OidnError {
+    pub(crate) fn new(call: &'static str, message: String) -> Self {
+        Self {
+            call,
+            message,
+            cancelled: false,
+        }
+    }
+
+    pub(crate) fn cancelled() -> Self {
+        Self {
+            call: "oidnExecuteFilter",
+            message: "cancelled".to_owned(),
+            cancelled: true,
+        }
+    }
 }
 
 /// For tests that need OIDN: the library, or a loud skip where it is not

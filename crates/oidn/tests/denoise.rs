@@ -196,3 +196,25 @@ fn the_device_reports_its_version() {
     assert_eq!(oidn.kind(), DeviceKind::Cpu);
     assert!(oidn.version().starts_with("2."), "{}", oidn.version());
 }
+
+/// The cancel flag stops a denoise (set before it, as a window closing
+/// does while one runs) with a "cancelled" error, not a failure; cleared,
+/// the same denoiser runs again.
+#[test]
+fn the_cancel_flag_stops_a_denoise() {
+    let Some(mut oidn) = cpu("the_cancel_flag_stops_a_denoise") else {
+        return;
+    };
+    let colour = vec![[0.5; 3]; 64 * 64];
+    let images = Images {
+        size: (64, 64),
+        colour: &colour,
+        guides: None,
+    };
+    let flag = oidn.cancel_flag();
+    flag.store(true, std::sync::atomic::Ordering::Relaxed);
+    let err = oidn.denoise(&images, Quality::Fast).unwrap_err();
+    assert!(err.cancelled, "{err}");
+    flag.store(false, std::sync::atomic::Ordering::Relaxed);
+    assert_eq!(oidn.denoise(&images, Quality::Fast).unwrap().len(), 64 * 64);
+}

@@ -13,7 +13,7 @@ mod oidn_worker;
 pub use oidn_worker::{Done, Job, OidnWorker};
 
 use crate::gpu::context::GpuContext;
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use marbre_core::scene::{DenoiseQuality, Denoiser as Choice};
 use marbre_oidn::{DeviceKind, Guides, Images, Library, Quality};
 use std::sync::Arc;
@@ -147,7 +147,7 @@ impl GuidedImage {
                 },
                 quality(q),
             )
-            .map_err(|e| anyhow!("{e}"))?;
+            .map_err(anyhow::Error::from)?;
         Ok(out
             .into_iter()
             .zip(&self.mean)

@@ -5,8 +5,9 @@
 
 use super::GuidedImage;
 use marbre_core::scene::DenoiseQuality;
-use marbre_oidn::{Denoiser, DeviceKind, Library};
+use marbre_oidn::{Denoiser, DeviceKind, Library, OidnError};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -23,6 +24,8 @@ pub struct Done<Tag> {
     pub tag: Tag,
     pub size: (u32, u32),
     pub pixels: Result<Vec<[f32; 4]>, String>,
+    /// Stopped by [`OidnWorker::cancel`] (then `pixels` is an error).
+    pub cancelled: bool,
     /// The filter's wall time on the thread.
     pub took: Duration,
     pub version: String,
@@ -35,6 +38,8 @@ pub struct OidnWorker<Tag: Send + 'static> {
     thread: Option<JoinHandle<()>>,
     busy: bool,
     device: DeviceKind,
+    /// Shared with the thread's denoiser: set, its filter stops.
+    cancel: Arc<AtomicBool>,
 }
 
 impl<Tag: Send + 'static> OidnWorker<Tag> {
@@ -42,6 +47,8 @@ impl<Tag: Send + 'static> OidnWorker<Tag> {
     pub fn start(library: Arc<Library>, device: DeviceKind) -> std::io::Result<Self> {
         let (jobs, inbox) = channel::<Job<Tag>>();
         let (outbox, done) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
         let thread = std::thread::Builder::new()
             .name("oidn".to_owned())
             .spawn(move || {
@@ -50,19 +57,23 @@ impl<Tag: Send + 'static> OidnWorker<Tag> {
                     let start = Instant::now();
                     let oidn = match &mut denoiser {
                         Some(d) => Ok(d),
-                        slot => Denoiser::new(library.clone(), device).map(|d| slot.insert(d)),
+                        slot => Denoiser::new(library.clone(), device).map(|mut d| {
+                            d.share_cancel_flag(flag.clone());
+                            slot.insert(d)
+                        }),
                     };
-                    let (pixels, version) = match oidn {
-                        Ok(d) => (
-                            job.image.denoise(d, job.quality).map_err(|e| e.to_string()),
-                            d.version(),
-                        ),
-                        Err(e) => (Err(e.to_string()), String::new()),
+                    let (result, version) = match oidn {
+                        Ok(d) => (job.image.denoise(d, job.quality), d.version()),
+                        Err(e) => (Err(e.into()), String::new()),
                     };
+                    let cancelled = result
+                        .as_ref()
+                        .is_err_and(|e| e.downcast_ref::<OidnError>().is_some_and(|e| e.cancelled));
                     let done = Done {
                         tag: job.tag,
                         size: job.image.size,
-                        pixels,
+                        pixels: result.map_err(|e| e.to_string()),
+                        cancelled,
                         took: start.elapsed(),
                         version,
                     };
@@ -77,6 +88,7 @@ impl<Tag: Send + 'static> OidnWorker<Tag> {
             thread: Some(thread),
             busy: false,
             device,
+            cancel,
         })
     }
 
@@ -95,6 +107,9 @@ impl<Tag: Send + 'static> OidnWorker<Tag> {
         if self.busy {
             return false;
         }
+        // Cleared here, not on the thread, so that a cancel between this
+        // and the job's start still stops it.
+        self.cancel.store(false, Ordering::Relaxed);
         let sent = self.jobs.as_ref().is_some_and(|s| s.send(job).is_ok());
         self.busy = sent;
         sent
@@ -116,13 +131,73 @@ impl<Tag: Send + 'static> OidnWorker<Tag> {
     }
 }
 
+impl<Tag: Send + 'static> OidnWorker<Tag> {
+    /// Stops the job under way at OIDN's next progress report; its result
+    /// comes back cancelled.
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// The job under way's result, waiting for it; `None` when idle.
+    pub fn wait(&mut self) -> Option<Done<Tag>> {
+        if !self.busy {
+            return None;
+        }
+        self.busy = false;
+        self.done.recv().ok()
+    }
+}
+
 impl<Tag: Send + 'static> Drop for OidnWorker<Tag> {
-    /// Waits for the job under way, so that OIDN never runs while the
-    /// process exits (issue 26's class of crash at exit).
+    /// Cancels the job under way and waits for the thread, so that OIDN
+    /// never runs while the process exits (issue 26's class of crash at
+    /// exit) and closing the window does not wait out a denoise.
     fn drop(&mut self) {
+        self.cancel();
         self.jobs = None;
         if let Some(thread) = self.thread.take() {
             let _ = thread.join();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn job(size: (u32, u32), tag: u32) -> Job<u32> {
+        let n = (size.0 * size.1) as usize;
+        Job {
+            tag,
+            image: GuidedImage {
+                size,
+                mean: vec![[0.5, 0.5, 0.5, 1.0]; n],
+                albedo: vec![[0.5, 0.5, 0.5, 1.0]; n],
+                normal: vec![[0.5, 0.5, 1.0, 1.0]; n],
+            },
+            quality: DenoiseQuality::High,
+        }
+    }
+
+    /// One job at a time; a cancelled one comes back cancelled, with no
+    /// pixels, and the thread takes the next.
+    #[test]
+    fn a_cancelled_job_comes_back_cancelled_and_the_next_runs() {
+        let test = "a_cancelled_job_comes_back_cancelled_and_the_next_runs";
+        let Some(library) = marbre_oidn::library_or_skip(test) else {
+            return;
+        };
+        let mut worker = OidnWorker::start(library, DeviceKind::Cpu).unwrap();
+        assert!(worker.submit(job((1920, 1080), 1)));
+        assert!(!worker.submit(job((8, 8), 2)), "a second job while busy");
+        worker.cancel();
+        let done = worker.wait().expect("the first job's result");
+        assert_eq!(done.tag, 1);
+        assert!(done.cancelled && done.pixels.is_err());
+        assert!(worker.submit(job((32, 16), 3)));
+        let done = worker.wait().unwrap();
+        assert!(!done.cancelled);
+        assert_eq!(done.pixels.unwrap().len(), 32 * 16);
+        assert!(done.version.starts_with("2."), "{}", done.version);
     }
 }

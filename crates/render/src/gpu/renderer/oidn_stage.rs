@@ -13,10 +13,12 @@
 //! ([`Renderer::finish_denoise`]).
 
 use super::Renderer;
-use crate::denoiser::{DenoiseReport, GuidedImage, Job, OidnWorker, Running, device_for, oidn_for};
+use crate::denoiser::{
+    DenoiseReport, Done, GuidedImage, Job, OidnWorker, Running, device_for, oidn_for,
+};
 use crate::gpu::accumulation::ACCUMULATION_FORMAT;
 use crate::gpu::context::GpuContext;
-use anyhow::{Result, anyhow};
+use anyhow::{Result, bail};
 use marbre_core::scene::DenoiseQuality;
 use marbre_oidn::Library;
 use std::sync::Arc;
@@ -187,9 +189,13 @@ impl Renderer {
         (from.generation == now.generation && from.size == now.size).then(|| view.clone())
     }
 
-    /// Hands a mapped read-back to the OIDN thread, and uploads a result
-    /// that came back.
+    /// Hands a mapped read-back of this accumulation to the OIDN thread
+    /// (one of an older one is dropped), cancels a denoise gone stale (an
+    /// edit restarted the accumulation), and shows a result that came
+    /// back.
     fn collect_oidn(&mut self, ctx: &GpuContext) {
+        let generation = self.accumulation.generation();
+        let quality = self.scene.render.display.denoise_quality;
         let stage = &mut self.display.oidn;
         if let Some(r) = &stage.readback
             && r.state.load(Ordering::Acquire) == MAPPED
@@ -200,8 +206,10 @@ impl Renderer {
                 .map(|bytes| guided_image(&bytes, r.from.size, r.row_bytes));
             r.buffer.unmap();
             r.state.store(IDLE, Ordering::Release);
-            let (tag, quality) = (r.from, self.scene.render.display.denoise_quality);
-            if let (Ok(image), Some(worker)) = (image, &mut stage.worker) {
+            let tag = r.from;
+            if let (Ok(image), Some(worker)) = (image, &mut stage.worker)
+                && tag.generation == generation
+            {
                 worker.submit(Job {
                     tag,
                     image,
@@ -209,34 +217,56 @@ impl Renderer {
                 });
             }
         }
-        let Some(done) = stage.worker.as_mut().and_then(OidnWorker::take) else {
-            return;
-        };
-        let device = stage.worker.as_ref().map(OidnWorker::device);
-        match done.pixels {
-            Ok(pixels) => {
-                let samples = done.tag.frames * self.scene.render.samples_per_frame;
-                self.upload_denoised(ctx, done.tag, &pixels);
-                let stage = &mut self.display.oidn;
-                let previous = stage.report.take().unwrap_or_default();
-                let meanwhile = stage.frames_meanwhile;
-                stage.report = Some(DenoiseReport {
-                    running: Running::Oidn {
-                        device: device.unwrap_or(marbre_oidn::DeviceKind::Cpu),
-                        version: Some(done.version),
-                        quality: self.scene.render.display.denoise_quality,
-                    },
-                    last: Some((done.took, samples)),
-                    images: previous.images + 1,
-                    fewest_frames_meanwhile: Some(
-                        previous
-                            .fewest_frames_meanwhile
-                            .map_or(meanwhile, |f| f.min(meanwhile)),
-                    ),
-                });
-            }
-            Err(why) => log::warn!("OIDN: {why}"),
+        let stale = stage
+            .requested
+            .is_some_and(|(g, _, q)| g != generation || q != quality);
+        if let Some(worker) = &stage.worker
+            && worker.is_busy()
+            && stale
+        {
+            worker.cancel();
         }
+        if let Some(done) = stage.worker.as_mut().and_then(OidnWorker::take) {
+            self.show_done(ctx, done);
+        }
+    }
+
+    /// Uploads a finished denoise and reports it; a cancelled one is
+    /// dropped, a failed one logged.
+    fn show_done(&mut self, ctx: &GpuContext, done: Done<DenoisedFrom>) {
+        let pixels = match done.pixels {
+            Ok(pixels) => pixels,
+            Err(_) if done.cancelled => return,
+            Err(why) => {
+                log::warn!("OIDN: {why}");
+                return;
+            }
+        };
+        let samples = done.tag.frames * self.scene.render.samples_per_frame;
+        self.upload_denoised(ctx, done.tag, &pixels);
+        let device = self
+            .display
+            .oidn
+            .worker
+            .as_ref()
+            .map_or(marbre_oidn::DeviceKind::Cpu, OidnWorker::device);
+        let stage = &mut self.display.oidn;
+        let previous = stage.report.take().unwrap_or_default();
+        let meanwhile = stage.frames_meanwhile;
+        stage.report = Some(DenoiseReport {
+            running: Running::Oidn {
+                device,
+                version: Some(done.version),
+                quality: self.scene.render.display.denoise_quality,
+            },
+            last: Some((done.took, samples)),
+            images: previous.images + 1,
+            fewest_frames_meanwhile: Some(
+                previous
+                    .fewest_frames_meanwhile
+                    .map_or(meanwhile, |f| f.min(meanwhile)),
+            ),
+        });
     }
 
     /// Records the copy of the mean and both guides of the shown region.
@@ -322,32 +352,35 @@ impl Renderer {
         };
         let now = self.denoise_source();
         let quality = self.scene.render.display.denoise_quality;
-        let device = device_for(ctx, &library);
-        let stage = &mut self.display.oidn;
-        if stage.in_place.is_none() {
-            stage.in_place =
-                Some(marbre_oidn::Denoiser::new(library, device).map_err(|e| anyhow!("{e}"))?);
-        }
-        let version = Some(stage.in_place.as_ref().expect("made above").version());
-        let running = Running::Oidn {
-            device,
-            version,
-            quality,
-        };
-        if self.shown_oidn(now).is_some()
-            && self
-                .display
+        let shown = |r: &Self| {
+            r.display
                 .oidn
                 .image
                 .as_ref()
                 .is_some_and(|(_, _, f)| *f == now)
-        {
-            return Ok(Some(running));
+                && r.display
+                    .oidn
+                    .requested
+                    .is_some_and(|(_, _, q)| q == quality)
+        };
+        if !shown(self) {
+            self.denoise_now(ctx, library, now, quality)?;
         }
+        Ok(self.display.oidn.report.as_ref().map(|r| r.running.clone()))
+    }
+
+    /// Denoises the latest image with OIDN, waited for: by the viewer's
+    /// OIDN thread if it has one (its job under way finished first), so
+    /// that no second device is made, else by a device on this thread.
+    fn denoise_now(
+        &mut self,
+        ctx: &GpuContext,
+        library: Arc<Library>,
+        now: DenoisedFrom,
+        quality: DenoiseQuality,
+    ) -> Result<()> {
         let Some([albedo, normal]) = self.read_guides(ctx)? else {
-            return Err(anyhow!(
-                "no guides to denoise with: the trace has not accumulated them"
-            ));
+            bail!("no guides to denoise with: the trace has not accumulated them");
         };
         let (w, h, mean) = self.read_radiance(ctx)?;
         let image = GuidedImage {
@@ -356,20 +389,43 @@ impl Renderer {
             albedo,
             normal,
         };
+        self.display.oidn.requested = Some((now.generation, now.frames, quality));
+        if let Some(worker) = &mut self.display.oidn.worker {
+            let before = worker.wait();
+            worker.submit(Job {
+                tag: now,
+                image,
+                quality,
+            });
+            let after = worker.wait();
+            for done in [before, after].into_iter().flatten() {
+                self.show_done(ctx, done);
+            }
+            return Ok(());
+        }
+        let device = device_for(ctx, &library);
+        let stage = &mut self.display.oidn;
+        let oidn = match &mut stage.in_place {
+            Some(d) => d,
+            slot => slot.insert(marbre_oidn::Denoiser::new(library, device)?),
+        };
         let start = Instant::now();
-        let oidn = self.display.oidn.in_place.as_mut().expect("made above");
         let pixels = image.denoise(oidn, quality)?;
         let took = start.elapsed();
+        let version = Some(oidn.version());
         self.upload_denoised(ctx, now, &pixels);
-        self.display.oidn.requested = Some((now.generation, now.frames, quality));
         let previous = self.display.oidn.report.take().unwrap_or_default();
         self.display.oidn.report = Some(DenoiseReport {
-            running: running.clone(),
+            running: Running::Oidn {
+                device,
+                version,
+                quality,
+            },
             last: Some((took, self.accumulation.samples())),
             images: previous.images + 1,
             ..previous
         });
-        Ok(Some(running))
+        Ok(())
     }
 
     /// Puts a denoised image where the display pass reads it.
