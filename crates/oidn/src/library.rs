@@ -20,7 +20,7 @@ use std::sync::{Arc, OnceLock};
 pub const DIR_VARIABLE: &str = "MARBRE_OIDN_DIR";
 
 /// The library's file name, as the platform's loader spells OIDN 2's.
-#[cfg(target_os = "linux")]
+#[cfg(not(any(target_os = "macos", target_os = "windows")))]
 pub const FILE_NAME: &str = "libOpenImageDenoise.so.2";
 #[cfg(target_os = "macos")]
 pub const FILE_NAME: &str = "libOpenImageDenoise.2.dylib";
