@@ -85,21 +85,21 @@ pub(super) fn stats_ui(ui: &mut Ui, stats: &Stats) {
 
 /// The NaN and Inf counters: red as soon as one sample was dropped, since a
 /// correct renderer never produces one.
-/// Which denoiser runs, on which device, and its last time.
+/// Which denoiser runs, on which device, and its last time: two short
+/// lines, as the panel's width clips a long one.
 fn denoise_ui(ui: &mut Ui, report: &DenoiseReport) {
-    let time = match report.last {
-        Some((took, samples)) => format!(
-            ", {:.0} ms for the {samples}-spp image",
-            took.as_secs_f64() * 1e3
-        ),
-        None => String::new(),
-    };
-    ui.label(format!("denoiser: {}{time}", report.running.describe()))
+    ui.label(format!("denoiser: {}", report.running.describe()))
         .on_hover_text(
             "OIDN filters a copy of the accumulation off the render thread: the image shown \
              is the last one filtered (at 1, 2, 4, 8… rounds and when the image settles), or \
              the raw one before the first",
         );
+    if let Some((took, samples)) = report.last {
+        ui.label(format!(
+            "last denoise: {:.0} ms, at {samples} spp",
+            took.as_secs_f64() * 1e3
+        ));
+    }
 }
 
 fn non_finite_ui(ui: &mut Ui, counts: &NonFiniteCounts) {
