@@ -73,6 +73,30 @@ pub struct DenoiseReport {
     pub fewest_frames_meanwhile: Option<u32>,
 }
 
+impl DenoiseReport {
+    /// This report after one more OIDN image: `took` to filter `samples`
+    /// per pixel, with `meanwhile` frames drawn while it ran (the
+    /// viewer's thread), or none counted (a denoise waited for).
+    pub fn after_image(
+        self,
+        running: Running,
+        took: Duration,
+        samples: u32,
+        meanwhile: Option<u32>,
+    ) -> Self {
+        let fewest = match (self.fewest_frames_meanwhile, meanwhile) {
+            (Some(f), Some(m)) => Some(f.min(m)),
+            (f, m) => f.or(m),
+        };
+        Self {
+            running,
+            last: Some((took, samples)),
+            images: self.images + 1,
+            fewest_frames_meanwhile: fewest,
+        }
+    }
+}
+
 impl Default for Running {
     fn default() -> Self {
         Running::Atrous {

@@ -251,22 +251,14 @@ impl Renderer {
             .as_ref()
             .map_or(marbre_oidn::DeviceKind::Cpu, OidnWorker::device);
         let stage = &mut self.display.oidn;
+        let running = Running::Oidn {
+            device,
+            version: Some(done.version),
+            quality: self.scene.render.display.denoise_quality,
+        };
         let previous = stage.report.take().unwrap_or_default();
-        let meanwhile = stage.frames_meanwhile;
-        stage.report = Some(DenoiseReport {
-            running: Running::Oidn {
-                device,
-                version: Some(done.version),
-                quality: self.scene.render.display.denoise_quality,
-            },
-            last: Some((done.took, samples)),
-            images: previous.images + 1,
-            fewest_frames_meanwhile: Some(
-                previous
-                    .fewest_frames_meanwhile
-                    .map_or(meanwhile, |f| f.min(meanwhile)),
-            ),
-        });
+        stage.report =
+            Some(previous.after_image(running, done.took, samples, Some(stage.frames_meanwhile)));
     }
 
     /// Records the copy of the mean and both guides of the shown region.
@@ -414,17 +406,14 @@ impl Renderer {
         let took = start.elapsed();
         let version = Some(oidn.version());
         self.upload_denoised(ctx, now, &pixels);
+        let running = Running::Oidn {
+            device,
+            version,
+            quality,
+        };
+        let samples = self.accumulation.samples();
         let previous = self.display.oidn.report.take().unwrap_or_default();
-        self.display.oidn.report = Some(DenoiseReport {
-            running: Running::Oidn {
-                device,
-                version,
-                quality,
-            },
-            last: Some((took, self.accumulation.samples())),
-            images: previous.images + 1,
-            ..previous
-        });
+        self.display.oidn.report = Some(previous.after_image(running, took, samples, None));
         Ok(())
     }
 
