@@ -363,6 +363,28 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
     var albedo_sum = vec3f(0.0);
     var normal_sum = vec3f(0.0);
 #endif
+#if CPU_SAMPLES
+    // The CPU kernel traced this pixel's samples (cpu_kernel/mod.rs): their
+    // mean, the guides' means and the dropped samples' counts, in three
+    // layers of the band's rows.
+    let at = vec2u(pixel.x, pixel.y - frame.band_start);
+    let traced = textureLoad(cpu_samples, at, 0, 0);
+    let guide_albedo = textureLoad(cpu_samples, at, 1, 0);
+    sum = traced.xyz;
+    let nan_samples = u32(traced.w);
+    let infinite_samples = u32(guide_albedo.w);
+    dropped = nan_samples + infinite_samples;
+    if nan_samples > 0u {
+        atomicAdd(&non_finite.nan, nan_samples);
+    }
+    if infinite_samples > 0u {
+        atomicAdd(&non_finite.infinite, infinite_samples);
+    }
+#if DENOISE_GUIDES
+    albedo_sum = guide_albedo.xyz;
+    normal_sum = textureLoad(cpu_samples, at, 2, 0).xyz;
+#endif
+#else
     for (var k = 0u; k < spp; k++) {
         rng_seed(image_pixel, (frame.accumulated + k) * 0x9E3779B9u + frame.frame_index);
         let jitter = vec2f(rand(), rand());
@@ -390,6 +412,7 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
             sum += l / f32(spp);
         }
     }
+#endif
     let x = sum;
     // The first frame ignores what the targets held before (a resize or a
     // reset leaves stale texels, which must not leak in, even as NaN * 0).
@@ -430,6 +453,13 @@ fn trace_pixel(pixel: vec2u) -> Accumulated {
 #endif
     return out;
 }
+
+#if CPU_SAMPLES
+// What the CPU kernel traced for the band this pass folds in (the fragment
+// kernel's group 1; the compute kernel's outputs are never in the same
+// module).
+@group(1) @binding(5) var cpu_samples: texture_2d_array<f32>;
+#endif
 
 @fragment
 fn fs_trace(@builtin(position) position: vec4f) -> Accumulated {

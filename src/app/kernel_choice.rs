@@ -1,7 +1,7 @@
 //! Which trace kernel the viewer runs (`gpu::kernel`): the one the user
 //! named (`--kernel`, the Render panel's Kernel switch), or for `auto` the
-//! faster on this adapter. `auto` times both kernels once, on the first
-//! scene, on a worker thread with its own device (the window keeps
+//! fastest here. `auto` times the kernels once (the CPU kernel where it
+//! traces the scene), on the first scene, on a worker thread with its own device (the window keeps
 //! drawing), and remembers the winner per adapter in the settings file, so
 //! the next start uses it at once.
 
@@ -22,8 +22,8 @@ pub fn stored(settings: &Settings, adapter: &str) -> Result<Option<Kernel>, Stri
         None => Ok(None),
         Some(name) => Kernel::parse(name).map(Some).ok_or_else(|| {
             format!(
-                "settings: the kernel stored for {adapter} is `{name}`, neither fragment nor \
-                 compute; ignored, timing both again"
+                "settings: the kernel stored for {adapter} is `{name}`, not a kernel's name; \
+                 ignored, timing the kernels again"
             )
         }),
     }
@@ -100,12 +100,12 @@ impl KernelChooser {
                 }
                 Ok(None) => {
                     self.needs_timing = true;
-                    "auto: timing both kernels on the first scene".to_owned()
+                    "auto: timing the kernels on the first scene".to_owned()
                 }
                 Err(note) => {
                     notes.push(note);
                     self.needs_timing = true;
-                    "auto: timing both kernels on the first scene".to_owned()
+                    "auto: timing the kernels on the first scene".to_owned()
                 }
             },
             _ => "chosen".to_owned(),
@@ -224,7 +224,8 @@ mod tests {
     fn timings(fragment_ms: f64, compute_ms: f64) -> KernelTimings {
         KernelTimings {
             fragment_ms,
-            compute_ms,
+            compute_ms: Some(compute_ms),
+            cpu_ms: None,
             size: (320, 180),
         }
     }

@@ -150,14 +150,15 @@ pub(super) fn tone_map_hint(tone_map: ToneMap) -> &'static str {
     }
 }
 
-/// The Kernel switch: which kernel traces (both draw the same image), or
-/// `auto`, the faster on this adapter.
+/// The Kernel switch: which kernel traces (all draw the same image), or
+/// `auto`, the fastest here.
 pub(super) fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelAction>) {
     use marbre_render::gpu::KernelChoice;
     let name = |c: KernelChoice| match c {
-        KernelChoice::Auto => "auto (the faster)",
+        KernelChoice::Auto => "auto (the fastest)",
         KernelChoice::Fragment => "fragment",
         KernelChoice::Compute => "compute",
+        KernelChoice::Cpu => "cpu",
     };
     let mut choice = stats.kernel_choice;
     egui::ComboBox::from_label("kernel")
@@ -167,14 +168,17 @@ pub(super) fn kernel_ui(ui: &mut Ui, stats: &Stats, actions: &mut Vec<PanelActio
                 KernelChoice::Auto,
                 KernelChoice::Fragment,
                 KernelChoice::Compute,
+                KernelChoice::Cpu,
             ] {
                 ui.selectable_value(&mut choice, c, name(c));
             }
         })
         .response
         .on_hover_text(
-            "The trace as a fragment shader or a compute kernel: the same image, at a speed that \
-             depends on the GPU; auto times both on the scene and remembers the faster",
+            "The trace as a fragment shader, a compute kernel, or native code on this machine's \
+             cores (cpu: scenes without environment maps, bump, images, cylinders or polygons; \
+             others are traced by the fragment kernel meanwhile): the same image, at a speed that \
+             depends on the machine; auto times them on the scene and remembers the fastest",
         );
     if choice != stats.kernel_choice {
         actions.push(PanelAction::SetKernel(choice));

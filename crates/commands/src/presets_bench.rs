@@ -72,6 +72,8 @@ struct SizeTimes {
     size: (u32, u32),
     fragment_ms: f64,
     compute_ms: Option<f64>,
+    /// The CPU kernel's, where it traces the preset.
+    cpu_ms: Option<f64>,
     uber_ms: f64,
 }
 
@@ -80,13 +82,20 @@ impl SizeTimes {
         match kernel {
             Kernel::Fragment => self.fragment_ms,
             Kernel::Compute => self.compute_ms.unwrap_or(f64::NAN),
+            Kernel::Cpu => self.cpu_ms.unwrap_or(f64::NAN),
         }
     }
 
-    /// The kernel measured faster here ([`kernel::faster`]).
+    /// The kernel measured fastest here ([`kernel::fastest`]).
     fn faster(&self) -> Kernel {
-        self.compute_ms
-            .map_or(Kernel::Fragment, |c| kernel::faster(self.fragment_ms, c))
+        let others: Vec<(Kernel, f64)> = [
+            (Kernel::Compute, self.compute_ms),
+            (Kernel::Cpu, self.cpu_ms),
+        ]
+        .into_iter()
+        .filter_map(|(k, ms)| ms.map(|ms| (k, ms)))
+        .collect();
+        kernel::fastest(self.fragment_ms, &others)
     }
 }
 
@@ -106,18 +115,36 @@ fn time_size(
     } else {
         None
     };
-    let mut uber = renderer_with(ctx, loaded, size, used)?;
+    let mut cpu_renderer = if marbre_render::cpu_kernel::support(&loaded.scene).is_ok() {
+        Some(renderer_with(ctx, loaded, size, Kernel::Cpu)?)
+    } else {
+        None
+    };
+    // The uber shader is a GPU kernel's: the CPU kernel has no shader to
+    // specialise in that sense.
+    let uber_kernel = if used == Kernel::Cpu {
+        Kernel::Fragment
+    } else {
+        used
+    };
+    let mut uber = renderer_with(ctx, loaded, size, uber_kernel)?;
     uber.set_feature_override(ctx, Some(FeatureSet::all()))?;
     let mut renderers: Vec<&mut Renderer> = vec![&mut fragment, &mut uber];
+    let with_compute = compute_renderer.is_some();
     if let Some(c) = compute_renderer.as_mut() {
         renderers.push(c);
     }
+    if let Some(c) = cpu_renderer.as_mut() {
+        renderers.push(c);
+    }
     let times = time_interleaved(ctx, &mut renderers, frames)?;
+    let mut rest = times[2..].iter().copied();
     Ok(SizeTimes {
         size,
         fragment_ms: times[0],
         uber_ms: times[1],
-        compute_ms: times.get(2).copied(),
+        compute_ms: if with_compute { rest.next() } else { None },
+        cpu_ms: rest.next(),
     })
 }
 
@@ -211,7 +238,7 @@ pub fn run(args: &PresetsBenchArgs) -> Result<()> {
         let used = args.kernel.fixed().unwrap_or(auto);
         used_kernels.push(used);
         let auto_cell = match &timings {
-            Some(t) => format!("{auto} ({:.2})", t.compute_ms / t.fragment_ms),
+            Some(t) => format!("{auto} ({:.2})", t.ms(auto) / t.fragment_ms),
             None => format!("{auto} (untimed)"),
         };
         let mut cells = Vec::new();

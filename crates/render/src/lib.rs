@@ -4,6 +4,7 @@
 
 pub mod bake_file;
 pub mod cpu_display;
+pub mod cpu_kernel;
 pub mod denoiser;
 pub mod final_render;
 pub mod frame_sequence;

@@ -268,27 +268,50 @@ const KERNEL_TIMING_FRAMES: u32 = 9;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KernelTimings {
     pub fragment_ms: f64,
-    pub compute_ms: f64,
+    /// Where the adapter runs the compute kernel.
+    pub compute_ms: Option<f64>,
+    /// Where the CPU kernel traces the scene (`cpu_kernel::support`).
+    pub cpu_ms: Option<f64>,
     pub size: (u32, u32),
 }
 
 impl KernelTimings {
+    /// The fastest kernel timed ([`kernel::fastest`]).
     pub fn faster(&self) -> Kernel {
-        kernel::faster(self.fragment_ms, self.compute_ms)
+        kernel::fastest(self.fragment_ms, &self.others())
+    }
+
+    /// The milliseconds a frame of `kernel` took (NaN if not timed).
+    pub fn ms(&self, kernel: Kernel) -> f64 {
+        match kernel {
+            Kernel::Fragment => self.fragment_ms,
+            Kernel::Compute => self.compute_ms.unwrap_or(f64::NAN),
+            Kernel::Cpu => self.cpu_ms.unwrap_or(f64::NAN),
+        }
+    }
+
+    fn others(&self) -> Vec<(Kernel, f64)> {
+        [
+            (Kernel::Compute, self.compute_ms),
+            (Kernel::Cpu, self.cpu_ms),
+        ]
+        .into_iter()
+        .filter_map(|(k, ms)| ms.map(|ms| (k, ms)))
+        .collect()
     }
 }
 
 impl std::fmt::Display for KernelTimings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "fragment {:.2} ms, compute {:.2} ms per frame at {}x{}",
-            self.fragment_ms, self.compute_ms, self.size.0, self.size.1
-        )
+        write!(f, "fragment {:.2} ms", self.fragment_ms)?;
+        for (kernel, ms) in self.others() {
+            write!(f, ", {kernel} {ms:.2} ms")?;
+        }
+        write!(f, " per frame at {}x{}", self.size.0, self.size.1)
     }
 }
 
-/// Times both kernels on `loaded` at `size` (at most
+/// Times every kernel the adapter runs and the CPU kernel where it traces the scene, on `loaded` at `size` (at most
 /// [`KERNEL_TIMING_SIZE`]): see [`KernelTimings`]. `cancel` is looked at
 /// between the steps that take long on a CPU adapter (each kernel's
 /// pipeline build and first draw): once it is set, the timing stops there
@@ -311,25 +334,30 @@ pub fn time_kernels(
         );
         Ok(())
     };
-    let mut fragment = renderer_with(ctx, loaded, size, Kernel::Fragment)?;
-    go_on()?;
-    trace_frame(ctx, &mut fragment)?;
-    go_on()?;
-    let mut compute = renderer_with(ctx, loaded, size, Kernel::Compute)?;
-    go_on()?;
-    trace_frame(ctx, &mut compute)?;
-    go_on()?;
+    let mut kernels = vec![Kernel::Fragment];
+    if kernel::compute_support(ctx).is_ok() {
+        kernels.push(Kernel::Compute);
+    }
+    if crate::cpu_kernel::support(&loaded.scene).is_ok() {
+        kernels.push(Kernel::Cpu);
+    }
+    let mut renderers = Vec::new();
+    for &kernel in &kernels {
+        let mut renderer = renderer_with(ctx, loaded, size, kernel)?;
+        go_on()?;
+        trace_frame(ctx, &mut renderer)?;
+        go_on()?;
+        renderers.push(renderer);
+    }
     // Each kernel drew its first frame above (the shader compile, on a CPU
     // adapter): one more untimed frame each makes the two of warm-up.
-    let ms = time_interleaved(
-        ctx,
-        &mut [&mut fragment, &mut compute],
-        1,
-        KERNEL_TIMING_FRAMES,
-    )?;
+    let mut timed: Vec<&mut Renderer> = renderers.iter_mut().collect();
+    let ms = time_interleaved(ctx, &mut timed, 1, KERNEL_TIMING_FRAMES)?;
+    let of = |kernel| kernels.iter().position(|&k| k == kernel).map(|i| ms[i]);
     Ok(KernelTimings {
         fragment_ms: ms[0],
-        compute_ms: ms[1],
+        compute_ms: of(Kernel::Compute),
+        cpu_ms: of(Kernel::Cpu),
         size,
     })
 }
@@ -384,7 +412,9 @@ pub fn pick_kernel(
     choice: KernelChoice,
 ) -> Result<(Kernel, Option<KernelTimings>)> {
     let kernel = kernel::resolve(ctx, choice)?;
-    if choice != KernelChoice::Auto || kernel == Kernel::Fragment {
+    let only_fragment =
+        kernel == Kernel::Fragment && crate::cpu_kernel::support(&loaded.scene).is_err();
+    if choice != KernelChoice::Auto || only_fragment {
         return Ok((kernel, None));
     }
     let timings = time_kernels(ctx, loaded, size, &AtomicBool::new(false))?;

@@ -547,6 +547,7 @@ impl Viewer {
         job.kernel = match self.renderer.kernel() {
             marbre_render::gpu::Kernel::Fragment => marbre_render::gpu::KernelChoice::Fragment,
             marbre_render::gpu::Kernel::Compute => marbre_render::gpu::KernelChoice::Compute,
+            marbre_render::gpu::Kernel::Cpu => marbre_render::gpu::KernelChoice::Cpu,
         };
         let output = job.output.display().to_string();
         let images = self.renderer.images().clone();

@@ -1,7 +1,10 @@
 //! Which kernel runs the trace: the fragment shader over a full-screen
-//! triangle, or a compute dispatch. Both call the same WGSL body
-//! (`trace_pixel` in shaders/trace.wgsl) and give the same image; which is
-//! faster depends on the adapter. An NVIDIA H100 runs pixel shaders on few
+//! triangle, a compute dispatch, or the CPU kernel (`crate::cpu_kernel`,
+//! the same path in Rust on the machine's cores, its samples folded into
+//! the accumulation by the fragment kernel's shader). The GPU kernels call
+//! the same WGSL body (`trace_pixel` in shaders/trace.wgsl) and give the
+//! same image, the CPU kernel the same image to rounding; which is faster
+//! depends on the adapter. An NVIDIA H100 runs pixel shaders on few
 //! of its units (the prototype traced the default preset at 1080p in 0.7 ms
 //! in compute against 19.5 ms in fragment), while on lavapipe neither wins
 //! everywhere (docs/PERFORMANCE.md). So `auto` times both on the scene at
@@ -21,16 +24,32 @@ pub enum Kernel {
     /// `cs_trace`: workgroups of [`WORKGROUP`] pixels, the targets as
     /// storage textures.
     Compute,
+    /// `crate::cpu_kernel` on the machine's cores, for the scenes it
+    /// traces (`cpu_kernel::support`); another scene is traced by the
+    /// fragment kernel meanwhile ([`Kernel::for_scene`]).
+    Cpu,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 2] = [Kernel::Fragment, Kernel::Compute];
+    pub const ALL: [Kernel; 3] = [Kernel::Fragment, Kernel::Compute, Kernel::Cpu];
+    /// The kernels that run on the adapter.
+    pub const GPU: [Kernel; 2] = [Kernel::Fragment, Kernel::Compute];
 
     /// Its name on the command line, in settings and in the panel.
     pub fn name(self) -> &'static str {
         match self {
             Kernel::Fragment => "fragment",
             Kernel::Compute => "compute",
+            Kernel::Cpu => "cpu",
+        }
+    }
+
+    /// The kernel that traces `scene` when this one is asked for: itself,
+    /// or the fragment kernel where the CPU kernel cannot trace the scene.
+    pub fn for_scene(self, scene: &marbre_core::scene::Scene) -> Kernel {
+        match self {
+            Kernel::Cpu if crate::cpu_kernel::support(scene).is_err() => Kernel::Fragment,
+            k => k,
         }
     }
 
@@ -53,6 +72,7 @@ impl fmt::Display for Kernel {
 pub enum KernelChoice {
     Fragment,
     Compute,
+    Cpu,
     /// Time both on the first scene and keep the faster (remembered per
     /// adapter by the viewer).
     #[default]
@@ -60,13 +80,14 @@ pub enum KernelChoice {
 }
 
 impl KernelChoice {
-    pub const ALL: [KernelChoice; 3] = [
+    pub const ALL: [KernelChoice; 4] = [
         KernelChoice::Fragment,
         KernelChoice::Compute,
+        KernelChoice::Cpu,
         KernelChoice::Auto,
     ];
     /// The names [`KernelChoice::name`] gives, in [`KernelChoice::ALL`]'s order.
-    pub const NAMES: [&'static str; 3] = ["fragment", "compute", "auto"];
+    pub const NAMES: [&'static str; 4] = ["fragment", "compute", "cpu", "auto"];
 
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
@@ -77,6 +98,7 @@ impl KernelChoice {
         match self {
             KernelChoice::Fragment => Some(Kernel::Fragment),
             KernelChoice::Compute => Some(Kernel::Compute),
+            KernelChoice::Cpu => Some(Kernel::Cpu),
             KernelChoice::Auto => None,
         }
     }
@@ -165,6 +187,7 @@ pub fn resolve(ctx: &GpuContext, choice: KernelChoice) -> anyhow::Result<Kernel>
         )),
         (KernelChoice::Fragment, _) | (KernelChoice::Auto, Err(_)) => Ok(Kernel::Fragment),
         (KernelChoice::Compute, Ok(())) | (KernelChoice::Auto, Ok(())) => Ok(Kernel::Compute),
+        (KernelChoice::Cpu, _) => Ok(Kernel::Cpu),
     }
 }
 
@@ -179,11 +202,18 @@ pub const COMPUTE_MARGIN: f64 = 0.95;
 /// scene and size. A near tie (within [`COMPUTE_MARGIN`]) keeps the
 /// fragment kernel, the one every adapter runs.
 pub fn faster(fragment_ms: f64, compute_ms: f64) -> Kernel {
-    if compute_ms < fragment_ms * COMPUTE_MARGIN {
-        Kernel::Compute
-    } else {
-        Kernel::Fragment
-    }
+    fastest(fragment_ms, &[(Kernel::Compute, compute_ms)])
+}
+
+/// The fastest of the fragment kernel and `others` (each timed on the same
+/// scene and size): another kernel is chosen only if it beats the
+/// fragment kernel by the margin, and the fastest of those wins.
+pub fn fastest(fragment_ms: f64, others: &[(Kernel, f64)]) -> Kernel {
+    others
+        .iter()
+        .filter(|(_, ms)| *ms < fragment_ms * COMPUTE_MARGIN)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(Kernel::Fragment, |(k, _)| *k)
 }
 
 #[cfg(test)]
@@ -207,6 +237,16 @@ mod tests {
         // Within the margin: a tie.
         assert_eq!(faster(10.0, 9.6), Kernel::Fragment);
         assert_eq!(faster(10.0, 9.4), Kernel::Compute);
+    }
+
+    #[test]
+    fn the_fastest_of_three_wins_past_the_margin() {
+        let others = |compute, cpu| [(Kernel::Compute, compute), (Kernel::Cpu, cpu)];
+        assert_eq!(fastest(10.0, &others(4.0, 2.0)), Kernel::Cpu);
+        assert_eq!(fastest(10.0, &others(2.0, 4.0)), Kernel::Compute);
+        assert_eq!(fastest(10.0, &others(9.8, 9.7)), Kernel::Fragment);
+        assert_eq!(fastest(10.0, &others(12.0, 9.0)), Kernel::Cpu);
+        assert_eq!(fastest(10.0, &[]), Kernel::Fragment);
     }
 
     #[test]

@@ -7,14 +7,20 @@
 
 use crate::gpu::accumulation::{ACCUMULATION_FORMAT, Accumulation};
 use crate::gpu::kernel::{Kernel, WORKGROUP};
-use crate::gpu::pipelines::{checked, entry, fullscreen_pipeline};
+use crate::gpu::pipelines::{checked, entry, fullscreen_pipeline, fullscreen_pipeline_with_layout};
 use anyhow::Result;
 use std::ops::Range;
 
-/// A built trace pipeline of either kernel.
+/// `cpu_samples`' binding in group 1 of shaders/trace.wgsl.
+pub const CPU_SAMPLES_BINDING: u32 = 5;
+
+/// A built trace pipeline of any kernel.
 pub enum TracePipeline {
     Fragment(wgpu::RenderPipeline),
     Compute(wgpu::ComputePipeline),
+    /// The fragment kernel's pass built with `CPU_SAMPLES`: it folds the
+    /// samples the CPU kernel traced (group 1) into the accumulation.
+    Cpu(wgpu::RenderPipeline),
 }
 
 impl TracePipeline {
@@ -22,6 +28,7 @@ impl TracePipeline {
         match self {
             TracePipeline::Fragment(_) => Kernel::Fragment,
             TracePipeline::Compute(_) => Kernel::Compute,
+            TracePipeline::Cpu(_) => Kernel::Cpu,
         }
     }
 
@@ -73,6 +80,22 @@ impl TracePipeline {
                 })?;
                 Ok(TracePipeline::Compute(pipeline))
             }
+            Kernel::Cpu => {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("trace (cpu samples)"),
+                    bind_group_layouts: &[Some(&layouts.scene), Some(&layouts.cpu_samples)],
+                    immediate_size: 0,
+                });
+                Ok(TracePipeline::Cpu(fullscreen_pipeline_with_layout(
+                    device,
+                    "trace (cpu samples)",
+                    module,
+                    &layout,
+                    "fs_trace",
+                    &vec![ACCUMULATION_FORMAT; TraceLayouts::targets(guides)],
+                    constants,
+                )?))
+            }
         }
     }
 }
@@ -84,6 +107,8 @@ impl TracePipeline {
 pub struct TraceLayouts {
     pub scene: wgpu::BindGroupLayout,
     pub outputs: [wgpu::BindGroupLayout; 2],
+    /// The CPU kernel's samples of a band (`cpu_samples`, binding 5).
+    pub cpu_samples: wgpu::BindGroupLayout,
 }
 
 impl TraceLayouts {
@@ -101,6 +126,21 @@ impl TraceLayouts {
     /// Both output layouts: 3 and 5 storage textures.
     pub fn output_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
         [false, true].map(|guides| Self::output_layout(device, Self::targets(guides)))
+    }
+
+    /// Group 1 of the CPU kernel's pass: the band's samples.
+    pub fn cpu_samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cpu samples"),
+            entries: &[entry(
+                CPU_SAMPLES_BINDING,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+            )],
+        })
     }
 
     fn output_layout(device: &wgpu::Device, count: usize) -> wgpu::BindGroupLayout {
@@ -160,6 +200,55 @@ impl<'a> PassTimestamps<'a> {
     }
 }
 
+/// The CPU kernel's samples of a band, traced now and uploaded as the
+/// group 1 of its pass: a layer each of `cpu_kernel::BLOCKS`.
+pub fn cpu_samples_group(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    layouts: &TraceLayouts,
+    scene: &crate::cpu_kernel::CpuScene,
+    frame: &crate::gpu::scene_gpu::Frame,
+) -> wgpu::BindGroup {
+    let texels = crate::cpu_kernel::trace_band(scene, frame);
+    let size = wgpu::Extent3d {
+        width: frame.render_size[0] as u32,
+        height: frame.band_end - frame.band_start,
+        depth_or_array_layers: crate::cpu_kernel::BLOCKS,
+    };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("cpu samples"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: ACCUMULATION_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size.width * 16),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("cpu samples"),
+        layout: &layouts.cpu_samples,
+        entries: &[wgpu::BindGroupEntry {
+            binding: CPU_SAMPLES_BINDING,
+            resource: wgpu::BindingResource::TextureView(&view),
+        }],
+    })
+}
+
 /// One band's pass: what it binds and where it stands among the call's.
 pub struct BandPass<'a> {
     pub pipeline: &'a TracePipeline,
@@ -168,6 +257,8 @@ pub struct BandPass<'a> {
     pub frame_offset: u32,
     /// The compute kernel's outputs (the accumulation's write set).
     pub outputs: Option<&'a wgpu::BindGroup>,
+    /// The CPU kernel's samples of this band.
+    pub cpu_samples: Option<&'a wgpu::BindGroup>,
     pub accumulation: &'a Accumulation,
     /// The traced region's width and the rows of this band.
     pub width: u32,
@@ -183,7 +274,7 @@ impl BandPass<'_> {
         let timestamps = timestamps.and_then(|t| t.for_band(self.index, self.count));
         let rows = self.rows.end - self.rows.start;
         match self.pipeline {
-            TracePipeline::Fragment(pipeline) => {
+            TracePipeline::Fragment(pipeline) | TracePipeline::Cpu(pipeline) => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("trace"),
                     color_attachments: &self.accumulation.attachments(),
@@ -196,6 +287,9 @@ impl BandPass<'_> {
                 pass.set_scissor_rect(0, self.rows.start, self.width, rows);
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, self.scene, &[self.frame_offset]);
+                if let Some(samples) = self.cpu_samples {
+                    pass.set_bind_group(1, samples, &[]);
+                }
                 pass.draw(0..3, 0..1);
             }
             TracePipeline::Compute(pipeline) => {

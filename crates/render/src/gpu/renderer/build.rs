@@ -31,7 +31,11 @@ impl Renderer {
         layouts: &TraceLayouts,
         key: &PipelineKey,
     ) -> Result<(TracePipeline, usize)> {
-        let source = assemble(Program::Trace, &key.features, &key.code)?;
+        let mut features = key.features.clone();
+        if key.kernel == Kernel::Cpu {
+            features.0.insert(Feature::CpuSamples);
+        }
+        let source = assemble(Program::Trace, &features, &key.code)?;
         let bytes = source.len();
         let module = compile_wgsl(device, Program::Trace, source)?;
         let pipeline = TracePipeline::build(
@@ -151,7 +155,7 @@ impl Renderer {
             .is_none_or(|(wgsl, _)| *wgsl == latest.code)
             && features == latest.features
             && switches == latest.switches
-            && self.trace.kernel == latest.kernel
+            && self.trace.kernel.for_scene(scene) == latest.kernel
             && sources_generation() == latest.sources;
         let target = Target {
             scene: scene.clone(),
@@ -177,7 +181,7 @@ impl Renderer {
             code,
             switches,
             sources: sources_generation(),
-            kernel: self.trace.kernel,
+            kernel: self.trace.kernel.for_scene(scene),
         };
         if key == self.trace.key {
             // Back to the pipeline in place (an edit undone while its build
@@ -332,6 +336,7 @@ impl Renderer {
             self.bindings.geometry.write(&ctx.queue, scene);
         }
         self.bindings.meshes.update(&ctx.device, scene, change);
+        self.cpu_scene = None;
         // Display-only edits (exposure, auto exposure, tone map, the debug
         // view) keep the samples.
         if change.resets_accumulation() {

@@ -5,6 +5,7 @@
 use super::display_stage::DisplayUniform;
 use super::trace_stage::{FRAME_BYTES, FRAME_SLOTS, frame_stride};
 use super::{DisplayTarget, MeteredFrom, Renderer, TraceWork, bind};
+use crate::cpu_kernel::CpuScene;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
@@ -12,11 +13,12 @@ use crate::gpu::pipelines::fullscreen_pipeline;
 use crate::gpu::preview_ladder;
 use crate::gpu::scene_gpu::Frame;
 use crate::gpu::trace_bands::TraceBudget;
-use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline};
+use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline, cpu_samples_group};
 use crate::gpu::{non_finite, scene_gpu};
 use anyhow::Result;
 use marbre_core::scene::{Metering, ToneMap};
 use marbre_core::tile::Tile;
+use std::sync::Arc;
 
 /// The step between the seeds of consecutive samples of a pixel: the
 /// golden-ratio constant `shaders/trace.wgsl` multiplies the sample's
@@ -292,11 +294,28 @@ impl Renderer {
                 entries: &entries,
             })
         });
+        let cpu_samples = matches!(self.trace.pipeline, TracePipeline::Cpu(_)).then(|| {
+            let scene = self.cpu_scene.get_or_insert_with(|| {
+                Arc::new(CpuScene::new(
+                    &self.scene,
+                    self.bindings.meshes.geometry().clone(),
+                    self.bindings.meshes.table(),
+                ))
+            });
+            cpu_samples_group(
+                &ctx.device,
+                &ctx.queue,
+                &self.trace.layouts,
+                scene,
+                &uniform,
+            )
+        });
         BandPass {
             pipeline: &self.trace.pipeline,
             scene: &scene_group,
             frame_offset: offset as u32,
             outputs: outputs.as_ref(),
+            cpu_samples: cpu_samples.as_ref(),
             accumulation: &self.accumulation,
             width: size.0,
             rows,

@@ -84,6 +84,9 @@ pub struct Renderer {
     /// The samples per pixel of the rounds that follow when fewer than
     /// the scene's per frame: the last round of an exact `--spp`.
     round_samples: Option<u32>,
+    /// The scene as the CPU kernel reads it, made at its first band after
+    /// each write of the scene (`apply`).
+    cpu_scene: Option<std::sync::Arc<crate::cpu_kernel::CpuScene>>,
 }
 
 /// What one trace call did.
@@ -127,11 +130,11 @@ impl Renderer {
             code: textures.wgsl,
             switches: RenderSwitches::of(scene),
             sources: sources_generation(),
-            kernel,
+            kernel: kernel.for_scene(scene),
         };
         Ok(Self {
             scene: scene.clone(),
-            trace: TraceStage::new(ctx, key, textures.plan, compute_supported)?,
+            trace: TraceStage::new(ctx, key, kernel, textures.plan, compute_supported)?,
             bindings: SceneBindings::new(ctx, scene, env, images, &textures.params),
             display: DisplayStage::new(&ctx.device)?,
             accumulation: Accumulation::new(&ctx.device, size, compute_supported),
@@ -142,6 +145,7 @@ impl Renderer {
             render_scale: 1.0,
             frame_index: 0,
             round_samples: None,
+            cpu_scene: None,
         })
     }
 

@@ -72,6 +72,7 @@ impl TraceStage {
     pub(super) fn new(
         ctx: &GpuContext,
         key: PipelineKey,
+        kernel: Kernel,
         texture_plan: ParamPlan,
         compute_supported: bool,
     ) -> Result<Self> {
@@ -99,6 +100,7 @@ impl TraceStage {
                 entries: &entries,
             }),
             outputs: TraceLayouts::output_layouts(device),
+            cpu_samples: TraceLayouts::cpu_samples_layout(device),
         };
         let (pipeline, shader_bytes) = Renderer::build_trace_pipeline(device, &layouts, &key)?;
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -112,7 +114,7 @@ impl TraceStage {
             builder: PipelineBuilder::default(),
             warm_up: None,
             last_build: None,
-            kernel: key.kernel,
+            kernel,
             key,
             texture_plan,
             code_generations: 1,

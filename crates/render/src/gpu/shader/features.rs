@@ -34,6 +34,11 @@ pub enum Feature {
     HashPcg,
     HashSin,
     DenoiseGuides,
+    /// The trace module of the CPU kernel: the samples come from the CPU
+    /// (`cpu_samples`), the GPU folds them in. Added by the kernel, never
+    /// by a scene (`Renderer::build_trace_pipeline`), so not in
+    /// [`Feature::all`].
+    CpuSamples,
 }
 
 impl Feature {
@@ -97,6 +102,7 @@ impl Feature {
             Feature::HashPcg => "HASH_PCG",
             Feature::HashSin => "HASH_SIN",
             Feature::DenoiseGuides => "DENOISE_GUIDES",
+            Feature::CpuSamples => "CPU_SAMPLES",
         }
     }
 

@@ -136,10 +136,31 @@ pub fn fullscreen_pipeline(
         bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
+    fullscreen_pipeline_with_layout(
+        device,
+        label,
+        module,
+        &pipeline_layout,
+        fragment_entry,
+        formats,
+        constants,
+    )
+}
+
+/// [`fullscreen_pipeline`] with a pipeline layout of several groups.
+pub fn fullscreen_pipeline_with_layout(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    pipeline_layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
+    formats: &[wgpu::TextureFormat],
+    constants: &[(&str, f64)],
+) -> Result<wgpu::RenderPipeline> {
     checked(device, label, || {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(label),
-            layout: Some(&pipeline_layout),
+            layout: Some(pipeline_layout),
             vertex: wgpu::VertexState {
                 module,
                 entry_point: Some("vs_fullscreen"),

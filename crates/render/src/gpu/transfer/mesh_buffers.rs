@@ -12,6 +12,7 @@ use glam::Vec3;
 use marbre_core::accel::{Bvh, TriangleVerts};
 use marbre_core::lights::{EmitterTriangle, Light, LightTable};
 use marbre_core::scene::{Change, MeshPlacement, Scene};
+use std::sync::Arc;
 use std::time::Duration;
 use wgpu::util::DeviceExt;
 
@@ -23,6 +24,26 @@ pub struct TriangleAttributes {
     pub uv2: [f32; 2],
     pub material: u32,
     pub _pad: u32,
+}
+
+/// The meshes as the CPU kernel walks them (`cpu_kernel`): the BVH, the
+/// triangles' corners and attributes in its order, the very data the
+/// storage buffers hold.
+pub struct MeshGeometry {
+    pub bvh: Bvh,
+    pub positions: Vec<[Vec3; 3]>,
+    pub attributes: Vec<TriangleAttributes>,
+}
+
+impl Default for MeshGeometry {
+    /// No triangle: the hierarchy of one empty node.
+    fn default() -> Self {
+        Self {
+            bvh: Bvh::build(&[]),
+            positions: Vec::new(),
+            attributes: Vec::new(),
+        }
+    }
 }
 
 /// What the BVH was built from: the same key, the same BVH.
@@ -66,6 +87,8 @@ pub struct MeshBuffers {
     triangles: wgpu::Buffer,
     attributes: wgpu::Buffer,
     lights: wgpu::Buffer,
+    /// The same geometry on the CPU, for the CPU kernel.
+    geometry: Arc<MeshGeometry>,
     /// The triangles in BVH order, as the light table reads them.
     emitters: Vec<EmitterTriangle>,
     table: LightTable,
@@ -95,9 +118,8 @@ fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::
 /// window keeps drawing.
 pub struct PreparedGeometry {
     key: GeometryKey,
-    bvh: Bvh,
+    geometry: MeshGeometry,
     verts: Vec<TriangleVerts>,
-    attributes: Vec<TriangleAttributes>,
     emitters: Vec<EmitterTriangle>,
 }
 
@@ -133,9 +155,12 @@ impl PreparedGeometry {
             .collect();
         Self {
             key,
-            bvh,
+            geometry: MeshGeometry {
+                bvh,
+                positions,
+                attributes,
+            },
             verts,
-            attributes,
             emitters,
         }
     }
@@ -149,6 +174,7 @@ impl MeshBuffers {
             triangles: storage_buffer(device, "mesh triangles", &[]),
             attributes: storage_buffer(device, "mesh attributes", &[]),
             lights: storage_buffer(device, "lights", &[]),
+            geometry: Arc::default(),
             emitters: Vec::new(),
             table: LightTable::default(),
             stats: MeshStats::default(),
@@ -187,7 +213,7 @@ impl MeshBuffers {
         self.nodes = storage_buffer(
             device,
             "bvh nodes",
-            bytemuck::cast_slice(&prepared.bvh.nodes),
+            bytemuck::cast_slice(&prepared.geometry.bvh.nodes),
         );
         self.triangles = storage_buffer(
             device,
@@ -197,11 +223,12 @@ impl MeshBuffers {
         self.attributes = storage_buffer(
             device,
             "mesh attributes",
-            bytemuck::cast_slice(&prepared.attributes),
+            bytemuck::cast_slice(&prepared.geometry.attributes),
         );
         self.stats.triangles = prepared.verts.len();
-        self.stats.bvh_nodes = prepared.bvh.nodes.len();
-        self.stats.bvh_build = prepared.bvh.stats.build_time;
+        self.stats.bvh_nodes = prepared.geometry.bvh.nodes.len();
+        self.stats.bvh_build = prepared.geometry.bvh.stats.build_time;
+        self.geometry = Arc::new(prepared.geometry);
     }
 
     /// Hands over geometry prepared off the render thread (a loader
@@ -223,6 +250,11 @@ impl MeshBuffers {
 
     pub fn table(&self) -> &LightTable {
         &self.table
+    }
+
+    /// The geometry the buffers hold, for the CPU kernel.
+    pub fn geometry(&self) -> &Arc<MeshGeometry> {
+        &self.geometry
     }
 
     pub fn stats(&self) -> MeshStats {
