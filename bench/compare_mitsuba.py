@@ -649,7 +649,7 @@ def main():
     p.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variants, comma-separated: llvm_ad_rgb, scalar_rgb (default: %(default)s)")
     default_marbre = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(REPO, "target")), "release", "marbre")
     p.add_argument("--marbre", default=default_marbre, help="the marbre binary (default: $CARGO_TARGET_DIR or target, then release/marbre)")
-    p.add_argument("--kernel", choices=["fragment", "compute", "auto"], default="auto",
+    p.add_argument("--kernel", choices=["fragment", "compute", "cpu", "auto"], default="auto",
                    help="marbre's trace kernel, passed to `marbre bench-convergence --kernel` (default: %(default)s: "
                    "the faster of the two on the preset, timed by marbre first)")
     p.add_argument("--out", default=os.path.join(REPO, "target", "compare-mitsuba"), help="output folder (default: target/compare-mitsuba)")

@@ -42,6 +42,7 @@ impl Surface {
 /// and near the peak cos θh rounds to 1 in steps of 6e-8, so 1 − cos²θh
 /// keeps few digits where a lobe of roughness 0.05 has sin²θh ~ 1e-5 (the
 /// chi² test rejected that D against its own samples).
+#[inline]
 pub fn ggx_d(cos2: f32, sin2: f32, a: f32) -> f32 {
     let a2 = a * a;
     let k = sin2 + cos2 * a2;
@@ -49,6 +50,7 @@ pub fn ggx_d(cos2: f32, sin2: f32, a: f32) -> f32 {
 }
 
 /// Smith's masking G1 for GGX at cos θ = `n_v`.
+#[inline]
 pub fn smith_g1(n_v: f32, a: f32) -> f32 {
     let a2 = a * a;
     2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt())
@@ -58,6 +60,7 @@ pub fn smith_g1(n_v: f32, a: f32) -> f32 {
 /// transmission); the diffuse lobe takes the rest. A black surface splits
 /// evenly between GGX and diffuse, as before transmission existed, so an
 /// opaque surface keeps its samples.
+#[inline]
 pub fn lobe_probabilities(s: &Surface) -> (f32, f32) {
     let d = luminance(s.diffuse);
     let g = luminance(s.specular);
@@ -74,6 +77,7 @@ pub const UNIFORM_HEMISPHERE_PDF: f32 = 0.5 * FRAC_1_PI;
 
 /// The diffuse lobe's sampling density at cos θi = `n_i` > 0: by cosine,
 /// or uniform over the hemisphere.
+#[inline]
 pub fn diffuse_pdf(n_i: f32, uniform: bool) -> f32 {
     if uniform {
         UNIFORM_HEMISPHERE_PDF
@@ -94,6 +98,7 @@ pub struct BsdfEval {
 /// The value and the sampling pdf of the continuous lobes. `n` faces `wo`;
 /// `wi` on its side meets the reflecting lobes, `wi` across it the
 /// transmission lobe alone.
+#[inline]
 pub fn eval_bsdf(s: &Surface, n: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
     let n_i = n.dot(wi);
     let n_o = n.dot(wo);
@@ -123,6 +128,7 @@ pub fn eval_bsdf(s: &Surface, n: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
 }
 
 /// An orthonormal basis around `n` (Duff et al. 2017), columns t, b, n.
+#[inline]
 pub fn basis(n: Vec3) -> Mat3 {
     let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
@@ -151,6 +157,7 @@ pub struct BsdfSample {
 /// A direction drawn from the BSDF with the four uniform numbers the shader
 /// draws in this order: mirror or not, cos θ, φ, which lobe (GGX below its
 /// chance, then transmission, then diffuse).
+#[inline]
 pub fn sample_bsdf(s: &Surface, n: Vec3, wo: Vec3, u: [f32; 4]) -> BsdfSample {
     let mirror = u[0] < s.mirror;
     let (u1, u2) = (u[1], u[2]);

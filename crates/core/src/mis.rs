@@ -15,6 +15,7 @@ pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/mis.w
 /// takes all the weight (half each if both are); otherwise both densities
 /// are divided by the larger first, so neither `a + b` nor a square can
 /// overflow (pbrt's guard) and tiny densities keep their ratio.
+#[inline]
 pub fn mis_heuristic(a: f32, b: f32, strategy: Strategy) -> f32 {
     let a_infinite = a > f32::MAX;
     let b_infinite = b > f32::MAX;
@@ -39,6 +40,7 @@ pub fn mis_heuristic(a: f32, b: f32, strategy: Strategy) -> f32 {
 
 /// The weight of a light sample of density `light_pdf` whose direction the
 /// BSDF samples with density `bsdf_pdf`.
+#[inline]
 pub fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32, strategy: Strategy) -> f32 {
     match strategy {
         Strategy::Light => 1.0,
@@ -50,6 +52,7 @@ pub fn light_sample_weight(light_pdf: f32, bsdf_pdf: f32, strategy: Strategy) ->
 /// The weight of light reached by a BSDF sample of density `bsdf_pdf`,
 /// which light sampling finds with density `light_pdf` (0 where it cannot:
 /// such light is always BSDF sampling's alone).
+#[inline]
 pub fn bsdf_sample_weight(bsdf_pdf: f32, light_pdf: f32, strategy: Strategy) -> f32 {
     if light_pdf <= 0.0 || strategy.directions_only() {
         return 1.0;

@@ -4,7 +4,7 @@
 
 use super::bvh::{Bvh, BvhNode, MAX_DEPTH};
 use super::triangle::WatertightRay;
-use glam::Vec3;
+use glam::{BVec3A, Vec3, Vec3A};
 
 /// The shader code this module is the CPU twin of (or, for a harness, runs).
 pub const WGSL: crate::wgsl::WgslFile = crate::wgsl_file!("crates/core/src/accel/traverse.wgsl");
@@ -45,33 +45,36 @@ pub const SLAB_INFLATE: f32 = 1.0 + 16.0 * f32::EPSILON;
 /// each slab it enters by.
 #[derive(Debug, Clone, Copy)]
 pub struct SlabRay {
-    origin: Vec3,
-    inv: Vec3,
-    pad: Vec3,
-    negative: [bool; 3],
+    origin: Vec3A,
+    inv: Vec3A,
+    pad: Vec3A,
+    /// Which slabs the ray enters by their max plane (d < 0).
+    negative: BVec3A,
 }
 
 impl SlabRay {
+    #[inline]
     pub fn new(origin: Vec3, direction: Vec3) -> Self {
         let largest = direction.abs().max_element();
         let parallel = direction.abs().cmple(Vec3::splat(SLAB_PARALLEL * largest));
         SlabRay {
-            origin,
-            inv: Vec3::select(parallel, Vec3::ZERO, direction.recip()),
-            pad: Vec3::select(parallel, Vec3::splat(SLAB_PAD), Vec3::ZERO),
-            negative: direction.cmplt(Vec3::ZERO).into(),
+            origin: origin.into(),
+            inv: Vec3::select(parallel, Vec3::ZERO, direction.recip()).into(),
+            pad: Vec3::select(parallel, Vec3::splat(SLAB_PAD), Vec3::ZERO).into(),
+            negative: Vec3A::from(direction).cmplt(Vec3A::ZERO),
         }
     }
 
     /// Where the ray enters the node's box, if it does before `t_far`
     /// (entry clamped to 0). The near and far planes are picked by the
     /// direction's sign rather than by min/max of the two distances, so an
-    /// inverted box (the empty one) is rejected.
+    /// inverted box (the empty one) is rejected. In SIMD lanes (`Vec3A`):
+    /// the same operations per axis as the shader's.
+    #[inline]
     pub fn entry(&self, node: &BvhNode, t_far: f32) -> Option<f32> {
-        let (lo, hi) = (Vec3::from_array(node.min), Vec3::from_array(node.max));
-        let neg = glam::BVec3::from_array(self.negative);
-        let near = Vec3::select(neg, hi, lo);
-        let far = Vec3::select(neg, lo, hi);
+        let (lo, hi) = (Vec3A::from_array(node.min), Vec3A::from_array(node.max));
+        let near = Vec3A::select(self.negative, hi, lo);
+        let far = Vec3A::select(self.negative, lo, hi);
         let t_near = (near - self.origin) * self.inv - self.pad;
         let t_far_axes = (far - self.origin) * self.inv + self.pad;
         let enter = t_near.max_element().max(0.0);
@@ -83,6 +86,7 @@ impl SlabRay {
 impl Bvh {
     /// The closest hit with t in (0, `t_max`) among `triangles`, which must
     /// be in the BVH's order ([`Bvh::reorder`]).
+    #[inline]
     pub fn intersect(
         &self,
         triangles: &[[Vec3; 3]],
@@ -107,6 +111,7 @@ impl Bvh {
     }
 
     /// Whether any triangle is hit with t in (0, `t_max`).
+    #[inline]
     pub fn occluded(
         &self,
         triangles: &[[Vec3; 3]],
@@ -124,6 +129,7 @@ impl Bvh {
 
     /// Visits the triangles of every leaf the ray reaches, near child first,
     /// handing each to `test` with the current far bound.
+    #[inline]
     fn walk(
         &self,
         origin: Vec3,

@@ -16,7 +16,7 @@
 //! both triangles, and since a zero edge function counts as inside, a ray
 //! through it is never lost.
 
-use glam::Vec3;
+use glam::{Mat3A, Vec3, Vec3A};
 
 /// Where a ray meets a triangle: the distance along the (not necessarily
 /// unit) direction, and the barycentric weights of `v1` and `v2` (the
@@ -33,20 +33,21 @@ pub struct TriangleHit {
 /// every triangle (a BVH traversal tests many).
 #[derive(Debug, Clone, Copy)]
 pub struct WatertightRay {
-    origin: Vec3,
-    /// The axis along which the direction is largest (|d|), and the other
-    /// two, swapped when d[kz] < 0 to keep the triangles' winding.
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    /// Shear constants: d[kx]/d[kz], d[ky]/d[kz], 1/d[kz].
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    origin: Vec3A,
+    /// The paper's transform as a matrix (as accel/traverse.wgsl holds
+    /// it): rows `e_kx − Sx e_kz`, `e_ky − Sy e_kz` and `Sz e_kz`, where kz
+    /// is the axis along which |d| is largest and kx, ky the other two,
+    /// swapped when d[kz] < 0 to keep the triangles' winding; Sx, Sy, Sz
+    /// are d[kx]/d[kz], d[ky]/d[kz] and 1/d[kz]. Each row has at most two
+    /// non-zero entries and the others add exact zeros, so the products
+    /// are the paper's `a[kx] − Sx a[kz]`… to the bit, with no indexing
+    /// by axis per triangle (the CPU kernel's hottest loop).
+    shear: Mat3A,
 }
 
 impl WatertightRay {
     /// `None` for a zero or non-finite direction, which meets nothing.
+    #[inline]
     pub fn new(origin: Vec3, direction: Vec3) -> Option<Self> {
         let a = direction.abs();
         if !direction.is_finite() || a.max_element() == 0.0 {
@@ -64,30 +65,34 @@ impl WatertightRay {
         if direction[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let (sx, sy, sz) = (
+            direction[kx] / direction[kz],
+            direction[ky] / direction[kz],
+            1.0 / direction[kz],
+        );
+        let unit = |k: usize| Vec3A::from(Vec3::AXES[k]);
+        let rows = [
+            unit(kx) - sx * unit(kz),
+            unit(ky) - sy * unit(kz),
+            sz * unit(kz),
+        ];
         Some(Self {
-            origin,
-            kx,
-            ky,
-            kz,
-            sx: direction[kx] / direction[kz],
-            sy: direction[ky] / direction[kz],
-            sz: 1.0 / direction[kz],
+            origin: origin.into(),
+            shear: Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose(),
         })
     }
 
     /// The vertex relative to the origin, sheared and scaled so that the
     /// ray becomes the +z axis: (x, y) in the plane across the ray, z the
     /// distance along it.
+    #[inline]
     fn transform(&self, v: Vec3) -> (f32, f32, f32) {
-        let a = v - self.origin;
-        (
-            a[self.kx] - self.sx * a[self.kz],
-            a[self.ky] - self.sy * a[self.kz],
-            self.sz * a[self.kz],
-        )
+        let t = self.shear * (Vec3A::from(v) - self.origin);
+        (t.x, t.y, t.z)
     }
 
     /// The closest-hit test against one triangle, with `t` in (0, `t_max`).
+    #[inline]
     pub fn intersect(&self, tri: &[Vec3; 3], t_max: f32) -> Option<TriangleHit> {
         let (ax, ay, az) = self.transform(tri[0]);
         let (bx, by, bz) = self.transform(tri[1]);

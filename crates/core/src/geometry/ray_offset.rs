@@ -23,6 +23,7 @@ pub const INT_SCALE: f32 = 256.0;
 /// offset serves every scene scale where a fixed ε is either lost in the
 /// rounding of large coordinates (acne) or visible at small ones
 /// (peter-panning).
+#[inline]
 pub fn offset_ray(p: Vec3, n: Vec3) -> Vec3 {
     // `as i32` truncates and saturates like WGSL's f32 → i32 conversion,
     // and the bits add with wrapping like WGSL's i32.

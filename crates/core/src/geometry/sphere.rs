@@ -16,6 +16,7 @@ pub const NO_HIT: f32 = 3.0e38;
 /// and far away keeps to full precision where b² − |f|² + r² cancels, and
 /// the roots come from the stable quadratic q = b ± √disc, t = c/q and q,
 /// where b ∓ √disc would cancel for the near root.
+#[inline]
 pub fn sphere_distance(o: Vec3, d: Vec3, center: Vec3, radius: f32) -> f32 {
     let f = o - center;
     let b = -f.dot(d);

@@ -39,6 +39,7 @@ impl HashKind {
 }
 
 /// The pcg3d hash: three rounds of an LCG and cross-multiplication.
+#[inline]
 pub fn pcg3d(v: UVec3) -> UVec3 {
     let mut v = v
         .wrapping_mul(UVec3::splat(1_664_525))

@@ -61,7 +61,11 @@ pub enum CpuMaterial {
 
 impl CpuMaterial {
     fn of(m: &Material, uniform_diffuse: bool) -> Self {
-        if m.patterns().is_empty() {
+        if m
+            .patterns()
+            .iter()
+            .all(|p| **p == marbre_core::scene::Pattern::Constant)
+        {
             let at = SurfacePoint::new(Vec3::ZERO, Vec2::ZERO);
             CpuMaterial::Constant(values(m, &at, uniform_diffuse))
         } else {
