@@ -61,8 +61,7 @@ pub enum CpuMaterial {
 
 impl CpuMaterial {
     fn of(m: &Material, uniform_diffuse: bool) -> Self {
-        if m
-            .patterns()
+        if m.patterns()
             .iter()
             .all(|p| **p == marbre_core::scene::Pattern::Constant)
         {
@@ -171,5 +170,62 @@ impl CpuScene {
             emission: features.contains(Feature::Emission),
             area_lights: features.contains(Feature::AreaLight),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use marbre_core::scene::{Cylinder, EnvSource, Pattern, Sphere, Texture, View};
+    use std::path::PathBuf;
+
+    fn lit_sphere() -> Scene {
+        let mut scene = Scene::default();
+        scene.spheres = vec![Sphere::default()];
+        scene.environment.source = EnvSource::Constant {
+            radiance: Vec3::ONE,
+        };
+        scene
+    }
+
+    /// What the CPU kernel traces is said, and each thing it does not is
+    /// named.
+    #[test]
+    fn support_names_what_the_cpu_kernel_does_not_trace() {
+        assert_eq!(support(&lit_sphere()), Ok(()));
+        let refused = |edit: &dyn Fn(&mut Scene), what: &str| {
+            let mut scene = lit_sphere();
+            edit(&mut scene);
+            let why = support(&scene).unwrap_err();
+            assert!(why.contains(what), "{why} (expected {what})");
+        };
+        refused(&|s| s.cylinders.push(Cylinder::default()), "cylinders");
+        refused(
+            &|s| {
+                s.environment.source = EnvSource::LatLong {
+                    path: PathBuf::from("sky.exr"),
+                }
+            },
+            "environment map",
+        );
+        refused(&|s| s.render.view = View::Normal, "view");
+        refused(
+            &|s| {
+                s.spheres[0].material.bump =
+                    Texture::blend(Pattern::Checker { size: 0.5 }, 0.0, 1.0)
+            },
+            "bump",
+        );
+    }
+
+    /// A material of constants is evaluated once; one with a pattern at
+    /// each hit.
+    #[test]
+    fn constant_materials_are_evaluated_once() {
+        let scene = lit_sphere();
+        assert!(CpuMaterial::of(&scene.spheres[0].material, false).is_constant());
+        let mut marble = scene.spheres[0].material.clone();
+        marble.diffuse = Texture::blend(Pattern::Checker { size: 0.5 }, Vec3::ZERO, Vec3::ONE);
+        assert!(!CpuMaterial::of(&marble, false).is_constant());
     }
 }

@@ -218,11 +218,11 @@ pub fn spheres_in_constant_light(radiance: f32) -> Scene {
 }
 
 /// The trace kernels `ctx`'s adapter runs, for tests that draw frames with
-/// each (`Kernel::ALL` where the compute kernel is supported; a loud note
+/// each (`Kernel::GPU` where the compute kernel is supported; a loud note
 /// where it is not).
 pub fn kernels(ctx: &GpuContext) -> Vec<marbre_render::gpu::Kernel> {
     match marbre_render::gpu::kernel::compute_support(ctx) {
-        Ok(()) => marbre_render::gpu::Kernel::ALL.to_vec(),
+        Ok(()) => marbre_render::gpu::Kernel::GPU.to_vec(),
         Err(why) => {
             eprintln!("NOTE: the compute kernel cannot run here ({why}): fragment only");
             vec![marbre_render::gpu::Kernel::Fragment]

@@ -24,13 +24,13 @@ use std::sync::atomic::AtomicBool;
 /// The size every test traces at: small, and neither side a multiple of
 /// the compute kernel's 16×8 workgroup (the invocations past the edge must
 /// do nothing): 60 = 3.75 workgroups, 44 = 5.5.
-const SIZE: (u32, u32) = (60, 44);
+pub(super) const SIZE: (u32, u32) = (60, 44);
 
-fn load(path: &Path) -> LoadedScene {
+pub(super) fn load(path: &Path) -> LoadedScene {
     load_scene(path, None).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()))
 }
 
-fn preset(name: &str) -> LoadedScene {
+pub(super) fn preset(name: &str) -> LoadedScene {
     load(&root().join("presets").join(name))
 }
 
@@ -51,15 +51,15 @@ fn gpu_with_compute(test: &str) -> Option<GpuContext> {
 
 /// What an accumulation holds, read back: the mean, the spread and the
 /// dropped-sample counters.
-struct Image {
-    size: (u32, u32),
-    mean: Vec<[f32; 4]>,
-    spread: Vec<[f32; 4]>,
-    dropped: NonFiniteCounts,
-    samples: u32,
+pub(super) struct Image {
+    pub(super) size: (u32, u32),
+    pub(super) mean: Vec<[f32; 4]>,
+    pub(super) spread: Vec<[f32; 4]>,
+    pub(super) dropped: NonFiniteCounts,
+    pub(super) samples: u32,
 }
 
-fn read(ctx: &GpuContext, r: &Renderer) -> Image {
+pub(super) fn read(ctx: &GpuContext, r: &Renderer) -> Image {
     let (w, h, mean) = r.read_radiance(ctx).unwrap();
     let (sw, sh, spread) = r.read_spread(ctx).unwrap();
     assert_eq!((w, h), (sw, sh));
@@ -84,14 +84,19 @@ fn trace_within(ctx: &GpuContext, r: &mut Renderer, pixels: u64) -> TraceWork {
 }
 
 /// `rounds` whole rounds, one `trace` call each.
-fn trace_rounds(ctx: &GpuContext, r: &mut Renderer, rounds: u32) {
+pub(super) fn trace_rounds(ctx: &GpuContext, r: &mut Renderer, rounds: u32) {
     for _ in 0..rounds {
         trace_frame(ctx, r).unwrap();
     }
 }
 
 /// A fresh renderer of `loaded` with `kernel`, `rounds` whole rounds traced.
-fn whole_pass(ctx: &GpuContext, loaded: &LoadedScene, kernel: Kernel, rounds: u32) -> Image {
+pub(super) fn whole_pass(
+    ctx: &GpuContext,
+    loaded: &LoadedScene,
+    kernel: Kernel,
+    rounds: u32,
+) -> Image {
     whole_pass_from_frame(ctx, loaded, kernel, 0, rounds)
 }
 
@@ -134,12 +139,12 @@ fn close(a: f32, b: f32, tolerance: impl Fn(f32) -> f32) -> bool {
 }
 
 /// A pixel that differs: x, y, and its value in each image.
-type Difference = (u32, u32, [f32; 4], [f32; 4]);
+pub(super) type Difference = (u32, u32, [f32; 4], [f32; 4]);
 
 /// The pixels of `a` and `b` (of `width` columns) that differ beyond
 /// `tolerance`, as (x, y, a, b), worst first, and how many differ at all
 /// (bit for bit).
-fn differences(
+pub(super) fn differences(
     a: &[[f32; 4]],
     b: &[[f32; 4]],
     width: u32,
@@ -215,7 +220,7 @@ fn assert_same_image(
 /// cutouts, an enclosed Cornell box with many bounces) and every hard case
 /// (extreme scales, radiances and noise parameters, degenerate meshes,
 /// environment importance sampling, MIS).
-fn parity_presets() -> Vec<PathBuf> {
+pub(super) fn parity_presets() -> Vec<PathBuf> {
     let mut out: Vec<PathBuf> = [
         "default.ron",
         "cornell.ron",
@@ -374,7 +379,7 @@ fn banded_budgets((w, h): (u32, u32)) -> Vec<u64> {
 
 /// Banded calls on `r` until `rounds` rounds are complete; the rows each
 /// call traced are checked against the budget.
-fn trace_in_bands(ctx: &GpuContext, r: &mut Renderer, rounds: u32) {
+pub(super) fn trace_in_bands(ctx: &GpuContext, r: &mut Renderer, rounds: u32) {
     let (w, h) = r.render_size();
     let spf = r.scene().render.samples_per_frame.max(1);
     let mut budgets = banded_budgets((w, h)).into_iter().cycle();
@@ -413,7 +418,7 @@ fn a_round_traced_in_bands_equals_a_whole_pass() {
         ("default.ron", preset("default.ron")),
         ("cornell.ron, 2 spp per frame", two_per_frame),
     ] {
-        for kernel in Kernel::ALL {
+        for kernel in Kernel::GPU {
             let what = format!("{name}, {kernel}");
             let mut banded = renderer_with(&ctx, &loaded, SIZE, kernel).unwrap();
             trace_in_bands(&ctx, &mut banded, 5);
@@ -441,7 +446,7 @@ fn without_accumulation_each_round_of_a_call_starts_anew() {
     loaded.scene.render.accumulate = false;
     let spp = loaded.scene.render.samples_per_frame;
     let round = u64::from(SIZE.0) * u64::from(SIZE.1);
-    for kernel in Kernel::ALL {
+    for kernel in Kernel::GPU {
         let mut r = renderer_with(&ctx, &loaded, SIZE, kernel).unwrap();
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let work = r.trace_within(&ctx, &mut encoder, TraceBudget::Pixels(3 * round), None);
@@ -478,7 +483,7 @@ fn a_preview_shows_first_and_the_full_image_follows() {
     let loaded = preset("default.ron");
     let full = SIZE;
     let round = u64::from(full.0) * u64::from(full.1);
-    for kernel in Kernel::ALL {
+    for kernel in Kernel::GPU {
         let mut r = renderer_with(&ctx, &loaded, full, kernel).unwrap();
         assert_eq!(r.render_size(), full);
         let work = trace_within(&ctx, &mut r, round / 4);
@@ -546,7 +551,7 @@ fn previews_refine_in_steps_before_the_first_round() {
     let loaded = preset("default.ron");
     let full = SIZE;
     let round = u64::from(full.0) * u64::from(full.1);
-    for kernel in Kernel::ALL {
+    for kernel in Kernel::GPU {
         let mut r = renderer_with(&ctx, &loaded, full, kernel).unwrap();
         let mut shown = vec![];
         let mut rounds = 0;

@@ -14,6 +14,7 @@ mod bvh;
 mod chi2;
 mod common;
 mod course_looks;
+mod cpu_kernel;
 mod cubemap;
 mod denoise;
 mod diffuse_transmission;
