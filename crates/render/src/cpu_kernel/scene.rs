@@ -10,14 +10,16 @@ use crate::gpu::mesh_buffers::MeshGeometry;
 use glam::{Vec2, Vec3};
 use marbre_core::bsdf::Surface;
 use marbre_core::lights::{LightSelection, LightTable, emitted_luminance};
-use marbre_core::scene::{Ground, Material, Property, Scene, Strategy, SurfacePoint};
+use marbre_core::scene::{Ground, Material, Pattern, Property, Scene, Strategy, SurfacePoint};
 use std::sync::Arc;
 
 /// Why the CPU kernel cannot trace `scene`, or `Ok`: it traces spheres,
 /// the ground and meshes, under the point light, area lights and a
-/// constant sky, with textures evaluated at points (no bump, no images,
-/// no environment map), recording the lit image.
+/// constant sky, with the patterns a point determines (no noise, no
+/// filtered pattern, no image, no bump, no environment map), recording
+/// the lit image.
 pub fn support(scene: &Scene) -> Result<(), String> {
+    let patterns: Vec<&Pattern> = scene.materials().flat_map(Material::patterns).collect();
     let lacking = if !scene.cylinders.is_empty() {
         Some("cylinders")
     } else if !scene.polygons.is_empty() {
@@ -28,12 +30,16 @@ pub fn support(scene: &Scene) -> Result<(), String> {
         Some("a view other than the lit image")
     } else if scene.materials().any(Material::has_bump) {
         Some("bump mapping")
-    } else if scene
-        .materials()
-        .flat_map(Material::patterns)
-        .any(|p| matches!(p, marbre_core::scene::Pattern::Image { .. }))
-    {
+    } else if patterns.iter().any(|p| matches!(p, Pattern::Image { .. })) {
         Some("image textures")
+    } else if patterns
+        .iter()
+        .any(|p| p.noise().is_some() || p.info().filtered)
+    {
+        // The GPU kernels filter these over the ray cone's footprint (box-
+        // filtered checkers, octaves clamped to the pixel); the CPU
+        // reference evaluates them at points.
+        Some("noise or filtered patterns")
     } else {
         None
     };
@@ -176,7 +182,8 @@ impl CpuScene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use marbre_core::scene::{Cylinder, EnvSource, Pattern, Sphere, Texture, View};
+    use marbre_core::noise::NoiseSettings;
+    use marbre_core::scene::{Cylinder, EnvSource, Sphere, Texture, View};
     use std::path::PathBuf;
 
     fn lit_sphere() -> Scene {
@@ -209,6 +216,18 @@ mod tests {
             "environment map",
         );
         refused(&|s| s.render.view = View::Normal, "view");
+        refused(
+            &|s| {
+                s.spheres[0].material.diffuse = Texture::blend(
+                    Pattern::Fbm {
+                        noise: NoiseSettings::default(),
+                    },
+                    Vec3::ZERO,
+                    Vec3::ONE,
+                )
+            },
+            "noise",
+        );
         refused(
             &|s| {
                 s.spheres[0].material.bump =

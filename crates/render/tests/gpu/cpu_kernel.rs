@@ -13,6 +13,7 @@ use crate::kernels::{
     Image, SIZE, differences, parity_presets, preset, read, trace_in_bands, trace_rounds,
     whole_pass,
 };
+use marbre_core::scene::EnvSource;
 use marbre_render::cpu_kernel::support;
 use marbre_render::gpu::Kernel;
 use marbre_render::gpu::testing::gpu_or_skip;
@@ -117,10 +118,10 @@ fn cpu_rounds_traced_in_bands_equal_a_whole_pass() {
     );
 }
 
-/// A scene the CPU kernel does not trace (the default preset's
+/// A scene the CPU kernel does not trace (the Cornell box under an
 /// environment map) is traced by the fragment kernel, and the reason is
 /// named; the same renderer goes back to the CPU kernel when the scene
-/// becomes one it traces.
+/// becomes one it traces (a constant sky).
 #[test]
 fn the_fragment_kernel_stands_in_for_scenes_the_cpu_kernel_cannot_trace() {
     let Some(ctx) =
@@ -128,20 +129,16 @@ fn the_fragment_kernel_stands_in_for_scenes_the_cpu_kernel_cannot_trace() {
     else {
         return;
     };
-    let loaded = preset("default.ron");
+    let mut loaded = preset("cornell.ron");
+    let sky = loaded.scene.clone();
+    loaded.scene.environment.source = EnvSource::LatLong {
+        path: crate::common::root().join("envmaps/esplanade.exr"),
+    };
     let why = support(&loaded.scene).unwrap_err();
     assert!(why.contains("environment map"), "{why}");
     let mut r = renderer_with(&ctx, &loaded, SIZE, Kernel::Cpu).unwrap();
     assert_eq!(r.kernel(), Kernel::Fragment);
-    let mut sky = loaded.scene.clone();
-    sky.environment.source = marbre_core::scene::EnvSource::Constant {
-        radiance: glam::Vec3::splat(0.5),
-    };
-    assert_eq!(
-        support(&sky),
-        Ok(()),
-        "the default preset under a constant sky"
-    );
+    assert_eq!(support(&sky), Ok(()));
     r.set_scene(&ctx, &sky).unwrap();
     assert_eq!(r.kernel(), Kernel::Cpu);
     trace_rounds(&ctx, &mut r, 1);
