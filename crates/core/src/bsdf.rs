@@ -115,6 +115,17 @@ pub fn eval_bsdf(s: &Surface, n: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
             pdf: pt * diffuse_pdf(-n_i, s.uniform_diffuse),
         };
     }
+    if s.specular == Vec3::ZERO && ps == 0.0 {
+        // No GGX lobe (a black specular on a surface that is not black
+        // all over, which samples GGX half the time): its value and
+        // density are exact zeros, so leaving them out changes no bit,
+        // and skips the costliest part of a diffuse surface's evaluation
+        // (the CPU kernel's hottest BSDF call).
+        return BsdfEval {
+            f_cos: s.diffuse * FRAC_1_PI * n_i,
+            pdf: (1.0 - pt) * diffuse_pdf(n_i, s.uniform_diffuse),
+        };
+    }
     let h = (wi + wo).normalize();
     let n_h = n.dot(h).max(0.0);
     let d = ggx_d(n_h * n_h, n.cross(h).length_squared(), s.alpha);
