@@ -8,10 +8,12 @@ pub mod bvh;
 pub mod shapes;
 pub mod traverse;
 pub mod triangle;
+pub mod wide;
 
 pub use bvh::{Bvh, BvhNode, BvhStats};
 pub use traverse::MeshHit;
 pub use triangle::{TriangleHit, intersect};
+pub use wide::WideBvh;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;

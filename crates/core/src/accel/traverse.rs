@@ -31,7 +31,7 @@ pub const SLAB_PARALLEL: f32 = 1.0 / (1u64 << 40) as f32;
 // finite (and far from overflow) in the slab test.
 const _: () = assert!(super::bvh::EMPTY_BOX_EXTENT / SLAB_PARALLEL < 1e36);
 /// Added to either side of a parallel axis's slab interval.
-const SLAB_PAD: f32 = 1.0e30;
+pub(super) const SLAB_PAD: f32 = 1.0e30;
 /// The exit distance is stretched by this before it is compared with the
 /// entry. Ize ("Robust BVH Ray Traversal", JCGT 2013) and pbrt show that
 /// 1 + 2γ₃ covers the rounding of (bound − origin) · (1/d) on both sides,

@@ -109,7 +109,7 @@ impl Tracer<'_> {
         }
         let mesh = &*s.mesh;
         if !mesh.positions.is_empty()
-            && let Some(m) = mesh.bvh.intersect(&mesh.positions, o, d, hit.t)
+            && let Some(m) = mesh.wide.intersect(&mesh.positions, o, d, hit.t)
             && m.t < hit.t
         {
             let [v0, v1, v2] = mesh.positions[m.triangle as usize];
@@ -148,7 +148,7 @@ impl Tracer<'_> {
             }
         }
         let mesh = &*s.mesh;
-        !mesh.positions.is_empty() && mesh.bvh.occluded(&mesh.positions, o, d, t_max)
+        !mesh.positions.is_empty() && mesh.wide.occluded(&mesh.positions, o, d, t_max)
     }
 
     /// The hit's texture coordinates, as intersect.wgsl computes them.

@@ -9,7 +9,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use marbre_core::accel::{Bvh, TriangleVerts};
+use marbre_core::accel::{Bvh, TriangleVerts, WideBvh};
 use marbre_core::lights::{EmitterTriangle, Light, LightTable};
 use marbre_core::scene::{Change, MeshPlacement, Scene};
 use std::sync::Arc;
@@ -31,6 +31,8 @@ pub struct TriangleAttributes {
 /// storage buffers hold.
 pub struct MeshGeometry {
     pub bvh: Bvh,
+    /// The BVH four children a node, as the CPU kernel walks it.
+    pub wide: WideBvh,
     pub positions: Vec<[Vec3; 3]>,
     pub attributes: Vec<TriangleAttributes>,
 }
@@ -40,6 +42,7 @@ impl Default for MeshGeometry {
     fn default() -> Self {
         Self {
             bvh: Bvh::build(&[]),
+            wide: WideBvh::default(),
             positions: Vec::new(),
             attributes: Vec::new(),
         }
@@ -156,6 +159,7 @@ impl PreparedGeometry {
         Self {
             key,
             geometry: MeshGeometry {
+                wide: WideBvh::build(&bvh),
                 bvh,
                 positions,
                 attributes,
