@@ -537,9 +537,12 @@ impl Viewer {
     /// queue runs on this machine's cores anyway and whose compute-pass
     /// timestamps are not usable (lavapipe's read about 0.02 ms for a pass
     /// of any size, where the frame took 300 ms: the budget then grew
-    /// without bound).
+    /// without bound), and for the CPU kernel, whose trace is CPU work
+    /// the timestamps do not see.
     fn trace_on_wall_clock(&self) -> bool {
-        self.meters.timer.is_none() || self.ctx.is_cpu()
+        self.meters.timer.is_none()
+            || self.ctx.is_cpu()
+            || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu
     }
 
     /// Traces this frame's budget in a submit of its own and waits for it,
