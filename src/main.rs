@@ -51,8 +51,9 @@ struct ViewerArgs {
     /// pipeline, and the panel shows the error).
     #[arg(long)]
     dev: bool,
-    /// The trace kernel: fragment, compute, or auto (the faster on this
-    /// adapter, timed on the first scene and remembered).
+    /// The trace kernel: fragment, compute, cpu (native code on this
+    /// machine's cores, for the scenes it traces), or auto (the fastest
+    /// here, timed on the first scene and remembered).
     #[arg(long, default_value_t = KernelChoice::Auto, value_parser = marbre_commands::kernel_choice_parser())]
     kernel: KernelChoice,
     /// Trace time per frame in ms: the panel stays live while a slow

@@ -57,8 +57,8 @@ pub struct ViewerOptions {
     /// Run as `marbre soak`: random edits driven frame by frame, memory
     /// judged at the end.
     pub soak: Option<soak::SoakOptions>,
-    /// The trace kernel: fragment, compute, or auto (the faster, timed on
-    /// the first scene and remembered per adapter).
+    /// The trace kernel: fragment, compute, cpu, or auto (the fastest,
+    /// timed on the first scene and remembered per adapter).
     pub kernel: marbre_render::gpu::KernelChoice,
     /// The trace time a frame may take, in ms (`app::frame_budget`); 0
     /// traces a whole round every frame.

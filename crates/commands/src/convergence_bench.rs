@@ -40,10 +40,10 @@ pub struct ConvergenceBenchArgs {
     /// Also writes the reference (cached or rendered) to this EXR file.
     #[arg(long)]
     pub reference_out: Option<PathBuf>,
-    /// The trace kernel of the measured renders: fragment, compute, or
-    /// auto (the faster of the two on this preset, timed first). The
-    /// reference is rendered with the fragment kernel: both give the same
-    /// image, so one cached reference serves both.
+    /// The trace kernel of the measured renders: fragment, compute, cpu,
+    /// or auto (the fastest on this preset, timed first). The reference is
+    /// rendered with the fragment kernel: all give the same image, so one
+    /// cached reference serves them all.
     #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }
@@ -79,7 +79,7 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
     let loaded = load_scene(&args.preset, None)?;
     let (kernel, timings) = pick_kernel(&ctx, &loaded, args.size, args.kernel)?;
     // compare_mitsuba.py reads this line.
-    println!("{}", describe_pick(kernel, timings.as_ref()));
+    println!("{}", describe_pick(kernel, timings.as_ref(), args.kernel, &loaded.scene));
     let reference = ReferenceCache::new(&args.cache).get_or_render(
         &ctx,
         &loaded,

@@ -27,9 +27,10 @@ pub struct PresetsBenchArgs {
     #[arg(long, value_delimiter = ',', default_values = ["1280x720", "640x360"], value_parser = super::render::parse_size)]
     pub sizes: Vec<(u32, u32)>,
     /// The kernel of the uber / specialised columns, of the build column
-    /// and of the anti-aliasing tables: fragment, compute, or auto (the
-    /// one `auto` picks for each preset). Both kernels' frame times are
-    /// measured whatever this is.
+    /// and of the anti-aliasing tables: fragment, compute, cpu, or auto
+    /// (the one `auto` picks for each preset). Every kernel's frame times
+    /// are measured whatever this is (the CPU kernel's where it traces the
+    /// preset).
     #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }

@@ -48,8 +48,9 @@ pub struct RenderArgs {
     /// radiance.
     #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "key", value_name = "METERING")]
     pub auto_exposure: Option<MeteringArg>,
-    /// The trace kernel: fragment, compute, or auto (the faster of the
-    /// two on this scene, timed first).
+    /// The trace kernel: fragment, compute, cpu (for the scenes it
+    /// traces; others go to the fragment kernel, and the output says why),
+    /// or auto (the fastest on this scene, timed first).
     #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
     /// What each sample records instead of the preset's view: lit (the

@@ -390,10 +390,15 @@ pub fn render_to_file(
         );
     }
     if job.kernel == crate::gpu::KernelChoice::Auto {
-        observer.stage("timing the two trace kernels");
+        observer.stage("timing the trace kernels");
     }
     let (kernel, timings) = pick_kernel(ctx, &loaded, pieces[0].size(), job.kernel)?;
-    observer.note(&describe_pick(kernel, timings.as_ref()));
+    observer.note(&describe_pick(
+        kernel,
+        timings.as_ref(),
+        job.kernel,
+        &loaded.scene,
+    ));
     observer.stage(&format!("building the {kernel} trace shader"));
     let mut renderer = renderer_fitting(ctx, &loaded, pieces[0].size(), kernel)?;
     observer.stage("tracing the first round");

@@ -411,7 +411,7 @@ pub fn pick_kernel(
     size: (u32, u32),
     choice: KernelChoice,
 ) -> Result<(Kernel, Option<KernelTimings>)> {
-    let kernel = kernel::resolve(ctx, choice)?;
+    let kernel = kernel::resolve(ctx, choice)?.for_scene(&loaded.scene);
     let only_fragment =
         kernel == Kernel::Fragment && crate::cpu_kernel::support(&loaded.scene).is_err();
     if choice != KernelChoice::Auto || only_fragment {
@@ -421,11 +421,21 @@ pub fn pick_kernel(
     Ok((timings.faster(), Some(timings)))
 }
 
-/// One line on how the kernel was chosen, for the commands' output.
-pub fn describe_pick(kernel: Kernel, timings: Option<&KernelTimings>) -> String {
-    match timings {
-        Some(t) => format!("kernel: {kernel} (auto: {t})"),
-        None => format!("kernel: {kernel}"),
+/// One line on how the kernel was chosen for `scene`, for the commands'
+/// output: the timings `auto` went by, or why the CPU kernel, asked for,
+/// left the scene to the fragment kernel.
+pub fn describe_pick(
+    kernel: Kernel,
+    timings: Option<&KernelTimings>,
+    choice: KernelChoice,
+    scene: &Scene,
+) -> String {
+    match (timings, crate::cpu_kernel::support(scene)) {
+        (Some(t), _) => format!("kernel: {kernel} (auto: {t})"),
+        (None, Err(why)) if choice == KernelChoice::Cpu => {
+            format!("kernel: {kernel} ({why}: the fragment kernel traces this scene)")
+        }
+        _ => format!("kernel: {kernel}"),
     }
 }
 

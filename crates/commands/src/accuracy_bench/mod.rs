@@ -59,10 +59,10 @@ pub struct AccuracyBenchArgs {
     /// this marbre was built from, wherever it is run).
     #[arg(long, default_value_os_t = repository_root())]
     pub root: PathBuf,
-    /// The trace kernel: fragment, compute, or auto (the faster of the two
-    /// on each sweep's scene, timed first; all the sweep's variants then
-    /// use it). References are rendered with the fragment kernel: both
-    /// kernels give the same image.
+    /// The trace kernel: fragment, compute, cpu, or auto (the fastest on
+    /// each sweep's scene, timed first; all the sweep's variants then use
+    /// it). References are rendered with the fragment kernel: all kernels
+    /// give the same image.
     #[arg(long, default_value_t = KernelChoice::Auto, value_parser = crate::kernel_choice_parser())]
     pub kernel: KernelChoice,
 }

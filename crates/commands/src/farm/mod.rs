@@ -108,7 +108,7 @@ pub struct JobArgs {
     /// Frames a second (default: the preset's animation's, else 24).
     #[arg(long)]
     pub fps: Option<f32>,
-    /// The trace kernel: fragment, compute or auto.
+    /// The trace kernel: fragment, compute, cpu or auto.
     #[arg(long, default_value = "auto", value_parser = crate::kernel_choice_parser())]
     pub kernel: marbre_render::gpu::KernelChoice,
     /// The finished images' format: exr (linear radiance) or png.

@@ -65,7 +65,7 @@ impl fmt::Display for Kernel {
     }
 }
 
-/// What the user asked for: a kernel, or the faster of the two. Its names
+/// What the user asked for: a kernel, or the fastest. Its names
 /// parse and print (`--kernel`'s values: the command-line crates hand
 /// [`KernelChoice::NAMES`] to clap; this crate has no clap).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
