@@ -79,7 +79,10 @@ pub fn run(args: &ConvergenceBenchArgs) -> Result<()> {
     let loaded = load_scene(&args.preset, None)?;
     let (kernel, timings) = pick_kernel(&ctx, &loaded, args.size, args.kernel)?;
     // compare_mitsuba.py reads this line.
-    println!("{}", describe_pick(kernel, timings.as_ref(), args.kernel, &loaded.scene));
+    println!(
+        "{}",
+        describe_pick(kernel, timings.as_ref(), args.kernel, &loaded.scene)
+    );
     let reference = ReferenceCache::new(&args.cache).get_or_render(
         &ctx,
         &loaded,

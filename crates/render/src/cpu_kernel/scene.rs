@@ -187,8 +187,10 @@ mod tests {
     use std::path::PathBuf;
 
     fn lit_sphere() -> Scene {
-        let mut scene = Scene::default();
-        scene.spheres = vec![Sphere::default()];
+        let mut scene = Scene {
+            spheres: vec![Sphere::default()],
+            ..Default::default()
+        };
         scene.environment.source = EnvSource::Constant {
             radiance: Vec3::ONE,
         };
