@@ -63,6 +63,16 @@ pub(crate) fn render_ball_with(
     name: &str,
     flags: &[&str],
 ) -> anyhow::Result<Vec<[f32; 4]>> {
+    render_ball_on(dir, name, "fragment", flags)
+}
+
+/// [`render_ball_with`] with the trace kernel named `kernel`.
+pub(crate) fn render_ball_on(
+    dir: &Path,
+    name: &str,
+    kernel: &str,
+    flags: &[&str],
+) -> anyhow::Result<Vec<[f32; 4]>> {
     let output = dir.join(name);
     let preset = dir.join("ball.ron");
     let mut all = vec![
@@ -74,7 +84,7 @@ pub(crate) fn render_ball_with(
         "--size",
         "40x24",
         "--kernel",
-        "fragment",
+        kernel,
     ];
     all.extend_from_slice(flags);
     render::run(&Cli::try_parse_from(all).unwrap().args)?;

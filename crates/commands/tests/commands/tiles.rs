@@ -6,7 +6,8 @@
 //! the GPU (lavapipe here).
 
 use super::batches::{
-    largest_relative_difference, merge_files, render_ball, render_ball_with, scratch,
+    largest_relative_difference, merge_files, render_ball, render_ball_on, render_ball_with,
+    scratch,
 };
 use marbre_commands::merge;
 use marbre_core::image_io;
@@ -80,6 +81,36 @@ fn tiles_assemble_to_the_whole_render() {
         "{e:#}"
     );
     assert!(!missing.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The CPU kernel's tiles (issue 33) assemble to its whole render bit
+/// for bit, as the GPU kernels' do: a tile traces its pixels with the
+/// whole image's camera and seeds, on the CPU too; each file records the
+/// kernel that traced it.
+#[test]
+fn cpu_kernel_tiles_assemble_to_its_whole_render() {
+    if gpu_or_skip("cpu_kernel_tiles_assemble_to_its_whole_render").is_none() {
+        return;
+    }
+    let dir = scratch("cpu-tiles", 1);
+    let whole = render_ball_on(&dir, "whole.exr", "cpu", &["--spp", "4"]).unwrap();
+    let tiles: Vec<PathBuf> = (0..4)
+        .map(|i| {
+            let name = format!("t{i}.exr");
+            let index = i.to_string();
+            let flags = ["--spp", "4", "--tiles", "2x2", "--tile-index", &index];
+            render_ball_on(&dir, &name, "cpu", &flags).unwrap();
+            dir.join(name)
+        })
+        .collect();
+    assert_eq!(merge::read_batch(&tiles[0]).unwrap().record.kernel, "cpu");
+    let merged = dir.join("merged.exr");
+    merge_files(&tiles, &merged, &[]).unwrap();
+    assert!(
+        merge::read_batch(&merged).unwrap().pixels == whole,
+        "the CPU kernel's assembled tiles differ from its whole render"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
