@@ -84,7 +84,17 @@ impl Viewer {
             ms_is_gpu: !self.trace_on_wall_clock(),
             kernel: self.renderer.kernel(),
             kernel_choice: self.kernels.choice(),
-            kernel_reason: self.kernels.reason().to_owned(),
+            kernel_reason: match marbre_render::cpu_kernel::support(&self.scene) {
+                // The CPU kernel asked for (or picked by auto) and the
+                // scene one it does not trace: say so beside the kernel.
+                Err(why)
+                    if self.renderer.kernel() != marbre_render::gpu::Kernel::Cpu
+                        && self.renderer.requested_kernel() == marbre_render::gpu::Kernel::Cpu =>
+                {
+                    format!("{}; {why}", self.kernels.reason())
+                }
+                _ => self.kernels.reason().to_owned(),
+            },
             round_progress: self.renderer.round_progress(),
             denoise: self.renderer.denoise_report().cloned(),
             samples: self.renderer.accumulated_samples(),

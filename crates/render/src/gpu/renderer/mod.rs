@@ -154,6 +154,13 @@ impl Renderer {
         self.trace.pipeline.kernel()
     }
 
+    /// The kernel asked for: the one drawing, except where the CPU kernel
+    /// was asked for and the fragment kernel stands in for a scene it does
+    /// not trace (`Kernel::for_scene`).
+    pub fn requested_kernel(&self) -> Kernel {
+        self.trace.kernel
+    }
+
     /// Triangles, BVH nodes, lights and the last BVH build time.
     pub fn mesh_stats(&self) -> MeshStats {
         self.bindings.meshes.stats()
