@@ -51,6 +51,23 @@ impl Viewer {
         }
     }
 
+    /// Why the kernel drawing runs; where the CPU kernel was asked for (or
+    /// picked by auto) and the fragment kernel stands in for a scene it
+    /// does not trace, why it does not (looked up only then: Stats is read
+    /// every frame).
+    fn kernel_reason(&self) -> String {
+        use marbre_render::gpu::Kernel;
+        let standing_in = self.renderer.requested_kernel() == Kernel::Cpu
+            && self.renderer.kernel() != Kernel::Cpu;
+        let why = standing_in
+            .then(|| marbre_render::cpu_kernel::support(&self.scene).err())
+            .flatten();
+        match why {
+            Some(why) => format!("{}; {why}", self.kernels.reason()),
+            None => self.kernels.reason().to_owned(),
+        }
+    }
+
     /// Whether tracing rests: the user asked to stop at the target error,
     /// and the estimate of the current image is there.
     fn paused_at_target(&self) -> bool {
@@ -84,17 +101,7 @@ impl Viewer {
             ms_is_gpu: !self.trace_on_wall_clock(),
             kernel: self.renderer.kernel(),
             kernel_choice: self.kernels.choice(),
-            kernel_reason: match marbre_render::cpu_kernel::support(&self.scene) {
-                // The CPU kernel asked for (or picked by auto) and the
-                // scene one it does not trace: say so beside the kernel.
-                Err(why)
-                    if self.renderer.kernel() != marbre_render::gpu::Kernel::Cpu
-                        && self.renderer.requested_kernel() == marbre_render::gpu::Kernel::Cpu =>
-                {
-                    format!("{}; {why}", self.kernels.reason())
-                }
-                _ => self.kernels.reason().to_owned(),
-            },
+            kernel_reason: self.kernel_reason(),
             round_progress: self.renderer.round_progress(),
             denoise: self.renderer.denoise_report().cloned(),
             samples: self.renderer.accumulated_samples(),

@@ -23,14 +23,11 @@ mod scene;
 
 pub use scene::{CpuScene, support};
 
-use crate::gpu::scene_gpu::Frame;
+use crate::gpu::scene_gpu::{Frame, SAMPLE_SEED_STEP};
 use glam::{Vec2, Vec3};
 use path::Tracer;
 use rayon::prelude::*;
 use rng::Rng;
-
-/// The seed step of trace.wgsl (`0x9E3779B9`, the golden ratio).
-const SAMPLE_SEED_STEP: u32 = 0x9E37_79B9;
 
 /// What a band of samples leaves for the GPU: three blocks of the band's
 /// rows, one `[f32; 4]` per pixel each: the mean of the pixel's finite

@@ -201,7 +201,10 @@ impl<'a> PassTimestamps<'a> {
 }
 
 /// The CPU kernel's samples of a band, traced now and uploaded as the
-/// group 1 of its pass: a layer each of `cpu_kernel::BLOCKS`.
+/// group 1 of its pass: a layer each of `cpu_kernel::BLOCKS`. A texture of
+/// its own per band: the bands of one submit each read their own samples,
+/// and a `write_texture` lands before the whole submit, so one shared
+/// texture would give every band the last band's.
 pub fn cpu_samples_group(
     device: &wgpu::Device,
     queue: &wgpu::Queue,

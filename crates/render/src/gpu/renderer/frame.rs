@@ -11,7 +11,7 @@ use crate::gpu::features::Feature;
 use crate::gpu::pass_timer::{Pass, PassTimer};
 use crate::gpu::pipelines::fullscreen_pipeline;
 use crate::gpu::preview_ladder;
-use crate::gpu::scene_gpu::Frame;
+use crate::gpu::scene_gpu::{Frame, SAMPLE_SEED_STEP};
 use crate::gpu::trace_bands::TraceBudget;
 use crate::gpu::trace_pass::{BandPass, PassTimestamps, TracePipeline, cpu_samples_group};
 use crate::gpu::{non_finite, scene_gpu};
@@ -19,11 +19,6 @@ use anyhow::Result;
 use marbre_core::scene::{Metering, ToneMap};
 use marbre_core::tile::Tile;
 use std::sync::Arc;
-
-/// The step between the seeds of consecutive samples of a pixel: the
-/// golden-ratio constant `shaders/trace.wgsl` multiplies the sample's
-/// number by.
-const SAMPLE_SEED_STEP: u32 = 0x9E37_79B9;
 
 impl Renderer {
     /// Traces the rest of the first round and waits for it, if none is

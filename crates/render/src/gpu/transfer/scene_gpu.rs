@@ -14,6 +14,12 @@ use marbre_core::scene::{
 };
 use marbre_core::tile::Tile;
 
+/// The step between the seeds of consecutive samples of a pixel: the
+/// golden-ratio constant `shaders/trace.wgsl` multiplies the sample's
+/// number by (`(accumulated + k) · φ + frame_index`), which the renderer's
+/// restarts and the CPU kernel's seeds follow too.
+pub const SAMPLE_SEED_STEP: u32 = 0x9E37_79B9;
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Frame {
