@@ -38,7 +38,9 @@ struct ViewerArgs {
     /// Environment map to use instead of the preset's.
     #[arg(long)]
     env: Option<PathBuf>,
-    /// Render this many frames, then exit (for tests and scripts).
+    /// Run this many frames, then exit (for tests and scripts). A frame
+    /// traces within the budget; an idle window shows only those with
+    /// something new, and the closing `quality:` line counts both.
     #[arg(long)]
     exit_after_frames: Option<u64>,
     /// Save the whole window, UI included, as PNG just before exiting.

@@ -17,6 +17,7 @@ mod frame_budget;
 pub mod frame_script;
 mod history;
 mod kernel_choice;
+mod present_schedule;
 mod prompts;
 mod recovery;
 mod render_job;

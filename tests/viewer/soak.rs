@@ -13,7 +13,7 @@
 //! `MARBRE_REQUIRE_GPU=1` (see `xvfb`).
 
 use crate::xvfb::{
-    TempDir, assert_success, display_or_skip, marbre_log, spawn_marbre, wait_for_exit,
+    TempDir, assert_success, display_or_skip, marbre_log, serial, spawn_marbre, wait_for_exit,
 };
 use std::path::Path;
 use std::process::Command;
@@ -62,6 +62,9 @@ fn parse_rows(csv: &str) -> Vec<Row> {
 #[test]
 fn a_short_soak_passes_and_writes_its_report() {
     const TEST: &str = "a_short_soak_passes_and_writes_its_report";
+    // One window at a time: a second one's load changes when the soak's
+    // allocations land, which its memory limits judge.
+    let _serial = serial();
     let dir = TempDir::new("soak");
     let Some(x) = display_or_skip(TEST, &dir, &[]) else {
         return;

@@ -10,6 +10,9 @@
 //!   nothing else into the configuration folder.
 //! - `number_keys_recall_saved_views`: Ctrl+3, then F12: the screenshot
 //!   shows the preset's third saved view.
+//! - `an_idle_window_shows_each_round_and_traces_between`: on an adapter
+//!   timed on the CPU clock, most frames of an untouched window trace
+//!   without being shown, and every round completed is shown.
 //! - `f12_writes_png_and_exr`: a real F12 key press (sent with `xdotool`)
 //!   writes `screenshots/marbre-<timestamp>.png` and `.exr` into the working
 //!   directory; both decode, have the same size and hold a sensible image
@@ -641,4 +644,65 @@ fn the_panel_keeps_drawing_while_a_slow_scene_accumulates() {
         panel.mean_luma < 0.25 && panel.light_fraction > 0.01,
         "no panel drawn: {panel:?}"
     );
+}
+
+/// Nobody touches the window: where the trace runs on this machine's
+/// cores (the quality line's "CPU clock"), the frames that only trace a
+/// band of a round are not shown, and each completed round is (the image
+/// on show changes exactly then). On the Cornell box a round takes several
+/// bands on lavapipe, so most frames go unshown; on an adapter timed by
+/// the GPU every frame is shown.
+#[test]
+fn an_idle_window_shows_each_round_and_traces_between() {
+    const TEST: &str = "an_idle_window_shows_each_round_and_traces_between";
+    let _serial = serial();
+    let dir = TempDir::new("idle");
+    let Some(x) = display_or_skip(TEST, &dir, &[]) else {
+        return;
+    };
+    let mut child = spawn_marbre(
+        &x,
+        &dir,
+        Path::new(REPO),
+        &[
+            "--preset".into(),
+            "presets/cornell.ron".into(),
+            "--exit-after-frames".into(),
+            "120".into(),
+        ],
+    );
+    assert_success(wait_for_exit(&mut child, &dir, CHILD_TIMEOUT), &dir);
+    let line = quality_line(&dir);
+    eprintln!("{TEST}: {line}");
+    let (spp, frames, shown) = (
+        number_before(&line, "spp"),
+        number_before(&line, "frames"),
+        number_before(&line, "shown"),
+    );
+    assert_eq!(frames, 120, "{line}");
+    assert!(shown <= frames, "{line}");
+    if !line.contains("(CPU clock)") {
+        assert_eq!(
+            shown, frames,
+            "a GPU-timed adapter shows every frame: {line}"
+        );
+        return;
+    }
+    assert!(
+        shown >= spp,
+        "{spp} rounds completed but only {shown} frames shown: {line}"
+    );
+    let round_ms: f32 = line
+        .split_once("trace pass ")
+        .and_then(|(_, rest)| rest.split_whitespace().next())
+        .and_then(|ms| ms.parse().ok())
+        .unwrap_or_else(|| panic!("no round time in: {line}"));
+    if round_ms >= 60.0 {
+        assert!(
+            2 * shown < frames,
+            "a round of {round_ms} ms spans several bands, yet {shown} of {frames} frames were shown: {line}"
+        );
+    } else {
+        eprintln!("{TEST}: a round takes {round_ms} ms here, about a band: frames are shown");
+    }
 }

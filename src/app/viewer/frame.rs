@@ -10,7 +10,7 @@ use anyhow::{Context as _, Result};
 use marbre_core::scene::Change;
 use marbre_render::gpu::pass_timer::Pass;
 use marbre_render::gpu::readback::read_texture;
-use marbre_render::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, Viewport};
+use marbre_render::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, TraceBudget, Viewport};
 use std::path::Path;
 use std::time::Instant;
 
@@ -266,7 +266,7 @@ impl Viewer {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         if !self.paused_at_target() {
             if self.trace_on_wall_clock() {
-                self.trace_and_wait();
+                self.trace_and_wait(self.budget.budget());
             } else {
                 let trace_writes = self
                     .meters
@@ -523,9 +523,18 @@ impl Viewer {
                 .filter_map(|&p| t.ms(p).map(|ms| format!("{} {ms:.1} ms", p.label())))
                 .collect()
         });
+        // Samples per second of the image's accumulation, what the
+        // window's throughput is measured by (docs/PERFORMANCE.md).
+        let seconds = self.renderer.accumulation_time().as_secs_f64();
+        let rate = if seconds > 0.0 {
+            format!("{:.2} spp/s", f64::from(spp) / seconds)
+        } else {
+            "no time yet".to_owned()
+        };
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames ({} kernel); {} restarts; window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
+            "quality: {spp} spp accumulated in {} frames of which {} shown; {seconds:.1} s, {rate} ({} kernel); {} restarts; window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
             self.clock.frames,
+            self.clock.shown,
             self.renderer.kernel(),
             // Images thrown away since the start (an edit, a resize…),
             // for the tests that an action keeps the image.
@@ -562,9 +571,36 @@ impl Viewer {
             || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu
     }
 
+    /// Whether this frame may trace without being shown
+    /// (`app/present_schedule.rs`): only where the trace runs on this
+    /// machine's cores and is timed on its clock, and while nothing but
+    /// the image moves (no animation playing, no script, no scene loading,
+    /// tracing not paused at the target, not a scripted run's last frame).
+    pub(super) fn may_leave_unshown(&self) -> bool {
+        let last = self
+            .options
+            .exit_after_frames
+            .is_some_and(|n| self.clock.frames + 1 >= n);
+        self.trace_on_wall_clock()
+            && self.script.is_none()
+            && !self.timeline.playing()
+            && self.incoming.startup.is_none()
+            && self.incoming.loading.is_none()
+            && !self.paused_at_target()
+            && !last
+    }
+
+    /// A frame that is not shown: the trace alone, as long as a shown
+    /// frame lasts ([`crate::app::frame_budget::FrameBudget::unshown_budget`]).
+    pub(super) fn trace_unshown(&mut self) {
+        self.trace_and_wait(self.budget.unshown_budget(self.clock.shown_frame_ms));
+        self.renderer.after_submit();
+        self.clock.frames += 1;
+    }
+
     /// Traces this frame's budget in a submit of its own and waits for it,
     /// timing it on the CPU clock.
-    fn trace_and_wait(&mut self) {
+    fn trace_and_wait(&mut self, budget: TraceBudget) {
         // The last frame's display and panel first: the time measured is
         // the trace's alone.
         if let Err(e) = self.ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
@@ -574,7 +610,7 @@ impl Viewer {
         let start = Instant::now();
         let work = self
             .renderer
-            .trace_within(&self.ctx, &mut encoder, self.budget.budget(), None);
+            .trace_within(&self.ctx, &mut encoder, budget, None);
         self.ctx.queue.submit([encoder.finish()]);
         if let Err(e) = self.ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
             log::warn!("waiting for the trace: {e}");

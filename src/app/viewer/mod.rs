@@ -20,6 +20,7 @@ use super::frame_budget::FrameBudget;
 use super::frame_script::{FrameScript, Presented, ScriptAction};
 use super::history::History;
 use super::kernel_choice::KernelChooser;
+use super::present_schedule::{FrameState, PresentSchedule};
 use super::prompts::{self, Prompt};
 use super::recovery::{self, Autosave};
 use super::render_job::{RenderJob, Update};
@@ -178,8 +179,16 @@ struct Incoming {
 
 /// Frames counted and timed.
 struct FrameClock {
+    /// Frames run, shown or not: each traces within the budget.
     frames: u64,
+    /// Frames shown, and which ones to show.
+    shown: u64,
+    schedule: PresentSchedule,
+    /// When the last frame was shown (`fps` counts frames shown).
     last_frame: Instant,
+    /// How long a shown frame takes, smoothed: what a frame that is not
+    /// shown may trace.
+    shown_frame_ms: f32,
     /// When free heap memory was last handed back ([`HEAP_TRIM_INTERVAL`]).
     last_heap_trim: Instant,
     fps: f32,
@@ -421,7 +430,10 @@ impl Viewer {
             timeline: Timeline::default(),
             clock: FrameClock {
                 frames: 0,
+                shown: 0,
+                schedule: PresentSchedule::new(Instant::now()),
                 last_frame: Instant::now(),
+                shown_frame_ms: 0.0,
                 last_heap_trim: Instant::now(),
                 fps: 0.0,
                 ms_per_frame: 0.0,
@@ -453,6 +465,9 @@ impl Viewer {
         // Keys reach the viewer through egui's input only, read where the
         // frame knows which widget has the keyboard (`app/shortcuts.rs`).
         let _ = self.egui_state.on_window_event(&self.window, event);
+        if !matches!(event, WindowEvent::RedrawRequested) {
+            self.clock.schedule.note_input();
+        }
         match event {
             WindowEvent::CloseRequested => self.request_quit(),
             // A minimised window has zero size: keep the last valid
@@ -973,6 +988,15 @@ impl Viewer {
         for message in self.device_watch.take_messages() {
             self.panel.error(format!("GPU error: {message}"));
         }
+        let state = FrameState {
+            now: Instant::now(),
+            images: self.renderer.images_made(),
+            may_skip: self.may_leave_unshown(),
+        };
+        if !self.clock.schedule.shows(&state) {
+            self.trace_unshown();
+            return Ok(!self.quitting);
+        }
         self.poll_dialog();
         self.poll_render();
         self.poll_file_watch();
@@ -1001,7 +1025,17 @@ impl Viewer {
             }
         }
         let to_free: Vec<egui::TextureId> = output.textures_delta.free.drain().collect();
+        let repaint_delay = output
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map_or(std::time::Duration::ZERO, |v| v.repaint_delay);
         let result = self.draw_frame(output, image_rect, dragging);
+        let took = now.elapsed().as_secs_f32() * 1000.0;
+        self.clock.shown_frame_ms += 0.2 * (took - self.clock.shown_frame_ms);
+        self.clock.shown += 1;
+        self.clock
+            .schedule
+            .shown(now, self.renderer.images_made(), repaint_delay);
         for id in &to_free {
             self.egui_renderer.free_texture(id);
         }

@@ -222,6 +222,12 @@ impl Renderer {
         self.accumulation.shown_size()
     }
 
+    /// Images made so far (complete rounds and previews), wrapping: what
+    /// the display shows changes exactly when this does.
+    pub fn images_made(&self) -> u32 {
+        self.accumulation.shown_count()
+    }
+
     /// The images the texture code reads.
     pub fn images(&self) -> &ImageSet {
         &self.bindings.images
