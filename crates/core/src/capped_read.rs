@@ -114,18 +114,32 @@ fn too_large(kind: FileKind) -> io::Error {
 
 /// What a non-regular file is, in words.
 fn describe(file_type: &std::fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
     if file_type.is_dir() {
         "a folder"
-    } else if file_type.is_fifo() {
-        "a FIFO"
-    } else if file_type.is_char_device() || file_type.is_block_device() {
-        "a device"
-    } else if file_type.is_socket() {
-        "a socket"
     } else {
-        "not a file"
+        special_file(file_type).unwrap_or("not a file")
     }
+}
+
+/// The kinds of special file Unix has.
+#[cfg(unix)]
+fn special_file(file_type: &std::fs::FileType) -> Option<&'static str> {
+    use std::os::unix::fs::FileTypeExt;
+    if file_type.is_fifo() {
+        Some("a FIFO")
+    } else if file_type.is_char_device() || file_type.is_block_device() {
+        Some("a device")
+    } else if file_type.is_socket() {
+        Some("a socket")
+    } else {
+        None
+    }
+}
+
+/// Elsewhere (Windows, the browser's wasm32) std names none.
+#[cfg(not(unix))]
+fn special_file(_: &std::fs::FileType) -> Option<&'static str> {
+    None
 }
 
 #[cfg(test)]

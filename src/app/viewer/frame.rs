@@ -575,13 +575,18 @@ impl Viewer {
     /// (`app/present_schedule.rs`): only where the trace runs on this
     /// machine's cores and is timed on its clock, and while nothing but
     /// the image moves (no animation playing, no script, no scene loading,
-    /// tracing not paused at the target, not a scripted run's last frame).
+    /// tracing not paused at the target, not a scripted run's last frame)
+    /// and there is an image to trace for (a minimised window traces
+    /// nothing, as before).
     pub(super) fn may_leave_unshown(&self) -> bool {
         let last = self
             .options
             .exit_after_frames
             .is_some_and(|n| self.clock.frames + 1 >= n);
-        self.trace_on_wall_clock()
+        let size = self.window.inner_size();
+        size.width > 0
+            && size.height > 0
+            && self.trace_on_wall_clock()
             && self.script.is_none()
             && !self.timeline.playing()
             && self.incoming.startup.is_none()
