@@ -27,6 +27,11 @@ const SMOOTHING: f64 = 0.3;
 /// the door to a frame many times too long.
 const MAX_GROWTH: f64 = 4.0;
 
+/// The longest a frame that is not shown traces, in targets: a shown
+/// frame on lavapipe lasts about twice the target (the trace, then the
+/// display and the panel), which this leaves room for.
+const MAX_UNSHOWN_STRETCH: f32 = 3.0;
+
 /// `--frame-budget-ms`: milliseconds, zero or more.
 pub fn parse_budget_ms(s: &str) -> Result<f32, String> {
     s.trim()
@@ -71,8 +76,15 @@ impl FrameBudget {
     /// larger bands: each band costs a fixed time besides its pixels
     /// (on lavapipe about 2–3 ms: 3.5 samples/s at a 12 ms budget against
     /// 4.1 at 24 ms on the default preset).
+    /// A shown frame that took long once (F12 finishing a round and
+    /// OIDN, a reload) must not stretch the bands after it: the budget
+    /// stays within [`MAX_UNSHOWN_STRETCH`] times the target.
     pub fn unshown_budget(&self, shown_frame_ms: f32) -> TraceBudget {
-        self.budget_of(self.target_ms.max(shown_frame_ms))
+        let longest = MAX_UNSHOWN_STRETCH * self.target_ms;
+        if shown_frame_ms.is_nan() {
+            return self.budget();
+        }
+        self.budget_of(shown_frame_ms.clamp(self.target_ms, longest))
     }
 
     fn budget_of(&self, ms: f32) -> TraceBudget {
@@ -172,6 +184,8 @@ mod tests {
         assert_eq!(budget.unshown_budget(26.0), TraceBudget::Pixels(26_000));
         assert_eq!(budget.unshown_budget(5.0), TraceBudget::Pixels(12_000));
         assert_eq!(budget.unshown_budget(f32::NAN), TraceBudget::Pixels(12_000));
+        // A 3 s screenshot frame does not make the next bands 3 s long.
+        assert_eq!(budget.unshown_budget(3000.0), TraceBudget::Pixels(36_000));
         assert_eq!(
             FrameBudget::new(0.0).unshown_budget(26.0),
             TraceBudget::Round

@@ -14,8 +14,11 @@
 //! frame budget: the window answers as fast as before. Blender's and
 //! Cycles' viewports likewise redraw when samples are ready, not per tile.
 //!
-//! On a GPU adapter every frame is shown: the trace runs beside the
-//! display there, and the swapchain paces the loop.
+//! On a GPU adapter every frame is shown (unless the CPU kernel traces):
+//! the trace runs beside the display there, and the swapchain paces the
+//! loop. A result that lands between rounds (an OIDN image, a shader
+//! build, a hot reload) shows with the next frame shown, within the
+//! panel's refresh.
 
 use super::ui_layer::STATS_REFRESH;
 use std::time::{Duration, Instant};

@@ -321,6 +321,7 @@ impl Viewer {
         self.ctx.queue.present(frame);
         let script_goes_on = self.script_after_present()?;
         self.clock.frames += 1;
+        self.clock.shown += 1;
         let controls = &self.panel.quality;
         if controls.screenshot_at_target
             && self
@@ -573,7 +574,7 @@ impl Viewer {
 
     /// Whether this frame may trace without being shown
     /// (`app/present_schedule.rs`): only where the trace runs on this
-    /// machine's cores and is timed on its clock, and while nothing but
+    /// machine's cores (a CPU adapter, or the CPU kernel), and while nothing but
     /// the image moves (no animation playing, no script, no scene loading,
     /// tracing not paused at the target, not a scripted run's last frame)
     /// and there is an image to trace for (a minimised window traces
@@ -584,9 +585,11 @@ impl Viewer {
             .exit_after_frames
             .is_some_and(|n| self.clock.frames + 1 >= n);
         let size = self.window.inner_size();
+        let on_these_cores =
+            self.ctx.is_cpu() || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu;
         size.width > 0
             && size.height > 0
-            && self.trace_on_wall_clock()
+            && on_these_cores
             && self.script.is_none()
             && !self.timeline.playing()
             && self.incoming.startup.is_none()

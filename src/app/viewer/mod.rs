@@ -1032,7 +1032,6 @@ impl Viewer {
         let result = self.draw_frame(output, image_rect, dragging);
         let took = now.elapsed().as_secs_f32() * 1000.0;
         self.clock.shown_frame_ms += 0.2 * (took - self.clock.shown_frame_ms);
-        self.clock.shown += 1;
         self.clock
             .schedule
             .shown(now, self.renderer.images_made(), repaint_delay);
