@@ -60,6 +60,7 @@ impl Api {
     /// # Safety
     /// `lib` must be OIDN 2's library, whose functions have the signatures
     /// above.
+    #[cfg(not(target_arch = "wasm32"))]
     pub unsafe fn read(lib: &libloading::Library) -> Result<Self, String> {
         macro_rules! symbol {
             ($name:literal) => {

@@ -34,6 +34,7 @@ pub struct Library {
     /// loader resolved).
     pub origin: PathBuf,
     /// Kept open for as long as `api`'s pointers are used.
+    #[cfg(not(target_arch = "wasm32"))]
     _library: libloading::Library,
 }
 
@@ -112,8 +113,18 @@ impl Library {
         Err(NotFound { tried })
     }
 
+    /// In a web page (wasm32) nothing opens: there is no native loader.
+    #[cfg(target_arch = "wasm32")]
+    fn open(path: &Path) -> Result<Self, String> {
+        Err(format!(
+            "{}: a web page cannot open native libraries",
+            path.display()
+        ))
+    }
+
     /// Opens the library at `path` (or, for a bare name, wherever the
     /// system's loader finds it) and reads its functions.
+    #[cfg(not(target_arch = "wasm32"))]
     fn open(path: &Path) -> Result<Self, String> {
         // SAFETY: opening runs the library's initialisers; OIDN's only set
         // up its C++ runtime. A file of that name that is not OIDN 2 fails

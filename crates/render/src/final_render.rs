@@ -22,7 +22,8 @@ use marbre_core::texture::ImageSet;
 use marbre_core::tile::{self, Tile};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// When a final render stops.
 #[derive(Debug, Clone, Copy, PartialEq)]

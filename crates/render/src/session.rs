@@ -387,7 +387,7 @@ pub fn time_interleaved(
             order.reverse();
         }
         for i in order {
-            let start = std::time::Instant::now();
+            let start = web_time::Instant::now();
             trace_frame(ctx, renderers[i])?;
             times[i].push(start.elapsed().as_secs_f64() * 1000.0);
         }

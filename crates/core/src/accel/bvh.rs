@@ -40,7 +40,8 @@
 use super::aabb::Aabb;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec3A};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// Triangles per leaf, at most.
 pub const MAX_LEAF_TRIANGLES: usize = 4;

@@ -14,7 +14,8 @@ use anyhow::{Result, ensure};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use marbre_core::accel::{BvhNode, MeshHit, TriangleVerts};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// `NO_TRIANGLE` in accel/traverse.wgsl: the triangle of a miss.
 pub const NO_TRIANGLE: u32 = u32::MAX;

@@ -18,7 +18,8 @@
 //! complete round, or the preview of a new accumulation at a reduced size.
 
 use super::preview_ladder::Previews;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// The format of both targets: linear radiance needs floats, and the
 /// running mean needs more than half precision to keep averaging.

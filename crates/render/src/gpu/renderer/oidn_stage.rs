@@ -23,7 +23,7 @@ use marbre_core::scene::DenoiseQuality;
 use marbre_oidn::Library;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
-use std::time::Instant;
+use web_time::Instant;
 
 /// What a denoised image was filtered from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -16,7 +16,8 @@ use crate::gpu::trace_pass::TracePipeline;
 use crate::worker::{Worker, names};
 use anyhow::{Result, anyhow};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// A built trace pipeline and the size of its WGSL.
 pub struct BuiltPipeline {
@@ -105,6 +106,13 @@ impl PipelineBuilder {
             sender,
             requested: Instant::now(),
         };
+        // A web page has no thread to build on, and needs none: WebGPU
+        // compiles a pipeline in the browser's GPU process, so creating it
+        // does not hold the page (issue 34).
+        if cfg!(target_arch = "wasm32") {
+            job.run();
+            return PipelineBuild { receiver };
+        }
         let (lock, ready) = &*self.queue;
         lock.lock().unwrap_or_else(|e| e.into_inner()).next = Some(job);
         ready.notify_one();
