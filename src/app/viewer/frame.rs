@@ -567,9 +567,13 @@ impl Viewer {
     /// without bound), and for the CPU kernel, whose trace is CPU work
     /// the timestamps do not see.
     fn trace_on_wall_clock(&self) -> bool {
-        self.meters.timer.is_none()
-            || self.ctx.is_cpu()
-            || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu
+        self.meters.timer.is_none() || self.traces_on_these_cores()
+    }
+
+    /// Whether the trace runs on this machine's cores: a CPU adapter, or
+    /// the CPU kernel.
+    fn traces_on_these_cores(&self) -> bool {
+        self.ctx.is_cpu() || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu
     }
 
     /// Whether this frame may trace without being shown
@@ -584,18 +588,18 @@ impl Viewer {
             .options
             .exit_after_frames
             .is_some_and(|n| self.clock.frames + 1 >= n);
-        let size = self.window.inner_size();
-        let on_these_cores =
-            self.ctx.is_cpu() || self.renderer.kernel() == marbre_render::gpu::Kernel::Cpu;
-        size.width > 0
-            && size.height > 0
-            && on_these_cores
+        // The window's size last: it asks the display server.
+        self.traces_on_these_cores()
             && self.script.is_none()
             && !self.timeline.playing()
             && self.incoming.startup.is_none()
             && self.incoming.loading.is_none()
             && !self.paused_at_target()
             && !last
+            && {
+                let size = self.window.inner_size();
+                size.width > 0 && size.height > 0
+            }
     }
 
     /// A frame that is not shown: the trace alone, as long as a shown
