@@ -87,3 +87,13 @@ impl OpenDialog {
         }
     }
 }
+
+/// Files dropped on the window arrive as winit's `DroppedFile`; only a web
+/// page collects its own (`app/web/file_dialogs.rs`).
+pub fn take_dropped() -> Vec<PathBuf> {
+    Vec::new()
+}
+
+/// A save on the desktop is on disk already; a web page offers it as a
+/// download.
+pub fn deliver_saved(_path: &std::path::Path) {}

@@ -98,7 +98,7 @@ pub fn is_same_file(changed: &Path, file: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::time::Instant;
+    use web_time::Instant;
 
     /// A file written after the watch starts is reported, once, after the
     /// debounce; a file in another folder is not.

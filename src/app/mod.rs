@@ -11,7 +11,11 @@ mod convergence;
 mod device_watch;
 mod document;
 mod feature_costs;
+// The platform's seams (issue 34): the desktop's and the web page's
+// implementations side by side, with the same items.
+#[cfg_attr(target_arch = "wasm32", path = "web/file_dialogs.rs")]
 mod file_dialogs;
+#[cfg_attr(target_arch = "wasm32", path = "web/file_watch.rs")]
 mod file_watch;
 mod frame_budget;
 pub mod frame_script;
@@ -24,11 +28,14 @@ mod render_job;
 mod scene_loader;
 mod screenshots;
 mod settings;
+pub mod share_link;
 mod shortcuts;
 pub mod soak;
 pub mod swatches;
 mod ui_layer;
 mod viewer;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 pub use frame_budget::{DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS, parse_budget_ms};
 

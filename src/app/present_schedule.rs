@@ -21,7 +21,8 @@
 //! panel's refresh.
 
 use super::ui_layer::STATS_REFRESH;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// What the schedule knows of the last frame shown.
 #[derive(Debug, Clone)]

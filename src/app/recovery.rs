@@ -19,7 +19,8 @@ use marbre_core::preset::{self, Preset};
 use marbre_core::scene::Scene;
 use marbre_core::viewer_files::RecoveryInfo;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// How often unsaved edits are copied to the recovery file.
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(20);
@@ -246,10 +247,10 @@ mod tests {
                 .to_owned()
         };
         // Not reaped, the child stays a zombie once it exits.
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        let deadline = web_time::Instant::now() + std::time::Duration::from_secs(60);
         while state() != "Z" {
             assert!(
-                std::time::Instant::now() < deadline,
+                web_time::Instant::now() < deadline,
                 "the child never exited"
             );
             std::thread::sleep(std::time::Duration::from_millis(10));

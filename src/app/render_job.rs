@@ -51,7 +51,7 @@ pub struct RenderJob {
     /// What it prepares before its first sample.
     stage: String,
     /// When it started: the log says how long it prepared.
-    started: std::time::Instant,
+    started: web_time::Instant,
     /// The render's thread, with its own device: joined on drop, after the
     /// cancel flag is set (it then stops after its current frame). Held
     /// only to be dropped.
@@ -97,7 +97,7 @@ impl RenderJob {
             events,
             progress: None,
             stage: "starting a device".to_owned(),
-            started: std::time::Instant::now(),
+            started: web_time::Instant::now(),
             _worker: worker,
         })
     }

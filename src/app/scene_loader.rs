@@ -95,7 +95,7 @@ impl SceneLoad {
         let stage = Arc::new(AtomicUsize::new(0));
         let (worker_path, worker_stage) = (path.to_owned(), stage.clone());
         let worker_env = env_override.map(Path::to_owned);
-        std::thread::spawn(move || {
+        let work = move || {
             let result = load_reporting(&worker_path, kind, worker_env.as_deref(), &mut |s| {
                 worker_stage.store(s.index(), Ordering::Relaxed);
                 if s == LoadStage::Meshes {
@@ -110,7 +110,14 @@ impl SceneLoad {
             });
             // The viewer may have given up on this load: then nobody listens.
             let _ = sender.send(result);
-        });
+        };
+        // A web page has no thread to load on: the files are in its memory
+        // already (`marbre_core::page_files`), and the load runs in place.
+        if cfg!(target_arch = "wasm32") {
+            work();
+        } else {
+            std::thread::spawn(work);
+        }
         Self {
             path: path.to_owned(),
             stage,

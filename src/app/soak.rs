@@ -10,6 +10,7 @@
 //! [`SoakDriver::record`] after presenting, and at the end the driver
 //! prints [`SoakDriver::verdict`].
 
+#[cfg(not(target_arch = "wasm32"))]
 pub mod command;
 mod edits;
 mod memory;

@@ -13,7 +13,7 @@ use marbre_render::gpu::GpuContext;
 use marbre_render::gpu::swatch::{MAX_BATCH, SWATCH_SIZE, SwatchPixels, SwatchRenderer, to_srgba8};
 use marbre_render::worker::{Worker, names};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
-use std::time::Instant;
+use web_time::Instant;
 
 /// A batch the worker finished: what was asked, the swatches or why not,
 /// and the milliseconds it took (pipeline build included).

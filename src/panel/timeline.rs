@@ -10,7 +10,7 @@ use super::widgets::slider;
 use egui::Ui;
 use marbre_core::animation::{Animation, Extrapolation, Interpolation};
 use marbre_core::scene::Scene;
-use std::time::Instant;
+use web_time::Instant;
 
 /// The play head.
 #[derive(Debug, Clone, Default)]

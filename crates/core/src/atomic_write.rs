@@ -20,7 +20,14 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// at `path` points to), flushes it to disk, renames it over that file and
 /// syncs the folder. A crash or a full disk at any point leaves either the
 /// old file or the new one, never a truncated mix.
+///
+/// In a web page (wasm32) the bytes replace the page's own file
+/// ([`crate::page_files`]) at once, which is atomic there.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    if cfg!(target_arch = "wasm32") {
+        crate::page_files::insert(path, bytes);
+        return Ok(());
+    }
     let path = &write_target(path)?;
     let dir = folder_of(path);
     std::fs::create_dir_all(dir)?;
@@ -63,6 +70,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// `first` is kept as a hard link until `second` is in place, and put back
 /// if it cannot be.
 pub fn write_atomic_pair(first: (&Path, &[u8]), second: (&Path, &[u8])) -> std::io::Result<()> {
+    if cfg!(target_arch = "wasm32") {
+        write_atomic(first.0, first.1)?;
+        return write_atomic(second.0, second.1);
+    }
     let (a, b) = (write_target(first.0)?, write_target(second.0)?);
     for path in [&a, &b] {
         check_writable(path)?;

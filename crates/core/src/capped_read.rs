@@ -58,7 +58,17 @@ pub const SMALL_TEXT: FileKind = FileKind {
 
 /// The bytes of the file at `path`, if it is a regular file of at most
 /// `kind.max_bytes`.
+///
+/// In a web page (wasm32) the file comes from the page's own files
+/// ([`crate::page_files`]), under the same cap.
 pub fn read_capped(path: &Path, kind: FileKind) -> io::Result<Vec<u8>> {
+    if cfg!(target_arch = "wasm32") {
+        let bytes = crate::page_files::read(path)?;
+        if bytes.len() as u64 > kind.max_bytes {
+            return Err(too_large(kind));
+        }
+        return Ok(bytes.to_vec());
+    }
     check_regular(&std::fs::metadata(path)?, kind)?;
     let file = std::fs::File::open(path)?;
     // The file behind the path may have been swapped since: check again

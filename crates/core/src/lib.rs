@@ -24,6 +24,7 @@ pub mod noise;
 pub mod obj_loader;
 pub mod obj_scene;
 pub mod obj_syntax;
+pub mod page_files;
 pub mod preset;
 pub mod render_record;
 pub mod scene;

@@ -35,7 +35,7 @@ pub struct Settings {
 }
 
 impl Settings {
-    fn file(dir: &Path) -> PathBuf {
+    pub fn file(dir: &Path) -> PathBuf {
         dir.join("settings.ron")
     }
 

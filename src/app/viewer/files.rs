@@ -9,7 +9,7 @@
 
 use super::{StartupLoad, Viewer};
 use crate::app::document::Document;
-use crate::app::file_dialogs::{DialogPurpose, OpenDialog, dialogs_available};
+use crate::app::file_dialogs::{self, DialogPurpose, OpenDialog, dialogs_available};
 use crate::app::file_watch::{FileWatch, is_same_file};
 use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
@@ -325,6 +325,7 @@ impl Viewer {
     pub(super) fn save_preset(&mut self, path: &Path) -> bool {
         match self.edits.document.save(&self.scene, path) {
             Ok(()) => {
+                file_dialogs::deliver_saved(path);
                 self.panel.save_as = None;
                 self.panel.preset_path = path.display().to_string();
                 self.panel.info(format!("saved {}", path.display()));

@@ -12,7 +12,7 @@ use marbre_render::gpu::pass_timer::Pass;
 use marbre_render::gpu::readback::read_texture;
 use marbre_render::gpu::{DisplayTarget, FeatureSet, NonFiniteCounts, TraceBudget, Viewport};
 use std::path::Path;
-use std::time::Instant;
+use web_time::Instant;
 
 /// The window's colour around the image and under the panels.
 const BACKGROUND: wgpu::Color = wgpu::Color {
@@ -566,8 +566,13 @@ impl Viewer {
     /// of any size, where the frame took 300 ms: the budget then grew
     /// without bound), and for the CPU kernel, whose trace is CPU work
     /// the timestamps do not see.
+    /// A web page never does: it cannot wait for the GPU (the browser
+    /// answers on its own event loop), so the frame budget follows the
+    /// timestamps where the browser gives them and traces whole rounds
+    /// where it does not.
     fn trace_on_wall_clock(&self) -> bool {
-        self.meters.timer.is_none() || self.traces_on_these_cores()
+        !cfg!(target_arch = "wasm32")
+            && (self.meters.timer.is_none() || self.traces_on_these_cores())
     }
 
     /// Whether the trace runs on this machine's cores: a CPU adapter, or
@@ -582,14 +587,16 @@ impl Viewer {
     /// the image moves (no animation playing, no script, no scene loading,
     /// tracing not paused at the target, not a scripted run's last frame)
     /// and there is an image to trace for (a minimised window traces
-    /// nothing, as before).
+    /// nothing, as before). Never in a web page: such a frame traces on
+    /// the wall clock, which a page cannot wait on.
     pub(super) fn may_leave_unshown(&self) -> bool {
         let last = self
             .options
             .exit_after_frames
             .is_some_and(|n| self.clock.frames + 1 >= n);
         // The window's size last: it asks the display server.
-        self.traces_on_these_cores()
+        self.trace_on_wall_clock()
+            && self.traces_on_these_cores()
             && self.script.is_none()
             && !self.timeline.playing()
             && self.incoming.startup.is_none()

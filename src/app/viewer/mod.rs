@@ -42,7 +42,7 @@ use marbre_render::session::{
 };
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 use winit::event::WindowEvent;
 use winit::window::{Fullscreen, Window};
 
@@ -281,17 +281,32 @@ fn startup_aspect(window: &Window) -> f32 {
 
 /// The default preset: in the working folder (a checkout, as the README
 /// runs it), else in the source tree this binary was built from.
+/// A web page serves it beside itself, under the same relative path.
 fn default_preset() -> PathBuf {
     let local = PathBuf::from(DEFAULT_PRESET);
-    if local.is_file() {
+    if cfg!(target_arch = "wasm32") || local.is_file() {
         return local;
     }
     Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_PRESET)
 }
 
 impl Viewer {
+    /// The viewer in `window`, on a device made for it here.
     pub fn new(
         window: Arc<Window>,
+        options: ViewerOptions,
+        settings: Settings,
+        config_dir: Option<PathBuf>,
+    ) -> Result<Self> {
+        let gpu = GpuContext::for_window(window.clone())?;
+        Self::with_gpu(window, gpu, options, settings, config_dir)
+    }
+
+    /// The viewer in `window`, on `gpu`'s device and surface (a web page
+    /// awaits them: `GpuContext::for_web_window`).
+    pub fn with_gpu(
+        window: Arc<Window>,
+        (ctx, surface): (GpuContext, wgpu::Surface<'static>),
         options: ViewerOptions,
         settings: Settings,
         config_dir: Option<PathBuf>,
@@ -316,7 +331,6 @@ impl Viewer {
         } else {
             (LoadedScene::placeholder(), Default::default())
         };
-        let (ctx, surface) = GpuContext::for_window(window.clone())?;
         let device_watch = DeviceWatch::default();
         device_watch.attach(&ctx.device);
         let size = window.inner_size();
@@ -380,7 +394,12 @@ impl Viewer {
                 panel.info(files::recovery_note(&offer));
             }
         }
-        let autosave = config_dir.clone().map(Autosave::new);
+        // A web page's memory goes with its tab: an autosave there would
+        // be lost with what it saves (its settings persist in local storage).
+        let autosave = config_dir
+            .clone()
+            .filter(|_| !cfg!(target_arch = "wasm32"))
+            .map(Autosave::new);
         let script = options
             .soak
             .as_ref()
@@ -664,10 +683,11 @@ impl Viewer {
     }
 
     fn save_settings(&mut self) {
-        if let Some(dir) = &self.config_dir
-            && let Err(e) = self.settings.save(dir)
-        {
-            self.panel.error(format!("cannot save settings: {e:#}"));
+        if let Some(dir) = &self.config_dir {
+            match self.settings.save(dir) {
+                Ok(()) => super::settings::persist(dir),
+                Err(e) => self.panel.error(format!("cannot save settings: {e:#}")),
+            }
         }
     }
 
@@ -998,6 +1018,9 @@ impl Viewer {
             return Ok(!self.quitting);
         }
         self.poll_dialog();
+        for dropped in super::file_dialogs::take_dropped() {
+            self.load_dropped(&dropped);
+        }
         self.poll_render();
         self.poll_file_watch();
         self.poll_loading()?;

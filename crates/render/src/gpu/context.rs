@@ -65,32 +65,59 @@ impl GpuContext {
         Self::from_instance(instance, Some(surface))
     }
 
+    /// A device able to present to `window` through the browser's WebGPU,
+    /// and the window's surface. A page cannot block on the adapter and
+    /// device requests (the browser answers them on its own event loop),
+    /// so this one is awaited (issue 34).
+    pub async fn for_web_window<W>(window: W) -> Result<(Self, wgpu::Surface<'static>)>
+    where
+        W: Into<wgpu::SurfaceTarget<'static>>,
+    {
+        let instance = instance_of(wgpu::Backends::BROWSER_WEBGPU);
+        let surface = instance
+            .create_surface(window)
+            .context("creating the canvas's WebGPU surface")?;
+        let ctx = Self::from_instance_async(instance, Some(&surface)).await?;
+        Ok((ctx, surface))
+    }
+
     fn from_instance(
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<Self> {
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: surface,
-            ..Default::default()
-        }))
-        .context(
-            "no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers)",
-        )?;
+        pollster::block_on(Self::from_instance_async(instance, surface))
+    }
+
+    async fn from_instance_async(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self> {
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: surface,
+                ..Default::default()
+            })
+            .await
+            .context(
+                "no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers)",
+            )?;
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features = if timestamps {
             wgpu::Features::TIMESTAMP_QUERY
         } else {
             wgpu::Features::empty()
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("marbre"),
-            required_features,
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .context("the adapter refused to create a device")?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("marbre"),
+                required_features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .context("the adapter refused to create a device")?;
         Ok(Self {
             instance,
             adapter,
@@ -102,8 +129,15 @@ impl GpuContext {
 
     /// A second device on the same adapter, with the same features and
     /// limits: somewhere to compile shaders without holding up this
-    /// device's queue (see `gpu::pipeline_build`).
+    /// device's queue (see `gpu::pipeline_build`). A web page cannot wait
+    /// for one (its request is answered on the browser's event loop, which
+    /// a blocked page never returns to): there it is an error, and each
+    /// caller's fallback (no warm-up, no timing, no background render)
+    /// applies.
     pub fn sibling(&self) -> Result<Self> {
+        if cfg!(target_arch = "wasm32") {
+            anyhow::bail!("a web page cannot wait for a second GPU device");
+        }
         let (device, queue) =
             pollster::block_on(self.adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("marbre shader warm-up"),

@@ -123,9 +123,18 @@ impl TraceLayouts {
         &self.outputs[usize::from(guides)]
     }
 
-    /// Both output layouts: 3 and 5 storage textures.
+    /// Both output layouts: 3 and 5 storage textures. A device allowed
+    /// fewer than 5 a stage (WebGPU's default is 4) gets the 3-texture one
+    /// for both: the compute kernel with guides is refused there before
+    /// it is built ([`TracePipeline::build`]), and a layout over the limit
+    /// would be a validation error at start-up.
     pub fn output_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
-        [false, true].map(|guides| Self::output_layout(device, Self::targets(guides)))
+        let limit = device.limits().max_storage_textures_per_shader_stage as usize;
+        [false, true].map(|guides| {
+            let targets = Self::targets(guides);
+            let fits = targets <= limit;
+            Self::output_layout(device, if fits { targets } else { Self::targets(false) })
+        })
     }
 
     /// Group 1 of the CPU kernel's pass: the band's samples.
@@ -144,8 +153,12 @@ impl TraceLayouts {
     }
 
     fn output_layout(device: &wgpu::Device, count: usize) -> wgpu::BindGroupLayout {
-        let output = |binding| {
-            entry(
+        // The compute kernel's alone: a page's WebGPU counts storage
+        // textures per stage (4 in a fragment stage), so none is declared
+        // to the fragment stage that never writes them.
+        let output = |binding| wgpu::BindGroupLayoutEntry {
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ..entry(
                 binding,
                 wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::WriteOnly,

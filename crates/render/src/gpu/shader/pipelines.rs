@@ -73,15 +73,33 @@ pub fn compile_wgsl(
     source: String,
 ) -> Result<wgpu::ShaderModule> {
     validate(&source).map_err(|e| anyhow!("{program:?} shader: {e}"))?;
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(&format!("{program:?}")),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
+    let (module, error) = in_validation_scope(device, || {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(&format!("{program:?}")),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
     });
-    if let Some(e) = pollster::block_on(scope.pop()) {
+    if let Some(e) = error {
         return Err(anyhow!("{program:?} shader rejected by the device: {e}"));
     }
     Ok(module)
+}
+
+/// Runs `create` and returns what it made with the validation error it
+/// caused, if any. A web page cannot wait for the scope's answer (the
+/// browser gives it on its own event loop, which a blocked page never
+/// returns to): there no scope is opened, and an error arrives as an
+/// uncaptured one, which the viewer's device watch shows (issue 34).
+fn in_validation_scope<T>(
+    device: &wgpu::Device,
+    create: impl FnOnce() -> T,
+) -> (T, Option<wgpu::Error>) {
+    if cfg!(target_arch = "wasm32") {
+        return (create(), None);
+    }
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = create();
+    (value, pollster::block_on(scope.pop()))
 }
 
 /// Parses and validates WGSL with naga, as the device will.
@@ -112,11 +130,9 @@ fn located(source: &str, location: Option<naga::SourceLocation>, report: String)
 
 /// Runs `create` inside a validation error scope.
 pub fn checked<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T) -> Result<T> {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let value = create();
-    match pollster::block_on(scope.pop()) {
-        Some(e) => Err(anyhow!("{what}: {e}")),
-        None => Ok(value),
+    match in_validation_scope(device, create) {
+        (_, Some(e)) => Err(anyhow!("{what}: {e}")),
+        (value, None) => Ok(value),
     }
 }
 
