@@ -63,6 +63,10 @@ struct ViewerArgs {
     /// of samples every frame.
     #[arg(long, default_value_t = marbre::app::DEFAULT_FRAME_BUDGET_MS, value_parser = marbre::app::parse_budget_ms)]
     frame_budget_ms: f32,
+    /// Stop tracing at this many samples per pixel, as a render's sample
+    /// count does (default: trace on, or to the Quality strip's target).
+    #[arg(long, value_parser = marbre_commands::parse_spp)]
+    max_spp: Option<u32>,
 }
 
 #[derive(Subcommand)]
@@ -169,6 +173,7 @@ fn main() -> ExitCode {
             soak: None,
             kernel: cli.viewer.kernel,
             frame_budget_ms: cli.viewer.frame_budget_ms,
+            max_spp: cli.viewer.max_spp,
         }),
     };
     let mut code = match result {

@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dist=web/dist
-wasm=target/wasm32-unknown-unknown/release/marbre_web.wasm
+wasm=target/wasm32-unknown-unknown/web/marbre_web.wasm
 
 bindgen_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3 }' Cargo.lock)
 if ! command -v wasm-bindgen > /dev/null; then
@@ -24,7 +24,12 @@ if [ "$(wasm-bindgen --version | awk '{print $2}')" != "$bindgen_version" ]; the
     exit 1
 fi
 
-cargo build --release --locked --target wasm32-unknown-unknown -p marbre-web
+# The `web` profile (Cargo.toml) optimises for size. Without reference
+# types: wasm-bindgen then keeps JavaScript objects in a table of its own,
+# which Debian's binaryen (108) optimises correctly; with them, its
+# wasm-opt broke the page (a table of functions typed as one of objects).
+CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS="-Ctarget-feature=-reference-types" \
+    cargo build --profile web --locked --target wasm32-unknown-unknown -p marbre-web
 rm -rf "$dist"
 mkdir -p "$dist"
 wasm-bindgen --target web --no-typescript --out-dir "$dist" "$wasm"
@@ -32,7 +37,7 @@ if command -v wasm-opt > /dev/null; then
     # The features rustc's wasm32 target enables by default; binaryen's
     # own defaults are older.
     wasm-opt -Oz --enable-bulk-memory --enable-mutable-globals --enable-sign-ext \
-        --enable-nontrapping-float-to-int --enable-reference-types --enable-multivalue \
+        --enable-nontrapping-float-to-int --enable-multivalue \
         "$dist/marbre_web_bg.wasm" -o "$dist/marbre_web_bg.wasm"
 else
     echo "web/build.sh: wasm-opt (Debian's binaryen) is not installed: the wasm is left unshrunk" >&2

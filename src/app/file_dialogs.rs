@@ -97,3 +97,15 @@ pub fn take_dropped() -> Vec<PathBuf> {
 /// A save on the desktop is on disk already; a web page offers it as a
 /// download.
 pub fn deliver_saved(_path: &std::path::Path) {}
+
+/// A link carries a scene to the web page: the desktop has no page
+/// address to put it in (Share is offered in a page only).
+pub fn publish_link(_fragment: &str) -> Result<String, String> {
+    Err(
+        "links open marbre's web page: share from the page (README, \"The viewer in a browser\")"
+            .into(),
+    )
+}
+
+/// On the desktop a file is saved where the user says (Save as).
+pub fn offer_download(_name: &std::path::Path, _bytes: &[u8]) {}

@@ -71,6 +71,10 @@ pub struct ViewerOptions {
     /// The trace time a frame may take, in ms (`app::frame_budget`); 0
     /// traces a whole round every frame.
     pub frame_budget_ms: f32,
+    /// Stop tracing once this many samples per pixel are accumulated, as
+    /// a render's sample count does (the web page's `?spp=`); None traces
+    /// on (or to the Quality strip's target error).
+    pub max_spp: Option<u32>,
 }
 
 struct App {

@@ -72,6 +72,17 @@ pub fn preset_ui(ui: &mut Ui, state: &mut PanelState, actions: &mut Vec<PanelAct
         {
             actions.push(PanelAction::BrowseSavePresetAs);
         }
+        if state.shares_links
+            && ui
+                .button("Share")
+                .on_hover_text(
+                    "Put the scene in the page's address and copy the link: opening it \
+                     shows this scene (files you dropped on the page are not in it)",
+                )
+                .clicked()
+        {
+            actions.push(PanelAction::ShareLink);
+        }
     });
     ui.horizontal(|ui| {
         let undo = ui

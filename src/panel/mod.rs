@@ -85,6 +85,9 @@ pub struct PanelState {
     pub can_redo: bool,
     /// Whether the scene has edits its preset file does not have.
     pub unsaved: bool,
+    /// Whether Share is offered: in a web page, whose address can carry
+    /// the scene (`app::share_link`).
+    pub shares_links: bool,
     /// Recently opened presets and environment maps, newest first.
     pub recent_files: Vec<PathBuf>,
     /// Set to put the keyboard in the preset or environment path field
@@ -118,6 +121,7 @@ impl PanelState {
             can_undo: false,
             can_redo: false,
             unsaved: false,
+            shares_links: cfg!(target_arch = "wasm32"),
             recent_files: Vec::new(),
             focus_preset_path: false,
             focus_env_path: false,
@@ -205,6 +209,9 @@ pub enum PanelAction {
     LoadPreset(PathBuf),
     /// Save to the preset file the scene came from.
     SavePreset,
+    /// Put the scene in the page's address, to pass on as a link (a web
+    /// page's Share; `app::share_link`).
+    ShareLink,
     /// Save to a typed path (the Preset field's Save as, or the Save as
     /// dialog); a file already there is replaced only once confirmed.
     SavePresetAs(PathBuf),

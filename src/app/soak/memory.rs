@@ -30,25 +30,37 @@ pub fn sample_memory(ctx: &GpuContext) -> MemorySample {
             .device
             .generate_allocator_report()
             .map(|r| r.total_allocated_bytes),
-        gpu_resources: ctx.instance.generate_report().map(|report| {
-            let hub = report.hub_report();
-            [
-                &hub.buffers,
-                &hub.textures,
-                &hub.texture_views,
-                &hub.bind_groups,
-                &hub.render_pipelines,
-                &hub.compute_pipelines,
-                &hub.shader_modules,
-                &hub.query_sets,
-                &hub.samplers,
-            ]
-            .iter()
-            .map(|r| r.num_allocated as u64)
-            .sum()
-        }),
+        gpu_resources: live_gpu_resources(ctx),
         heap: crate::heap::usage(),
     }
+}
+
+/// The GPU objects alive now, by wgpu-core's count. A web page's WebGPU
+/// keeps no such count (wgpu there has no wgpu-core).
+#[cfg(target_arch = "wasm32")]
+fn live_gpu_resources(_ctx: &GpuContext) -> Option<u64> {
+    None
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+fn live_gpu_resources(ctx: &GpuContext) -> Option<u64> {
+    ctx.instance.generate_report().map(|report| {
+        let hub = report.hub_report();
+        [
+            &hub.buffers,
+            &hub.textures,
+            &hub.texture_views,
+            &hub.bind_groups,
+            &hub.render_pipelines,
+            &hub.compute_pipelines,
+            &hub.shader_modules,
+            &hub.query_sets,
+            &hub.samplers,
+        ]
+        .iter()
+        .map(|r| r.num_allocated as u64)
+        .sum()
+    })
 }
 
 /// The process's resident set, from the `VmRSS` line of

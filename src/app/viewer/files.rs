@@ -15,6 +15,7 @@ use crate::app::history::History;
 use crate::app::prompts::{Answer, Prompt};
 use crate::app::recovery;
 use crate::app::scene_loader::{FileKind, ReadyScene, SceneKind, SceneLoad};
+use crate::app::share_link;
 use crate::panel::save_as::SaveAs;
 use anyhow::{Context as _, Result};
 use marbre_core::envmap;
@@ -316,6 +317,34 @@ impl Viewer {
             self.edits.prompt = Some(Prompt::Replace(path.to_owned()));
         } else {
             self.save_preset(path);
+        }
+    }
+
+    /// Puts the scene in the page's address as a link (`app::share_link`);
+    /// a scene too large for one is offered as a preset file instead.
+    pub(super) fn share_link(&mut self) {
+        let preset = self.edits.document.preset(&self.scene);
+        let text = match preset::to_text(&preset, Path::new(share_link::SHARED_PRESET_PATH)) {
+            Ok(text) => text,
+            Err(e) => {
+                self.panel.error(format!("cannot share the scene: {e}"));
+                return;
+            }
+        };
+        match share_link::encode(&text).map_err(|e| e.to_string()) {
+            Ok(fragment) => match file_dialogs::publish_link(&fragment) {
+                Ok(url) => self.panel.info(format!(
+                    "the link to this scene ({} characters) is in the address bar and copied: {url}",
+                    url.len()
+                )),
+                Err(e) => self.panel.error(format!("cannot share the scene: {e}")),
+            },
+            Err(too_large) => {
+                self.panel.error(too_large);
+                let name = self.edits.document.save_as_suggestion();
+                let name = name.file_name().map_or_else(|| "scene.ron".into(), PathBuf::from);
+                file_dialogs::offer_download(&name, text.as_bytes());
+            }
         }
     }
 

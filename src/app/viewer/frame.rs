@@ -72,7 +72,11 @@ impl Viewer {
     /// and the estimate of the current image is there.
     fn paused_at_target(&self) -> bool {
         let controls = &self.panel.quality;
-        controls.stop_at_target && self.meters.convergence.reached(controls.target_error)
+        let enough = self
+            .options
+            .max_spp
+            .is_some_and(|n| self.renderer.accumulated_samples() >= n);
+        enough || controls.stop_at_target && self.meters.convergence.reached(controls.target_error)
     }
 
     /// Follows the non-finite counters: they restart with the

@@ -469,6 +469,11 @@ impl Viewer {
         Ok(viewer)
     }
 
+    /// Samples per pixel accumulated in the image on screen.
+    pub fn samples_accumulated(&self) -> u32 {
+        self.renderer.accumulated_samples()
+    }
+
     pub fn request_redraw(&self) {
         self.window.request_redraw();
     }
@@ -758,6 +763,7 @@ impl Viewer {
                     self.save_document();
                 }
                 PanelAction::SavePresetAs(p) => self.request_save_as(&p),
+                PanelAction::ShareLink => self.share_link(),
                 PanelAction::BrowsePreset => {
                     self.open_dialog(super::file_dialogs::DialogPurpose::OpenPreset)
                 }

@@ -191,9 +191,33 @@ pub fn deliver_saved(path: &Path) {
     let name = path
         .file_name()
         .map_or_else(|| "scene.ron".into(), |n| n.to_string_lossy().into_owned());
-    if let Err(e) = download(&name, &bytes) {
+    offer_download(Path::new(&name), &bytes);
+}
+
+/// Offers `bytes` as a download called `name`.
+pub fn offer_download(name: &Path, bytes: &[u8]) {
+    let name = name.to_string_lossy();
+    if let Err(e) = download(&name, bytes) {
         log::warn!("cannot offer {name} as a download: {e:?}");
     }
+}
+
+/// Puts `fragment` in the page's address (replacing the history entry, so
+/// Back leaves the page as before) and copies the whole link; returns it.
+pub fn publish_link(fragment: &str) -> Result<String, String> {
+    let window = web_sys::window().ok_or("no browser window")?;
+    let location = window.location();
+    let base = location.href().map_err(|e| format!("{e:?}"))?;
+    let base = base.split('#').next().unwrap_or_default();
+    let url = format!("{base}#{fragment}");
+    window
+        .history()
+        .and_then(|h| h.replace_state_with_url(&JsValue::NULL, "", Some(&url)))
+        .map_err(|e| format!("the browser refused the new address: {e:?}"))?;
+    // The clipboard may be refused (no focus, no permission): the link is
+    // in the address bar all the same.
+    let _ = window.navigator().clipboard().write_text(&url);
+    Ok(url)
 }
 
 fn download(name: &str, bytes: &[u8]) -> Result<(), JsValue> {

@@ -84,6 +84,13 @@ async fn open_page() -> Result<()> {
         options: ViewerOptions {
             preset: Some(preset),
             kernel: query_kernel()?,
+            max_spp: query_value(&search()?, "spp")
+                .map(|n| {
+                    n.parse::<u32>().ok().filter(|&n| n >= 1).ok_or_else(|| {
+                        anyhow!("?spp={n}: give a whole number of samples, 1 or more")
+                    })
+                })
+                .transpose()?,
             // Whole rounds: the browser paces the frames, and a page cannot
             // wait for the GPU to time bands on the wall clock.
             frame_budget_ms: 0.0,
@@ -152,8 +159,7 @@ fn startup_preset() -> Result<PathBuf> {
         page_files::insert(&path, text.into_bytes());
         return Ok(path);
     }
-    let search = location.search().unwrap_or_default();
-    Ok(query_value(&search, "preset").map_or_else(
+    Ok(query_value(&search()?, "preset").map_or_else(
         || PathBuf::from(marbre_render::session::DEFAULT_PRESET),
         PathBuf::from,
     ))
@@ -164,12 +170,7 @@ fn startup_preset() -> Result<PathBuf> {
 /// need a second device to time the kernels on, which a page cannot wait
 /// for.
 fn query_kernel() -> Result<KernelChoice> {
-    let search = web_sys::window()
-        .context("no browser window")?
-        .location()
-        .search()
-        .unwrap_or_default();
-    match query_value(&search, "kernel") {
+    match query_value(&search()?, "kernel") {
         Some(name) => name.parse().map_err(|_| {
             anyhow!(
                 "?kernel={name}: give one of {}",
@@ -180,6 +181,15 @@ fn query_kernel() -> Result<KernelChoice> {
     }
 }
 
+/// The page address's query string (`?preset=…&kernel=…&spp=…`).
+fn search() -> Result<String> {
+    Ok(web_sys::window()
+        .context("no browser window")?
+        .location()
+        .search()
+        .unwrap_or_default())
+}
+
 /// The value of `key` in a query string (`?a=1&b=2`), undecoded: the
 /// values marbre reads are plain paths and names.
 fn query_value(search: &str, key: &str) -> Option<String> {
@@ -188,6 +198,17 @@ fn query_value(search: &str, key: &str) -> Option<String> {
         .split('&')
         .find_map(|pair| pair.strip_prefix(key)?.strip_prefix('='))
         .map(str::to_owned)
+}
+
+/// The tab's title says how far the image is, as a render's progress
+/// does: "marbre · 12 spp" (the browser tests wait on it).
+fn show_progress(viewer: &Viewer) {
+    let title = format!("marbre · {} spp", viewer.samples_accumulated());
+    if let Some(document) = web_sys::window().and_then(|w| w.document())
+        && document.title() != title
+    {
+        document.set_title(&title);
+    }
 }
 
 /// Shows `message` in the page's status line (an error stays shown).
@@ -267,7 +288,9 @@ impl ApplicationHandler for PageApp {
         let Some(viewer) = slot.as_mut() else {
             return;
         };
+        let redraw = matches!(event, WindowEvent::RedrawRequested);
         match viewer.handle_event(&event) {
+            Ok(true) if redraw => show_progress(viewer),
             Ok(true) => {}
             Ok(false) => event_loop.exit(),
             Err(e) => {

@@ -81,6 +81,12 @@ impl GpuContext {
         Ok((ctx, surface))
     }
 
+    /// A device with no surface from the browser's WebGPU, awaited: for
+    /// tests that run inside a page (issue 34).
+    pub async fn for_browser() -> Result<Self> {
+        Self::from_instance_async(instance_of(wgpu::Backends::BROWSER_WEBGPU), None).await
+    }
+
     fn from_instance(
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,

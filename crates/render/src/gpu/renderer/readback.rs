@@ -10,7 +10,7 @@ use crate::gpu::error_meter;
 use crate::gpu::error_meter::ErrorEstimate;
 use crate::gpu::non_finite::NonFiniteCounts;
 use crate::gpu::pass_timer::PassTimer;
-use crate::gpu::readback::read_texture;
+use crate::gpu::readback::{read_texture, read_texture_async};
 use anyhow::Result;
 
 impl Renderer {
@@ -25,6 +25,14 @@ impl Renderer {
         self.read_accumulated(ctx, self.accumulation.latest_spread_texture())
     }
 
+    /// [`Renderer::read_radiance`] awaited: for a web page, which cannot
+    /// wait for the GPU (`readback::read_texture_async`).
+    pub async fn read_radiance_async(&self, ctx: &GpuContext) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+        let texture = self.accumulation.latest_mean_texture();
+        let bytes = read_texture_async(&ctx.device, &ctx.queue, texture, 16).await?;
+        Ok(self.shown_region(&bytes))
+    }
+
     /// The traced region of one of the accumulation targets.
     pub(super) fn read_accumulated(
         &self,
@@ -32,14 +40,19 @@ impl Renderer {
         texture: &wgpu::Texture,
     ) -> Result<(u32, u32, Vec<[f32; 4]>)> {
         let bytes = read_texture(&ctx.device, &ctx.queue, texture, 16)?;
-        let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(self.shown_region(&bytes))
+    }
+
+    /// The shown region's texels of a whole accumulation target's bytes.
+    fn shown_region(&self, bytes: &[u8]) -> (u32, u32, Vec<[f32; 4]>) {
+        let all: &[[f32; 4]] = bytemuck::cast_slice(bytes);
         let (rw, rh) = self.shown_size();
         let mut out = Vec::with_capacity((rw * rh) as usize);
         for y in 0..rh {
             let start = (y * self.size.0) as usize;
             out.extend_from_slice(&all[start..start + rw as usize]);
         }
-        Ok((rw, rh, out))
+        (rw, rh, out)
     }
 
     /// Meters the latest mean for auto exposure and reads the result back,

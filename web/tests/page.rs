@@ -1,0 +1,378 @@
+//! The web page end to end, as a person uses it (issue 34): headless
+//! Chromium on SwiftShader's WebGPU, driven through chromedriver's
+//! WebDriver API (which drives Chromium over its DevTools protocol),
+//! opens the built page (`web/build.sh`), served as `web/serve.sh` does:
+//! - the default preset loads and the page shows the panel and an image;
+//! - dragging a noise slider in the panel changes the image;
+//! - Share puts the scene in the address, and opening that link in a
+//!   fresh page shows the edited scene again.
+//!
+//! The page stops at `?spp=8`, and the tab's title says the samples
+//! ("marbre · 8 spp"): screenshots are taken of finished images, the same
+//! samples of the same scene, so the reopened link must match closely.
+//! Needs Chromium, chromedriver and `web/dist`; without one it skips
+//! loudly, and `web/test.sh` (`MARBRE_REQUIRE_WEB=1`) makes that a failure.
+
+#![cfg(not(target_arch = "wasm32"))]
+
+use base64::Engine as _;
+use serde_json::{Value, json};
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The window the page is tested in, in CSS pixels (device scale 1).
+const WINDOW: (u32, u32) = (1280, 720);
+/// The samples each image is traced to.
+const SPP: u32 = 8;
+/// The image's part of the window, left of the panel and above the
+/// Quality strip at this size (`app::viewer`'s layout).
+const IMAGE: (u32, u32) = (880, 540);
+/// Where the default preset's controls are, at this window size: the
+/// marble's noise frequency slider (its knob at 1.0, the slider 948 to
+/// 1046 wide) and the Share button beside Save as….
+const FREQUENCY_KNOB: (i64, i64) = (996, 395);
+const SHARE_BUTTON: (i64, i64) = (1132, 92);
+/// How long SwiftShader may take to load the page and trace 8 samples.
+const PAGE_TIMEOUT: Duration = Duration::from_secs(120);
+
+fn require_web() -> bool {
+    std::env::var_os("MARBRE_REQUIRE_WEB").is_some_and(|v| v == "1")
+}
+
+/// Skips (loudly) or fails, as [`require_web`] says.
+fn missing(what: &str) {
+    assert!(!require_web(), "MARBRE_REQUIRE_WEB=1 and {what}");
+    eprintln!("\n*** SKIPPED: the web page test: {what} ***\n");
+}
+
+fn dist() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("dist")
+}
+
+fn free_port() -> u16 {
+    TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+/// A child process killed when the test ends, however it ends.
+struct Running(Child);
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn start(program: &str, args: &[&str], dir: &Path) -> Running {
+    Running(
+        Command::new(program)
+            .args(args)
+            .current_dir(dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {program}: {e}")),
+    )
+}
+
+/// Waits until `port` accepts connections.
+fn wait_for_port(port: u16, what: &str) {
+    let start = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "{what} never listened on {port}"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// A WebDriver session on chromedriver.
+struct Browser {
+    base: String,
+    agent: ureq::Agent,
+}
+
+impl Browser {
+    fn open(driver_port: u16) -> Self {
+        let agent: ureq::Agent = ureq::Agent::config_builder()
+            .http_status_as_error(false)
+            .timeout_global(Some(Duration::from_secs(180)))
+            .build()
+            .into();
+        let options: Value =
+            serde_json::from_str(include_str!("../webdriver.json")).expect("web/webdriver.json");
+        let capabilities = json!({ "capabilities": { "alwaysMatch": options } });
+        let root = format!("http://127.0.0.1:{driver_port}");
+        let created = post(&agent, &format!("{root}/session"), &capabilities);
+        let id = created["sessionId"]
+            .as_str()
+            .unwrap_or_else(|| panic!("no WebDriver session: {created}"))
+            .to_owned();
+        Self {
+            base: format!("{root}/session/{id}"),
+            agent,
+        }
+    }
+
+    fn post(&self, path: &str, body: &Value) -> Value {
+        post(&self.agent, &format!("{}{path}", self.base), body)
+    }
+
+    fn get(&self, path: &str) -> Value {
+        let mut response = self
+            .agent
+            .get(&format!("{}{path}", self.base))
+            .call()
+            .expect("chromedriver answers");
+        let value: Value = response
+            .body_mut()
+            .read_json()
+            .expect("JSON from chromedriver");
+        value["value"].clone()
+    }
+
+    fn go(&self, url: &str) {
+        self.post("/url", &json!({ "url": url }));
+    }
+
+    fn title(&self) -> String {
+        self.get("/title").as_str().unwrap_or_default().to_owned()
+    }
+
+    /// The samples the title reports ("marbre · 8 spp"), if any.
+    fn spp(&self) -> Option<u32> {
+        self.title()
+            .strip_prefix("marbre · ")?
+            .strip_suffix(" spp")?
+            .parse()
+            .ok()
+    }
+
+    /// Waits until the page has traced [`SPP`] samples, then returns the
+    /// window as an image. Fails with the page's status line if it stops.
+    fn finished_image(&self) -> image::RgbImage {
+        let start = Instant::now();
+        while self.spp() != Some(SPP) {
+            assert!(
+                start.elapsed() < PAGE_TIMEOUT,
+                "the page never reached {SPP} spp (title {:?}, status {:?})",
+                self.title(),
+                self.status()
+            );
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        self.screenshot()
+    }
+
+    /// The page's status line (errors show there).
+    fn status(&self) -> String {
+        self.post(
+            "/execute/sync",
+            &json!({ "script": "return document.getElementById('marbre-status').textContent", "args": [] }),
+        )
+        .as_str()
+        .unwrap_or_default()
+        .to_owned()
+    }
+
+    fn screenshot(&self) -> image::RgbImage {
+        let data = self.get("/screenshot");
+        let png = base64::engine::general_purpose::STANDARD
+            .decode(data.as_str().expect("a screenshot"))
+            .unwrap();
+        image::load_from_memory(&png).unwrap().to_rgb8()
+    }
+
+    /// Presses the mouse at `from`, moves to `to` in steps, and releases.
+    fn drag(&self, from: (i64, i64), to: (i64, i64)) {
+        let mut actions = vec![
+            json!({ "type": "pointerMove", "origin": "viewport", "x": from.0, "y": from.1 }),
+            json!({ "type": "pointerDown", "button": 0 }),
+        ];
+        for step in 1..=5 {
+            let x = from.0 + (to.0 - from.0) * step / 5;
+            let y = from.1 + (to.1 - from.1) * step / 5;
+            actions.push(json!({ "type": "pointerMove", "origin": "viewport", "x": x, "y": y, "duration": 50 }));
+        }
+        actions.push(json!({ "type": "pointerUp", "button": 0 }));
+        self.post(
+            "/actions",
+            &json!({ "actions": [{ "type": "pointer", "id": "mouse", "parameters": { "pointerType": "mouse" }, "actions": actions }] }),
+        );
+    }
+
+    fn click(&self, at: (i64, i64)) {
+        self.drag(at, at);
+    }
+}
+
+impl Drop for Browser {
+    fn drop(&mut self) {
+        let _ = self.agent.delete(&self.base).call();
+    }
+}
+
+fn post(agent: &ureq::Agent, url: &str, body: &Value) -> Value {
+    let mut response = agent
+        .post(url)
+        .send_json(body)
+        .expect("chromedriver answers");
+    let value: Value = response
+        .body_mut()
+        .read_json()
+        .expect("JSON from chromedriver");
+    value["value"].clone()
+}
+
+/// The mean absolute difference of two screenshots' image parts, per
+/// channel, in 0–255.
+fn image_difference(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    let mut sum = 0u64;
+    for y in 0..IMAGE.1 {
+        for x in 0..IMAGE.0 {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            sum += (0..3).map(|c| u64::from(p[c].abs_diff(q[c]))).sum::<u64>();
+        }
+    }
+    sum as f64 / f64::from(IMAGE.0 * IMAGE.1 * 3)
+}
+
+/// The spread of the image part's luminance: a blank canvas has none.
+fn image_spread(shot: &image::RgbImage) -> f64 {
+    let values: Vec<f64> = (0..IMAGE.1)
+        .flat_map(|y| (0..IMAGE.0).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let p = shot.get_pixel(x, y);
+            0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+        })
+        .collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64).sqrt()
+}
+
+/// The share of the panel's pixels that are its text (bright on its dark
+/// background): egui's panel is drawn, labels and all.
+fn panel_text_share(shot: &image::RgbImage) -> f64 {
+    let (x0, w, h) = (IMAGE.0 + 20, WINDOW.0 - IMAGE.0 - 20, WINDOW.1);
+    let bright = (0..h)
+        .flat_map(|y| (x0..x0 + w).map(move |x| (x, y)))
+        .filter(|&(x, y)| shot.get_pixel(x, y).0.iter().all(|&c| c > 150))
+        .count();
+    bright as f64 / f64::from(w * h)
+}
+
+#[test]
+fn the_page_loads_edits_and_reopens_a_shared_scene() {
+    let chromedriver = Path::new("/usr/bin/chromedriver");
+    if !chromedriver.exists() {
+        return missing("no chromedriver (Debian's chromium-driver)");
+    }
+    if !dist().join("marbre_web_bg.wasm").exists() {
+        return missing("no web/dist (build it with bash web/build.sh)");
+    }
+    let (page_port, driver_port) = (free_port(), free_port());
+    let _server = start(
+        "python3",
+        &[
+            "-m",
+            "http.server",
+            &page_port.to_string(),
+            "--bind",
+            "127.0.0.1",
+        ],
+        &dist(),
+    );
+    let _driver = start(
+        chromedriver.to_str().unwrap(),
+        &[&format!("--port={driver_port}")],
+        &dist(),
+    );
+    wait_for_port(page_port, "the page's server");
+    wait_for_port(driver_port, "chromedriver");
+    let browser = Browser::open(driver_port);
+    let page = format!("http://127.0.0.1:{page_port}/?spp={SPP}");
+
+    let opened = Instant::now();
+    browser.go(&page);
+    let start = Instant::now();
+    while browser.spp().is_none_or(|n| n == 0) {
+        assert!(
+            start.elapsed() < PAGE_TIMEOUT,
+            "no first image: {}",
+            browser.status()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    eprintln!(
+        "page to first image: {:.2} s (the target is under 5 s)",
+        opened.elapsed().as_secs_f64()
+    );
+    let loaded = browser.finished_image();
+    assert_eq!(loaded.dimensions(), WINDOW, "the window's size");
+    assert!(
+        image_spread(&loaded) > 20.0,
+        "the image is blank: spread {:.1}",
+        image_spread(&loaded)
+    );
+    let text = panel_text_share(&loaded);
+    assert!(
+        text > 0.01,
+        "the panel shows no text: {text:.4} of its pixels bright"
+    );
+    loaded.save(dist().join("../target-page-loaded.png")).ok();
+
+    browser.drag(FREQUENCY_KNOB, (FREQUENCY_KNOB.0 + 40, FREQUENCY_KNOB.1));
+    // The edit restarts the samples: wait for that, then for the image.
+    let start = Instant::now();
+    while browser.spp() == Some(SPP) {
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "the slider drag changed nothing"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let edited = browser.finished_image();
+    let changed = image_difference(&loaded, &edited);
+    assert!(
+        changed > 2.0,
+        "the slider edit did not change the image: {changed:.2}"
+    );
+
+    browser.click(SHARE_BUTTON);
+    let start = Instant::now();
+    let link = loop {
+        let url = browser.get("/url").as_str().unwrap_or_default().to_owned();
+        if url.contains("#scene=") {
+            break url;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "Share put no scene in the address: {url}"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    browser.go("about:blank");
+    browser.go(&link);
+    let reopened = browser.finished_image();
+    let same = image_difference(&edited, &reopened);
+    let from_original = image_difference(&loaded, &reopened);
+    eprintln!(
+        "shared link: {} characters; the reopened image is {same:.3} from the edited one, {from_original:.2} from the original",
+        link.len()
+    );
+    assert!(
+        same < 1.0,
+        "the shared link reopened another image: {same:.2}"
+    );
+    assert!(
+        from_original > 2.0,
+        "the shared link lost the edit: {from_original:.2}"
+    );
+}
