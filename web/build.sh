@@ -24,24 +24,25 @@ if [ "$(wasm-bindgen --version | awk '{print $2}')" != "$bindgen_version" ]; the
     exit 1
 fi
 
-# The `web` profile (Cargo.toml) optimises for size. Without reference
-# types: wasm-bindgen then keeps JavaScript objects in a table of its own,
-# which Debian's binaryen (108) optimises correctly; with them, its
-# wasm-opt broke the page (a table of functions typed as one of objects).
-CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS="-Ctarget-feature=-reference-types" \
-    cargo build --profile web --locked --target wasm32-unknown-unknown -p marbre-web
+# The `web` profile (Cargo.toml) optimises for size.
+cargo build --profile web --locked --target wasm32-unknown-unknown -p marbre-web
 rm -rf "$dist"
 mkdir -p "$dist"
-wasm-bindgen --target web --no-typescript --out-dir "$dist" "$wasm"
 if command -v wasm-opt > /dev/null; then
-    # The features rustc's wasm32 target enables by default; binaryen's
-    # own defaults are older.
+    # Shrunk before wasm-bindgen adds its table of JavaScript objects:
+    # Debian's binaryen (108) writes a module with two tables back with
+    # the table export pointing at the wrong one (the page then fails in
+    # WebAssembly.Table.set). The features are those rustc's wasm32 target
+    # uses, which binaryen 108 does not assume.
+    mkdir -p target/web-opt
     wasm-opt -Oz --enable-bulk-memory --enable-mutable-globals --enable-sign-ext \
-        --enable-nontrapping-float-to-int --enable-multivalue \
-        "$dist/marbre_web_bg.wasm" -o "$dist/marbre_web_bg.wasm"
+        --enable-nontrapping-float-to-int --enable-reference-types --enable-multivalue \
+        "$wasm" -o target/web-opt/marbre_web.wasm
+    wasm=target/web-opt/marbre_web.wasm
 else
     echo "web/build.sh: wasm-opt (Debian's binaryen) is not installed: the wasm is left unshrunk" >&2
 fi
+wasm-bindgen --target web --no-typescript --out-dir "$dist" "$wasm"
 cp web/index.html "$dist/"
 # The shipped files, with their paths as the presets name them.
 find presets envmaps -type f ! -name README.md | sort > "$dist/.assets"

@@ -125,6 +125,51 @@ impl Renderer {
     /// denoised, when denoising, from the latest round (OIDN waited for).
     pub fn read_display(&mut self, ctx: &GpuContext) -> Result<image::RgbaImage> {
         self.finish_denoise(ctx)?;
+        let target = self.display_texture(ctx)?;
+        let (w, h) = (target.width(), target.height());
+        let bytes = read_texture(&ctx.device, &ctx.queue, &target, 4)?;
+        image::RgbaImage::from_raw(w, h, bytes)
+            .ok_or_else(|| anyhow::anyhow!("readback returned the wrong number of bytes"))
+    }
+
+    /// The displayed image (sRGB, RGBA8) and the linear mean (RGBA f32) of
+    /// the shown region, drawn and copied now into textures of their own:
+    /// a web page reads them back later, awaited
+    /// (`readback::read_texture_async`), while the renderer goes on.
+    pub fn snapshot(&mut self, ctx: &GpuContext) -> Result<(wgpu::Texture, wgpu::Texture)> {
+        let display = self.display_texture(ctx)?;
+        let (w, h) = (display.width(), display.height());
+        let source = self.accumulation.latest_mean_texture();
+        let mean = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mean snapshot"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: source.format(),
+            usage: wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_texture(
+            source.as_image_copy(),
+            mean.as_image_copy(),
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        ctx.queue.submit([encoder.finish()]);
+        Ok((display, mean))
+    }
+
+    /// The display pass drawn into a new texture of the shown size.
+    fn display_texture(&mut self, ctx: &GpuContext) -> Result<wgpu::Texture> {
         let (w, h) = self.shown_size();
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let target = ctx.device.create_texture(&wgpu::TextureDescriptor {
@@ -156,8 +201,6 @@ impl Renderer {
         };
         self.display(ctx, &mut encoder, &display_target, None)?;
         ctx.queue.submit([encoder.finish()]);
-        let bytes = read_texture(&ctx.device, &ctx.queue, &target, 4)?;
-        image::RgbaImage::from_raw(w, h, bytes)
-            .ok_or_else(|| anyhow::anyhow!("readback returned the wrong number of bytes"))
+        Ok(target)
     }
 }
