@@ -222,6 +222,25 @@ impl Browser {
     fn click(&self, at: (i64, i64)) {
         self.drag(at, at);
     }
+
+    /// Presses and releases `key` (a WebDriver key: F12 is U+E03C).
+    fn press(&self, key: char) {
+        let key = key.to_string();
+        self.post(
+            "/actions",
+            &json!({ "actions": [{ "type": "key", "id": "keyboard", "actions": [
+                { "type": "keyDown", "value": key }, { "type": "keyUp", "value": key }] }] }),
+        );
+    }
+
+    /// Lets the page's downloads land in `dir` (over the DevTools protocol).
+    fn download_to(&self, dir: &Path) {
+        self.post(
+            "/goog/cdp/execute",
+            &json!({ "cmd": "Browser.setDownloadBehavior", "params": {
+                "behavior": "allow", "downloadPath": dir.to_str().unwrap() } }),
+        );
+    }
 }
 
 impl Drop for Browser {
@@ -411,9 +430,100 @@ fn the_page_loads_edits_and_reopens_a_shared_scene() {
          {from_original:.2} from the original (the edit made {changed:.2})",
         link.len()
     );
+    screenshot_downloads(&browser, &reopened);
+    dropped_preset_opens(&browser, &reopened);
     assert!(
         from_edited < from_original / 2.0,
         "the shared link did not reopen the edited scene: {from_edited:.2} from it, \
          {from_original:.2} from the original"
+    );
+}
+
+/// F12 in the page saves the image as the desktop does, as two downloads:
+/// a PNG of what the page shows and an EXR of the linear radiance.
+fn screenshot_downloads(browser: &Browser, shown: &image::RgbImage) {
+    let downloads = Path::new(env!("CARGO_TARGET_TMPDIR")).join("page-downloads");
+    let _ = std::fs::remove_dir_all(&downloads);
+    std::fs::create_dir_all(&downloads).unwrap();
+    browser.download_to(&downloads);
+    browser.press('\u{E03C}');
+    let start = Instant::now();
+    let (png, exr) = loop {
+        let files: Vec<PathBuf> = std::fs::read_dir(&downloads)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        let find = |ext: &str| {
+            files
+                .iter()
+                .find(|p| p.extension().is_some_and(|e| e == ext))
+                .cloned()
+        };
+        if let (Some(png), Some(exr)) = (find("png"), find("exr")) {
+            break (png, exr);
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "F12 downloaded no PNG and EXR: {files:?}; status {:?}",
+            browser.status()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let saved = image::open(&png).unwrap().to_rgb8();
+    let (w, h) = saved.dimensions();
+    assert!(
+        w >= IMAGE.0 && h >= IMAGE.1 && w < WINDOW.0,
+        "the PNG is {w} × {h}: the image, without the panel, was expected"
+    );
+    let unlike = scene_difference(shown, &saved, (0, 0, IMAGE.0, IMAGE.1));
+    assert!(
+        unlike < 2.0,
+        "the PNG is not the image the page shows: {unlike:.2}"
+    );
+    let linear = exr::prelude::read_first_rgba_layer_from_file(
+        &exr,
+        |size, _| vec![[0f32; 3]; size.0 * size.1],
+        move |pixels, at, (r, g, b, _): (f32, f32, f32, f32)| {
+            pixels[at.1 * w as usize + at.0] = [r, g, b]
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
+    let size = linear.layer_data.size;
+    assert_eq!((size.0 as u32, size.1 as u32), (w, h), "the EXR's size");
+    let pixels = &linear.layer_data.channel_data.pixels;
+    assert!(pixels.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(pixels.iter().any(|p| p[0] > 0.05), "the EXR is black");
+}
+
+/// A preset dropped on the page opens as on the desktop window: here the
+/// checkerboard preset, whose env map the page holds under the path the
+/// preset names. The drop is the browser's own event, carrying a file.
+fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets/checkers.ron"),
+    )
+    .unwrap();
+    browser.post(
+        "/execute/sync",
+        &json!({ "script": "const files = new DataTransfer(); \
+            files.items.add(new File([arguments[0]], 'checkers.ron')); \
+            window.dispatchEvent(new DragEvent('drop', { dataTransfer: files, cancelable: true }));",
+            "args": [text] }),
+    );
+    let start = Instant::now();
+    while browser.spp() == Some(SPP) {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the dropped preset did not open: status {:?}",
+            browser.status()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let dropped = browser.finished_image();
+    keep("dropped", &dropped);
+    let changed = scene_difference(before, &dropped, (0, 0, IMAGE.0, IMAGE.1));
+    assert!(
+        changed > 10.0,
+        "the dropped preset did not change the scene: {changed:.2}"
     );
 }
