@@ -223,14 +223,32 @@ impl Browser {
         self.drag(at, at);
     }
 
-    /// Presses and releases `key` (a WebDriver key: F12 is U+E03C).
-    fn press(&self, key: char) {
-        let key = key.to_string();
+    /// Presses `keys` together and releases them (WebDriver keys: F12 is
+    /// U+E03C, Control U+E009).
+    fn press(&self, keys: &[char]) {
+        let down = keys
+            .iter()
+            .map(|k| json!({ "type": "keyDown", "value": k.to_string() }));
+        let up = keys
+            .iter()
+            .rev()
+            .map(|k| json!({ "type": "keyUp", "value": k.to_string() }));
+        let actions: Vec<Value> = down.chain(up).collect();
         self.post(
             "/actions",
-            &json!({ "actions": [{ "type": "key", "id": "keyboard", "actions": [
-                { "type": "keyDown", "value": key }, { "type": "keyUp", "value": key }] }] }),
+            &json!({ "actions": [{ "type": "key", "id": "keyboard", "actions": actions }] }),
         );
+    }
+
+    /// What the page keeps in its local storage under `key`.
+    fn stored(&self, key: &str) -> String {
+        self.post(
+            "/execute/sync",
+            &json!({ "script": "return window.localStorage.getItem(arguments[0])", "args": [key] }),
+        )
+        .as_str()
+        .unwrap_or_default()
+        .to_owned()
     }
 
     /// Lets the page's downloads land in `dir` (over the DevTools protocol).
@@ -328,51 +346,112 @@ fn keep(name: &str, shot: &image::RgbImage) {
     }
 }
 
-#[test]
-fn the_page_loads_edits_and_reopens_a_shared_scene() {
-    let chromedriver = Path::new("/usr/bin/chromedriver");
-    if !chromedriver.exists() {
-        return missing("no chromedriver (Debian's chromium-driver)");
-    }
-    if !dist().join("marbre_web_bg.wasm").exists() {
-        return missing("no web/dist (build it with bash web/build.sh)");
-    }
-    let (page_port, driver_port) = (free_port(), free_port());
-    let _server = start(
-        "python3",
-        &[
-            "-m",
-            "http.server",
-            &page_port.to_string(),
-            "--bind",
-            "127.0.0.1",
-        ],
-        &dist(),
-    );
-    let _driver = start(
-        chromedriver.to_str().unwrap(),
-        &[&format!("--port={driver_port}")],
-        &dist(),
-    );
-    wait_for_port(page_port, "the page's server");
-    wait_for_port(driver_port, "chromedriver");
-    let browser = Browser::open(driver_port);
-    let page = format!("http://127.0.0.1:{page_port}/?spp={SPP}");
+/// The built page served on a free port, and chromedriver on another;
+/// None (after a loud skip) where either is missing.
+struct Served {
+    page_port: u16,
+    driver_port: u16,
+    _server: Running,
+    _driver: Running,
+}
 
+impl Served {
+    fn start() -> Option<Self> {
+        let chromedriver = Path::new("/usr/bin/chromedriver");
+        if !chromedriver.exists() {
+            missing("no chromedriver (Debian's chromium-driver)");
+            return None;
+        }
+        if !dist().join("marbre_web_bg.wasm").exists() {
+            missing("no web/dist (build it with bash web/build.sh)");
+            return None;
+        }
+        let (page_port, driver_port) = (free_port(), free_port());
+        let server = start(
+            "python3",
+            &[
+                "-m",
+                "http.server",
+                &page_port.to_string(),
+                "--bind",
+                "127.0.0.1",
+            ],
+            &dist(),
+        );
+        let driver = start(
+            chromedriver.to_str().unwrap(),
+            &[&format!("--port={driver_port}")],
+            &dist(),
+        );
+        wait_for_port(page_port, "the page's server");
+        wait_for_port(driver_port, "chromedriver");
+        Some(Self {
+            page_port,
+            driver_port,
+            _server: server,
+            _driver: driver,
+        })
+    }
+}
+
+/// Seconds from navigating to the page to its first traced image.
+fn seconds_to_first_image(browser: &Browser, page: &str) -> f64 {
     let opened = Instant::now();
-    browser.go(&page);
-    let start = Instant::now();
+    browser.go(page);
     while browser.spp().is_none_or(|n| n == 0) {
         assert!(
-            start.elapsed() < PAGE_TIMEOUT,
+            opened.elapsed() < PAGE_TIMEOUT,
             "no first image: {}",
             browser.status()
         );
         std::thread::sleep(Duration::from_millis(20));
     }
+    opened.elapsed().as_secs_f64()
+}
+
+/// The benchmark of the page's start (`bench/web_first_image.sh`): a new
+/// browser session (an empty cache) per run, `MARBRE_WEB_RUNS` runs
+/// (default 5); prints each time and the median. The target is under 5 s.
+#[test]
+#[ignore = "a benchmark: bench/web_first_image.sh runs it"]
+fn bench_first_image() {
+    let Some(served) = Served::start() else {
+        return;
+    };
+    let runs: usize = std::env::var("MARBRE_WEB_RUNS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(5);
+    let page = format!("http://127.0.0.1:{}/?spp=1", served.page_port);
+    let mut times: Vec<f64> = (0..runs)
+        .map(|run| {
+            let browser = Browser::open(served.driver_port);
+            let s = seconds_to_first_image(&browser, &page);
+            println!("run {}: page to first image {s:.2} s", run + 1);
+            s
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    println!(
+        "page to first image: median {:.2} s of {runs} (min {:.2}, max {:.2})",
+        times[runs / 2],
+        times[0],
+        times[runs - 1]
+    );
+}
+
+#[test]
+fn the_page_loads_edits_and_reopens_a_shared_scene() {
+    let Some(served) = Served::start() else {
+        return;
+    };
+    let browser = Browser::open(served.driver_port);
+    let page_port = served.page_port;
+    let page = format!("http://127.0.0.1:{page_port}/?spp={SPP}");
+
     eprintln!(
         "page to first image: {:.2} s (the target is under 5 s)",
-        opened.elapsed().as_secs_f64()
+        seconds_to_first_image(&browser, &page)
     );
     let loaded = browser.finished_image();
     assert_eq!(loaded.dimensions(), WINDOW, "the window's size");
@@ -446,7 +525,7 @@ fn screenshot_downloads(browser: &Browser, shown: &image::RgbImage) {
     let _ = std::fs::remove_dir_all(&downloads);
     std::fs::create_dir_all(&downloads).unwrap();
     browser.download_to(&downloads);
-    browser.press('\u{E03C}');
+    browser.press(&['\u{E03C}']);
     let start = Instant::now();
     let (png, exr) = loop {
         let files: Vec<PathBuf> = std::fs::read_dir(&downloads)
@@ -526,4 +605,25 @@ fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) {
         changed > 10.0,
         "the dropped preset did not change the scene: {changed:.2}"
     );
+    // The settings remember it, in the browser's local storage.
+    let settings = browser.stored("marbre/settings.ron");
+    assert!(
+        settings.contains("uploads/checkers.ron"),
+        "the recent files in local storage: {settings:?}"
+    );
+    // Ctrl+S saves it: the preset comes down as a download.
+    let downloads = Path::new(env!("CARGO_TARGET_TMPDIR")).join("page-downloads");
+    browser.press(&['\u{E009}', 's']);
+    let saved = downloads.join("checkers.ron");
+    let start = Instant::now();
+    while !saved.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "Ctrl+S downloaded no checkers.ron: status {:?}",
+            browser.status()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let text = std::fs::read_to_string(&saved).unwrap();
+    assert!(text.contains("Checker2d"), "the saved preset: {text}");
 }

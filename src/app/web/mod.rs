@@ -11,6 +11,7 @@
 //!   (`GpuContext::for_web_window`): a page cannot block on them.
 //! - **The scene.** A link's fragment (`#scene=…`, `app::share_link`)
 //!   opens its scene; else `?preset=` names a shipped preset; else the
+//!   last preset opened (the settings are in local storage), else the
 //!   default preset.
 //!
 //! The platform seams beside this module: `file_dialogs.rs` (the browser's
@@ -82,7 +83,7 @@ async fn open_page() -> Result<()> {
     event_loop.set_control_flow(ControlFlow::Poll);
     event_loop.spawn_app(PageApp {
         options: ViewerOptions {
-            preset: Some(preset),
+            preset,
             kernel: query_kernel()?,
             max_spp: query_value(&search()?, "spp")
                 .map(|n| {
@@ -149,20 +150,18 @@ async fn response_bytes(path: &str, response: Result<JsValue, JsValue>) -> Resul
 }
 
 /// The scene to open: a shared link's (put among the page's files at
-/// `share_link::SHARED_PRESET_PATH`), `?preset=`'s, or the default.
-fn startup_preset() -> Result<PathBuf> {
+/// `share_link::SHARED_PRESET_PATH`), or `?preset=`'s; None opens the
+/// last preset, as the desktop does, else the default.
+fn startup_preset() -> Result<Option<PathBuf>> {
     let location = web_sys::window().context("no browser window")?.location();
     let hash = location.hash().unwrap_or_default();
     if let Some(shared) = share_link::decode(&hash) {
         let text = shared?;
         let path = PathBuf::from(share_link::SHARED_PRESET_PATH);
         page_files::insert(&path, text.into_bytes());
-        return Ok(path);
+        return Ok(Some(path));
     }
-    Ok(query_value(&search()?, "preset").map_or_else(
-        || PathBuf::from(marbre_render::session::DEFAULT_PRESET),
-        PathBuf::from,
-    ))
+    Ok(query_value(&search()?, "preset").map(PathBuf::from))
 }
 
 /// `?kernel=compute` (or fragment, cpu): the trace kernel, as the

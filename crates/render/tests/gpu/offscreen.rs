@@ -533,7 +533,8 @@ fn a_feature_can_be_compiled_out_unless_the_texture_code_needs_it() {
 
 /// A texture read back in bands of a few rows (as a 16384² image is, in
 /// bands of 256 MiB) comes back as written, rows tightly packed, whatever
-/// the band: one row, three rows with a short last band, all at once.
+/// the band: one row, three rows with a short last band, all at once; and
+/// read awaited, as a web page reads it.
 #[test]
 fn a_texture_read_in_bands_comes_back_as_written() {
     let Some(ctx) = gpu_or_skip("a_texture_read_in_bands_comes_back_as_written") else {
@@ -572,4 +573,13 @@ fn a_texture_read_in_bands_comes_back_as_written() {
         let read = read_texture_in_bands(&ctx.device, &ctx.queue, &texture, 4, band).unwrap();
         assert!(read == written, "band of {band} bytes");
     }
+    // The awaited readback a web page uses reads the same bytes.
+    let awaited = pollster::block_on(marbre_render::gpu::readback::read_texture_async(
+        &ctx.device,
+        &ctx.queue,
+        &texture,
+        4,
+    ))
+    .unwrap();
+    assert!(awaited == written, "the awaited readback");
 }
