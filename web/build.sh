@@ -11,7 +11,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dist=web/dist
-wasm=target/wasm32-unknown-unknown/web/marbre_web.wasm
+target=${CARGO_TARGET_DIR:-target}
+wasm=$target/wasm32-unknown-unknown/web/marbre_web.wasm
 
 bindgen_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3 }' Cargo.lock)
 if ! command -v wasm-bindgen > /dev/null; then
@@ -34,11 +35,11 @@ if command -v wasm-opt > /dev/null; then
     # the table export pointing at the wrong one (the page then fails in
     # WebAssembly.Table.set). The features are those rustc's wasm32 target
     # uses, which binaryen 108 does not assume.
-    mkdir -p target/web-opt
+    mkdir -p "$target/web-opt"
     wasm-opt -Oz --enable-bulk-memory --enable-mutable-globals --enable-sign-ext \
         --enable-nontrapping-float-to-int --enable-reference-types --enable-multivalue \
-        "$wasm" -o target/web-opt/marbre_web.wasm
-    wasm=target/web-opt/marbre_web.wasm
+        "$wasm" -o "$target/web-opt/marbre_web.wasm"
+    wasm=$target/web-opt/marbre_web.wasm
 else
     echo "web/build.sh: wasm-opt (Debian's binaryen) is not installed: the wasm is left unshrunk" >&2
 fi

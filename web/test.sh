@@ -13,6 +13,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export MARBRE_REQUIRE_WEB=1
+# The browser test builds in the native step's images: without an adapter
+# that step must fail, not skip and leave an older run's images in place.
+export MARBRE_REQUIRE_GPU=1
+target=${CARGO_TARGET_DIR:-target}
+rm -f "$target"/wasm32-unknown-unknown/tmp/web-parity-*.f32
 for tool in chromium chromedriver wasm-bindgen-test-runner; do
     command -v "$tool" > /dev/null || { echo "web/test.sh: $tool is not installed (README, \"The viewer in a browser\")" >&2; exit 1; }
 done

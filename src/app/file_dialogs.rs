@@ -94,6 +94,12 @@ pub fn take_dropped() -> Vec<PathBuf> {
     Vec::new()
 }
 
+/// The desktop's dialogs report through the viewer itself: nothing
+/// waits here (a web page's own work does, `app/web/file_dialogs.rs`).
+pub fn take_notes() -> Vec<String> {
+    Vec::new()
+}
+
 /// A save on the desktop is on disk already; a web page offers it as a
 /// download.
 pub fn deliver_saved(_path: &std::path::Path) {}

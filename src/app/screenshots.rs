@@ -29,6 +29,7 @@ pub fn save(ctx: &GpuContext, renderer: &mut Renderer, folder: &Path) -> Result<
 /// files and offers them as downloads; returns their paths at once.
 #[cfg(target_arch = "wasm32")]
 pub fn save(ctx: &GpuContext, renderer: &mut Renderer, folder: &Path) -> Result<[PathBuf; 2]> {
+    use crate::app::file_dialogs;
     use marbre_render::gpu::readback::read_texture_async;
     let stamp = chrono::Local::now().format("%Y%m%d-%H%M%S%.3f");
     let png = folder.join(format!("marbre-{stamp}.png"));
@@ -49,11 +50,14 @@ pub fn save(ctx: &GpuContext, renderer: &mut Renderer, folder: &Path) -> Result<
             anyhow::Ok(())
         };
         match written.await {
+            // Delivered, they need no place in the page's memory.
             Ok(()) => {
-                crate::app::file_dialogs::deliver_saved(&png);
-                crate::app::file_dialogs::deliver_saved(&exr);
+                for file in [&png, &exr] {
+                    file_dialogs::deliver_saved(file);
+                    marbre_core::page_files::remove(file);
+                }
             }
-            Err(e) => log::error!("screenshot failed: {e:#}"),
+            Err(e) => file_dialogs::note(format!("screenshot failed: {e:#}")),
         }
     });
     Ok(paths)

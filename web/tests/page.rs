@@ -54,12 +54,25 @@ fn dist() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("dist")
 }
 
-fn free_port() -> u16 {
-    TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
+/// Two ports free now, and different (both are held while asked for).
+fn free_ports() -> (u16, u16) {
+    let a = TcpListener::bind("127.0.0.1:0").unwrap();
+    let b = TcpListener::bind("127.0.0.1:0").unwrap();
+    (
+        a.local_addr().unwrap().port(),
+        b.local_addr().unwrap().port(),
+    )
+}
+
+/// chromedriver: `$CHROMEDRIVER` (as wasm-bindgen's runner takes it), else
+/// the first on PATH.
+fn chromedriver() -> Option<PathBuf> {
+    if let Some(path) = std::env::var_os("CHROMEDRIVER") {
+        return Some(PathBuf::from(path));
+    }
+    std::env::split_paths(&std::env::var_os("PATH")?)
+        .map(|dir| dir.join("chromedriver"))
+        .find(|p| p.is_file())
 }
 
 /// A child process killed when the test ends, however it ends.
@@ -357,16 +370,15 @@ struct Served {
 
 impl Served {
     fn start() -> Option<Self> {
-        let chromedriver = Path::new("/usr/bin/chromedriver");
-        if !chromedriver.exists() {
-            missing("no chromedriver (Debian's chromium-driver)");
+        let Some(chromedriver) = chromedriver() else {
+            missing("no chromedriver on PATH (Debian's chromium-driver)");
             return None;
-        }
+        };
         if !dist().join("marbre_web_bg.wasm").exists() {
             missing("no web/dist (build it with bash web/build.sh)");
             return None;
         }
-        let (page_port, driver_port) = (free_port(), free_port());
+        let (page_port, driver_port) = free_ports();
         let server = start(
             "python3",
             &[

@@ -82,6 +82,15 @@ pub fn read_capped(path: &Path, kind: FileKind) -> io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// Whether `path` names a file marbre can read: a regular file on disk,
+/// or in a web page one of the page's files (where `std::fs` knows none).
+pub fn is_file(path: &Path) -> bool {
+    if cfg!(target_arch = "wasm32") {
+        return crate::page_files::contains(path);
+    }
+    path.is_file()
+}
+
 /// [`read_capped`] as UTF-8 text.
 pub fn read_capped_to_string(path: &Path, kind: FileKind) -> io::Result<String> {
     String::from_utf8(read_capped(path, kind)?).map_err(|e| {

@@ -624,8 +624,12 @@ fn mean_of_four(mut f: impl FnMut(f32, f32) -> [f32; 3]) -> [f32; 3] {
     sum.map(|s| s * 0.25)
 }
 
-/// `(0..count).map(f)`, computed in chunks on the available cores.
+/// `(0..count).map(f)`, computed in chunks on the available cores; in a
+/// web page (wasm32, no threads) on the page's one.
 fn parallel_map<T: Send + Default + Clone>(count: u32, f: impl Fn(u32) -> T + Sync) -> Vec<T> {
+    if cfg!(target_arch = "wasm32") {
+        return (0..count).map(f).collect();
+    }
     let mut out = vec![T::default(); count as usize];
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let chunk = (count as usize).div_ceil(threads).max(4096);

@@ -312,7 +312,7 @@ fn image_texture(
 ) -> Texture {
     let (file, _) = strip_options(file);
     let path = folder.join(file);
-    if !path.exists() {
+    if !crate::capped_read::is_file(&path) {
         notes.push(format!(
             "texture {} not found: shown as the magenta placeholder",
             shown(&path.display().to_string())

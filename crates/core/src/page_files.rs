@@ -44,6 +44,15 @@ pub fn read(path: &Path) -> io::Result<Arc<[u8]>> {
     })
 }
 
+/// Forgets the file at `path` (a download delivered: the page's memory
+/// is all it has).
+pub fn remove(path: &Path) {
+    FILES
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .remove(&key(path));
+}
+
 /// Whether the page holds a file at `path`.
 pub fn contains(path: &Path) -> bool {
     FILES
@@ -94,5 +103,7 @@ mod tests {
             &*read(Path::new("page-test/envmaps/sky.exr")).unwrap(),
             b"new sky"
         );
+        remove(Path::new("page-test/presets/../envmaps/sky.exr"));
+        assert!(!contains(Path::new("page-test/envmaps/sky.exr")));
     }
 }

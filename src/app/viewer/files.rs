@@ -313,7 +313,7 @@ impl Viewer {
     pub(super) fn request_save_as(&mut self, path: &Path) {
         if path.as_os_str().is_empty() {
             self.panel.error("Save as: type the path to save to first");
-        } else if path.is_file() {
+        } else if marbre_core::capped_read::is_file(path) {
             self.edits.prompt = Some(Prompt::Replace(path.to_owned()));
         } else {
             self.save_preset(path);
@@ -334,7 +334,7 @@ impl Viewer {
         match share_link::encode(&text).map_err(|e| e.to_string()) {
             Ok(fragment) => match file_dialogs::publish_link(&fragment) {
                 Ok(url) => self.panel.info(format!(
-                    "the link to this scene ({} characters) is in the address bar and copied: {url}",
+                    "the link to this scene ({} characters) is in the address bar, and copied where the browser allows: {url}",
                     url.len()
                 )),
                 Err(e) => self.panel.error(format!("cannot share the scene: {e}")),

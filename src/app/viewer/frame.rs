@@ -79,6 +79,19 @@ impl Viewer {
         enough || controls.stop_at_target && self.meters.convergence.reached(controls.target_error)
     }
 
+    /// With `max_spp`, the last round traces only the samples left, so that
+    /// the image stops at exactly that many (as a render's `--spp` does).
+    /// Decided between rounds: a round under way keeps its samples.
+    fn limit_rounds_to_max_spp(&mut self) {
+        let Some(max) = self.options.max_spp else {
+            return;
+        };
+        let left = max.saturating_sub(self.renderer.accumulated_samples());
+        if left > 0 && self.renderer.round_progress() == 0.0 {
+            self.renderer.limit_round_samples(left);
+        }
+    }
+
     /// Follows the non-finite counters: they restart with the
     /// accumulation, and a readback arrives a frame or two late.
     fn observe_non_finite(&mut self) {
@@ -269,6 +282,7 @@ impl Viewer {
         }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         if !self.paused_at_target() {
+            self.limit_rounds_to_max_spp();
             if self.trace_on_wall_clock() {
                 self.trace_and_wait(self.budget.budget());
             } else {
@@ -616,6 +630,7 @@ impl Viewer {
     /// A frame that is not shown: the trace alone, as long as a shown
     /// frame lasts ([`crate::app::frame_budget::FrameBudget::unshown_budget`]).
     pub(super) fn trace_unshown(&mut self) {
+        self.limit_rounds_to_max_spp();
         self.trace_and_wait(self.budget.unshown_budget(self.clock.shown_frame_ms));
         self.renderer.after_submit();
         self.clock.frames += 1;

@@ -260,7 +260,7 @@ fn startup_preset(options: &ViewerOptions, settings: &Settings) -> PathBuf {
     settings
         .last_preset
         .clone()
-        .filter(|p| p.is_file())
+        .filter(|p| marbre_core::capped_read::is_file(p))
         .unwrap_or_else(default_preset)
 }
 
@@ -469,7 +469,9 @@ impl Viewer {
         Ok(viewer)
     }
 
-    /// Samples per pixel accumulated in the image on screen.
+    /// Samples per pixel accumulated in the image on screen (the web
+    /// page's title says them).
+    #[cfg(target_arch = "wasm32")]
     pub fn samples_accumulated(&self) -> u32 {
         self.renderer.accumulated_samples()
     }
@@ -1026,6 +1028,9 @@ impl Viewer {
         self.poll_dialog();
         for dropped in super::file_dialogs::take_dropped() {
             self.load_dropped(&dropped);
+        }
+        for note in super::file_dialogs::take_notes() {
+            self.panel.error(note);
         }
         self.poll_render();
         self.poll_file_watch();

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use wasm_bindgen::JsCast as _;
 use wasm_bindgen::prelude::*;
+use wasm_bindgen_futures::JsFuture;
 
 /// Where the files the user gives the page are put.
 pub const UPLOADS: &str = "uploads";
@@ -43,6 +44,25 @@ pub fn dialogs_available() -> bool {
 thread_local! {
     /// Files dropped on the page and read, waiting for the next frame.
     static DROPPED: RefCell<Vec<PathBuf>> = const { RefCell::new(Vec::new()) };
+    /// What went wrong in the page's own work (a file refused, a download
+    /// or a screenshot that failed), for the panel at the next frame.
+    static NOTES: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The largest file the page takes from the user: the page's memory is at
+/// most 4 GiB (wasm32), and a file is held whole, then decoded. (On the
+/// desktop an OBJ or an image may be 2 GiB: `capped_read`.)
+const MAX_GIVEN_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Says `note` in the panel at the next frame.
+pub fn note(note: String) {
+    log::warn!("{note}");
+    NOTES.with(|n| n.borrow_mut().push(note));
+}
+
+/// What the page's own work has to say since the last call.
+pub fn take_notes() -> Vec<String> {
+    NOTES.with(|n| std::mem::take(&mut *n.borrow_mut()))
 }
 
 impl OpenDialog {
@@ -96,6 +116,7 @@ fn show_chooser(accept: &str, purpose: DialogPurpose, outcome: Outcome) -> Resul
     // An OBJ comes with its MTL and images: all are chosen at once.
     input.set_multiple(purpose == DialogPurpose::OpenPreset);
     let chosen = input.clone();
+    let outcome_on_cancel = outcome.clone();
     let on_change = Closure::once(move || {
         let files = chosen.files();
         wasm_bindgen_futures::spawn_local(async move {
@@ -108,6 +129,12 @@ fn show_chooser(accept: &str, purpose: DialogPurpose, outcome: Outcome) -> Resul
     });
     input.add_event_listener_with_callback("change", on_change.as_ref().unchecked_ref())?;
     on_change.forget();
+    // A chooser closed without a file fires `cancel`, not `change`.
+    let cancelled = Closure::once(move || {
+        outcome_on_cancel.borrow_mut().get_or_insert(None);
+    });
+    input.add_event_listener_with_callback("cancel", cancelled.as_ref().unchecked_ref())?;
+    cancelled.forget();
     input.click();
     Ok(())
 }
@@ -138,13 +165,23 @@ async fn read_into_page(files: &web_sys::FileList) -> Vec<PathBuf> {
     let mut paths = Vec::new();
     for i in 0..files.length() {
         let Some(file) = files.get(i) else { continue };
+        if file.size() > MAX_GIVEN_BYTES {
+            note(format!(
+                "{}: {:.0} MiB is more than a web page can hold ({:.0} MiB at most); open it in \
+                 the desktop viewer",
+                file.name(),
+                file.size() / 1048576.0,
+                MAX_GIVEN_BYTES / 1048576.0
+            ));
+            continue;
+        }
         let path = Path::new(UPLOADS).join(file.name());
-        match wasm_bindgen_futures::JsFuture::from(file.array_buffer()).await {
+        match JsFuture::from(file.array_buffer()).await {
             Ok(buffer) => {
                 page_files::insert(&path, js_sys::Uint8Array::new(&buffer).to_vec());
                 paths.push(path);
             }
-            Err(e) => log::warn!("cannot read {}: {e:?}", file.name()),
+            Err(e) => note(format!("cannot read {}: {e:?}", file.name())),
         }
     }
     paths
@@ -198,7 +235,7 @@ pub fn deliver_saved(path: &Path) {
 pub fn offer_download(name: &Path, bytes: &[u8]) {
     let name = name.to_string_lossy();
     if let Err(e) = download(&name, bytes) {
-        log::warn!("cannot offer {name} as a download: {e:?}");
+        note(format!("cannot offer {name} as a download: {e:?}"));
     }
 }
 
@@ -215,8 +252,17 @@ pub fn publish_link(fragment: &str) -> Result<String, String> {
         .and_then(|h| h.replace_state_with_url(&JsValue::NULL, "", Some(&url)))
         .map_err(|e| format!("the browser refused the new address: {e:?}"))?;
     // The clipboard may be refused (no focus, no permission): the link is
-    // in the address bar all the same.
-    let _ = window.navigator().clipboard().write_text(&url);
+    // in the address bar all the same, and the panel says which.
+    let copied = JsFuture::from(window.navigator().clipboard().write_text(&url));
+    let shown = url.clone();
+    wasm_bindgen_futures::spawn_local(async move {
+        if copied.await.is_err() {
+            note(format!(
+                "the browser did not let the page copy the link: copy it from the address bar ({} characters)",
+                shown.len()
+            ));
+        }
+    });
     Ok(url)
 }
 
@@ -231,5 +277,17 @@ fn download(name: &str, bytes: &[u8]) -> Result<(), JsValue> {
     link.set_href(&url);
     link.set_download(name);
     link.click();
-    web_sys::Url::revoke_object_url(&url)
+    // Not at once: some browsers start the download after `click` returns,
+    // and cancel it if the address is gone by then.
+    let revoke = Closure::once(move || {
+        let _ = web_sys::Url::revoke_object_url(&url);
+    });
+    web_sys::window()
+        .ok_or("no window")?
+        .set_timeout_with_callback_and_timeout_and_arguments_0(
+            revoke.as_ref().unchecked_ref(),
+            60_000,
+        )?;
+    revoke.forget();
+    Ok(())
 }

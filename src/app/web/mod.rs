@@ -156,7 +156,15 @@ fn startup_preset() -> Result<Option<PathBuf>> {
     let location = web_sys::window().context("no browser window")?.location();
     let hash = location.hash().unwrap_or_default();
     if let Some(shared) = share_link::decode(&hash) {
-        let text = shared?;
+        // A damaged link opens what the page would open without it, and
+        // says why in the panel.
+        let text = match shared {
+            Ok(text) => text,
+            Err(e) => {
+                file_dialogs::note(e.to_string());
+                return Ok(query_value(&search()?, "preset").map(PathBuf::from));
+            }
+        };
         let path = PathBuf::from(share_link::SHARED_PRESET_PATH);
         page_files::insert(&path, text.into_bytes());
         return Ok(Some(path));

@@ -60,8 +60,16 @@ impl GpuContext {
         }
     }
 
-    /// A device able to present to `surface`.
+    /// A device able to present to `surface`: a lost device's replacement.
+    /// A web page cannot wait for one (as [`GpuContext::sibling`]): there it
+    /// is an error that says to reload the page.
     pub fn for_surface(instance: wgpu::Instance, surface: &wgpu::Surface<'_>) -> Result<Self> {
+        if cfg!(target_arch = "wasm32") {
+            anyhow::bail!(
+                "a web page cannot wait for a new GPU device: reload the page (the scene is in \
+                 its address if you pressed Share)"
+            );
+        }
         Self::from_instance(instance, Some(surface))
     }
 
