@@ -40,7 +40,6 @@ pub mod web;
 pub use frame_budget::{DEFAULT_BUDGET_MS as DEFAULT_FRAME_BUDGET_MS, parse_budget_ms};
 
 use anyhow::Result;
-use settings::Settings;
 use std::path::PathBuf;
 use std::sync::Arc;
 use viewer::Viewer;
@@ -89,13 +88,7 @@ impl ApplicationHandler for App {
         if self.viewer.is_some() {
             return;
         }
-        let config_dir = settings::config_dir();
-        let (settings, note) = config_dir
-            .as_deref()
-            .map_or_else(|| (Settings::default(), None), Settings::load);
-        if let Some(note) = note {
-            log::warn!("{note}");
-        }
+        let (config_dir, settings) = settings::load();
         // A soak is about what frames leave behind, not what they show: a
         // smaller window keeps its many frames quick on a software
         // rasteriser.

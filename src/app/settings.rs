@@ -30,6 +30,19 @@ pub fn config_dir() -> Option<PathBuf> {
     Some(crate::app::web::local_storage::restore())
 }
 
+/// The configuration folder and the settings in it (the defaults where
+/// there is none, or where they cannot be read: that is logged).
+pub fn load() -> (Option<PathBuf>, Settings) {
+    let dir = config_dir();
+    let (settings, note) = dir
+        .as_deref()
+        .map_or_else(|| (Settings::default(), None), Settings::load);
+    if let Some(note) = note {
+        log::warn!("{note}");
+    }
+    (dir, settings)
+}
+
 /// Keeps what was just saved in `dir` for the next run: on the desktop it
 /// is on disk already; a web page copies it to local storage.
 pub fn persist(dir: &std::path::Path) {

@@ -150,16 +150,7 @@ impl Browser {
     }
 
     fn get(&self, path: &str) -> Value {
-        let mut response = self
-            .agent
-            .get(&format!("{}{path}", self.base))
-            .call()
-            .expect("chromedriver answers");
-        let value: Value = response
-            .body_mut()
-            .read_json()
-            .expect("JSON from chromedriver");
-        value["value"].clone()
+        answer(self.agent.get(&format!("{}{path}", self.base)).call())
     }
 
     fn go(&self, url: &str) {
@@ -281,11 +272,13 @@ impl Drop for Browser {
 }
 
 fn post(agent: &ureq::Agent, url: &str, body: &Value) -> Value {
-    let mut response = agent
-        .post(url)
-        .send_json(body)
-        .expect("chromedriver answers");
+    answer(agent.post(url).send_json(body))
+}
+
+/// The `value` of chromedriver's JSON answer.
+fn answer(response: Result<ureq::http::Response<ureq::Body>, ureq::Error>) -> Value {
     let value: Value = response
+        .expect("chromedriver answers")
         .body_mut()
         .read_json()
         .expect("JSON from chromedriver");

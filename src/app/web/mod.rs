@@ -21,7 +21,6 @@
 pub mod local_storage;
 
 use super::file_dialogs;
-use super::settings::Settings;
 use super::share_link;
 use super::viewer::Viewer;
 use super::{ViewerOptions, settings};
@@ -93,7 +92,9 @@ async fn open_page() -> Result<()> {
                 })
                 .transpose()?,
             // Whole rounds: the browser paces the frames, and a page cannot
-            // wait for the GPU to time bands on the wall clock.
+            // wait for the GPU to time bands on the wall clock. Bands sized
+            // by SwiftShader's timestamps made the first image take 42 s
+            // instead of 1.3 (docs/PERFORMANCE.md, "The web page").
             frame_budget_ms: 0.0,
             ..Default::default()
         },
@@ -260,13 +261,7 @@ impl ApplicationHandler for PageApp {
         let slot = self.viewer.clone();
         let options = self.options.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            let config_dir = settings::config_dir();
-            let (settings, note) = config_dir
-                .as_deref()
-                .map_or_else(|| (Settings::default(), None), Settings::load);
-            if let Some(note) = note {
-                log::warn!("{note}");
-            }
+            let (config_dir, settings) = settings::load();
             let viewer = GpuContext::for_web_window(window.clone())
                 .await
                 .context(

@@ -140,20 +140,13 @@ impl Renderer {
         let display = self.display_texture(ctx)?;
         let (w, h) = (display.width(), display.height());
         let source = self.accumulation.latest_mean_texture();
-        let mean = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mean snapshot"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: source.format(),
-            usage: wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let mean = readback_texture(
+            ctx,
+            "mean snapshot",
+            (w, h),
+            source.format(),
+            wgpu::TextureUsages::COPY_DST,
+        );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         encoder.copy_texture_to_texture(
             source.as_image_copy(),
@@ -172,20 +165,13 @@ impl Renderer {
     fn display_texture(&mut self, ctx: &GpuContext) -> Result<wgpu::Texture> {
         let (w, h) = self.shown_size();
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-        let target = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("display readback"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
+        let target = readback_texture(
+            ctx,
+            "display readback",
+            (w, h),
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
         let view = target.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let display_target = DisplayTarget {
@@ -203,4 +189,28 @@ impl Renderer {
         ctx.queue.submit([encoder.finish()]);
         Ok(target)
     }
+}
+
+/// A 2D texture of `size` to be read back (`COPY_SRC`, and `usage`).
+fn readback_texture(
+    ctx: &GpuContext,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: usage | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
 }

@@ -29,25 +29,35 @@ pub fn read_texture_in_bands(
     bytes_per_texel: u32,
     band_bytes: u64,
 ) -> Result<Vec<u8>> {
-    let bands = Bands::new(device, texture, bytes_per_texel, band_bytes);
-    let mut out = Vec::with_capacity(bands.row as usize * texture.height() as usize);
-    for top in bands.tops() {
-        let rows = bands.copy(device, queue, texture, top);
-        bands.append(&read_buffer(device, &bands.buffer)?, rows, &mut out);
-    }
-    Ok(out)
+    pollster::block_on(read_bands(
+        device,
+        queue,
+        texture,
+        bytes_per_texel,
+        band_bytes,
+    ))
 }
 
 /// [`read_texture`] awaited rather than waited for: a web page cannot
 /// block on the GPU (the browser maps the buffer on its own event loop),
-/// so its tests await this (issue 34).
+/// so it awaits this (issue 34).
 pub async fn read_texture_async(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
 ) -> Result<Vec<u8>> {
-    let bands = Bands::new(device, texture, bytes_per_texel, BAND_BYTES);
+    read_bands(device, queue, texture, bytes_per_texel, BAND_BYTES).await
+}
+
+async fn read_bands(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+    band_bytes: u64,
+) -> Result<Vec<u8>> {
+    let bands = Bands::new(device, texture, bytes_per_texel, band_bytes);
     let mut out = Vec::with_capacity(bands.row as usize * texture.height() as usize);
     for top in bands.tops() {
         let rows = bands.copy(device, queue, texture, top);
@@ -147,26 +157,14 @@ impl Bands {
 }
 
 /// Maps a MAP_READ buffer and copies its contents out, waiting for the GPU.
+/// (The awaited version's own wait does the waiting natively: its future
+/// is ready when blocked on.)
 pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| anyhow!("waiting for the GPU failed: {e}"))?;
-    rx.recv()?
-        .map_err(|e| anyhow!("mapping a readback buffer failed: {e}"))?;
-    let bytes = buffer
-        .get_mapped_range(..)
-        .map_err(|e| anyhow!("reading a mapped buffer failed: {e}"))?
-        .to_vec();
-    buffer.unmap();
-    Ok(bytes)
+    pollster::block_on(read_buffer_async(device, buffer))
 }
 
-/// [`read_buffer`] awaited: the map's callback completes a one-shot
-/// future instead of a channel the thread waits on.
+/// [`read_buffer`] awaited, for a web page: the map's callback completes
+/// a one-shot future.
 pub async fn read_buffer_async(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let mapped = MapFuture::default();
     let done = mapped.0.clone();
