@@ -37,6 +37,7 @@ const IMAGE: (u32, u32) = (880, 540);
 /// show where they went.
 const FREQUENCY_KNOB: (i64, i64) = (996, 347);
 const SHARE_BUTTON: (i64, i64) = (1130, 81);
+const OPEN_BUTTON: (i64, i64) = (993, 58);
 /// How long SwiftShader may take to load the page and trace 8 samples.
 const PAGE_TIMEOUT: Duration = Duration::from_secs(120);
 
@@ -515,7 +516,8 @@ fn the_page_loads_edits_and_reopens_a_shared_scene() {
         link.len()
     );
     screenshot_downloads(&browser, &reopened);
-    dropped_preset_opens(&browser, &reopened);
+    let dropped = dropped_preset_opens(&browser, &reopened);
+    chosen_preset_opens(&browser, &dropped);
     assert!(
         from_edited < from_original / 2.0,
         "the shared link did not reopen the edited scene: {from_edited:.2} from it, \
@@ -582,7 +584,7 @@ fn screenshot_downloads(browser: &Browser, shown: &image::RgbImage) {
 /// A preset dropped on the page opens as on the desktop window: here the
 /// checkerboard preset, whose env map the page holds under the path the
 /// preset names. The drop is the browser's own event, carrying a file.
-fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) {
+fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) -> image::RgbImage {
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets/checkers.ron"),
     )
@@ -631,4 +633,65 @@ fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) {
     }
     let text = std::fs::read_to_string(&saved).unwrap();
     assert!(text.contains("Checker2d"), "the saved preset: {text}");
+    dropped
+}
+
+/// Open… shows the browser's file chooser, and the file chosen there opens.
+/// A headless browser shows no chooser: the page's `click` on its file
+/// input is caught, and the file is given to that input as a person's
+/// choice would be (its `files`, then its `change` event).
+fn chosen_preset_opens(browser: &Browser, before: &image::RgbImage) {
+    browser.post(
+        "/execute/sync",
+        &json!({ "script": "window.chooserInputs = []; \
+            const click = HTMLInputElement.prototype.click; \
+            HTMLInputElement.prototype.click = function () { \
+                if (this.type === 'file') { window.chooserInputs.push(this); } else { click.call(this); } };",
+            "args": [] }),
+    );
+    browser.click(OPEN_BUTTON);
+    let start = Instant::now();
+    loop {
+        let shown = browser.post(
+            "/execute/sync",
+            &json!({ "script": "return window.chooserInputs.length", "args": [] }),
+        );
+        if shown.as_u64() == Some(1) {
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "Open… showed no file chooser (is OPEN_BUTTON still on it? see target/tmp/page-dropped.png)"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets/marble.ron"),
+    )
+    .unwrap();
+    browser.post(
+        "/execute/sync",
+        &json!({ "script": "const input = window.chooserInputs[0]; \
+            const files = new DataTransfer(); \
+            files.items.add(new File([arguments[0]], 'marble.ron')); \
+            input.files = files.files; \
+            input.dispatchEvent(new Event('change'));",
+            "args": [text] }),
+    );
+    let start = Instant::now();
+    while browser.spp() == Some(SPP) {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the chosen preset did not open: status {:?}",
+            browser.status()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let chosen = browser.finished_image();
+    keep("chosen", &chosen);
+    let changed = scene_difference(before, &chosen, (0, 0, IMAGE.0, IMAGE.1));
+    assert!(
+        changed > 10.0,
+        "the chosen preset did not change the scene: {changed:.2}"
+    );
 }
