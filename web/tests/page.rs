@@ -187,6 +187,24 @@ impl Browser {
         self.screenshot()
     }
 
+    /// After a change that restarts the samples: waits up to `seconds` for
+    /// the restart (failing with `unchanged` and the status line if none
+    /// comes), then for the finished image, which is kept as `name`.
+    fn restarted_image(&self, name: &str, unchanged: &str, seconds: u64) -> image::RgbImage {
+        let start = Instant::now();
+        while self.spp() == Some(SPP) {
+            assert!(
+                start.elapsed() < Duration::from_secs(seconds),
+                "{unchanged}: status {:?}",
+                self.status()
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let image = self.finished_image();
+        keep(name, &image);
+        image
+    }
+
     /// The page's status line (errors show there).
     fn status(&self) -> String {
         self.post(
@@ -474,17 +492,7 @@ fn the_page_loads_edits_and_reopens_a_shared_scene() {
     keep("loaded", &loaded);
 
     browser.drag(FREQUENCY_KNOB, (FREQUENCY_KNOB.0 + 40, FREQUENCY_KNOB.1));
-    // The edit restarts the samples: wait for that, then for the image.
-    let start = Instant::now();
-    while browser.spp() == Some(SPP) {
-        assert!(
-            start.elapsed() < Duration::from_secs(10),
-            "the slider drag changed nothing"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let edited = browser.finished_image();
-    keep("edited", &edited);
+    let edited = browser.restarted_image("edited", "the slider drag changed nothing", 10);
     let changed = scene_difference(&loaded, &edited, MARBLE);
     assert!(
         changed > 4.0,
@@ -596,17 +604,7 @@ fn dropped_preset_opens(browser: &Browser, before: &image::RgbImage) -> image::R
             window.dispatchEvent(new DragEvent('drop', { dataTransfer: files, cancelable: true }));",
             "args": [text] }),
     );
-    let start = Instant::now();
-    while browser.spp() == Some(SPP) {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "the dropped preset did not open: status {:?}",
-            browser.status()
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let dropped = browser.finished_image();
-    keep("dropped", &dropped);
+    let dropped = browser.restarted_image("dropped", "the dropped preset did not open", 20);
     let changed = scene_difference(before, &dropped, (0, 0, IMAGE.0, IMAGE.1));
     assert!(
         changed > 10.0,
@@ -678,17 +676,7 @@ fn chosen_preset_opens(browser: &Browser, before: &image::RgbImage) {
             input.dispatchEvent(new Event('change'));",
             "args": [text] }),
     );
-    let start = Instant::now();
-    while browser.spp() == Some(SPP) {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "the chosen preset did not open: status {:?}",
-            browser.status()
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let chosen = browser.finished_image();
-    keep("chosen", &chosen);
+    let chosen = browser.restarted_image("chosen", "the chosen preset did not open", 20);
     let changed = scene_difference(before, &chosen, (0, 0, IMAGE.0, IMAGE.1));
     assert!(
         changed > 10.0,
