@@ -4,9 +4,11 @@
 //! an animated WebP or an MP4 (H.264). Written atomically, as every
 //! output.
 
-use crate::atomic_write::write_atomic;
+use crate::atomic_write::{write_atomic, write_atomic_with};
+use crate::child_process;
 use anyhow::{Context, Result, bail};
 use image::RgbaImage;
+use std::borrow::Borrow;
 use std::io::Write;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -59,12 +61,15 @@ pub fn check_writable(path: &Path) -> Result<AnimatedFormat> {
 }
 
 fn ffmpeg_available() -> bool {
-    Command::new("ffmpeg")
-        .arg("-version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
+    child_process::spawn(
+        Command::new("ffmpeg")
+            .arg("-version")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .stdin(Stdio::null()),
+    )
+    .and_then(|p| p.wait_after(None))
+    .is_ok_and(|(status, _)| status.success())
 }
 
 /// Writes `frames` (all one size) shown `fps` a second, looping forever.
@@ -84,7 +89,9 @@ pub fn save_animation(frames: &[RgbaImage], fps: f32, path: &Path) -> Result<()>
     let bytes = match format {
         AnimatedFormat::Gif => encode_gif(frames, fps)?,
         AnimatedFormat::Apng => encode_apng(frames, fps)?,
-        AnimatedFormat::Webp | AnimatedFormat::Mp4 => encode_with_ffmpeg(frames, fps, format)?,
+        AnimatedFormat::Webp | AnimatedFormat::Mp4 => {
+            return save_through_ffmpeg(frames.iter().map(Ok), fps, path);
+        }
     };
     write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
     Ok(())
@@ -131,52 +138,96 @@ fn encode_apng(frames: &[RgbaImage], fps: f32) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// WebP and MP4 through ffmpeg, the frames piped in as PNGs: the image
-/// crate writes neither an animated WebP nor video, and ffmpeg is what
-/// Blender and every farm use for both.
-fn encode_with_ffmpeg(frames: &[RgbaImage], fps: f32, format: AnimatedFormat) -> Result<Vec<u8>> {
-    let dir = tempfile::tempdir()?;
-    let out = dir.path().join(match format {
-        AnimatedFormat::Mp4 => "out.mp4",
-        _ => "out.webp",
-    });
-    let codec: &[&str] = match format {
+/// Writes a WebP or an MP4 (by `path`'s extension) through ffmpeg, the
+/// frames (all one size) piped in as PNGs as `frames` gives them: the
+/// image crate writes neither an animated WebP nor video, and ffmpeg is
+/// what Blender and every farm use for both. ffmpeg writes the save's
+/// temporary beside `path` ([`write_atomic_with`]) and is listed as a
+/// child ([`child_process`]): a command stopped by a signal ends it and
+/// removes that temporary, and nothing is left in the system's temporary
+/// folder.
+pub fn save_through_ffmpeg<F: Borrow<RgbaImage>>(
+    frames: impl IntoIterator<Item = Result<F>>,
+    fps: f32,
+    path: &Path,
+) -> Result<()> {
+    let format = AnimatedFormat::from_path(path)?;
+    let (muxer, codec): (&str, &[&str]) = match format {
         // yuv420p plays everywhere; it needs even sides, hence the pad.
-        AnimatedFormat::Mp4 => &[
-            "-c:v",
-            "libx264",
-            "-pix_fmt",
-            "yuv420p",
-            "-vf",
-            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-        ],
-        _ => &["-c:v", "libwebp_anim", "-lossless", "1", "-loop", "0"],
-    };
-    let mut child = Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-f", "image2pipe", "-framerate"])
-        .arg(fps.to_string())
-        .args(["-i", "-"])
-        .args(codec)
-        .arg(&out)
-        .stdin(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("starting ffmpeg")?;
-    {
-        let mut stdin = child.stdin.take().expect("piped");
-        for frame in frames {
-            stdin.write_all(&crate::image_io::encode_png(frame)?)?;
+        AnimatedFormat::Mp4 => (
+            "mp4",
+            &[
+                "-c:v",
+                "libx264",
+                "-pix_fmt",
+                "yuv420p",
+                "-vf",
+                "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            ],
+        ),
+        AnimatedFormat::Webp => (
+            "webp",
+            &["-c:v", "libwebp_anim", "-lossless", "1", "-loop", "0"],
+        ),
+        AnimatedFormat::Gif | AnimatedFormat::Apng => {
+            bail!("{}: ffmpeg writes only .webp and .mp4 here", path.display())
         }
+    };
+    write_atomic_with(path, |temporary: &Path| -> Result<()> {
+        let ffmpeg = child_process::spawn(
+            Command::new("ffmpeg")
+                .args(["-y", "-loglevel", "error", "-f", "image2pipe", "-framerate"])
+                .arg(fps.to_string())
+                .args(["-i", "-"])
+                .args(codec)
+                // The temporary's name ends in .tmp: the muxer is named.
+                .args(["-f", muxer])
+                .arg(temporary)
+                .stdin(Stdio::piped())
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped()),
+        )
+        .context("starting ffmpeg")?;
+        let stdin = ffmpeg.take_stdin();
+        let stderr = ffmpeg.take_stderr();
+        // stderr is read on a thread while the frames go in, so that
+        // neither pipe fills and stops the other.
+        let errors = std::thread::spawn(move || ffmpeg.wait_after(stderr));
+        let piped = pipe_frames(frames, stdin, path);
+        let (status, text) = errors
+            .join()
+            .map_err(|_| anyhow::anyhow!("reading ffmpeg's messages failed"))??;
+        if !status.success() {
+            bail!("ffmpeg failed ({status}): {}", text.trim());
+        }
+        piped
+    })
+    .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Writes each frame, as a PNG, to ffmpeg's stdin, which is closed after
+/// the last (the end of ffmpeg's input).
+fn pipe_frames<F: Borrow<RgbaImage>>(
+    frames: impl IntoIterator<Item = Result<F>>,
+    stdin: Option<std::process::ChildStdin>,
+    path: &Path,
+) -> Result<()> {
+    let mut stdin = stdin.context("ffmpeg's stdin")?;
+    let mut size = None;
+    for frame in frames {
+        let frame = frame?;
+        let frame = frame.borrow();
+        let first = *size.get_or_insert(frame.dimensions());
+        if frame.dimensions() != first {
+            bail!(
+                "{}: the frames are not all one size ({first:?} and {:?})",
+                path.display(),
+                frame.dimensions()
+            );
+        }
+        stdin.write_all(&crate::image_io::encode_png(frame)?)?;
     }
-    let output = child.wait_with_output()?;
-    if !output.status.success() {
-        bail!(
-            "ffmpeg failed ({}): {}",
-            output.status,
-            String::from_utf8_lossy(&output.stderr).trim()
-        );
-    }
-    Ok(std::fs::read(&out)?)
+    Ok(())
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ pub mod atomic_write;
 pub mod bake;
 pub mod bsdf;
 pub mod capped_read;
+pub mod child_process;
 pub mod cubemap;
 pub mod env_sampling;
 pub mod envmap;
