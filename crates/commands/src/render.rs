@@ -101,7 +101,8 @@ pub struct RenderArgs {
     /// frame/fps, to the output with its run of # replaced by the frame
     /// number (`-o out/frame_####.png`). Frames whose file exists are
     /// skipped (a stopped sequence resumes) unless --overwrite. Each
-    /// frame's samples are its own, seeded by its number.
+    /// frame's samples are its own, seeded by its number. At most 100 000
+    /// frames a render (a longer sequence: several ranges).
     #[arg(long, value_parser = marbre_render::frame_sequence::parse_frame_range, conflicts_with = "time")]
     pub frames: Option<std::ops::RangeInclusive<u32>>,
     /// Frames a second for --frames and --time (default: the preset's
@@ -251,11 +252,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         moments: args.moments,
         guides: args.guides,
     };
+    // Checked first: a range's count (at most MAX_SEQUENCE_FRAMES) then
+    // fits.
+    marbre_render::final_render::check_job(&job)?;
     let frames = match &job.timing {
         Timing::Sequence { frames, .. } => frames.end() - frames.start() + 1,
         Timing::Still { .. } => 1,
     };
-    marbre_render::final_render::check_job(&job)?;
     let ctx = GpuContext::headless()?;
     let mut bar = Bar::new(spp, frames, ctx.describe());
     render_to_file(&ctx, loaded, &job, &mut bar)?;

@@ -4,6 +4,7 @@
 //! already written are skipped, so that a stopped sequence resumes.
 
 use anyhow::{Result, bail};
+use marbre_core::atomic_write::check_replaceable;
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +14,13 @@ use std::path::{Path, PathBuf};
 /// moving images), deterministic, and disjoint for up to 2¹⁶ rounds a
 /// frame. Frame 0 traces the samples a still always traced.
 pub const FRAME_SEED_STRIDE: u32 = 1 << 16;
+
+/// The most frames one render traces: 100 000, more than an hour at 24
+/// fps. A sequence's plan holds each frame's path and checks each file
+/// before tracing, so a range of 100 million frames would fill the memory
+/// before the first frame; a longer sequence is rendered as several
+/// ranges (or on a farm, which cuts it into tasks).
+pub const MAX_SEQUENCE_FRAMES: u64 = 100_000;
 
 /// What a final render traces in time.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,7 +96,10 @@ pub fn frame_path(pattern: &Path, frame: u32) -> PathBuf {
 
 /// The frames a render traces, in order, with the files that exist
 /// already (skipped) apart; an error before any work if a sequence of
-/// more than one frame has no `#` in its output's name.
+/// more than one frame has no `#` in its output's name, has more than
+/// [`MAX_SEQUENCE_FRAMES`], or a frame's file is there but is not a
+/// regular file (a FIFO or a device is no frame written, nor one to
+/// replace).
 pub fn plan(timing: &Timing, output: &Path) -> Result<(Vec<PlannedFrame>, Vec<PlannedFrame>)> {
     match timing {
         Timing::Still { time, frame } => Ok((
@@ -111,6 +122,15 @@ pub fn plan(timing: &Timing, output: &Path) -> Result<(Vec<PlannedFrame>, Vec<Pl
             let numbered = output
                 .file_name()
                 .is_some_and(|n| n.to_string_lossy().contains('#'));
+            let count = u64::from(frames.end() - frames.start()) + 1;
+            if count > MAX_SEQUENCE_FRAMES {
+                bail!(
+                    "--frames {}..{} is {count} frames, more than one render traces \
+                     ({MAX_SEQUENCE_FRAMES}); render the sequence as several ranges",
+                    frames.start(),
+                    frames.end()
+                );
+            }
             if !numbered && frames.start() != frames.end() {
                 bail!(
                     "{}: a sequence's output names each frame's number with a run of # \
@@ -118,12 +138,24 @@ pub fn plan(timing: &Timing, output: &Path) -> Result<(Vec<PlannedFrame>, Vec<Pl
                     output.display()
                 );
             }
-            let all = frames.clone().map(|frame| PlannedFrame {
-                frame,
-                time: (f64::from(frame) / f64::from(*fps)) as f32,
-                output: frame_path(output, frame),
-            });
-            Ok(all.partition(|f| *overwrite || !f.output.exists()))
+            let mut todo = Vec::new();
+            let mut written = Vec::new();
+            for frame in frames.clone() {
+                let planned = PlannedFrame {
+                    frame,
+                    time: (f64::from(frame) / f64::from(*fps)) as f32,
+                    output: frame_path(output, frame),
+                };
+                check_replaceable(&planned.output).map_err(|e| {
+                    anyhow::anyhow!("cannot write {}: {e}", planned.output.display())
+                })?;
+                if *overwrite || !planned.output.exists() {
+                    todo.push(planned);
+                } else {
+                    written.push(planned);
+                }
+            }
+            Ok((todo, written))
         }
     }
 }
@@ -173,5 +205,67 @@ mod tests {
         assert_eq!(todo.len(), 3);
         let e = plan(&timing(false), &dir.path().join("f.png")).unwrap_err();
         assert!(e.to_string().contains("run of #"), "{e}");
+    }
+
+    fn sequence(frames: RangeInclusive<u32>, overwrite: bool) -> Timing {
+        Timing::Sequence {
+            frames,
+            fps: 24.0,
+            overwrite,
+            animation: None,
+        }
+    }
+
+    /// A range over the maximum is refused before any path is made (it
+    /// used to build 100 million paths, 1.66 GB, before the first frame);
+    /// the whole u32 range too, whose count does not fit a u32. The
+    /// pattern's folder does not exist: nothing is looked at on disk.
+    #[test]
+    fn a_range_over_the_maximum_is_refused_before_any_work() {
+        let pattern = Path::new("/nonexistent/f_####.png");
+        let last = (MAX_SEQUENCE_FRAMES - 1) as u32;
+        for (range, count) in [
+            (0..=last + 1, "100001"),
+            (0..=100_000_000, "100000001"),
+            (0..=u32::MAX, "4294967296"),
+        ] {
+            let e = plan(&sequence(range.clone(), false), pattern)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(&format!("is {count} frames")) && e.contains("(100000)"),
+                "{e}"
+            );
+        }
+        let (todo, _) = plan(&sequence(7..=7 + last, false), pattern).unwrap();
+        assert_eq!(todo.len() as u64, MAX_SEQUENCE_FRAMES);
+    }
+
+    /// A frame's file that is a FIFO (or a link to one) is refused before
+    /// tracing, with or without --overwrite, and stays a FIFO.
+    #[test]
+    fn a_frame_that_is_a_fifo_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("f_01.png");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        for overwrite in [false, true] {
+            let e = plan(&sequence(0..=2, overwrite), &dir.path().join("f_##.png"))
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "cannot write {}: it is a FIFO, not a regular file; marbre replaces only \
+                     regular files",
+                    fifo.display()
+                )
+            );
+        }
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
     }
 }
