@@ -6,12 +6,12 @@
 
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
-use marbre_core::image_decode::{IntegerDecode, decode_file};
 use marbre_core::image_io::LayerName;
 use marbre_core::image_io::{self, ImageFormat};
 use marbre_core::merge::{Batch, Guides, Merged, merge};
-use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord};
+use marbre_core::render_record::{RECORD_ATTRIBUTE, RenderRecord, check_seal};
 use marbre_core::scene::{DenoiseQuality, Denoiser, DisplaySettings, Metering};
+use marbre_core::shown::shown;
 use marbre_oidn::DeviceKind;
 use marbre_render::cpu_display;
 use marbre_render::denoiser::{GuidedImage, Running, oidn_for};
@@ -62,7 +62,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     if let Some(input) = args.inputs.iter().find(|i| same_file(i, &args.output)) {
         bail!(
             "{} is one of the inputs: the merge would write over it",
-            input.display()
+            shown(&input.display().to_string())
         );
     }
     image_io::check_output(&args.output)?;
@@ -73,6 +73,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .map(|path| read_batch(path))
         .collect::<Result<Vec<Batch>>>()?;
     let merged = merge(&batches).map_err(|e| anyhow!(e))?;
+    for note in &merged.notes {
+        println!("{note}");
+    }
     let how = MergedOutput {
         display,
         denoise: args.denoise.map(|d| (d, args.denoise_quality)),
@@ -112,7 +115,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     println!(
         "merged {} files{tiles} into {}: {}×{} at {} spp (samples {}..{}); {error}",
         batches.len(),
-        args.output.display(),
+        shown(&args.output.display().to_string()),
         merged.width,
         merged.height,
         merged.record.spp,
@@ -268,54 +271,115 @@ fn display_of(args: &MergeArgs) -> Result<DisplaySettings> {
     Ok(display)
 }
 
-/// One batch: its pixels and its render's record, or why not.
+/// One batch: its pixels, its layers and its render's record, or why not.
+///
+/// The file is read as it is ([`image_io::read_exr_channels`]), not
+/// through the texture decoder, which clamps: a merge averages the
+/// radiance the render wrote. Its record must match its pixels (its seal,
+/// [`marbre_core::render_record::check_seal`]): an `spp` edited after the
+/// render would weigh the file wrongly. NaN and infinite values, which
+/// would make every mean they enter NaN, are set to 0, and a note counts
+/// them.
 pub fn read_batch(path: &Path) -> Result<Batch> {
+    let name = shown(&path.display().to_string());
     let attributes = image_io::read_exr_attributes(path)?;
     let record = RenderRecord::from_attributes(&attributes)
-        .map_err(|e| anyhow!("{}: {e}", path.display()))?
+        .map_err(|e| anyhow!("{name}: {}", shown(&e)))?
         .ok_or_else(|| {
             anyhow!(
-                "{} has no marbre render record: merge takes the EXR files `marbre render` writes",
-                path.display()
+                "{name} has no marbre render record: merge takes the EXR files `marbre render` \
+                 writes"
             )
         })?;
-    let image = decode_file(path, IntegerDecode::Linear)?;
-    let [variance, albedo, normal]: [Option<Vec<[f32; 3]>>; 3] = image_io::read_exr_layers(
-        path,
-        &[image_io::VARIANCE, image_io::ALBEDO, image_io::NORMAL],
-    )?
-    .try_into()
-    .expect("one answer a layer asked");
-    // A layer of another size (subsampled channels, another part) is not
-    // the picture's.
-    for (layer, values) in [
-        ("variance", &variance),
-        ("albedo", &albedo),
-        ("normal", &normal),
-    ] {
-        if let Some(values) = values
-            && values.len() != image.pixels.len()
-        {
-            bail!(
-                "{}: its {layer} layer has {} values, not one a pixel of its {}×{} picture",
-                path.display(),
-                values.len(),
-                image.width,
-                image.height
-            );
+    let file = image_io::read_exr_channels(path)?;
+    let mut notes = Vec::new();
+    match check_seal(&attributes[RECORD_ATTRIBUTE], &file.named()) {
+        Ok(true) => {}
+        Ok(false) => notes.push(format!(
+            "{name}: its render record has no seal (a file of a marbre before seals): its samples \
+             are taken as its record says, unchecked"
+        )),
+        Err(e) => bail!("{name}: {e}"),
+    }
+    let count = file.width as usize * file.height as usize;
+    let channel = |c: &str| file.channel(c).filter(|v| v.len() == count);
+    let (Some(r), Some(g), Some(b)) = (channel("R"), channel("G"), channel("B")) else {
+        bail!(
+            "{name}: no R, G and B channels of one value a pixel of its {}×{} picture",
+            file.width,
+            file.height
+        );
+    };
+    let alpha = channel("A");
+    let mut pixels: Vec<[f32; 4]> = (0..count)
+        .map(|p| [r[p], g[p], b[p], alpha.map_or(1.0, |a| a[p])])
+        .collect();
+    notes.extend(replace_not_finite(
+        &name,
+        "picture",
+        pixels.iter_mut().flatten(),
+    ));
+    let mut layers =
+        [image_io::VARIANCE, image_io::ALBEDO, image_io::NORMAL].map(|l| file.layer(l));
+    // A layer of another size (subsampled channels) is not the picture's.
+    for (layer, values) in ["variance", "albedo", "normal"].iter().zip(&mut layers) {
+        if let Some(values) = values {
+            if values.len() != count {
+                bail!(
+                    "{name}: its {layer} layer has {} values, not one a pixel of its {}×{} \
+                     picture",
+                    values.len(),
+                    file.width,
+                    file.height
+                );
+            }
+            let what = format!("{layer} layer");
+            notes.extend(replace_not_finite(
+                &name,
+                &what,
+                values.iter_mut().flatten(),
+            ));
         }
     }
+    let [variance, albedo, normal] = layers;
     Ok(Batch {
         path: path.to_path_buf(),
-        width: image.width,
-        height: image.height,
-        pixels: image.pixels,
+        width: file.width,
+        height: file.height,
+        pixels,
         variance,
         guides: match (albedo, normal) {
             (Some(albedo), Some(normal)) => Some(Guides { albedo, normal }),
             _ => None,
         },
         record,
+        notes,
+    })
+}
+
+/// Sets the NaN and infinite `values` to 0; a note naming the file and
+/// `what` of it counts them, if any.
+fn replace_not_finite<'a>(
+    name: &str,
+    what: &str,
+    values: impl Iterator<Item = &'a mut f32>,
+) -> Option<String> {
+    let (mut nan, mut infinite) = (0usize, 0usize);
+    for v in values {
+        if v.is_nan() {
+            nan += 1;
+        } else if v.is_infinite() {
+            infinite += 1;
+        } else {
+            continue;
+        }
+        *v = 0.0;
+    }
+    (nan + infinite > 0).then(|| {
+        format!(
+            "note: {name}: {nan} NaN and {infinite} infinite values of its {what} set to 0 \
+             before the merge"
+        )
     })
 }
 

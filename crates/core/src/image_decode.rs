@@ -349,6 +349,93 @@ fn check_size(
     Ok(())
 }
 
+/// Refuses an OpenEXR file whose headers declare more than its `file_len`
+/// bytes can hold, before its texels are allocated: a 598-byte file
+/// claiming 16384×8192 texels used to cost 2 GiB before the reader found
+/// its chunks missing.
+///
+/// The least a file holds for its headers ([`exr_least_bytes`]) is a
+/// bound, not an estimate: every chunk has its offset and its own header,
+/// and no compression shrinks the texels further than its method can
+/// (deflate's longest match, 258 bytes in 2 bits, is 1032:1). A file
+/// within the bound may still be truncated further on; the reader finds
+/// that, having allocated at most what the file's bytes could hold.
+pub fn check_exr_fits(
+    path: &Path,
+    file_len: usize,
+    headers: &[exr::meta::header::Header],
+) -> Result<(), DecodeError> {
+    let least: u64 = headers
+        .iter()
+        .map(exr_least_bytes)
+        .fold(0, u64::saturating_add);
+    if (file_len as u64) < least {
+        let declared: Vec<String> = headers
+            .iter()
+            .map(|h| format!("{}x{}", h.layer_size.width(), h.layer_size.height()))
+            .collect();
+        return Err(DecodeError::Decode {
+            path: path.to_path_buf(),
+            format: "OpenEXR",
+            message: format!(
+                "the file declares {} texels with {}, which take {least} bytes at least, but \
+                 it is {file_len} bytes: the file is truncated or its header is wrong",
+                declared.join(" and "),
+                headers
+                    .first()
+                    .map_or("no".into(), |h| h.compression.to_string())
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The fewest bytes a file holds for `header`'s part: 8 bytes of offset
+/// table and a chunk header (8 bytes for lines, 20 for a tile) a chunk,
+/// and its largest resolution's texels shrunk by its compression's
+/// largest ratio ([`largest_ratio`]). Deep parts count their chunks only.
+fn exr_least_bytes(header: &exr::meta::header::Header) -> u64 {
+    use exr::meta::BlockDescription;
+    let chunk_header: u64 = match header.blocks {
+        BlockDescription::ScanLines => 8,
+        BlockDescription::Tiles(_) => 20,
+    };
+    let chunks = (header.chunk_count as u64).saturating_mul(8 + chunk_header);
+    if header.deep {
+        return chunks;
+    }
+    let texel_bytes = header
+        .channels
+        .list
+        .iter()
+        .map(|c| {
+            let size = c.subsampled_resolution(header.layer_size);
+            (size.width() as u64)
+                .saturating_mul(size.height() as u64)
+                .saturating_mul(c.sample_type.bytes_per_sample() as u64)
+        })
+        .fold(0, u64::saturating_add);
+    chunks.saturating_add(texel_bytes / largest_ratio(header.compression))
+}
+
+/// How many times smaller than its texels a compression can make them, at
+/// most, rounded up: none 1; RLE 64 (127 bytes in 2); ZIP 1032 (deflate's
+/// limit); PXR24 4/3 more (f32 to 24 bits, then deflate); B44 11 (a flat
+/// 4×4 block of halves, 32 bytes, in 3); PIZ's Huffman runs (256 halves in
+/// 10 bits, 410:1) under deflate's; DWA and HTJ2K, whose flat blocks keep
+/// one value in 64 and deflate it, 64 × 1032.
+fn largest_ratio(compression: exr::compression::Compression) -> u64 {
+    use exr::compression::Compression as C;
+    match compression {
+        C::Uncompressed => 1,
+        C::RLE => 64,
+        C::ZIP1 | C::ZIP16 | C::PIZ => 1032,
+        C::PXR24 => 1376,
+        C::B44 | C::B44A => 11,
+        C::DWAA(_) | C::DWAB(_) | C::HTJ2K32 | C::HTJ2K256 => 64 * 1032,
+    }
+}
+
 /// The channels of an OpenEXR file that hold the picture: red, green and
 /// blue, or luminance alone.
 enum ExrChannels {
@@ -502,6 +589,7 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<DecodedImage, DecodeError> {
         let header = &meta.headers[choice.part];
         let size = header.layer_size;
         check_size(path, "OpenEXR", size.width() as u64, size.height() as u64)?;
+        check_exr_fits(path, bytes.len(), &meta.headers)?;
         let mut image = read_exr_channels(bytes, &choice.channels)
             .map_err(|e| exr_error(path, Some(header.compression), e))?;
         image.notes.extend(choice.note);
@@ -938,6 +1026,26 @@ pub(crate) mod test_support {
     pub(crate) fn close(a: f32, b: f32, tol: f32) -> bool {
         (a - b).abs() <= tol
     }
+
+    /// `exr`, a file of one part, with its data window patched to claim
+    /// `width × height` texels: the probe's lying header (598 bytes
+    /// claiming 16384×8192).
+    pub(crate) fn exr_claiming(exr: &[u8], width: i32, height: i32) -> Vec<u8> {
+        let name = b"dataWindow\0box2i\0";
+        let at = exr
+            .windows(name.len())
+            .position(|w| w == name)
+            .expect("an EXR header has a data window")
+            + name.len();
+        assert_eq!(exr[at..at + 4], 16i32.to_le_bytes(), "a box2i is 16 bytes");
+        let mut lying = exr.to_vec();
+        let window = [0, 0, width - 1, height - 1];
+        for (k, v) in window.iter().enumerate() {
+            let start = at + 4 + 4 * k;
+            lying[start..start + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        lying
+    }
 }
 
 #[cfg(test)]
@@ -963,6 +1071,45 @@ mod tests {
                     .to_string()
             });
             assert!(error.contains("not a regular file"), "{error}");
+        }
+    }
+
+    /// A small file claiming 16384×8192 texels, within [`MAX_TEXELS`], is
+    /// refused from its size, naming the file and what it claims, before
+    /// its texels are allocated (the probe's 598-byte file cost 2.1 GB);
+    /// the file it was patched from still decodes.
+    #[test]
+    fn an_exr_claiming_more_than_its_bytes_hold_is_refused() {
+        for compression in [
+            exr::compression::Compression::Uncompressed,
+            exr::compression::Compression::ZIP16,
+            exr::compression::Compression::PIZ,
+        ] {
+            use exr::prelude::*;
+            let channels = SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32));
+            let encoding = Encoding {
+                compression,
+                ..Encoding::FAST_LOSSLESS
+            };
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            Image::from_encoded_channels((4, 2), encoding, channels)
+                .write()
+                .to_buffered(&mut bytes)
+                .unwrap();
+            let small = bytes.into_inner();
+            let path = Path::new("lying.exr");
+            decode_bytes(&small, path, IntegerDecode::Linear).unwrap();
+            let lying = test_support::exr_claiming(&small, 16384, 8192);
+            assert!(lying.len() < 2000, "{}", lying.len());
+            let e = decode_bytes(&lying, path, IntegerDecode::Linear)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("lying.exr: ")
+                    && e.contains("declares 16384x8192 texels")
+                    && e.contains(&format!("it is {} bytes", lying.len())),
+                "{compression:?}: {e}"
+            );
         }
     }
 

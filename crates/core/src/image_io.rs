@@ -238,62 +238,148 @@ pub fn encode_exr_layers(
         AnyChannels::sort(list),
     );
     if let Some((name, value)) = text {
-        layer.attributes.other.insert(
-            latin1_text(name),
-            exr::meta::attribute::AttributeValue::Text(latin1_text(value)),
-        );
+        let values: Vec<(String, &[f32])> = layer
+            .channel_data
+            .list
+            .iter()
+            .filter_map(|c| match &c.sample_data {
+                FlatSamples::F32(v) => Some((c.name.to_string(), &v[..])),
+                _ => None,
+            })
+            .collect();
+        let named: Vec<(&str, &[f32])> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let (name, value) = header_text(name, value, &named);
+        layer
+            .attributes
+            .other
+            .insert(name, exr::meta::attribute::AttributeValue::Text(value));
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer).write().to_buffered(&mut bytes)?;
     Ok(bytes.into_inner())
 }
 
-/// The layers `names` of an EXR file ([`encode_exr_layers`]), each `None`
-/// where the file lacks one of its channels; the file decoded once.
-pub fn read_exr_layers(path: &Path, names: &[LayerName]) -> Result<Vec<Option<Vec<[f32; 3]>>>> {
+/// An EXR file's picture and layers as the file holds them: its first
+/// valid part's channels, each by its full name (`R`, `variance.G`), the
+/// values as written (no NaN replaced, nothing clamped: a merge averages
+/// them as they are).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExrChannels {
+    pub width: u32,
+    pub height: u32,
+    pub channels: Vec<(String, Vec<f32>)>,
+}
+
+impl ExrChannels {
+    /// The values of the channel `name`, if the file has it.
+    pub fn channel(&self, name: &str) -> Option<&[f32]> {
+        self.channels
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| &v[..])
+    }
+
+    /// The layer `layer` ([`encode_exr_layers`]), `None` where the file
+    /// lacks one of its channels.
+    pub fn layer(&self, layer: LayerName) -> Option<Vec<[f32; 3]>> {
+        let [a, b, c] = layer
+            .channels
+            .map(|ch| self.channel(&format!("{}.{ch}", layer.name)));
+        Some(
+            a?.iter()
+                .zip(b?)
+                .zip(c?)
+                .map(|((a, b), c)| [*a, *b, *c])
+                .collect(),
+        )
+    }
+
+    /// The channels by name, as [`crate::render_record::check_seal`] takes
+    /// them.
+    pub fn named(&self) -> Vec<(&str, &[f32])> {
+        self.channels
+            .iter()
+            .map(|(n, v)| (n.as_str(), &v[..]))
+            .collect()
+    }
+}
+
+/// Every channel of an EXR file's first valid part ([`ExrChannels`]).
+/// Its declared size is checked against [`crate::image_decode::MAX_TEXELS`]
+/// and against what the file's bytes can hold
+/// ([`crate::image_decode::check_exr_fits`]) before anything is
+/// allocated, and the `exr` crate's panics on malformed files are caught.
+pub fn read_exr_channels(path: &Path) -> Result<ExrChannels> {
     use exr::prelude::*;
     let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
         .with_context(|| format!("reading {}", path.display()))?;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(std::io::Cursor::new(bytes))
-        .map_err(|e| anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display()))?;
-    let channels = &image.layer_data.channel_data.list;
-    let find = |full: String| {
-        channels
-            .iter()
-            .find(|c| c.name.to_string() == full)
-            .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
+    let unreadable = |e: &dyn std::fmt::Display| {
+        anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display())
     };
-    Ok(names
-        .iter()
-        .map(|layer| {
-            let [a, b, c] = layer
-                .channels
-                .map(|ch| find(format!("{}.{ch}", layer.name)));
-            Some(
-                a?.into_iter()
-                    .zip(b?)
-                    .zip(c?)
-                    .map(|((a, b), c)| [a, b, c])
-                    .collect(),
-            )
-        })
-        .collect())
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
+        .map_err(|e| unreadable(&e))?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let texels = (size.width() as u64).saturating_mul(size.height() as u64);
+        if texels > crate::image_decode::MAX_TEXELS {
+            bail!(
+                "{}: the file declares {}x{} texels, more than the {} (16384x8192) marbre reads",
+                path.display(),
+                size.width(),
+                size.height(),
+                crate::image_decode::MAX_TEXELS
+            );
+        }
+    }
+    crate::image_decode::check_exr_fits(path, bytes.len(), &meta.headers)?;
+    let image = std::panic::catch_unwind(|| {
+        read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(std::io::Cursor::new(&bytes))
+    })
+    .map_err(|_| unreadable(&"the OpenEXR reader failed on it"))?
+    .map_err(|e| unreadable(&e))?;
+    let size = image.layer_data.size;
+    Ok(ExrChannels {
+        width: size.width() as u32,
+        height: size.height() as u32,
+        channels: image
+            .layer_data
+            .channel_data
+            .list
+            .iter()
+            .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
+            .collect(),
+    })
 }
 
-/// `s` as EXR text, its characters beyond Latin-1 (which EXR text cannot
-/// hold) written as `?`.
-fn latin1_text(s: &str) -> exr::meta::attribute::Text {
-    let latin1: String = s
-        .chars()
+/// `s` as EXR text can hold it: its characters beyond Latin-1 written as
+/// `?`.
+fn latin1(s: &str) -> String {
+    s.chars()
         .map(|c| if u32::from(c) < 256 { c } else { '?' })
-        .collect();
-    exr::meta::attribute::Text::new_or_panic(latin1)
+        .collect()
+}
+
+/// A header text attribute as a file holds it: in Latin-1, and a render's
+/// record sealed with the file's `channels`
+/// ([`crate::render_record::sealed`]), so that a merge finds a record
+/// changed after the render.
+fn header_text(
+    name: &str,
+    value: &str,
+    channels: &[(&str, &[f32])],
+) -> (exr::meta::attribute::Text, exr::meta::attribute::Text) {
+    let mut value = latin1(value);
+    if name == crate::render_record::RECORD_ATTRIBUTE {
+        value = crate::render_record::sealed(&value, channels);
+    }
+    let text = exr::meta::attribute::Text::new_or_panic;
+    (text(latin1(name)), text(value))
 }
 
 /// The text attributes of an EXR file's header (its first part's and
@@ -354,10 +440,19 @@ pub fn encode_exr(
     };
     let mut image = Image::from_encoded_channels((w, h), encoding, channels);
     if let Some((name, value)) = text {
-        image.layer_data.attributes.other.insert(
-            latin1_text(name),
-            exr::meta::attribute::AttributeValue::Text(latin1_text(value)),
-        );
+        let values: Vec<Vec<f32>> = (0..4)
+            .map(|c| pixels.iter().map(|p| p[c]).collect())
+            .collect();
+        let named: Vec<(&str, &[f32])> = ["R", "G", "B", "A"]
+            .into_iter()
+            .zip(values.iter().map(Vec::as_slice))
+            .collect();
+        let (name, value) = header_text(name, value, &named);
+        image
+            .layer_data
+            .attributes
+            .other
+            .insert(name, exr::meta::attribute::AttributeValue::Text(value));
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut bytes)?;
@@ -375,11 +470,11 @@ mod tests {
     fn an_exr_text_attribute_reads_back() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("a.exr");
-        let text = Some(("marbre:render", "spp=16\nadapter=GPU ✓ é"));
+        let text = Some(("marbre:note", "spp=16\nadapter=GPU ✓ é"));
         save_exr(2, 1, &[[0.5; 4]; 2], text, &path).unwrap();
         let read = read_exr_attributes(&path).unwrap();
         assert_eq!(
-            read.get("marbre:render").map(String::as_str),
+            read.get("marbre:note").map(String::as_str),
             Some("spp=16\nadapter=GPU ? é")
         );
         let bytes = std::fs::read(&path).unwrap();
@@ -398,10 +493,12 @@ mod tests {
         let normal = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]];
         let layers = [(VARIANCE, &variance[..]), (NORMAL, &normal[..])];
         save_exr_layers(2, 1, &pixels, &layers, Some(("k", "v")), &path).unwrap();
+        let read = read_exr_channels(&path).unwrap();
         assert_eq!(
-            read_exr_layers(&path, &[VARIANCE, ALBEDO, NORMAL]).unwrap(),
-            vec![Some(variance.to_vec()), None, Some(normal.to_vec())]
+            [VARIANCE, ALBEDO, NORMAL].map(|l| read.layer(l)),
+            [Some(variance.to_vec()), None, Some(normal.to_vec())]
         );
+        assert_eq!((read.width, read.height), (2, 1));
         let decoded =
             crate::image_decode::decode_file(&path, crate::image_decode::IntegerDecode::Linear)
                 .unwrap();
@@ -409,7 +506,57 @@ mod tests {
         assert_eq!(read_exr_attributes(&path).unwrap()["k"], "v");
         let plain = dir.path().join("p.exr");
         save_exr(2, 1, &pixels, None, &plain).unwrap();
-        assert_eq!(read_exr_layers(&plain, &[VARIANCE]).unwrap(), vec![None]);
+        assert_eq!(read_exr_channels(&plain).unwrap().layer(VARIANCE), None);
+    }
+
+    /// A render's record is written sealed with the file's channels, with
+    /// layers or without: the file as written checks; its `spp` patched
+    /// in place (the probe's edit) does not. Another text is kept as is.
+    #[test]
+    fn a_render_record_is_sealed_with_the_pixels() {
+        use crate::render_record::{RECORD_ATTRIBUTE, check_seal};
+        let dir = tempfile::tempdir().unwrap();
+        let pixels = [[0.5, 1.0, 2.0, 1.0], [3.0, f32::INFINITY, 5.0, 1.0]];
+        let variance = [[0.01, 0.02, 0.03], [0.04, 0.05, 0.06]];
+        let record = Some((RECORD_ATTRIBUTE, "spp=4\nscene=x\n"));
+        for layers in [&[][..], &[(VARIANCE, &variance[..])][..]] {
+            let path = dir.path().join("r.exr");
+            save_exr_layers(2, 1, &pixels, layers, record, &path).unwrap();
+            let text = |path: &Path| read_exr_attributes(path).unwrap()[RECORD_ATTRIBUTE].clone();
+            let read = read_exr_channels(&path).unwrap();
+            assert!(text(&path).starts_with("spp=4\nscene=x\nseal="));
+            assert_eq!(check_seal(&text(&path), &read.named()), Ok(true));
+            let bytes = std::fs::read(&path).unwrap();
+            let at = bytes.windows(5).position(|w| w == b"spp=4").unwrap();
+            let mut edited = bytes.clone();
+            edited[at + 4] = b'8';
+            std::fs::write(&path, edited).unwrap();
+            let read = read_exr_channels(&path).unwrap();
+            assert!(check_seal(&text(&path), &read.named()).is_err());
+        }
+        let path = dir.path().join("k.exr");
+        save_exr(2, 1, &pixels, Some(("k", "v")), &path).unwrap();
+        assert_eq!(read_exr_attributes(&path).unwrap()["k"], "v");
+    }
+
+    /// The probe's lying header (a small file claiming 16384×8192) is
+    /// refused by the merge's reader from its size, naming the file,
+    /// before its channels are allocated (it cost 2.1 GB).
+    #[test]
+    fn an_exr_claiming_more_than_its_bytes_is_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("lying.exr");
+        let small =
+            encode_exr_layers(2, 1, &[[1.0; 4]; 2], &[(VARIANCE, &[[0.0; 3]; 2])], None).unwrap();
+        let lying = crate::image_decode::test_support::exr_claiming(&small, 16384, 8192);
+        std::fs::write(&path, &lying).unwrap();
+        let e = read_exr_channels(&path).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("{}: ", path.display()))
+                && e.contains("declares 16384x8192 texels")
+                && e.contains(&format!("it is {} bytes", lying.len())),
+            "{e}"
+        );
     }
 
     /// A PNG's text chunk reads back by keyword, any character included,

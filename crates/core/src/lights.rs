@@ -9,7 +9,7 @@
 //! cumulative distribution of power, searched by bisection on the GPU
 //! (`crates/core/src/lights.wgsl`).
 
-use crate::scene::{Material, Property, Scene, SurfacePoint};
+use crate::scene::{Material, PointLight, Property, Scene, SurfacePoint};
 use crate::texture::luminance;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
@@ -101,8 +101,7 @@ impl LightTable {
         let mut table = LightTable::default();
         let emitted: Vec<f32> = scene.materials().map(emitted_luminance).collect();
         if let Some(light) = &scene.point_light {
-            let power = 4.0 * PI * luminance(light.color * light.intensity);
-            table.push(LightKind::Point, 0, power, "the point light");
+            table.push(LightKind::Point, 0, light.power(), "the point light");
         }
         for (i, sphere) in scene
             .spheres
@@ -202,6 +201,50 @@ impl LightTable {
     }
 }
 
+impl PointLight {
+    /// The power the light table gives the light: 4π times the luminance
+    /// of its intensity.
+    pub fn power(&self) -> f32 {
+        4.0 * PI * luminance(self.color * self.intensity)
+    }
+
+    /// A light the table would leave out for a value that is no number
+    /// (a NaN or infinite position, colour or intensity, or a power past
+    /// f32) is fixed at load with a note, as every other value no control
+    /// produces: the table dropped it, and its note reached no one.
+    pub fn sanitize(&mut self, notes: &mut Vec<String>) {
+        if !self.position.is_finite() {
+            notes.push(format!(
+                "point light: non-finite position {} set to 0",
+                self.position
+            ));
+            self.position = Vec3::ZERO;
+        }
+        if !self.color.is_finite() {
+            notes.push(format!(
+                "point light: non-finite colour {} set to 0 (no light)",
+                self.color
+            ));
+            self.color = Vec3::ZERO;
+        }
+        if !self.intensity.is_finite() {
+            notes.push(format!(
+                "point light: non-finite intensity {} set to 0 (no light)",
+                self.intensity
+            ));
+            self.intensity = 0.0;
+        }
+        if !self.power().is_finite() {
+            notes.push(format!(
+                "point light: intensity {} times colour {} is past f32's range: intensity set \
+                 to 0 (no light)",
+                self.intensity, self.color
+            ));
+            self.intensity = 0.0;
+        }
+    }
+}
+
 pub fn triangle_area(v: &[Vec3; 3]) -> f32 {
     0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
 }
@@ -289,6 +332,58 @@ mod tests {
         let table = LightTable::build(&scene, &[tiny]);
         assert!(table.lights.is_empty(), "{:?}", table.lights);
         assert_eq!(table.notes.len(), 2, "{:?}", table.notes);
+    }
+
+    /// A point light of an infinite or NaN value, or whose power is past
+    /// f32, is fixed at load with a note (the table left it out, and its
+    /// note was shown nowhere); a plain one is kept and noted nowhere.
+    #[test]
+    fn a_point_light_of_no_number_is_noted_at_load() {
+        let light = |position: Vec3, color: Vec3, intensity: f32| Scene {
+            point_light: Some(PointLight {
+                position,
+                color,
+                intensity,
+            }),
+            ..Scene::default()
+        };
+        let cases = [
+            (
+                light(Vec3::ONE, Vec3::ONE, f32::INFINITY),
+                "non-finite intensity inf",
+            ),
+            (
+                light(Vec3::ONE, Vec3::ONE, f32::NAN),
+                "non-finite intensity NaN",
+            ),
+            (
+                light(Vec3::ONE, Vec3::new(1.0, f32::NAN, 1.0), 1.0),
+                "non-finite colour",
+            ),
+            (
+                light(Vec3::splat(f32::INFINITY), Vec3::ONE, 1.0),
+                "non-finite position",
+            ),
+            (light(Vec3::ONE, Vec3::ONE, 3e38), "past f32's range"),
+        ];
+        for (mut scene, expected) in cases {
+            let notes = scene.sanitize();
+            assert!(
+                notes
+                    .iter()
+                    .any(|n| n.starts_with("point light: ") && n.contains(expected)),
+                "{expected}: {notes:?}"
+            );
+            let light = scene.point_light.as_ref().unwrap();
+            assert!(light.position.is_finite() && light.power().is_finite());
+            assert_eq!(
+                LightTable::build(&scene, &[]).lights.len(),
+                usize::from(light.power() > 0.0)
+            );
+        }
+        let mut plain = light(Vec3::ONE, Vec3::ONE, 40.0);
+        assert_eq!(plain.sanitize(), Vec::<String>::new());
+        assert_eq!(LightTable::build(&plain, &[]).lights.len(), 1);
     }
 
     /// The pmf sums to one in both modes, and bisection inverts the cdf.

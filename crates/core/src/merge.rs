@@ -9,6 +9,7 @@
 //! tile merge do.
 
 use crate::render_record::RenderRecord;
+use crate::shown::shown;
 use crate::tile::{Tile, check_cover};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -26,6 +27,10 @@ pub struct Batch {
     /// The denoiser's guides, when the file has them (`render --guides`).
     pub guides: Option<Guides>,
     pub record: RenderRecord,
+    /// What reading the file changed or could not check, each line naming
+    /// the file (NaN and infinite values set to 0, a record without a
+    /// seal): the merge passes them on.
+    pub notes: Vec<String>,
 }
 
 /// A denoiser's guides: per pixel, the mean of its samples' first-hit
@@ -61,6 +66,8 @@ pub struct Merged {
     /// How many of them have an estimated variance, which `error`
     /// covers.
     pub measured_tiles: usize,
+    /// The batches' notes, in their order, for the user.
+    pub notes: Vec<String>,
 }
 
 /// An estimate of a merged image's error.
@@ -78,10 +85,17 @@ const REL_EPSILON: f64 = 0.01;
 
 /// Assembles `batches` into one image: the batches of each tile averaged
 /// weighted by their samples, the tiles put in their place. Refused,
-/// naming the files: fewer than two, another image size, scene or frame,
-/// a file whose pixels are not its tile's, samples counted twice
-/// (overlapping sample ranges), tiles that overlap or leave pixels out,
-/// and tiles of different sample counts.
+/// naming the files: fewer than two, another image size, scene, frame or
+/// moment, a file whose pixels are not its tile's, a batch of no samples,
+/// samples counted twice (overlapping sample ranges), tiles that overlap
+/// or leave pixels out, tiles of different sample counts, and more
+/// samples than a record holds.
+///
+/// What the records say is checked against each other and against the
+/// pixels' size here; whether a record's samples are the pixels' own
+/// (an `spp` edited after the render) cannot be seen in the pixels, and
+/// is checked by the record's seal as the file is read
+/// ([`crate::render_record::check_seal`]).
 pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
     let [first, rest @ ..] = batches else {
         return Err("a merge needs two files or more (got none)".into());
@@ -89,12 +103,28 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
     if rest.is_empty() {
         return Err(format!(
             "a merge needs two files or more (got only {})",
-            first.path.display()
+            shown(&first.path.display().to_string())
         ));
     }
-    let name = |b: &Batch| b.path.display().to_string();
+    let name = |b: &Batch| shown(&b.path.display().to_string());
     let image = first.record.image;
     for b in batches {
+        // A batch of no samples has no mean: its weight would be 0 (or
+        // every weight 0/0), and the spread would call the merge exact.
+        if b.record.spp == 0 {
+            return Err(format!(
+                "{} holds no samples (its record says spp=0): a batch of no samples has \
+                 nothing to merge",
+                name(b)
+            ));
+        }
+        if !b.record.time.is_finite() {
+            return Err(format!(
+                "{}: its record's time is {}, not a moment of an animation",
+                name(b),
+                b.record.time
+            ));
+        }
         if b.record.tile.size() != (b.width, b.height) {
             return Err(format!(
                 "{} is {}×{}, but its record says it holds the tile {}: the file was changed \
@@ -124,8 +154,8 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
                 "{} is a render of another scene than {} (scene {} and {})",
                 name(b),
                 name(first),
-                b.record.scene,
-                first.record.scene
+                shown(&b.record.scene),
+                shown(&first.record.scene)
             ));
         }
         if b.record.frame != first.record.frame {
@@ -135,6 +165,17 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
                 b.record.frame,
                 name(first),
                 first.record.frame
+            ));
+        }
+        if b.record.time != first.record.time {
+            return Err(format!(
+                "{} holds the moment {} s of frame {}, but {} the moment {} s: a frame's \
+                 batches trace one moment",
+                name(b),
+                b.record.time,
+                b.record.frame,
+                name(first),
+                first.record.time
             ));
         }
     }
@@ -173,6 +214,15 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
             b.end
         ));
     }
+    let samples = range(&groups[0]);
+    let Ok(spp) = u32::try_from(samples.end - samples.start) else {
+        return Err(format!(
+            "{} and the others hold {} samples a pixel, more than a render record holds ({})",
+            name(first),
+            samples.end - samples.start,
+            u32::MAX
+        ));
+    };
     let count = image.0 as usize * image.1 as usize;
     let mut out = Assembly {
         width: image.0,
@@ -195,7 +245,7 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
         height: image.1,
         pixels: out.pixels,
         record: RenderRecord {
-            spp: groups[0].samples.min(u64::from(u32::MAX)) as u32,
+            spp,
             sample_offset: groups[0].batches[0].record.sample_offset,
             tile: Tile::whole(image),
             kernel: kernels,
@@ -207,6 +257,7 @@ pub fn merge(batches: &[Batch]) -> Result<Merged, String> {
         guides: out.guides,
         error: out.spread.error(),
         tiles: groups.len(),
+        notes: batches.iter().flat_map(|b| b.notes.clone()).collect(),
     })
 }
 
@@ -240,10 +291,10 @@ impl<'a> TileGroup<'a> {
                 return Err(format!(
                     "{} (samples {}..{}) and {} (samples {}..{}) leave samples {}..{} out: \
                      merge batches whose samples follow one another (render the missing batch)",
-                    pair[0].path.display(),
+                    shown(&pair[0].path.display().to_string()),
                     a.start,
                     a.end,
-                    pair[1].path.display(),
+                    shown(&pair[1].path.display().to_string()),
                     b.start,
                     b.end,
                     a.end,
@@ -254,10 +305,10 @@ impl<'a> TileGroup<'a> {
                 return Err(format!(
                     "{} (samples {}..{}) and {} (samples {}..{}) overlap: those samples would \
                      count twice; render batches at offsets spp apart (--sample-offset)",
-                    pair[0].path.display(),
+                    shown(&pair[0].path.display().to_string()),
                     a.start,
                     a.end,
-                    pair[1].path.display(),
+                    shown(&pair[1].path.display().to_string()),
                     b.start,
                     b.end
                 ));
@@ -399,6 +450,7 @@ mod tests {
             pixels: vec![[value, value, value, 1.0]; tile.pixels() as usize],
             variance: None,
             guides: None,
+            notes: Vec::new(),
             record: RenderRecord {
                 spp,
                 sample_offset: offset,
@@ -532,6 +584,61 @@ mod tests {
         let e = merge(&[a, far]).unwrap_err();
         assert!(
             e.contains("a.exr (samples 0..4) and far.exr (samples 8..12) leave samples 4..8 out"),
+            "{e}"
+        );
+    }
+
+    /// A batch of no samples is refused (it merged, weighing 0, and the
+    /// spread of the other batch around itself called the merge exact:
+    /// "0.000 %"); so are a batch of another moment of the frame, a time
+    /// that is no moment, and more samples than a record holds (which the
+    /// merged record cut to 2³² − 1).
+    #[test]
+    fn batches_their_records_disagree_on_are_refused() {
+        let a = batch("a.exr", 0, 4, 1.0);
+        let empty = batch("empty.exr", 4, 0, 3.0);
+        let e = merge(&[a.clone(), empty]).unwrap_err();
+        assert!(
+            e.contains("empty.exr holds no samples (its record says spp=0)"),
+            "{e}"
+        );
+        let e = merge(&[batch("z0.exr", 0, 0, 1.0), batch("z1.exr", 0, 0, 2.0)]).unwrap_err();
+        assert!(e.contains("z0.exr holds no samples"), "{e}");
+        let mut moved = batch("moved.exr", 4, 4, 1.0);
+        moved.record.time = 0.5;
+        let e = merge(&[a.clone(), moved]).unwrap_err();
+        assert!(
+            e.contains("moved.exr holds the moment 0.5 s of frame 0, but a.exr the moment 0 s"),
+            "{e}"
+        );
+        let mut never = batch("never.exr", 4, 4, 1.0);
+        never.record.time = f32::NAN;
+        let e = merge(&[a, never]).unwrap_err();
+        assert!(e.contains("never.exr: its record's time is NaN"), "{e}");
+        let e = merge(&[
+            batch("x.exr", 0, u32::MAX, 1.0),
+            batch("y.exr", u32::MAX, 1, 1.0),
+        ])
+        .unwrap_err();
+        assert!(e.contains("hold 4294967296 samples a pixel"), "{e}");
+    }
+
+    /// The batches' notes reach the merge's; a file name or a record's
+    /// text with control characters is shown escaped in a refusal, so
+    /// that a file cannot drive the terminal that prints it.
+    #[test]
+    fn notes_pass_on_and_record_text_is_shown_escaped() {
+        let mut a = batch("a.exr", 0, 4, 1.0);
+        a.notes = vec!["a.exr: 1 NaN value set to 0".into()];
+        let merged = merge(&[a.clone(), batch("b.exr", 4, 4, 1.0)]).unwrap();
+        assert_eq!(merged.notes, a.notes);
+        let mut hostile = batch("c\u{1b}]0;owned\u{7}.exr", 4, 4, 1.0);
+        hostile.record.scene = "\u{1b}[2J\r".into();
+        let e = merge(&[a, hostile]).unwrap_err();
+        assert!(
+            !e.chars().any(char::is_control)
+                && e.contains("c\\u{1b}]0;owned\\u{7}.exr is a render of another scene")
+                && e.contains("scene \\u{1b}[2J\\r and"),
             "{e}"
         );
     }

@@ -143,10 +143,99 @@ pub fn scene_hash(scene: &Scene) -> String {
 /// 16 hex digits of the 64-bit FNV-1a hash of `bytes`: the same on every
 /// machine and run.
 pub fn fnv1a_hex(bytes: &[u8]) -> String {
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    format!("{hash:016x}")
+    let mut hash = Fnv1a::default();
+    hash.write(bytes);
+    hash.hex()
+}
+
+/// The 64-bit FNV-1a hash, fed in pieces.
+struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv1a {
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    fn hex(&self) -> String {
+        format!("{:016x}", self.0)
+    }
+}
+
+/// The record's last line in a file: the seal of the record's other
+/// lines and of the file's channels.
+const SEAL: &str = "seal";
+
+/// `text`, a record as a file's header holds it, with its seal appended:
+/// the FNV-1a hash of `text` and of `channels` (name, values) as the file
+/// holds them.
+///
+/// Why: merge weighs each file by its record's samples, and nothing in
+/// the pixels says how many there were. The seal binds the record to the
+/// pixels, so that a record edited after the render (the probe's `spp`
+/// changed in place), or pixels changed under it, are refused
+/// ([`check_seal`]) rather than merged with wrong weights. It is a
+/// checksum, not a signature: it finds a change made by hand or by
+/// another tool, not a forger who computes it again.
+pub fn sealed(text: &str, channels: &[(&str, &[f32])]) -> String {
+    let mut body = text.to_owned();
+    if !body.is_empty() && !body.ends_with('\n') {
+        body.push('\n');
+    }
+    let seal = seal_of(&body, channels);
+    format!("{body}{SEAL}={seal}\n")
+}
+
+/// Whether a file's record `text` (its header attribute) matches the
+/// file's `channels`: `Ok(true)` when its seal does, `Ok(false)` when it
+/// has none (a file of a marbre before seals), else why not.
+pub fn check_seal(text: &str, channels: &[(&str, &[f32])]) -> Result<bool, String> {
+    let prefix = format!("{SEAL}=");
+    let at = if text.starts_with(&prefix) {
+        Some(0)
+    } else {
+        text.find(&format!("\n{prefix}")).map(|at| at + 1)
+    };
+    let Some(at) = at else {
+        return Ok(false);
+    };
+    let (body, line) = text.split_at(at);
+    let seal = line[prefix.len()..].trim_end_matches('\n');
+    if seal != seal_of(body, channels) {
+        return Err(
+            "its render record does not match its pixels (its seal is not theirs): the record \
+             or the pixels were changed after marbre wrote the file, and merge weighs a file by \
+             its record's samples; merge the files as `marbre render` wrote them"
+                .into(),
+        );
+    }
+    Ok(true)
+}
+
+/// The seal's hash: the record's text, then each channel, in name order,
+/// as its name, a 0 byte, its value count and its values (little-endian
+/// u64 and f32, so the same on every machine).
+fn seal_of(text: &str, channels: &[(&str, &[f32])]) -> String {
+    let mut sorted: Vec<&(&str, &[f32])> = channels.iter().collect();
+    sorted.sort_by_key(|(name, _)| *name);
+    let mut hash = Fnv1a::default();
+    hash.write(text.as_bytes());
+    for (name, values) in sorted {
+        hash.write(name.as_bytes());
+        hash.write(&[0]);
+        hash.write(&(values.len() as u64).to_le_bytes());
+        for v in *values {
+            hash.write(&v.to_le_bytes());
+        }
+    }
+    hash.hex()
 }
 
 #[cfg(test)]
@@ -189,6 +278,35 @@ mod tests {
         let outside = text.replace("tile=16,0,48,24", "tile=16,0,80,24");
         let e = RenderRecord::from_attributes(&attributes(outside)).unwrap_err();
         assert!(e.contains("`tile`") && e.contains("64 × 48"), "{e}");
+    }
+
+    /// A sealed record checks against its channels, in any order; a
+    /// changed `spp`, a changed value, a changed channel name or a line
+    /// after the seal does not; a record without a seal says so.
+    #[test]
+    fn a_seal_binds_the_record_to_the_channels() {
+        let (r, g) = ([0.5f32, 1.0], [2.0f32, f32::NAN]);
+        let channels = [("R", &r[..]), ("G", &g[..])];
+        let text = record().to_text();
+        let sealed = sealed(&text, &channels);
+        assert!(sealed.starts_with(&text) && sealed.ends_with('\n'));
+        assert_eq!(check_seal(&sealed, &channels), Ok(true));
+        assert_eq!(check_seal(&sealed, &[channels[1], channels[0]]), Ok(true));
+        assert_eq!(check_seal(&text, &channels), Ok(false));
+        let edited = sealed.replace("spp=16", "spp=32");
+        let e = check_seal(&edited, &channels).unwrap_err();
+        assert!(e.contains("does not match its pixels"), "{e}");
+        let other = [0.5f32, 1.5];
+        assert!(check_seal(&sealed, &[("R", &other[..]), channels[1]]).is_err());
+        assert!(check_seal(&sealed, &[("B", &r[..]), channels[1]]).is_err());
+        assert!(check_seal(&format!("{sealed}spp=32\n"), &channels).is_err());
+        let read =
+            RenderRecord::from_attributes(&BTreeMap::from([(RECORD_ATTRIBUTE.to_owned(), sealed)]));
+        assert_eq!(
+            read,
+            Ok(Some(record())),
+            "the seal is no field of the record"
+        );
     }
 
     /// FNV-1a's published value for "a" (0xaf63dc4c8601ec8c) pins the

@@ -303,6 +303,9 @@ impl Scene {
             g.material.sanitize("ground", &mut notes);
         }
         self.sanitize_meshes(&mut notes);
+        if let Some(light) = &mut self.point_light {
+            light.sanitize(&mut notes);
+        }
         self.render.sanitize(&mut notes);
         self.camera.sanitize(&mut notes);
         for view in &mut self.views {
