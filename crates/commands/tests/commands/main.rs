@@ -5,6 +5,7 @@
 
 mod accuracy_bench;
 mod batches;
+mod merge_checks;
 mod render;
 mod sequence;
 mod tiles;
