@@ -43,6 +43,14 @@ struct ViewerArgs {
     /// something new, and the closing `quality:` line counts both.
     #[arg(long)]
     exit_after_frames: Option<u64>,
+    /// Exit once the image holds this many samples per pixel (tracing
+    /// stops there): a run that ends when its image is done, however
+    /// fast the machine traces.
+    #[arg(long, value_parser = marbre_commands::parse_spp)]
+    exit_after_spp: Option<u32>,
+    /// Exit once the denoiser has made this many images.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    exit_after_denoised: Option<u32>,
     /// Save the whole window, UI included, as PNG just before exiting.
     #[arg(long)]
     window_screenshot: Option<PathBuf>,
@@ -168,6 +176,8 @@ fn main() -> ExitCode {
             obj: cli.viewer.obj,
             env: cli.viewer.env,
             exit_after_frames: cli.viewer.exit_after_frames,
+            exit_after_spp: cli.viewer.exit_after_spp,
+            exit_after_denoised: cli.viewer.exit_after_denoised,
             window_screenshot: cli.viewer.window_screenshot,
             dev: cli.viewer.dev,
             soak: None,

@@ -30,6 +30,7 @@ mod screenshots;
 mod settings;
 pub mod share_link;
 mod shortcuts;
+mod shown_frames;
 pub mod soak;
 pub mod swatches;
 mod ui_layer;
@@ -57,6 +58,12 @@ pub struct ViewerOptions {
     pub obj: Option<PathBuf>,
     pub env: Option<PathBuf>,
     pub exit_after_frames: Option<u64>,
+    /// Exit once the image holds this many samples per pixel (tracing
+    /// stops there, as with `max_spp`): a run that ends on an event of the
+    /// trace, however slow the machine (issue 47).
+    pub exit_after_spp: Option<u32>,
+    /// Exit once the denoiser has made this many images.
+    pub exit_after_denoised: Option<u32>,
     pub window_screenshot: Option<PathBuf>,
     /// Read the WGSL files from the source tree and rebuild the trace
     /// pipeline when one changes.
@@ -74,6 +81,27 @@ pub struct ViewerOptions {
     /// a render's sample count does (the web page's `?spp=`); None traces
     /// on (or to the Quality strip's target error).
     pub max_spp: Option<u32>,
+}
+
+impl ViewerOptions {
+    /// Whether the run ends by itself (a frame count or an event): a
+    /// script's or a test's run rather than a person's, whose scene must
+    /// be there from the first frame and which leaves no trace in the
+    /// settings.
+    pub fn ends_by_itself(&self) -> bool {
+        self.exit_after_frames.is_some()
+            || self.exit_after_spp.is_some()
+            || self.exit_after_denoised.is_some()
+    }
+
+    /// The samples per pixel tracing stops at: `max_spp` or the run's
+    /// last image, whichever comes first.
+    pub fn stop_at_spp(&self) -> Option<u32> {
+        match (self.max_spp, self.exit_after_spp) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
 }
 
 struct App {

@@ -13,7 +13,8 @@ use std::time::Duration;
 /// the window's size (its thread runs at a lower priority than the
 /// trace's): the window keeps drawing all the while. Each image OIDN
 /// filtered was read back and filtered while several frames were drawn; a
-/// viewer that waited for it would draw one.
+/// viewer that waited for it would draw one. The run ends once the first
+/// image is denoised, however long that takes on a loaded machine.
 #[test]
 fn the_window_keeps_drawing_while_oidn_denoises() {
     const TEST: &str = "the_window_keeps_drawing_while_oidn_denoises";
@@ -46,8 +47,8 @@ fn the_window_keeps_drawing_while_oidn_denoises() {
         &[
             "--preset".into(),
             preset.into(),
-            "--exit-after-frames".into(),
-            "400".into(),
+            "--exit-after-denoised".into(),
+            "1".into(),
         ],
     );
     assert_success(
@@ -55,7 +56,6 @@ fn the_window_keeps_drawing_while_oidn_denoises() {
         &dir,
     );
     let quality = quality_line(&dir);
-    assert_eq!(number_before(&quality, "frames"), 400, "{quality}");
     let log = marbre_log(&dir);
     let line = log
         .lines()

@@ -199,6 +199,8 @@ pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> G
         // Loads wait while this file exists (`hold_loads`); none does
         // unless a test makes it.
         .env("MARBRE_TEST_HOLD_LOADS", hold_loads(dir))
+        // The count of frames shown, which `wait_for_frames` reads.
+        .env("MARBRE_TEST_SHOWN_FRAMES", shown_frames_file(dir))
         // winit would prefer Wayland if the test itself runs in a Wayland session.
         .env_remove("WAYLAND_DISPLAY")
         .stdin(Stdio::null())
@@ -213,6 +215,47 @@ pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> G
 /// meshes are read (`MARBRE_TEST_HOLD_LOADS`): a slow disk, on demand.
 pub fn hold_loads(dir: &TempDir) -> std::path::PathBuf {
     dir.path().join("hold-loads")
+}
+
+/// The file the viewer writes its count of frames shown to
+/// (`MARBRE_TEST_SHOWN_FRAMES`, `src/app/shown_frames.rs`).
+fn shown_frames_file(dir: &TempDir) -> PathBuf {
+    dir.path().join("shown-frames")
+}
+
+/// How many frames the viewer started in `dir` has shown so far (0 before
+/// its first).
+pub fn shown_frames(dir: &TempDir) -> u64 {
+    std::fs::read_to_string(shown_frames_file(dir))
+        .ok()
+        .and_then(|text| text.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+/// How long the viewer may take to show a few frames: a generous bound
+/// that fails loudly. A frame takes about a second on lavapipe, several
+/// with both cores busy, and a preset load's shader build tens of them.
+const FRAMES_TIMEOUT: Duration = Duration::from_secs(180);
+
+/// Waits until the viewer has shown `n` more frames than now: after an
+/// input event, two more mean a frame has read it (the event makes the
+/// next frame shown, and egui reads input once a frame). The wait the
+/// window tests use between input steps instead of a fixed sleep, so a
+/// slow or loaded machine only makes them slower (issue 47). Fails, with
+/// the log, after [`FRAMES_TIMEOUT`].
+pub fn wait_for_frames(dir: &TempDir, n: u64) {
+    let target = shown_frames(dir) + n;
+    let start = Instant::now();
+    while shown_frames(dir) < target {
+        if start.elapsed() > FRAMES_TIMEOUT {
+            panic!(
+                "the viewer showed {} of {target} frames within {FRAMES_TIMEOUT:?}; its log:\n{}",
+                shown_frames(dir),
+                marbre_log(dir)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 pub fn marbre_log(dir: &TempDir) -> String {
@@ -480,4 +523,44 @@ fn percent_encode(path: &Path) -> String {
             _ => format!("%{b:02X}"),
         })
         .collect()
+}
+
+/// Waits, as [`wait_for_frames`] does, for `n` more frames shown, unless
+/// the viewer exits first; its exit status then. The wait of a check
+/// that the viewer must not act on a request (a close it must ask about):
+/// once two more frames are shown the viewer has handled the request,
+/// however slow the machine, where a fixed sleep only guessed (issue 47);
+/// a viewer that wrongly exits is seen at once, not after the timeout.
+pub fn frames_or_exit(child: &mut Guard, dir: &TempDir, n: u64) -> Option<ExitStatus> {
+    let target = shown_frames(dir) + n;
+    let start = Instant::now();
+    while shown_frames(dir) < target {
+        if let Some(status) = child.0.try_wait().unwrap() {
+            return Some(status);
+        }
+        if start.elapsed() > FRAMES_TIMEOUT {
+            panic!(
+                "the viewer showed {} of {target} frames within {FRAMES_TIMEOUT:?}; its log:\n{}",
+                shown_frames(dir),
+                marbre_log(dir)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.0.try_wait().unwrap()
+}
+
+/// Waits until `done` holds, polling; fails loudly, naming `what` and
+/// with the log, after `timeout` (a generous bound, never one a figure
+/// depends on).
+pub fn wait_until(what: &str, timeout: Duration, dir: &TempDir, mut done: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !done() {
+        assert!(
+            start.elapsed() < timeout,
+            "{what}: not within {timeout:?}; marbre's log:\n{}",
+            marbre_log(dir)
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }

@@ -7,6 +7,7 @@ pub mod convergence_bench;
 pub mod edit_bench;
 pub mod farm;
 pub mod interrupt;
+pub mod markdown;
 pub mod merge;
 pub mod noise;
 pub mod noise_figure;

@@ -4,6 +4,7 @@
 //! uses; `--print` writes the parsed text back; `--gallery` renders every
 //! example of a folder and writes a Markdown page of them.
 
+use crate::markdown;
 use crate::render::parse_size;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -154,13 +155,16 @@ fn gallery(folder: &Path, out: &Path, markdown: &Path, size: (u32, u32), spp: u3
         render(&ctx, &doc, &file, &png, &preview)?;
         let link = pathdiff::diff_paths(&png, page_dir).unwrap_or(png.clone());
         let source = read_capped_to_string(&file, capped_read::TX)?;
+        // The title, the link and the source as the page's reader must
+        // read them back (`markdown`); the description is the author's
+        // own Markdown prose.
         page.push_str(&format!(
-            "## {}\n\n![{}]({})\n\n{}\n\n```\n{}\n```\n\n",
-            entry.title,
-            entry.title,
-            link.display(),
+            "## {}\n\n![{}]({})\n\n{}\n\n{}\n",
+            markdown::inline(&entry.title),
+            markdown::inline(&entry.title),
+            markdown::link_target(&link.to_string_lossy()),
             entry.description,
-            source.trim_end()
+            markdown::code_block(source.trim_end())
         ));
     }
     std::fs::write(markdown, page).with_context(|| format!("writing {}", markdown.display()))?;

@@ -74,16 +74,35 @@ impl Viewer {
         let controls = &self.panel.quality;
         let enough = self
             .options
-            .max_spp
+            .stop_at_spp()
             .is_some_and(|n| self.renderer.accumulated_samples() >= n);
         enough || controls.stop_at_target && self.meters.convergence.reached(controls.target_error)
+    }
+
+    /// Whether this frame ends a run that ends by itself: its count of
+    /// frames, or the event it waits for (the image's samples, the
+    /// denoiser's images) has come. Such a frame is shown, and captured
+    /// for `--window-screenshot`.
+    fn is_last_frame(&self) -> bool {
+        let options = &self.options;
+        options
+            .exit_after_frames
+            .is_some_and(|n| self.clock.frames + 1 >= n)
+            || options
+                .exit_after_spp
+                .is_some_and(|n| self.renderer.accumulated_samples() >= n)
+            || options.exit_after_denoised.is_some_and(|n| {
+                self.renderer
+                    .denoise_report()
+                    .is_some_and(|report| report.images >= n)
+            })
     }
 
     /// With `max_spp`, the last round traces only the samples left, so that
     /// the image stops at exactly that many (as a render's `--spp` does).
     /// Decided between rounds: a round under way keeps its samples.
     fn limit_rounds_to_max_spp(&mut self) {
-        let Some(max) = self.options.max_spp else {
+        let Some(max) = self.options.stop_at_spp() else {
             return;
         };
         let left = max.saturating_sub(self.renderer.accumulated_samples());
@@ -248,10 +267,7 @@ impl Viewer {
             _ => return Ok(true),
         };
         let target = frame.texture.create_view(&Default::default());
-        let is_last = self
-            .options
-            .exit_after_frames
-            .is_some_and(|n| self.clock.frames + 1 >= n);
+        let is_last = self.is_last_frame();
         let capture = if is_last && self.options.window_screenshot.is_some() {
             Some(self.capture_texture())
         } else {
@@ -340,6 +356,7 @@ impl Viewer {
         let script_goes_on = self.script_after_present()?;
         self.clock.frames += 1;
         self.clock.shown += 1;
+        self.clock.shown_file.publish(self.clock.shown);
         let controls = &self.panel.quality;
         if controls.screenshot_at_target
             && self
@@ -551,7 +568,7 @@ impl Viewer {
             "no time yet".to_owned()
         };
         eprintln!(
-            "quality: {spp} spp accumulated in {} frames of which {} shown; {seconds:.1} s, {rate} ({} kernel); {} restarts; window at {:.1} fps; estimated error {error}; trace pass {trace}; other passes: {}",
+            "quality: {spp} spp accumulated in {} frames of which {} shown; {seconds:.1} s, {rate} ({} kernel); {} restarts; window at {:.1} fps, open {:.1} s; estimated error {error}; trace pass {trace}; other passes: {}",
             self.clock.frames,
             self.clock.shown,
             self.renderer.kernel(),
@@ -559,6 +576,7 @@ impl Viewer {
             // for the tests that an action keeps the image.
             self.renderer.accumulation_generation(),
             self.clock.fps,
+            self.clock.opened.elapsed().as_secs_f64(),
             if passes.is_empty() {
                 "not timed".to_owned()
             } else {
@@ -608,10 +626,7 @@ impl Viewer {
     /// nothing, as before). Never in a web page: such a frame traces on
     /// the wall clock, which a page cannot wait on.
     pub(super) fn may_leave_unshown(&self) -> bool {
-        let last = self
-            .options
-            .exit_after_frames
-            .is_some_and(|n| self.clock.frames + 1 >= n);
+        let last = self.is_last_frame();
         // The window's size last: it asks the display server.
         self.trace_on_wall_clock()
             && self.traces_on_these_cores()

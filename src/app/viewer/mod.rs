@@ -27,6 +27,7 @@ use super::render_job::{RenderJob, Update};
 use super::scene_loader::{FileKind, SceneKind, SceneLoad, load_reporting};
 use super::settings::Settings;
 use super::shortcuts::{Keys, Shortcut};
+use super::shown_frames::ShownFramesFile;
 use super::soak::SoakDriver;
 use super::swatches::Swatches;
 use super::ui_layer::{Compositor, STATS_REFRESH, UiLayer};
@@ -191,6 +192,11 @@ struct FrameClock {
     shown_frame_ms: f32,
     /// When free heap memory was last handed back ([`HEAP_TRIM_INTERVAL`]).
     last_heap_trim: Instant,
+    /// When the window opened: the closing line's time open, which bounds
+    /// the frames shown for the panel's refreshes.
+    opened: Instant,
+    /// Where the count of frames shown goes for the window tests.
+    shown_file: ShownFramesFile,
     fps: f32,
     ms_per_frame: f32,
 }
@@ -317,7 +323,7 @@ impl Viewer {
         // A scripted run counts its frames from the first, so its scene must
         // be there; a person gets the window at once and the scene when it
         // has loaded.
-        let scripted = options.exit_after_frames.is_some() || options.soak.is_some();
+        let scripted = options.ends_by_itself() || options.soak.is_some();
         let mut startup_notes = Vec::new();
         let (loaded, header) = if scripted {
             let loaded = load_before_first_frame(
@@ -376,7 +382,7 @@ impl Viewer {
         if !document.has_preset_file() {
             panel.preset_path = document.save_as_suggestion().display().to_string();
         }
-        // A scripted run (--exit-after-frames, --window-screenshot, a soak)
+        // A scripted run (--exit-after-*, --window-screenshot, a soak)
         // is not the user's work: nothing of it is autosaved or remembered,
         // so the user's next start (window size, last preset, recent files)
         // is the one their own last session left.
@@ -454,6 +460,8 @@ impl Viewer {
                 last_frame: Instant::now(),
                 shown_frame_ms: 0.0,
                 last_heap_trim: Instant::now(),
+                opened: Instant::now(),
+                shown_file: ShownFramesFile::from_env(),
                 fps: 0.0,
                 ms_per_frame: 0.0,
             },
@@ -513,7 +521,7 @@ impl Viewer {
     /// The window's close button or the system asks to quit: with unsaved
     /// edits the user chooses first (a scripted run just ends).
     fn request_quit(&mut self) {
-        if self.options.exit_after_frames.is_none() && self.edits.document.is_dirty(&self.scene) {
+        if !self.options.ends_by_itself() && self.edits.document.is_dirty(&self.scene) {
             self.edits.prompt = Some(Prompt::Quit);
         } else {
             self.quit();
