@@ -26,8 +26,9 @@
 use crate::xvfb;
 
 use crate::xvfb::{
-    TempDir, assert_success, display_or_skip, grab_window, marbre_log, number_before, quality_line,
-    request_close, serial, spawn_marbre, wait_for_exit, xdotool,
+    TempDir, assert_success, display_or_skip, frames_or_exit, grab_window, marbre_log,
+    number_before, quality_line, request_close, serial, spawn_marbre, wait_for_exit,
+    wait_for_frames, wait_until, xdotool,
 };
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -39,9 +40,11 @@ use crate::REPO;
 pub(crate) const PANEL_LEFT: i32 = 884;
 /// Height of a folded section header, in pixels.
 const HEADER_STEP: i32 = 23;
-/// How long one step may take to show: a preset load builds a shader
-/// (seconds on lavapipe), and each frame takes about a second.
-pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(60);
+/// How long one step may take to show: a generous bound that fails
+/// loudly, never one a figure depends on. A preset load builds a shader
+/// (seconds on lavapipe), each frame takes about a second, and several
+/// with both cores busy (issue 47).
+pub(crate) const STEP_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// Mean luma (0..1), its standard deviation (a pattern) and mean
 /// blue-minus-red of the image's central quarter, the luma of its top-left
@@ -132,38 +135,56 @@ impl Session<'_> {
         self.run(&["windowfocus", "--sync", &self.window]);
     }
 
+    /// Returns once the viewer has read the input sent so far: two more
+    /// frames shown ([`wait_for_frames`]). egui reads input once a frame,
+    /// so steps that must reach it in different frames (the pointer
+    /// resting before a press, a drag's press, moves and release, a key
+    /// after the focus moved) are sent with this between them: a fixed
+    /// sleep was outrun by a loaded machine's slower frames (issue 47).
+    pub(crate) fn settle(&self) {
+        wait_for_frames(self.dir, 2);
+    }
+
+    /// Moves the pointer to `(x, y)` and lets the viewer see it there.
+    pub(crate) fn move_to(&self, x: i32, y: i32) {
+        self.run(&["mousemove", &x.to_string(), &y.to_string()]);
+        self.settle();
+    }
+
+    /// A click at `(x, y)`: the pointer rests there first (a press where
+    /// egui still has the pointer elsewhere would hit what it was over),
+    /// and the viewer has handled the click when this returns.
     pub(crate) fn click(&self, x: i32, y: i32) {
-        self.run(&["mousemove", &x.to_string(), &y.to_string(), "click", "1"]);
-        std::thread::sleep(Duration::from_millis(1500));
+        self.move_to(x, y);
+        self.run(&["click", "1"]);
+        self.settle();
     }
 
     /// Folds the Preset, Materials and Environment sections, opens Point
     /// light and drags its intensity slider (logarithmic, 0 to 10 000, the
     /// fourth row of the section) from its knob to the far left. Each step
-    /// waits a second: egui reads the pointer once per frame, and a press,
-    /// moves and release within one slow frame would be a click on the knob.
+    /// waits until the viewer has read it: egui reads the pointer once per
+    /// frame, and a press, moves and release within one slow frame would
+    /// be a click on the knob.
     pub(crate) fn drag_light_intensity_to_zero(&self) {
         for header in 0..4 {
             self.click(PANEL_LEFT + 50, 12 + header * HEADER_STEP);
         }
         let (knob_x, knob_y) = (PANEL_LEFT + 79, 173);
-        self.run(&[
-            "mousemove",
-            &knob_x.to_string(),
-            &knob_y.to_string(),
-            "mousedown",
-            "1",
-        ]);
+        self.move_to(knob_x, knob_y);
+        self.run(&["mousedown", "1"]);
+        self.settle();
         for x in [knob_x - 20, knob_x - 40, knob_x - 60, PANEL_LEFT + 5] {
-            std::thread::sleep(Duration::from_secs(1));
-            self.run(&["mousemove", &x.to_string(), &knob_y.to_string()]);
+            self.move_to(x, knob_y);
         }
-        std::thread::sleep(Duration::from_secs(1));
         self.run(&["mouseup", "1"]);
+        self.settle();
     }
 
     /// Presses F12 until a screenshot satisfies `wanted`, returning its
-    /// look; fails after [`STEP_TIMEOUT`] with the last look seen.
+    /// look; fails after [`STEP_TIMEOUT`] with the last look seen. Each
+    /// F12 waits for its own screenshot (the viewer saves it within the
+    /// frame that reads the key), however long the frame takes.
     pub(crate) fn wait_for(&self, what: &str, wanted: impl Fn(&Look) -> bool) -> Look {
         let start = Instant::now();
         let mut last = None;
@@ -171,10 +192,7 @@ impl Session<'_> {
             let before = pngs(&self.screenshots).len();
             self.focus();
             self.run(&["key", "F12"]);
-            let shot_start = Instant::now();
-            while pngs(&self.screenshots).len() == before
-                && shot_start.elapsed() < Duration::from_secs(20)
-            {
+            while pngs(&self.screenshots).len() == before && start.elapsed() < STEP_TIMEOUT {
                 std::thread::sleep(Duration::from_millis(200));
             }
             // The PNG is renamed into place once complete (atomic save).
@@ -200,8 +218,19 @@ pub(crate) fn open<'a>(
     dir: &'a TempDir,
     preset: &Path,
 ) -> (xvfb::Guard, Session<'a>) {
+    open_with(x, dir, preset, &[])
+}
+
+/// [`open`], with `extra` arguments for the viewer.
+fn open_with<'a>(
+    x: &'a xvfb::Xvfb,
+    dir: &'a TempDir,
+    preset: &Path,
+    extra: &[&str],
+) -> (xvfb::Guard, Session<'a>) {
     let cwd = dir.subdir("cwd");
-    let args: Vec<OsString> = vec!["--preset".into(), preset.into()];
+    let mut args: Vec<OsString> = vec!["--preset".into(), preset.into()];
+    args.extend(extra.iter().map(OsString::from));
     let child = spawn_marbre(x, dir, &cwd, &args);
     let found = xdotool(
         x,
@@ -302,24 +331,32 @@ fn closing_with_unsaved_edits_asks_and_save_writes_the_preset() {
         l.centre_luma < 0.02
     });
 
+    // Each request is handled once two more frames are shown: a viewer
+    // that quit on it has exited by then.
     request_close(&x, &session.window);
-    std::thread::sleep(Duration::from_secs(4));
+    let closed = frames_or_exit(&mut child, &dir, 2);
     assert!(
-        child.0.try_wait().unwrap().is_none(),
-        "closed without asking about the unsaved edit; log:\n{}",
+        closed.is_none(),
+        "closed ({closed:?}) without asking about the unsaved edit; log:\n{}",
         marbre_log(&dir)
     );
     session.focus();
     session.run(&["key", "Escape"]);
-    std::thread::sleep(Duration::from_secs(3));
+    let cancelled = frames_or_exit(&mut child, &dir, 2);
     assert!(
-        child.0.try_wait().unwrap().is_none(),
-        "Esc must cancel the quit"
+        cancelled.is_none(),
+        "Esc must cancel the quit, not {cancelled:?}; log:\n{}",
+        marbre_log(&dir)
     );
     assert_eq!(intensity(), 40.0, "nothing saved yet");
 
     request_close(&x, &session.window);
-    std::thread::sleep(Duration::from_secs(4));
+    let asked = frames_or_exit(&mut child, &dir, 2);
+    assert!(
+        asked.is_none(),
+        "closed ({asked:?}) without asking the second time; log:\n{}",
+        marbre_log(&dir)
+    );
     session.focus();
     // Save is the default: Enter chooses it, although the slider dragged
     // a moment ago had the keyboard focus.
@@ -372,17 +409,18 @@ fn a_crashed_runs_autosave_is_offered_kept_for_later_and_recovered() {
         session.wait_for("the start scene behind the offer", start_look);
         session.focus();
         session.run(&["key", "Escape"]);
-        std::thread::sleep(Duration::from_secs(2));
+        session.settle();
         // Had Esc left the offer open, Enter would choose its default,
-        // Recover.
+        // Recover, which removes the files in the frame that reads the
+        // key: once the viewer has read it, they must still be there.
         session.run(&["key", "Return"]);
-        std::thread::sleep(Duration::from_secs(5));
-        session.wait_for("the start scene after Esc", start_look);
+        session.settle();
         assert!(
             recovered.is_file() && info.is_file(),
             "Esc must keep the autosave for the next start; log:\n{}",
             marbre_log(&dir)
         );
+        session.wait_for("the start scene after Esc", start_look);
         assert_clean_log(&dir);
     }
 
@@ -421,7 +459,8 @@ fn shrinking_the_window_to_a_pixel_and_back_keeps_rendering() {
             &w.to_string(),
             &h.to_string(),
         ]);
-        std::thread::sleep(Duration::from_secs(3));
+        // At each size, frames drawn after the resize reached the viewer.
+        session.settle();
     }
     session.wait_for("lit.ron after the resizes", lit_look);
     assert_clean_log(&dir);
@@ -509,24 +548,17 @@ fn a_slow_preset_at_start_shows_its_progress_and_keeps_keys_pressed_meanwhile() 
     std::fs::write(&preset, SLOW_PRESET).unwrap();
     let (_child, session) = open(&x, &dir, &preset);
     let loading = || progress_bar_shown(&grab_window(&x, &session.window));
-    let wait_while = |what: &str, still: &dyn Fn() -> bool| {
-        let start = Instant::now();
-        while still() {
-            assert!(
-                start.elapsed() < STEP_TIMEOUT,
-                "{what}: not within {STEP_TIMEOUT:?}; marbre's log:\n{}",
-                marbre_log(&dir)
-            );
-            std::thread::sleep(Duration::from_millis(100));
-        }
-    };
+    let wait_while =
+        |what: &str, still: &dyn Fn() -> bool| wait_until(what, STEP_TIMEOUT, &dir, || !still());
 
     // The loader is held: the bar stays until the test lets it go.
     wait_while("the progress bar while the preset loads", &|| !loading());
     session.focus();
     session.run(&["key", "ctrl+2"]);
     session.run(&["key", "F12"]);
-    std::thread::sleep(Duration::from_secs(2));
+    // The viewer has read both keys (an F12 it did not hold would have
+    // saved the placeholder within that frame).
+    session.settle();
     assert!(loading(), "the load cannot end while it is held");
     assert!(
         pngs(&session.screenshots).is_empty(),
@@ -567,8 +599,11 @@ fn mean_luma(img: &image::RgbImage, xs: std::ops::Range<u32>, ys: std::ops::Rang
 /// panel opens at its width (its edge at `PANEL_LEFT`: rows too wide
 /// scroll rather than widen it and shrink the image); folding and opening
 /// sections keeps the samples; and at a first launch (a fresh settings
-/// folder) the kernel chosen by timing both, a few seconds in, keeps them
-/// too. The viewer's closing line counts the images thrown away: none.
+/// folder, `--kernel auto`) the kernel chosen by timing both, a few
+/// seconds in, keeps them too. The viewer's closing line counts the
+/// images thrown away: none. The test waits for each event (the timing
+/// stored in the settings, a first image, each click read), however
+/// long a loaded machine takes.
 #[test]
 fn sections_and_the_first_kernel_choice_keep_the_image() {
     const TEST: &str = "sections_and_the_first_kernel_choice_keep_the_image";
@@ -578,10 +613,22 @@ fn sections_and_the_first_kernel_choice_keep_the_image() {
         return;
     };
     let preset = Path::new(REPO).join("presets/default.ron");
-    let (mut child, session) = open(&x, &dir, &preset);
-    // Rounds take about a second in a debug build on lavapipe; the auto
-    // kernel timing ends within this too.
-    std::thread::sleep(Duration::from_secs(12));
+    let (mut child, session) = open_with(&x, &dir, &preset, &["--kernel", "auto"]);
+    // `auto` stores the kernel it found faster once both are timed.
+    let config = dir.path().join("config");
+    let stored_kernel = || {
+        let (settings, _) = marbre_core::viewer_files::Settings::load(&config);
+        settings.kernels.into_values().next()
+    };
+    wait_until(
+        "the kernels timed and one stored",
+        STEP_TIMEOUT,
+        &dir,
+        || stored_kernel().is_some(),
+    );
+    // F12's screenshot finishes the first round; the frames after it show it.
+    session.wait_for("a first image", |_| true);
+    session.settle();
     let window = grab_window(&x, &session.window);
     let (edge, rows) = (PANEL_LEFT as u32, 300..340);
     let (image, panel) = (
@@ -596,12 +643,16 @@ fn sections_and_the_first_kernel_choice_keep_the_image() {
     for (x, y) in [(50, 12), (50, 12), (60, 265), (60, 265)] {
         session.click(PANEL_LEFT + x, y);
     }
-    session.run(&["mousemove", "400", "300"]);
-    std::thread::sleep(Duration::from_secs(3));
+    session.move_to(400, 300);
     request_close(&x, &session.window);
     assert_success(wait_for_exit(&mut child, &dir, STEP_TIMEOUT), &dir);
     let line = quality_line(&dir);
     eprintln!("{TEST}: {line}");
+    let kernel = stored_kernel().expect("stored above");
+    assert!(
+        line.contains(&format!("({kernel} kernel)")),
+        "the viewer did not switch to the {kernel} kernel auto chose: {line}"
+    );
     assert!(
         number_before(&line, "spp") > 0,
         "nothing accumulated: {line}"

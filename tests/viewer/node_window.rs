@@ -18,8 +18,8 @@
 //! Preset section folded, so that the button sits at a fixed height.
 
 use crate::REPO;
-use crate::e2e_window::{PANEL_LEFT, assert_clean_log, open};
-use crate::xvfb::{TempDir, display_or_skip, serial};
+use crate::e2e_window::{PANEL_LEFT, STEP_TIMEOUT, assert_clean_log, open};
+use crate::xvfb::{TempDir, display_or_skip, marbre_log, serial};
 use marbre_core::scene::texture_graph::NodePath;
 use marbre_core::scene::{MaterialKey, Pattern, PatternKind, Texture};
 use std::path::Path;
@@ -35,19 +35,21 @@ const HEADER: (i32, i32) = (ADD_AT.0 + 60, ADD_AT.1 + 22);
 const DRAG: (i32, i32) = (-100, 60);
 
 /// The saved preset's diffuse tree and the graph positions of the ball's
-/// material, once the file shows `wanted`.
+/// material, once the file shows `wanted` (both it): fails after
+/// [`STEP_TIMEOUT`], with the log.
 fn saved(
+    dir: &TempDir,
     path: &Path,
     what: &str,
-    wanted: impl Fn(&Texture) -> bool,
+    wanted: impl Fn(&Texture, &[(String, glam::Vec2)]) -> bool,
 ) -> (Texture, Vec<(String, glam::Vec2)>) {
     let start = Instant::now();
     let mut last = None;
-    while start.elapsed() < Duration::from_secs(30) {
+    while start.elapsed() < STEP_TIMEOUT {
         if let Ok(loaded) = marbre_core::preset::load(path) {
             let scene = loaded.preset.scene;
             let diffuse = scene.spheres[0].material.diffuse.clone();
-            let positions = scene
+            let positions: Vec<(String, glam::Vec2)> = scene
                 .graph_layout
                 .get(MaterialKey::Sphere(0))
                 .map(|l| {
@@ -60,17 +62,20 @@ fn saved(
                         .collect()
                 })
                 .unwrap_or_default();
-            if wanted(&diffuse) {
+            if wanted(&diffuse, &positions) {
                 return (diffuse, positions);
             }
-            last = Some(diffuse);
+            last = Some((diffuse, positions));
         }
         std::thread::sleep(Duration::from_millis(300));
     }
-    panic!("{what}: the saved preset's diffuse is {last:?}");
+    panic!(
+        "{what}: not within {STEP_TIMEOUT:?}; the saved preset's diffuse and positions are {last:?}; log:\n{}",
+        marbre_log(dir)
+    );
 }
 
-fn is_checker(t: &Texture) -> bool {
+fn is_checker(t: &Texture, _: &[(String, glam::Vec2)]) -> bool {
     t.pattern.kind() == PatternKind::Checker
 }
 
@@ -88,24 +93,26 @@ fn the_node_editor_adds_zooms_moves_deletes_and_undoes() {
     let plain = session.wait_for("the grey ball", |l| l.centre_luma > 0.2);
     assert!(plain.centre_spread < 0.05, "{plain:?}");
 
+    // Each step waits until the viewer has read it (`Session::settle`):
+    // egui reads input once a frame, and a slow frame would merge steps.
     session.focus();
     session.click(PANEL_LEFT + 50, 12);
     session.click(PANEL_LEFT + 86, 81);
-    std::thread::sleep(Duration::from_secs(2));
+    // The graph's window, opened by that click, is drawn.
+    session.settle();
 
     // Add a checker on the diffuse.
-    let mv = |(x, y): (i32, i32)| session.run(&["mousemove", &x.to_string(), &y.to_string()]);
+    let mv = |(x, y): (i32, i32)| session.move_to(x, y);
     mv(ADD_AT);
-    std::thread::sleep(Duration::from_secs(1));
     session.focus();
     session.run(&["key", "shift+a"]);
-    std::thread::sleep(Duration::from_secs(2));
+    session.settle();
     session.run(&["type", "--delay", "50", "checker"]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
     session.run(&["key", "Return"]);
-    std::thread::sleep(Duration::from_secs(2));
+    session.settle();
     session.run(&["key", "ctrl+s"]);
-    let (_, added) = saved(&preset, "Shift+A, checker, Enter, Ctrl+S", is_checker);
+    let (_, added) = saved(&dir, &preset, "Shift+A, checker, Enter, Ctrl+S", is_checker);
     let checker = session.wait_for("a checker on the ball", |l| l.centre_spread > 0.08);
     let place = |positions: &[(String, glam::Vec2)], path: &str| {
         positions
@@ -118,35 +125,34 @@ fn the_node_editor_adds_zooms_moves_deletes_and_undoes() {
 
     // Zoom out about the header, then drag it.
     mv(HEADER);
-    std::thread::sleep(Duration::from_secs(1));
     for _ in 0..3 {
         session.run(&["click", "5"]);
-        std::thread::sleep(Duration::from_millis(600));
+        session.settle();
     }
-    std::thread::sleep(Duration::from_secs(2));
     session.run(&["mousedown", "1"]);
+    session.settle();
     for k in 1..=4 {
-        std::thread::sleep(Duration::from_secs(1));
         mv((HEADER.0 + DRAG.0 * k / 4, HEADER.1 + DRAG.1 * k / 4));
     }
-    std::thread::sleep(Duration::from_secs(1));
     session.run(&["mouseup", "1"]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
     session.focus();
     session.run(&["key", "ctrl+s"]);
     // Zoomed out, a drag on screen moves the node further in the graph,
     // along the drag. (How far a notch of X's wheel reaches egui varies:
     // under Xvfb each reaches the viewer twice, 1.2⁻⁶ for three.)
     let drag = glam::Vec2::new(DRAG.0 as f32, DRAG.1 as f32);
-    let start = Instant::now();
-    let moved = loop {
-        let (_, positions) = saved(&preset, "the drag saved", is_checker);
-        let at = place(&positions, "diffuse");
-        if at != at_add || start.elapsed() > Duration::from_secs(30) {
-            break positions;
-        }
-        std::thread::sleep(Duration::from_millis(300));
-    };
+    let (_, moved) = saved(
+        &dir,
+        &preset,
+        "the drag saved (the node somewhere else)",
+        |t, positions| {
+            is_checker(t, positions)
+                && positions
+                    .iter()
+                    .any(|(p, at)| p == "diffuse" && *at != at_add)
+        },
+    );
     let at_drag = place(&moved, "diffuse");
     let in_graph = at_drag - at_add;
     let zoom = drag.length() / in_graph.length();
@@ -163,16 +169,16 @@ fn the_node_editor_adds_zooms_moves_deletes_and_undoes() {
     // Delete the selected node, then undo.
     session.focus();
     session.run(&["key", "Delete"]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
     session.run(&["key", "ctrl+s"]);
-    let (constant, _) = saved(&preset, "Delete, Ctrl+S", |t| {
+    let (constant, _) = saved(&dir, &preset, "Delete, Ctrl+S", |t, _| {
         t.pattern == Pattern::Constant
     });
     let plain_again = session.wait_for("the plain ball", |l| l.centre_spread < 0.05);
     session.run(&["key", "ctrl+z"]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
     session.run(&["key", "ctrl+s"]);
-    saved(&preset, "Ctrl+Z, Ctrl+S", is_checker);
+    saved(&dir, &preset, "Ctrl+Z, Ctrl+S", is_checker);
     let back = session.wait_for("the checker back", |l| l.centre_spread > 0.08);
     println!(
         "{TEST}: plain {plain:?}\nchecker {checker:?}\nafter delete {plain_again:?} ({constant:?})\nundone {back:?}\nadded at {at_add}, dragged to {at_drag} at a zoom of {zoom}"

@@ -19,10 +19,9 @@ use crate::e2e_window::{STEP_TIMEOUT, assert_clean_log, open};
 use crate::window::cornell_box_in_the_window;
 use crate::xvfb::{
     TempDir, assert_success, display_or_skip, drop_file, marbre_log, request_close, serial,
-    wait_for_exit,
+    wait_for_exit, wait_until,
 };
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 /// The Cornell box's OBJ and MTL files, as the repository ships them.
 const CORNELL: &str = "presets/scenes/cornell-box";
@@ -84,19 +83,20 @@ fn a_dropped_obj_becomes_the_scene_and_save_leaves_it_alone() {
 
     // Ctrl+S: the scene has no preset file yet, so nothing is written
     // (where no dialog can open, Save as asks for the path instead).
+    // A save is written within the frame that reads the key: once the
+    // viewer has read it, a wrong write would be there.
     session.focus();
     session.run(&["key", "ctrl+s"]);
-    std::thread::sleep(Duration::from_secs(4));
+    session.settle();
     untouched();
     assert!(!preset.exists(), "Save wrote {} unasked", preset.display());
 
     // Save as's field holds the suggestion, `<name>.ron` beside the OBJ,
     // and has the keyboard: Enter saves there.
     session.run(&["key", "Return"]);
-    let deadline = Instant::now() + STEP_TIMEOUT;
-    while !preset.exists() && Instant::now() < deadline {
-        std::thread::sleep(Duration::from_millis(200));
-    }
+    wait_until("Save as writing the preset", STEP_TIMEOUT, &dir, || {
+        preset.exists()
+    });
     let saved = marbre_core::preset::load(&preset)
         .unwrap_or_else(|e| panic!("Save as: {e}; log:\n{}", marbre_log(&dir)))
         .preset;

@@ -10,8 +10,8 @@
 //! that the Environment section's rows and the Time section's (the last
 //! but Stats) sit at fixed heights.
 
-use crate::e2e_window::{PANEL_LEFT, Session, assert_clean_log, open};
-use crate::xvfb::{TempDir, display_or_skip, serial};
+use crate::e2e_window::{PANEL_LEFT, STEP_TIMEOUT, Session, assert_clean_log, open};
+use crate::xvfb::{TempDir, display_or_skip, marbre_log, serial};
 use marbre_core::animation::Animation;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -29,9 +29,10 @@ fn saved_animation(preset: &Path) -> Animation {
 }
 
 /// Saves with Ctrl+S (the pointer over the image, where no widget takes
-/// the keys) and waits until the file holds `tracks` tracks.
-fn save_and_count(session: &Session, preset: &Path, tracks: usize) -> Animation {
-    session.run(&["mousemove", "400", "300"]);
+/// the keys) and waits until the file holds `tracks` tracks; fails after
+/// [`STEP_TIMEOUT`].
+fn save_and_count(session: &Session, dir: &TempDir, preset: &Path, tracks: usize) -> Animation {
+    session.move_to(400, 300);
     session.focus();
     session.run(&["key", "ctrl+s"]);
     let start = Instant::now();
@@ -41,24 +42,24 @@ fn save_and_count(session: &Session, preset: &Path, tracks: usize) -> Animation 
             return animation;
         }
         assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "the saved preset has {} tracks, not {tracks}: {animation:?}",
-            animation.tracks.len()
+            start.elapsed() < STEP_TIMEOUT,
+            "the saved preset has {} tracks, not {tracks}: {animation:?}; log:\n{}",
+            animation.tracks.len(),
+            marbre_log(dir)
         );
         std::thread::sleep(Duration::from_millis(500));
     }
 }
 
 /// A click as a slow frame sees it: the pointer rests on the spot, then
-/// the button goes down and up a frame or so apart.
+/// the button goes down and up in different frames, each step read by
+/// the viewer before the next (`Session::settle`).
 fn press(session: &Session, x: i32, y: i32) {
-    std::thread::sleep(Duration::from_secs(1));
-    session.run(&["mousemove", &x.to_string(), &y.to_string()]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.move_to(x, y);
     session.run(&["mousedown", "1"]);
-    std::thread::sleep(Duration::from_millis(500));
+    session.settle();
     session.run(&["mouseup", "1"]);
-    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
 }
 
 #[test]
@@ -82,13 +83,18 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
     }
 
     // Space over the image plays: past 1 s the keyed light is off.
-    session.run(&["mousemove", "400", "300"]);
+    session.move_to(400, 300);
     session.focus();
     session.run(&["key", "space"]);
     session.wait_for("playing past 1 s (the light off)", |l| l.centre_luma < 0.02);
-    // Playback stops on the last frame (1.75 s) at most 0.75 s later; a
-    // scrub during playback would play on from where it set the time.
-    std::thread::sleep(Duration::from_secs(2));
+    // Playback runs on the wall clock: it stops (on the last frame, 1.75 s)
+    // at the first frame 2 s after it started (8 frames at 4 fps), and it
+    // had run 1 s by the frame the screenshot just seen was taken in: so
+    // by a second after now. A scrub during playback would play on from
+    // where it set the time. The sleep waits for the play head's own
+    // clock, not for the viewer; the frames after it are waited for.
+    std::thread::sleep(Duration::from_secs(1));
+    session.settle();
 
     // A press at the time slider's left end scrubs back to 0 s (the
     // pointer first rests there: egui reads it once per slow frame).
@@ -97,7 +103,7 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
 
     // The Environment's intensity row, its key button at the row's end.
     press(&session, PANEL_LEFT + 244, 127);
-    let keyed = save_and_count(&session, &preset, 2);
+    let keyed = save_and_count(&session, &dir, &preset, 2);
     let track = &keyed.tracks[1];
     assert_eq!(track.path, "environment.intensity");
     assert_eq!(track.keys.len(), 1);
@@ -107,8 +113,8 @@ fn space_plays_a_click_scrubs_and_a_key_is_undone() {
     session.run(&["key", "ctrl+z"]);
     // Not in the same frame as the Ctrl+S that follows: that frame would
     // save (a shortcut taken before the widgets) before undoing.
-    std::thread::sleep(Duration::from_secs(2));
-    let undone = save_and_count(&session, &preset, 1);
+    session.settle();
+    let undone = save_and_count(&session, &dir, &preset, 1);
     assert_eq!(undone.tracks[0].path, "point_light.intensity");
     assert_clean_log(&dir);
 }
