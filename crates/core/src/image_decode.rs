@@ -1028,22 +1028,31 @@ pub(crate) mod test_support {
     }
 
     /// `exr`, a file of one part, with its data window patched to claim
-    /// `width × height` texels: the probe's lying header (598 bytes
-    /// claiming 16384×8192).
+    /// `width × height` texels, and its chunk count to match: the probe's
+    /// lying header (598 bytes claiming 16384×8192), which the `exr` crate
+    /// reads as valid up to its missing chunks.
     pub(crate) fn exr_claiming(exr: &[u8], width: i32, height: i32) -> Vec<u8> {
-        let name = b"dataWindow\0box2i\0";
-        let at = exr
-            .windows(name.len())
-            .position(|w| w == name)
-            .expect("an EXR header has a data window")
-            + name.len();
-        assert_eq!(exr[at..at + 4], 16i32.to_le_bytes(), "a box2i is 16 bytes");
+        let meta =
+            exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(exr), false).unwrap();
+        let header = &meta.headers[0];
+        let size = exr::math::Vec2(width as usize, height as usize);
+        let chunks = exr::meta::compute_chunk_count(header.compression, size, header.blocks) as i32;
         let mut lying = exr.to_vec();
-        let window = [0, 0, width - 1, height - 1];
-        for (k, v) in window.iter().enumerate() {
-            let start = at + 4 + 4 * k;
-            lying[start..start + 4].copy_from_slice(&v.to_le_bytes());
-        }
+        let mut patch = |name: &[u8], values: &[i32]| {
+            let at = exr
+                .windows(name.len())
+                .position(|w| w == name)
+                .expect("the `exr` crate writes both attributes")
+                + name.len();
+            let size = 4 * values.len() as i32;
+            assert_eq!(exr[at..at + 4], size.to_le_bytes(), "{values:?}");
+            for (k, v) in values.iter().enumerate() {
+                let start = at + 4 + 4 * k;
+                lying[start..start + 4].copy_from_slice(&v.to_le_bytes());
+            }
+        };
+        patch(b"dataWindow\0box2i\0", &[0, 0, width - 1, height - 1]);
+        patch(b"chunkCount\0int\0", &[chunks]);
         lying
     }
 }

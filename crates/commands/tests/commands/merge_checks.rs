@@ -147,16 +147,24 @@ fn replaced_values_are_counted_in_a_note() {
 fn a_header_claiming_more_than_its_file_holds_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let [a, lying] = two_batches(dir.path());
-    let mut window = b"dataWindow\0box2i\0".to_vec();
-    window.extend(16i32.to_le_bytes());
-    let mut claimed = window.clone();
-    for v in [0i32, 0, 1, 0] {
-        window.extend(v.to_le_bytes());
-    }
-    for v in [0i32, 0, 16383, 8191] {
-        claimed.extend(v.to_le_bytes());
-    }
-    patch(&lying, &window, &claimed);
+    let attribute = |name: &[u8], values: &[i32]| {
+        let mut bytes = name.to_vec();
+        bytes.extend((4 * values.len() as i32).to_le_bytes());
+        bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        bytes
+    };
+    let window = |w: i32, h: i32| attribute(b"dataWindow\0box2i\0", &[0, 0, w - 1, h - 1]);
+    patch(&lying, &window(2, 1), &window(16384, 8192));
+    // The chunk count to match, as the `exr` crate checks it: the file's
+    // 64×64 tiles.
+    let meta = exr::meta::MetaData::read_from_file(&lying, false).unwrap();
+    let header = &meta.headers[0];
+    let chunks = |w, h| {
+        exr::meta::compute_chunk_count(header.compression, exr::math::Vec2(w, h), header.blocks)
+            as i32
+    };
+    let count = |n: i32| attribute(b"chunkCount\0int\0", &[n]);
+    patch(&lying, &count(chunks(2, 1)), &count(chunks(16384, 8192)));
     let size = std::fs::metadata(&lying).unwrap().len();
     assert!(size < 2000, "{size}");
     let e = merge_files(&[a, lying.clone()], &dir.path().join("m.exr"), &[])
