@@ -113,7 +113,7 @@ pub fn run(
         "streams",
         bytemuck::cast_slice(&states),
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    );
+    )?;
     let mut encoder = device.create_command_encoder(&Default::default());
     for first_frame in (0..frames).step_by(CHUNK as usize) {
         let chunk = AccumulationHarness {
@@ -127,14 +127,14 @@ pub fn run(
             "accumulation harness",
             bytemuck::bytes_of(&chunk),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("accumulation harness"),
             layout: &layout,
             entries: &[buffer_entry(0, &uniform_buffer), buffer_entry(1, &streams)],
         });
         let groups = ((seeds.len() as u32).div_ceil(64), 1);
-        dispatch::record(&mut encoder, &pipeline, &bind_group, groups);
+        dispatch::record(ctx, &mut encoder, &pipeline, &bind_group, groups)?;
     }
     let states: Vec<Stream> = dispatch::read_back(ctx, encoder, &streams)?;
     Ok(states

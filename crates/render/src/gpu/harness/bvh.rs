@@ -119,8 +119,8 @@ impl BvhHarness {
             dispatch::upload(ctx, label, contents, wgpu::BufferUsages::STORAGE)
         };
         Ok(Self {
-            nodes: storage_buffer("bvh nodes", bytemuck::cast_slice(nodes)),
-            triangles: storage_buffer("mesh triangles", bytemuck::cast_slice(triangles)),
+            nodes: storage_buffer("bvh nodes", bytemuck::cast_slice(nodes))?,
+            triangles: storage_buffer("mesh triangles", bytemuck::cast_slice(triangles))?,
             layout,
             closest,
             occluded,
@@ -168,10 +168,11 @@ impl BvhHarness {
         let batch = self.batch(ctx, rays)?;
         let dispatch = || -> Result<()> {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, &batch, query);
+            self.encode(ctx, &mut encoder, &batch, query)?;
             ctx.queue.submit([encoder.finish()]);
             ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-            Ok(())
+            // Invalid work times nothing.
+            ctx.uncaptured.check()
         };
         dispatch()?;
         let mut times = Vec::new();
@@ -190,16 +191,22 @@ impl BvhHarness {
         }
         let batch = self.batch(ctx, rays)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.encode(&mut encoder, &batch, query);
+        self.encode(ctx, &mut encoder, &batch, query)?;
         dispatch::read_back(ctx, encoder, &batch.results)
     }
 
-    fn encode(&self, encoder: &mut wgpu::CommandEncoder, batch: &Batch, query: Query) {
+    fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        batch: &Batch,
+        query: Query,
+    ) -> Result<()> {
         let pipeline = match query {
             Query::Closest => &self.closest,
             Query::Occluded => &self.occluded,
         };
-        dispatch::record(encoder, pipeline, &batch.bind_group, batch.groups);
+        dispatch::record(ctx, encoder, pipeline, &batch.bind_group, batch.groups)
     }
 
     fn batch(&self, ctx: &GpuContext, rays: &[Ray]) -> Result<Batch> {
@@ -229,13 +236,13 @@ impl BvhHarness {
             "bvh harness",
             bytemuck::bytes_of(&params),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
         let ray_buffer = init(
             "rays",
             bytemuck::cast_slice(&gpu_rays),
             wgpu::BufferUsages::STORAGE,
-        );
-        let results = dispatch::output(ctx, "bvh results", (rays.len() * 16) as u64);
+        )?;
+        let results = dispatch::output(ctx, "bvh results", (rays.len() * 16) as u64)?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bvh harness"),
             layout: &self.layout,

@@ -5,7 +5,7 @@
 //! stability tests can hold the real WGSL to its CPU twins
 //! ([`marbre_core::geometry`], [`marbre_core::texture::bump`]) and to double precision.
 
-use super::points;
+use super::points::PointsHarness;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::FeatureSet;
 use crate::gpu::shader_source::Program;
@@ -57,20 +57,16 @@ pub struct ShadingNormal {
 }
 
 fn run(ctx: &GpuContext, mode: u32, queries: Vec<[Vec3; QUERY_POINTS]>) -> Result<Vec<[Vec3; 2]>> {
-    let uniform = GeometryHarness {
-        mode,
-        count: queries.len() as u32,
-        _pad: [0; 2],
-    };
     let points: Vec<Vec3> = queries.into_iter().flatten().collect();
-    let results = points::run(
-        ctx,
-        Program::GeometryHarness,
-        &FeatureSet::default(),
-        bytemuck::bytes_of(&uniform),
-        None,
-        &points,
-    )?;
+    let harness = PointsHarness::new(ctx, Program::GeometryHarness, &FeatureSet::default(), None)?;
+    let results = harness.run(ctx, &points, QUERY_POINTS, |count| {
+        let uniform = GeometryHarness {
+            mode,
+            count: (count / QUERY_POINTS) as u32,
+            _pad: [0; 2],
+        };
+        Ok(bytemuck::bytes_of(&uniform).to_vec())
+    })?;
     Ok(results
         .chunks_exact(QUERY_POINTS)
         .map(|r| [0, 1].map(|k| Vec3::from_slice(&r[k][..3])))

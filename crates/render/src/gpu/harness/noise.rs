@@ -2,7 +2,7 @@
 //! real WGSL can be checked against the CPU reference and queried from the
 //! command line (`marbre noise`).
 
-use super::points;
+use super::points::PointsHarness;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::FeatureSet;
 use crate::gpu::scene_gpu::NoiseParams;
@@ -63,6 +63,51 @@ struct NoiseHarness {
     _pad1: f32,
 }
 
+/// The noise harness built for one request, for any number of points:
+/// `marbre noise` evaluates its input in batches with one pipeline.
+pub struct NoiseEvaluator {
+    harness: PointsHarness,
+    params: NoiseHarness,
+}
+
+impl NoiseEvaluator {
+    pub fn new(ctx: &GpuContext, noise: &NoiseSettings, what: Evaluate) -> Result<Self> {
+        let (mode, param) = what.mode_and_param();
+        Ok(Self {
+            harness: PointsHarness::new(
+                ctx,
+                Program::NoiseHarness,
+                &FeatureSet::for_noise_harness(noise),
+                None,
+            )?,
+            params: NoiseHarness {
+                noise: NoiseParams::new(noise, FractalShape::Signed),
+                mode,
+                count: 0,
+                param,
+                _pad1: 0.0,
+            },
+        })
+    }
+
+    /// One vec4 of results at each point (x for scalars, xy for uv, xyz
+    /// for directions).
+    pub fn evaluate(&self, ctx: &GpuContext, points: &[Vec3]) -> Result<Vec<[f32; 4]>> {
+        self.harness.run(ctx, points, 1, |count| {
+            let params = NoiseHarness {
+                count: count as u32,
+                ..self.params
+            };
+            Ok(bytemuck::bytes_of(&params).to_vec())
+        })
+    }
+
+    /// The scalar results (the x component).
+    pub fn evaluate_scalar(&self, ctx: &GpuContext, points: &[Vec3]) -> Result<Vec<f32>> {
+        Ok(self.evaluate(ctx, points)?.iter().map(|r| r[0]).collect())
+    }
+}
+
 /// Evaluates `what` at every point on the GPU; one vec4 of results each
 /// (x for scalars, xy for uv, xyz for directions).
 pub fn evaluate(
@@ -71,22 +116,7 @@ pub fn evaluate(
     what: Evaluate,
     points: &[Vec3],
 ) -> Result<Vec<[f32; 4]>> {
-    let (mode, param) = what.mode_and_param();
-    let params = NoiseHarness {
-        noise: NoiseParams::new(noise, FractalShape::Signed),
-        mode,
-        count: points.len() as u32,
-        param,
-        _pad1: 0.0,
-    };
-    points::run(
-        ctx,
-        Program::NoiseHarness,
-        &FeatureSet::for_noise_harness(noise),
-        bytemuck::bytes_of(&params),
-        None,
-        points,
-    )
+    NoiseEvaluator::new(ctx, noise, what)?.evaluate(ctx, points)
 }
 
 /// Scalar results (the x component).
@@ -96,10 +126,7 @@ pub fn evaluate_scalar(
     what: Evaluate,
     points: &[Vec3],
 ) -> Result<Vec<f32>> {
-    Ok(evaluate(ctx, noise, what, points)?
-        .iter()
-        .map(|r| r[0])
-        .collect())
+    NoiseEvaluator::new(ctx, noise, what)?.evaluate_scalar(ctx, points)
 }
 
 /// The GPU's lat-long uv for each direction.

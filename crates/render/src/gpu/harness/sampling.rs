@@ -301,13 +301,13 @@ impl SamplingHarness {
             "sampling frame",
             bytemuck::bytes_of(&frame),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
         let input_buffer = init(
             "sampling inputs",
             bytemuck::cast_slice(inputs),
             wgpu::BufferUsages::STORAGE,
-        );
-        let output_buffer = dispatch::output(ctx, "sampling results", (inputs.len() * 32) as u64);
+        )?;
+        let output_buffer = dispatch::output(ctx, "sampling results", (inputs.len() * 32) as u64)?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sampling harness"),
             layout: &self.layout,
@@ -328,7 +328,7 @@ impl SamplingHarness {
         });
         let mut encoder = device.create_command_encoder(&Default::default());
         let groups = ((inputs.len() as u32).div_ceil(64), 1);
-        dispatch::record(&mut encoder, &self.pipeline, &bind_group, groups);
+        dispatch::record(ctx, &mut encoder, &self.pipeline, &bind_group, groups)?;
         dispatch::read_back(ctx, encoder, &output_buffer)
     }
 }

@@ -2,7 +2,7 @@
 //! in a compute pass, so the parity tests can hold them to the CPU reference
 //! in [`marbre_core::texture`].
 
-use super::points;
+use super::points::PointsHarness;
 use crate::gpu::context::GpuContext;
 use crate::gpu::features::FeatureSet;
 use crate::gpu::scene_gpu::NoiseParams;
@@ -356,19 +356,20 @@ impl PatternQuery {
 /// Evaluates `query` at every point on the GPU: one vec4 each (see
 /// [`PatternQuery`] for what its components hold).
 pub fn evaluate(ctx: &GpuContext, query: &PatternQuery, points: &[Vec3]) -> Result<Vec<[f32; 4]>> {
-    let uniform = query.uniform(points.len() as u32)?;
     let noise = query.noise();
-    points::run(
+    let atlas = match query {
+        PatternQuery::Image { atlas, .. } => Some(atlas),
+        _ => None,
+    };
+    PointsHarness::new(
         ctx,
         Program::TextureHarness,
         &FeatureSet::for_texture_library(&noise),
-        bytemuck::bytes_of(&uniform),
-        match query {
-            PatternQuery::Image { atlas, .. } => Some(atlas),
-            _ => None,
-        },
-        points,
-    )
+        atlas,
+    )?
+    .run(ctx, points, 1, |count| {
+        Ok(bytemuck::bytes_of(&query.uniform(count as u32)?).to_vec())
+    })
 }
 
 #[cfg(test)]

@@ -104,17 +104,17 @@ pub fn bake(
         "materials",
         bytemuck::cast_slice(&scene_gpu::materials(scene)),
         wgpu::BufferUsages::UNIFORM,
-    );
+    )?;
     let permutation = init(
         "permutation",
         bytemuck::cast_slice(&permutation_table()),
         wgpu::BufferUsages::UNIFORM,
-    );
+    )?;
     let params = init(
         "texture params",
         bytemuck::cast_slice(&generated.params),
         wgpu::BufferUsages::UNIFORM,
-    );
+    )?;
     let atlas = upload_atlas(ctx, images.atlas());
 
     let count = size as usize * size as usize;
@@ -138,13 +138,13 @@ pub fn bake(
             "bake settings",
             bytemuck::bytes_of(&settings),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
         let points = init(
             "bake texels",
             bytemuck::cast_slice(&texels),
             wgpu::BufferUsages::STORAGE,
-        );
-        let values = dispatch::output(ctx, "bake values", (texels.len() * 16) as u64);
+        )?;
+        let values = dispatch::output(ctx, "bake values", (texels.len() * 16) as u64)?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bake"),
             layout: &layout,
@@ -163,7 +163,7 @@ pub fn bake(
         });
         let mut encoder = device.create_command_encoder(&Default::default());
         let groups = ((texels.len() as u32).div_ceil(64), 1);
-        dispatch::record(&mut encoder, &pipeline, &bind_group, groups);
+        dispatch::record(ctx, &mut encoder, &pipeline, &bind_group, groups)?;
         let results: Vec<[f32; 4]> = dispatch::read_back(ctx, encoder, &values)?;
         for (i, v) in indices.into_iter().zip(results) {
             out[i] = v;

@@ -108,13 +108,13 @@ impl SwatchRenderer {
             "swatch points",
             bytemuck::cast_slice(&points),
             wgpu::BufferUsages::STORAGE,
-        );
+        )?;
         let permutation = dispatch::upload(
             &ctx,
             "swatch permutation",
             bytemuck::cast_slice(&permutation_table()),
             wgpu::BufferUsages::UNIFORM,
-        );
+        )?;
         // Image nodes show the CPU reference's stand-in colour: swatches do
         // not load the scene's images.
         let atlas = upload_atlas(&ctx, &ImageAtlas::pack(&[], 1)?);
@@ -181,14 +181,14 @@ impl SwatchRenderer {
         let init = |label: &str, contents: &[u8]| {
             dispatch::upload(&self.ctx, label, contents, wgpu::BufferUsages::UNIFORM)
         };
-        let batch_buffer = init("swatch batch", bytemuck::bytes_of(&batch));
-        let materials_buffer = init("swatch materials", bytemuck::cast_slice(&materials));
-        let params_buffer = init("swatch params", bytemuck::cast_slice(&generated.params));
+        let batch_buffer = init("swatch batch", bytemuck::bytes_of(&batch))?;
+        let materials_buffer = init("swatch materials", bytemuck::cast_slice(&materials))?;
+        let params_buffer = init("swatch params", bytemuck::cast_slice(&generated.params))?;
         let output = dispatch::output(
             &self.ctx,
             "swatch results",
             (count * textures.len() * 16) as u64,
-        );
+        )?;
         let buffers = [
             (2, &materials_buffer),
             (6, &self.permutation),
@@ -218,7 +218,13 @@ impl SwatchRenderer {
             });
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         let groups = ((count as u32).div_ceil(64), textures.len() as u32);
-        dispatch::record(&mut encoder, &pipeline.pipeline, &bind_group, groups);
+        dispatch::record(
+            &self.ctx,
+            &mut encoder,
+            &pipeline.pipeline,
+            &bind_group,
+            groups,
+        )?;
         let values: Vec<[f32; 4]> = dispatch::read_back(&self.ctx, encoder, &output)?;
         Ok(values.chunks(count).map(<[_]>::to_vec).collect())
     }

@@ -1,6 +1,11 @@
-//! Adapter and device creation, headless or for a window.
+//! Adapter and device creation, headless or for a window; each device
+//! with the handler of its uncaptured errors ([`uncaptured`]).
 
 use anyhow::{Context as _, Result};
+
+pub mod uncaptured;
+
+pub use uncaptured::UncapturedErrors;
 
 /// A device and what the stats panel and the benchmarks report about it.
 /// A clone shares the device (wgpu handles are reference counted): the
@@ -13,6 +18,9 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// Whether GPU timestamp queries are enabled (not every adapter has them).
     pub timestamps: bool,
+    /// The device's errors that no error scope caught, logged and kept
+    /// instead of wgpu's panic.
+    pub uncaptured: UncapturedErrors,
 }
 
 impl GpuContext {
@@ -135,6 +143,7 @@ impl GpuContext {
         Ok(Self {
             instance,
             adapter,
+            uncaptured: UncapturedErrors::watch(&device),
             device,
             queue,
             timestamps,
@@ -149,20 +158,34 @@ impl GpuContext {
     /// caller's fallback (no warm-up, no timing, no background render)
     /// applies.
     pub fn sibling(&self) -> Result<Self> {
+        self.device_with("a second device", self.device.limits())
+    }
+
+    /// A device on the same adapter held to `limits` (lower ones than the
+    /// adapter's): how tests check that work sized by its input is split
+    /// to a device's limits without inputs as large as real limits.
+    pub fn limited(&self, limits: wgpu::Limits) -> Result<Self> {
+        self.device_with("a device with these limits", limits)
+    }
+
+    /// Another device on this one's adapter and features: `what` it is,
+    /// in its errors.
+    fn device_with(&self, what: &str, required_limits: wgpu::Limits) -> Result<Self> {
         if cfg!(target_arch = "wasm32") {
-            anyhow::bail!("a web page cannot wait for a second GPU device");
+            anyhow::bail!("a web page cannot wait for {what} on its GPU");
         }
         let (device, queue) =
             pollster::block_on(self.adapter.request_device(&wgpu::DeviceDescriptor {
-                label: Some("marbre shader warm-up"),
+                label: Some(what),
                 required_features: self.device.features(),
-                required_limits: self.device.limits(),
+                required_limits,
                 ..Default::default()
             }))
-            .context("the adapter refused a second device")?;
+            .with_context(|| format!("the adapter refused {what}"))?;
         Ok(Self {
             instance: self.instance.clone(),
             adapter: self.adapter.clone(),
+            uncaptured: UncapturedErrors::watch(&device),
             device,
             queue,
             timestamps: self.timestamps,
