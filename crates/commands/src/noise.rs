@@ -2,6 +2,12 @@
 //! real WGSL through the compute harness, in f32) or on the CPU reference
 //! (in f64: Perlin's own Java is double precision, and far from the origin
 //! f32 has lost the noise's digits).
+//!
+//! The points are read, evaluated and printed in batches of
+//! [`BATCH_POINTS`], so that memory stays bounded and values come out while
+//! a pipe still sends points (issue 47: 20 million points once held 5 GB
+//! and then panicked, over the GPU's binding and dispatch limits, which
+//! the harness now splits its work to).
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
@@ -12,8 +18,8 @@ use marbre_core::noise::{
     Evolution, FractalParams, HashKind, NoiseKind, NoiseSettings, Progression, noise4_f64,
 };
 use marbre_render::gpu::GpuContext;
-use marbre_render::gpu::harness::noise::{Evaluate, evaluate_scalar};
-use std::io::{BufRead, Write};
+use marbre_render::gpu::harness::noise::{Evaluate, NoiseEvaluator};
+use std::io::{BufRead, BufWriter, Write};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -149,58 +155,103 @@ pub fn evaluate_cpu(settings: &NoiseSettings, what: Evaluate, points: &[DVec3]) 
         .collect()
 }
 
+/// How many points are read before they are evaluated and printed: a
+/// few MiB of points, values and buffers at a time, and one GPU dispatch
+/// large enough that its overhead does not count.
+pub const BATCH_POINTS: usize = 1 << 16;
+
 pub fn run(args: &NoiseArgs) -> Result<()> {
     if let Some(path) = &args.stability_figure {
         return super::noise_figure::write(path);
     }
     let settings = args.settings();
+    let what = args.what();
+    let mut gpu: Option<GpuNoise> = None;
     evaluate_input(
         std::io::stdin().lock(),
-        &mut std::io::stdout().lock(),
+        &mut BufWriter::new(std::io::stdout().lock()),
         &mut std::io::stderr().lock(),
+        BATCH_POINTS,
         |points| {
             if args.cpu {
-                Ok(evaluate_cpu(&settings, args.what(), points))
-            } else {
-                evaluate_gpu(&GpuContext::headless()?, &settings, args.what(), points)
+                return Ok(evaluate_cpu(&settings, what, points));
             }
+            let noise = match gpu.take() {
+                Some(noise) => noise,
+                None => GpuNoise::open(&settings, what)?,
+            };
+            let values = noise.evaluate(points);
+            gpu = Some(noise);
+            values
         },
     )
 }
 
-/// The shader's values at `points` (rounded to f32 first, as the shader
-/// sees them), widened to f64 exactly.
-fn evaluate_gpu(
-    ctx: &GpuContext,
-    settings: &NoiseSettings,
-    what: Evaluate,
-    points: &[DVec3],
-) -> Result<Vec<f64>> {
-    let points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
-    Ok(evaluate_scalar(ctx, settings, what, &points)?
-        .into_iter()
-        .map(f64::from)
-        .collect())
+/// The shader's noise on a device, opened at the first batch and kept for
+/// the others.
+struct GpuNoise {
+    ctx: GpuContext,
+    harness: NoiseEvaluator,
+}
+
+impl GpuNoise {
+    fn open(settings: &NoiseSettings, what: Evaluate) -> Result<Self> {
+        Self::on(GpuContext::headless()?, settings, what)
+    }
+
+    fn on(ctx: GpuContext, settings: &NoiseSettings, what: Evaluate) -> Result<Self> {
+        let harness = NoiseEvaluator::new(&ctx, settings, what)?;
+        Ok(Self { ctx, harness })
+    }
+
+    /// The shader's values at `points` (rounded to f32 first, as the
+    /// shader sees them), widened to f64 exactly.
+    fn evaluate(&self, points: &[DVec3]) -> Result<Vec<f64>> {
+        let points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
+        Ok(self
+            .harness
+            .evaluate_scalar(&self.ctx, &points)?
+            .into_iter()
+            .map(f64::from)
+            .collect())
+    }
 }
 
 /// Reads the points of `input`, reporting each bad line on `err` by its
-/// number and what is wrong with it, then writes the value `evaluate`
-/// gives at each good one to `out`, one a line in their order (`evaluate`
-/// is not called when there is none: no GPU is opened for nothing). Any
-/// bad line fails the run at the end, once the good ones are written, so
-/// that one typo neither hides the other values nor passes unnoticed.
+/// number and what is wrong with it, and writes the value `evaluate`
+/// gives at each good one to `out`, one a line in their order: `batch`
+/// points at a time, each batch flushed once written, so that at most one
+/// batch is held (`evaluate` is not called when there is none: no GPU is
+/// opened for nothing). Any bad line fails the run at the end, once the
+/// good ones are written, so that one typo neither hides the other values
+/// nor passes unnoticed.
 fn evaluate_input(
     input: impl BufRead,
     out: &mut impl Write,
     err: &mut impl Write,
-    evaluate: impl FnOnce(&[DVec3]) -> Result<Vec<f64>>,
+    batch: usize,
+    mut evaluate: impl FnMut(&[DVec3]) -> Result<Vec<f64>>,
 ) -> Result<()> {
-    let mut points = Vec::new();
-    let mut bad = 0usize;
+    let mut points = Vec::with_capacity(batch);
+    let (mut good, mut bad) = (0usize, 0usize);
+    let mut write_batch = |points: &mut Vec<DVec3>| -> Result<()> {
+        for v in evaluate(points)? {
+            writeln!(out, "{}", format_value(v))?;
+        }
+        out.flush()?;
+        good += points.len();
+        points.clear();
+        Ok(())
+    };
     for line in read_points(input) {
         let line = line.context("reading stdin")?;
         match line.point {
-            Ok(p) => points.push(p),
+            Ok(p) => {
+                points.push(p);
+                if points.len() == batch {
+                    write_batch(&mut points)?;
+                }
+            }
             Err(why) => {
                 bad += 1;
                 writeln!(err, "marbre noise: line {}: {why}", line.number)?;
@@ -208,14 +259,12 @@ fn evaluate_input(
         }
     }
     if !points.is_empty() {
-        for v in evaluate(&points)? {
-            writeln!(out, "{}", format_value(v))?;
-        }
+        write_batch(&mut points)?;
     }
     if bad > 0 {
         bail!(
-            "{bad} input line(s) were not points x,y,z (listed above); the {} others were evaluated",
-            points.len()
+            "{bad} input line(s) were not points x,y,z (listed above); the {good} others were \
+             evaluated"
         );
     }
     Ok(())
@@ -254,7 +303,11 @@ mod tests {
     use super::*;
     use clap::Parser;
     use marbre_core::noise::improved_noise_f32;
+    use marbre_render::gpu::harness::noise::evaluate_scalar;
     use marbre_render::gpu::testing::gpu_or_skip;
+    use std::cell::RefCell;
+    use std::io::Read;
+    use std::rc::Rc;
 
     #[derive(Parser)]
     struct Cli {
@@ -379,14 +432,14 @@ mod tests {
         }
     }
 
-    /// `evaluate_input` on `input` with `evaluate`: (its result, stdout,
-    /// stderr).
+    /// `evaluate_input` on `input` with `evaluate`, in batches of
+    /// [`BATCH_POINTS`]: (its result, stdout, stderr).
     fn evaluate_text(
         input: &str,
-        evaluate: impl FnOnce(&[DVec3]) -> Result<Vec<f64>>,
+        evaluate: impl FnMut(&[DVec3]) -> Result<Vec<f64>>,
     ) -> (Result<()>, String, String) {
         let (mut out, mut err) = (Vec::new(), Vec::new());
-        let result = evaluate_input(input.as_bytes(), &mut out, &mut err, evaluate);
+        let result = evaluate_input(input.as_bytes(), &mut out, &mut err, BATCH_POINTS, evaluate);
         let text = |bytes| String::from_utf8(bytes).unwrap();
         (result, text(out), text(err))
     }
@@ -468,9 +521,8 @@ mod tests {
             .iter()
             .map(|p| format!("{},{},{}\n", p.x, p.y, p.z))
             .collect();
-        let (result, out, err) = evaluate_text(&input, |points| {
-            evaluate_gpu(&ctx, &args.settings(), args.what(), points)
-        });
+        let gpu = GpuNoise::on(ctx.clone(), &args.settings(), args.what()).unwrap();
+        let (result, out, err) = evaluate_text(&input, |points| gpu.evaluate(points));
         result.unwrap();
         assert_eq!(err, "");
         let f32_points: Vec<_> = points.iter().map(|p| p.as_vec3()).collect();
@@ -481,5 +533,187 @@ mod tests {
             out.lines().all(|l| l == format_value(l.parse().unwrap())),
             "{out}"
         );
+    }
+
+    /// The text of `count` points, generated as it is read (a pipe's
+    /// worth of points never held whole): point `i` is a fixed
+    /// pseudo-random spread in [-8, 8)³, written to 6 decimals.
+    struct GeneratedPoints {
+        next: usize,
+        count: usize,
+        line: Vec<u8>,
+        at: usize,
+    }
+
+    impl GeneratedPoints {
+        fn new(count: usize) -> Self {
+            Self {
+                next: 0,
+                count,
+                line: Vec::new(),
+                at: 0,
+            }
+        }
+
+        fn point(i: usize) -> DVec3 {
+            let c = |k: u64| {
+                let h = (i as u64 * 3 + k).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 40;
+                (h % 16_000_000) as f64 * 1e-6 - 8.0
+            };
+            DVec3::new(c(0), c(1), c(2))
+        }
+    }
+
+    impl Read for GeneratedPoints {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            if self.at == self.line.len() {
+                if self.next == self.count {
+                    return Ok(0);
+                }
+                let p = Self::point(self.next);
+                self.line = format!("{:.6},{:.6},{:.6}\n", p.x, p.y, p.z).into_bytes();
+                self.at = 0;
+                self.next += 1;
+            }
+            let n = buf.len().min(self.line.len() - self.at);
+            buf[..n].copy_from_slice(&self.line[self.at..self.at + n]);
+            self.at += n;
+            Ok(n)
+        }
+    }
+
+    /// More points than one GPU dispatch covers (65535 workgroups of 64:
+    /// 4,194,240; the old single dispatch panicked at 4,194,304) give the
+    /// GPU's values in order, each within f32's error of the CPU
+    /// reference's for the same point.
+    #[test]
+    fn the_gpu_path_over_one_dispatch_gives_the_cpu_references_values() {
+        let Some(ctx) =
+            gpu_or_skip("the_gpu_path_over_one_dispatch_gives_the_cpu_references_values")
+        else {
+            return;
+        };
+        let count = 65535 * 64 + 65;
+        assert!(count > 4_194_304);
+        let args = args(&["--kind", "perlin"]);
+        let (settings, what) = (args.settings(), args.what());
+        let gpu = GpuNoise::on(ctx, &settings, what).unwrap();
+        let mut out = Vec::new();
+        let input = std::io::BufReader::new(GeneratedPoints::new(count));
+        evaluate_input(input, &mut out, &mut Vec::new(), BATCH_POINTS, |points| {
+            gpu.evaluate(points)
+        })
+        .unwrap();
+        let mut lines = 0;
+        let mut worst = 0.0_f64;
+        for (i, line) in out
+            .split(|&b| b == b'\n')
+            .filter(|l| !l.is_empty())
+            .enumerate()
+        {
+            let printed: f64 = std::str::from_utf8(line).unwrap().parse().unwrap();
+            // The point as printed, 6 decimals, is the point read.
+            let p = GeneratedPoints::point(i);
+            let p = DVec3::new(round6(p.x), round6(p.y), round6(p.z));
+            let cpu = evaluate_cpu(&settings, what, &[p])[0];
+            worst = worst.max((printed - cpu).abs());
+            assert!(
+                (printed - cpu).abs() < 1e-4,
+                "point {i} {p}: GPU {printed}, CPU {cpu}"
+            );
+            lines += 1;
+        }
+        assert_eq!(lines, count);
+        assert!(worst > 0.0, "f32 and f64 agree exactly everywhere");
+    }
+
+    /// `x` as its 6-decimal text reads back.
+    fn round6(x: f64) -> f64 {
+        format!("{x:.6}").parse().unwrap()
+    }
+
+    /// Output whose flushed bytes are kept apart from those still
+    /// buffered: what a reader at the other end of a pipe has seen.
+    #[derive(Clone, Default)]
+    struct Flushed {
+        seen: Rc<RefCell<Vec<u8>>>,
+        pending: Vec<u8>,
+    }
+
+    impl Write for Flushed {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.pending.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            self.seen.borrow_mut().append(&mut self.pending);
+            Ok(())
+        }
+    }
+
+    /// Input that gives one batch of points, then, asked for more, notes
+    /// how many values the output has shown by then, and gives one more
+    /// point.
+    struct ThenLook {
+        first: std::io::Cursor<Vec<u8>>,
+        output: Rc<RefCell<Vec<u8>>>,
+        shown_before_more: Option<usize>,
+        rest: std::io::Cursor<Vec<u8>>,
+    }
+
+    impl Read for ThenLook {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = self.first.read(buf)?;
+            if n > 0 {
+                return Ok(n);
+            }
+            if self.shown_before_more.is_none() {
+                let lines = self.output.borrow().iter().filter(|&&b| b == b'\n').count();
+                self.shown_before_more = Some(lines);
+            }
+            self.rest.read(buf)
+        }
+    }
+
+    /// `marbre noise` streams: the values of a first batch of points are
+    /// written and flushed before any more input is read, so that a pipe
+    /// that has not ended yet already gets them, and at most a batch is
+    /// held; the last, partial batch follows at the end.
+    #[test]
+    fn each_batch_is_printed_before_more_input_is_read() {
+        let args = args(&["--kind", "perlin", "--cpu"]);
+        let first: String = (0..BATCH_POINTS)
+            .map(|i| format!("{i},0.5,0.25\n"))
+            .collect();
+        let out = Flushed::default();
+        let mut input = ThenLook {
+            first: std::io::Cursor::new(first.into_bytes()),
+            output: out.seen.clone(),
+            shown_before_more: None,
+            rest: std::io::Cursor::new(b"1,2\n0.5,0.5,0.5\n".to_vec()),
+        };
+        let mut calls = Vec::new();
+        let result = evaluate_input(
+            std::io::BufReader::new(&mut input),
+            &mut out.clone(),
+            &mut Vec::new(),
+            BATCH_POINTS,
+            |points| {
+                calls.push(points.len());
+                Ok(evaluate_cpu(&args.settings(), args.what(), points))
+            },
+        );
+        assert_eq!(input.shown_before_more, Some(BATCH_POINTS));
+        assert_eq!(calls, [BATCH_POINTS, 1]);
+        let e = result.unwrap_err().to_string();
+        assert!(
+            e.ends_with(&format!("the {} others were evaluated", BATCH_POINTS + 1)),
+            "{e}"
+        );
+        let seen = out.seen.borrow();
+        let text = std::str::from_utf8(&seen).unwrap();
+        let last = evaluate_cpu(&args.settings(), args.what(), &[DVec3::splat(0.5)])[0];
+        assert_eq!(text.lines().count(), BATCH_POINTS + 1);
+        assert_eq!(text.lines().last(), Some(format_value(last).as_str()));
     }
 }
