@@ -449,6 +449,7 @@ pub fn render_to_file(
             layers: &layers,
             record: &record,
         };
+        refuse_gpu_errors(ctx, &planned.output)?;
         write_assembled(&renderer, &assembled, format, planned, observer)?;
     }
     let mut all: Vec<PlannedFrame> = frames.into_iter().chain(written).collect();
@@ -675,6 +676,15 @@ fn trace_to_stop(
     })
 }
 
+/// Fails, naming the file that is then not written, if the device
+/// reported an error no scope caught while the image was traced: its
+/// pixels cannot be trusted (issue 47; `gpu::context::uncaptured`).
+fn refuse_gpu_errors(ctx: &GpuContext, output: &std::path::Path) -> Result<()> {
+    ctx.uncaptured
+        .check()
+        .with_context(|| format!("{} is not written", output.display()))
+}
+
 /// Writes the frame traced to its file.
 fn write_image(
     ctx: &GpuContext,
@@ -700,6 +710,7 @@ fn write_image(
     }
     let record = record_of(ctx, renderer, job, planned, Tile::whole(job.size)).to_text();
     let text = Some((RECORD_ATTRIBUTE, record.as_str()));
+    refuse_gpu_errors(ctx, output)?;
     match format {
         ImageFormat::Png => {
             if let Some(running) = renderer.finish_denoise(ctx)? {

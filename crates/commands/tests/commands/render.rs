@@ -217,6 +217,46 @@ fn a_missing_folder_is_named_before_rendering() {
     assert_eq!(dir.files(), Vec::<String>::new(), "no folder was made");
 }
 
+/// A GPU error that no error scope caught (here an invalid buffer made on
+/// the render's device beforehand) no longer panics the process through
+/// wgpu's default handler: the render fails, naming the file it does not
+/// write, and writes nothing, since its pixels cannot be trusted
+/// (issue 47).
+#[test]
+fn an_uncaptured_gpu_error_fails_the_render_and_writes_nothing() {
+    let Some(ctx) = gpu_or_skip("an_uncaptured_gpu_error_fails_the_render_and_writes_nothing")
+    else {
+        return;
+    };
+    let dir = Scratch::new("render-uncaptured");
+    let output = dir.0.join("out.png");
+    let loaded = load_scene(&preset(), None).unwrap();
+    let _invalid = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("invalid on purpose"),
+        size: 16,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let mut counter = Counter {
+        reports: Vec::new(),
+        cancel_after: None,
+    };
+    let err = render_to_file(
+        &ctx,
+        loaded,
+        &dialog_job(output.clone(), false),
+        &mut counter,
+    )
+    .unwrap_err();
+    let message = format!("{err:#}");
+    assert!(
+        message.contains(&format!("{} is not written", output.display()))
+            && message.contains("the GPU reported 1 error(s)"),
+        "{message}"
+    );
+    assert_eq!(dir.files(), Vec::<String>::new(), "nothing was written");
+}
+
 /// `--denoise` filters the PNG; the EXR stays the raw accumulation (the
 /// same bytes as without the flag) unless `--denoise-exr` asks for the
 /// filtered one, which then differs.
