@@ -805,7 +805,7 @@ fn decode_with_image(
 /// ends early: the decoders' own words for it vary ("unexpected end of
 /// file", "not enough bytes", "failed to fill whole buffer", "reference to
 /// missing bytes").
-fn decode_message(message: &str) -> String {
+pub(crate) fn decode_message(message: &str) -> String {
     let message = message.trim();
     let lower = message.to_ascii_lowercase();
     let cut_short = [

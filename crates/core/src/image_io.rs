@@ -314,7 +314,11 @@ pub fn read_exr_channels(path: &Path) -> Result<ExrChannels> {
     let bytes = crate::capped_read::read_capped(path, crate::capped_read::IMAGE)
         .with_context(|| format!("reading {}", path.display()))?;
     let unreadable = |e: &dyn std::fmt::Display| {
-        anyhow::anyhow!("{}: not a readable OpenEXR file ({e})", path.display())
+        anyhow::anyhow!(
+            "{}: not a readable OpenEXR file ({})",
+            path.display(),
+            crate::image_decode::decode_message(&e.to_string())
+        )
     };
     let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
         .map_err(|e| unreadable(&e))?;
