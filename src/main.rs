@@ -52,7 +52,7 @@ struct ViewerArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     exit_after_denoised: Option<u32>,
     /// Save the whole window, UI included, as PNG just before exiting.
-    #[arg(long)]
+    #[arg(long, value_name = "FILE.png", value_parser = parse_window_screenshot)]
     window_screenshot: Option<PathBuf>,
     /// Development mode: read the WGSL files from the source tree
     /// (`shaders/`, and each CPU twin's beside it under `crates/`) and
@@ -137,6 +137,24 @@ fn parse_obj_path(text: &str) -> Result<PathBuf, String> {
     } else {
         Err(format!(
             "{text}: not an OBJ file (the name must end in .obj)"
+        ))
+    }
+}
+
+/// `--window-screenshot`'s file: a PNG that can be written there, checked
+/// before the window opens as every other output is (issue 47): a name
+/// not ending in `.png`, a missing folder, or a device node or FIFO
+/// already there is refused, naming the file.
+fn parse_window_screenshot(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    if marbre_core::image_io::ImageFormat::from_path(&path)
+        .is_ok_and(|f| f == marbre_core::image_io::ImageFormat::Png)
+    {
+        marbre_core::image_io::check_output(&path).map_err(|e| format!("{e:#}"))?;
+        Ok(path)
+    } else {
+        Err(format!(
+            "{text}: a window screenshot is a PNG (the name must end in .png)"
         ))
     }
 }

@@ -141,3 +141,47 @@ fn render_denoise_says_which_denoiser_ran_and_falls_back_without_oidn() {
         "{stderr}"
     );
 }
+
+/// `--window-screenshot` is checked before any window opens, as every
+/// output is (issue 47): a name that is not a PNG's (it once wrote PNG
+/// bytes into `s.txt`) and a FIFO already there (it once turned
+/// `/dev/full` into a PNG) are refused naming the file, and the FIFO
+/// stays a FIFO. No display is needed: the refusal comes first.
+#[test]
+fn a_window_screenshot_that_is_not_a_png_file_is_refused_before_the_window() {
+    let dir = TempDir::new("screenshot-output");
+    let text = dir.path().join("s.txt");
+    let fifo = dir.path().join("pipe.png");
+    let status = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(status.success(), "mkfifo failed");
+    for (output, why) in [(&text, "must end in .png"), (&fifo, "FIFO")] {
+        let run = Command::new(BIN)
+            .arg("--window-screenshot")
+            .arg(output)
+            .args(["--exit-after-frames", "1"])
+            .current_dir(REPO)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run {BIN}: {e}"));
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success(),
+            "{}: accepted; {stderr}",
+            output.display()
+        );
+        assert!(
+            stderr.contains(&output.display().to_string()) && stderr.contains(why),
+            "{}: {stderr}",
+            output.display()
+        );
+    }
+    assert!(!text.exists(), "s.txt was written");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+}

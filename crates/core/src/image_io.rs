@@ -36,11 +36,18 @@ impl ImageFormat {
 
 /// Fails unless a file can be written at `path`, naming the cause: the
 /// path component that is a file, the topmost folder missing, or why the
-/// file itself cannot be written.
+/// file itself cannot be written. A bare name (the working folder) is
+/// checked too: only its folders need no walk.
 pub fn check_output(path: &Path) -> Result<()> {
-    let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) else {
-        return Ok(());
-    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        check_output_folders(path, dir)?;
+    }
+    check_writable(path).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+}
+
+/// The folders `path` (in `dir`) needs: none of them a file, the topmost
+/// missing one named.
+fn check_output_folders(path: &Path, dir: &Path) -> Result<()> {
     let mut missing = None;
     for folder in dir.ancestors().take_while(|d| !d.as_os_str().is_empty()) {
         match std::fs::metadata(folder) {
@@ -64,7 +71,7 @@ pub fn check_output(path: &Path) -> Result<()> {
             folder.display()
         );
     }
-    check_writable(path).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+    Ok(())
 }
 
 pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<()> {
