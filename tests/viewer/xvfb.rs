@@ -244,9 +244,24 @@ const FRAMES_TIMEOUT: Duration = Duration::from_secs(180);
 /// slow or loaded machine only makes them slower (issue 47). Fails, with
 /// the log, after [`FRAMES_TIMEOUT`].
 pub fn wait_for_frames(dir: &TempDir, n: u64) {
+    frames_or(dir, n, || None);
+}
+
+/// Waits for `n` more frames shown, unless `exited` first returns the
+/// viewer's exit status, which it then returns; fails loudly after
+/// [`FRAMES_TIMEOUT`]. The one loop of [`wait_for_frames`] and
+/// [`frames_or_exit`].
+fn frames_or(
+    dir: &TempDir,
+    n: u64,
+    mut exited: impl FnMut() -> Option<ExitStatus>,
+) -> Option<ExitStatus> {
     let target = shown_frames(dir) + n;
     let start = Instant::now();
     while shown_frames(dir) < target {
+        if let Some(status) = exited() {
+            return Some(status);
+        }
         if start.elapsed() > FRAMES_TIMEOUT {
             panic!(
                 "the viewer showed {} of {target} frames within {FRAMES_TIMEOUT:?}; its log:\n{}",
@@ -256,6 +271,7 @@ pub fn wait_for_frames(dir: &TempDir, n: u64) {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
+    None
 }
 
 pub fn marbre_log(dir: &TempDir) -> String {
@@ -532,22 +548,7 @@ fn percent_encode(path: &Path) -> String {
 /// however slow the machine, where a fixed sleep only guessed (issue 47);
 /// a viewer that wrongly exits is seen at once, not after the timeout.
 pub fn frames_or_exit(child: &mut Guard, dir: &TempDir, n: u64) -> Option<ExitStatus> {
-    let target = shown_frames(dir) + n;
-    let start = Instant::now();
-    while shown_frames(dir) < target {
-        if let Some(status) = child.0.try_wait().unwrap() {
-            return Some(status);
-        }
-        if start.elapsed() > FRAMES_TIMEOUT {
-            panic!(
-                "the viewer showed {} of {target} frames within {FRAMES_TIMEOUT:?}; its log:\n{}",
-                shown_frames(dir),
-                marbre_log(dir)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.0.try_wait().unwrap()
+    frames_or(dir, n, || child.0.try_wait().unwrap()).or_else(|| child.0.try_wait().unwrap())
 }
 
 /// Waits until `done` holds, polling; fails loudly, naming `what` and
