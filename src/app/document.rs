@@ -48,6 +48,16 @@ impl Document {
         }
     }
 
+    /// The document of `path`, whose file holds `saved`, with `scene` on
+    /// screen: edits recovered from a crashed run's autosave, unsaved from
+    /// the first frame (the panel's mark, the autosave), not only once
+    /// edited again. `Document::new` would count them saved.
+    pub fn with_edits(path: &Path, header: Header, saved: &Scene, scene: &Scene) -> Self {
+        let mut document = Self::new(path, header, saved);
+        document.unsaved = document.is_dirty(scene);
+        document
+    }
+
     /// Follows the frame's `change` (from the scene of the frame before):
     /// only an edit can make the scene differ from the file, or, undone,
     /// the same again.
@@ -144,6 +154,22 @@ mod tests {
         edited.render.display.exposure += 1.0;
         assert!(document.is_dirty(&edited));
         assert!(!document.is_dirty(&moved), "undoing the edit cleans it");
+    }
+
+    /// Recovered edits are unsaved before any further edit, and a
+    /// recovered scene the file already holds is not.
+    #[test]
+    fn recovered_edits_are_unsaved_from_the_start() {
+        let saved = Scene::default();
+        let mut recovered = saved.clone();
+        recovered.render.display.exposure += 1.0;
+        let path = Path::new("recovered.ron");
+        let document = Document::with_edits(path, Header::default(), &saved, &recovered);
+        assert!(document.unsaved());
+        let mut moved = saved.clone();
+        moved.camera.distance *= 2.0;
+        let document = Document::with_edits(path, Header::default(), &saved, &moved);
+        assert!(!document.unsaved(), "a camera alone is no edit");
     }
 
     #[test]

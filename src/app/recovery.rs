@@ -3,6 +3,10 @@
 //! removes it. A recovery file found later means the run that wrote it
 //! ended without that (a crash, a kill, a power cut), and the viewer
 //! offers it when the preset it was edited from is opened ([`offer_for`]).
+//! Edits recovered from it are unsaved edits like any others: written at
+//! once to this process's own file, before the crashed run's is removed
+//! ([`Autosave::write_now`]), then autosaved on the same schedule, so that
+//! a second crash offers them again.
 //!
 //! The copy is a preset (written by `preset::save`, so its paths are made
 //! relative to the recovery folder and it loads like any other), beside a
@@ -175,6 +179,16 @@ impl Autosave {
         if self.written.as_ref() == Some(&preset.scene) {
             return Ok(());
         }
+        self.write_now(source, preset)
+    }
+
+    /// Writes `preset` (unsaved edits of `source`) at once, whatever the
+    /// interval: a scene just recovered from a crashed run's file is
+    /// copied to this process's own before that one is removed, so that a
+    /// second crash at any moment still leaves it on disk. From then on
+    /// [`Autosave::tick`] keeps it as any unsaved edits.
+    pub fn write_now(&mut self, source: &Path, preset: Preset) -> anyhow::Result<()> {
+        self.last_write = Instant::now();
         self.write(&preset, source)?;
         self.written = Some(preset.scene);
         Ok(())
@@ -391,6 +405,43 @@ mod tests {
             .tick(false, Path::new("a.ron"), || unreachable!())
             .unwrap();
         assert!(!mine.exists(), "clean again: removed");
+    }
+
+    /// Recovered edits are written at once, then kept on the usual
+    /// schedule while unsaved, and removed once clean.
+    #[test]
+    fn a_recovered_scene_is_written_at_once_and_kept_while_unsaved() {
+        let dir = tempfile::Builder::new()
+            .prefix("recovery-recovered")
+            .tempdir()
+            .unwrap();
+        let mut autosave = Autosave::new(dir.path().to_owned());
+        let mine = preset_file(dir.path(), std::process::id());
+        let mut recovered = Preset::default();
+        recovered.scene.render.display.exposure = 3.0;
+        autosave
+            .write_now(Path::new("a.ron"), recovered.clone())
+            .unwrap();
+        let info = std::fs::read_to_string(info_file(dir.path(), std::process::id())).unwrap();
+        let source = RecoveryInfo::parse(&info).unwrap().source;
+        assert_eq!(source, std::path::absolute("a.ron").unwrap());
+        let saved = preset::load(&mine).unwrap().preset;
+        assert_eq!(saved.scene.render.display.exposure, 3.0, "written at once");
+        autosave
+            .tick(true, Path::new("a.ron"), || recovered.clone())
+            .unwrap();
+        assert!(mine.exists(), "still unsaved: kept");
+        recovered.scene.render.display.exposure = 4.0;
+        autosave.last_write -= AUTOSAVE_INTERVAL;
+        autosave
+            .tick(true, Path::new("a.ron"), || recovered.clone())
+            .unwrap();
+        let saved = preset::load(&mine).unwrap().preset;
+        assert_eq!(saved.scene.render.display.exposure, 4.0, "rewritten");
+        autosave
+            .tick(false, Path::new("a.ron"), || unreachable!())
+            .unwrap();
+        assert!(!mine.exists(), "saved: removed");
     }
 
     #[test]

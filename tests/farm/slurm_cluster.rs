@@ -32,11 +32,14 @@ const TOOLS: [&str; 6] = [
     "squeue",
 ];
 
-/// The node reaches IDLE in about a second; the rest is headroom for a loaded CI machine.
-const START_TIMEOUT: Duration = Duration::from_secs(30);
+/// The node reaches IDLE in about a second; the rest is headroom for a
+/// machine whose cores are all busy (issue 47): a bound that fails loudly,
+/// never one a figure depends on.
+const START_TIMEOUT: Duration = Duration::from_secs(180);
 
-/// A client command that hangs (controller wedged) must not hang the test with it.
-const COMMAND_TIMEOUT: Duration = Duration::from_secs(30);
+/// A client command that hangs (controller wedged) must not hang the test
+/// with it; generous, as [`START_TIMEOUT`] is.
+const COMMAND_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// slurmctld saves its state on SIGTERM (well under a second here); a daemon
 /// still alive after this long is stuck and gets SIGKILL.

@@ -16,16 +16,21 @@
 //!   up, the window draws about as many frames as without it (it used to
 //!   fall to about a third: egui's whole pass, a backdrop over the whole
 //!   window included, was drawn again every frame).
+//! - `recovered_edits_survive_a_second_crash`: an edit autosaved, the
+//!   viewer killed, its edits recovered at the next start, the viewer
+//!   killed again: the start after offers them again (issue 47). Recover
+//!   used to count them saved, delete their file and write none, so the
+//!   second crash lost them.
 //! - `keys_typed_for_the_panel_fire_no_shortcut`: "h3" typed after a click
 //!   beside a text field, or into a field at once after the click that
 //!   focuses it, neither hides the panel (H) nor recalls a saved view
 //!   (which takes Ctrl+digit now).
 
 use crate::REPO;
-use crate::e2e_window::{Look, PANEL_LEFT, STEP_TIMEOUT, assert_clean_log, open};
+use crate::e2e_window::{Look, PANEL_LEFT, STEP_TIMEOUT, Session, assert_clean_log, open};
 use crate::xvfb::{
-    TempDir, assert_success, display_or_skip, grab_window, marbre_log, number_before, quality_line,
-    request_close, serial, wait_for_exit,
+    Guard, TempDir, Xvfb, assert_success, display_or_skip, grab_window, marbre_log, number_before,
+    quality_line, request_close, serial, wait_for_exit, xdotool,
 };
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -358,5 +363,126 @@ fn keys_typed_for_the_panel_fire_no_shortcut() {
         );
         std::thread::sleep(Duration::from_millis(500));
     }
+    assert_clean_log(&dir);
+}
+
+/// How long an autosave may take to appear: the viewer's interval (20 s
+/// after the first unsaved frame) and then a step.
+const AUTOSAVE_TIMEOUT: Duration = Duration::from_secs(20 + STEP_TIMEOUT.as_secs());
+
+/// Waits until `done`, polling; fails loudly, with the log, after
+/// `timeout`.
+fn wait_until(what: &str, timeout: Duration, dir: &TempDir, mut done: impl FnMut() -> bool) {
+    let deadline = Instant::now() + timeout;
+    while !done() {
+        assert!(
+            Instant::now() < deadline,
+            "{what}: not within {timeout:?}; marbre's log:\n{}",
+            marbre_log(dir)
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+/// The recovery files a viewer with pid `pid` writes in `config`: its
+/// autosaved preset, and the info file written after it that makes it an
+/// offer.
+fn recovery_files(config: &Path, pid: u32) -> [std::path::PathBuf; 2] {
+    [
+        config.join(format!("recovery-{pid}.ron")),
+        config.join(format!("recovery-{pid}-info.ron")),
+    ]
+}
+
+/// Whether a prompt's box covers the middle of `window` (the image there
+/// is black or lit, never the dialogs' grey).
+fn prompt_shown(x: &Xvfb, window: &str) -> bool {
+    fraction_of(&grab_window(x, window), 560..720, 330..400, PANEL_FILL) > 0.4
+}
+
+/// Kills the viewer as a crash would (SIGKILL: no clean exit, nothing
+/// removed), asserting that it was still running, and waits until its
+/// window is gone, so that the next start's window is the only one.
+fn crash(x: &Xvfb, mut child: Guard, dir: &TempDir) {
+    use std::os::unix::process::ExitStatusExt;
+    child.0.kill().unwrap();
+    let status = child.0.wait().unwrap();
+    assert_eq!(
+        status.signal(),
+        Some(9),
+        "marbre ended by itself ({status}) before the kill; log:\n{}",
+        marbre_log(dir)
+    );
+    wait_until("the killed viewer's window gone", STEP_TIMEOUT, dir, || {
+        xdotool(x, &["search", "--onlyvisible", "--name", "^marbre$"])
+            .stdout
+            .is_empty()
+    });
+}
+
+/// Answers the recovery offer of `files` with Enter (Recover, the
+/// default) once the offer is up, until the files are gone (recovered).
+fn recover(session: &Session, files: &[std::path::PathBuf], dir: &TempDir) {
+    wait_until("the recovery offered and taken", STEP_TIMEOUT, dir, || {
+        if files.iter().all(|f| !f.exists()) {
+            return true;
+        }
+        if prompt_shown(session.x, &session.window) {
+            session.focus();
+            session.run(&["key", "Return"]);
+        }
+        false
+    });
+}
+
+#[test]
+fn recovered_edits_survive_a_second_crash() {
+    const TEST: &str = "recovered_edits_survive_a_second_crash";
+    let _serial = serial();
+    let dir = TempDir::new("risk-twice");
+    let Some(x) = display_or_skip(TEST, &dir, &["xdotool"]) else {
+        return;
+    };
+    let mine = dir.path().join("mine.ron");
+    std::fs::copy(Path::new(REPO).join("tests/data/e2e/lit.ron"), &mine).unwrap();
+    let config = dir.subdir("config");
+    let lit_look = |l: &Look| l.corner_luma < 0.02 && l.centre_luma > 0.6;
+    let dark_look = |l: &Look| l.centre_luma < 0.02;
+
+    // The edit, autosaved on the viewer's own schedule, then a crash.
+    let (child, session) = open(&x, &dir, &mine);
+    session.wait_for("mine.ron", lit_look);
+    session.drag_light_intensity_to_zero();
+    session.wait_for("the light's intensity dragged to 0", dark_look);
+    let first = recovery_files(&config, child.0.id());
+    wait_until("the edit's autosave", AUTOSAVE_TIMEOUT, &dir, || {
+        first[1].is_file()
+    });
+    assert!(intensity(&first[0]) < 1e-3, "the autosave lacks the edit");
+    crash(&x, child, &dir);
+
+    // Recovered, the edits are unsaved work of this run: it writes its
+    // own recovery file (at once, before the first run's is removed).
+    let (child, session) = open(&x, &dir, &mine);
+    recover(&session, &first, &dir);
+    session.wait_for("the recovered edit", dark_look);
+    let second = recovery_files(&config, child.0.id());
+    wait_until(
+        "the recovered edits' autosave",
+        AUTOSAVE_TIMEOUT,
+        &dir,
+        || second[1].is_file(),
+    );
+    assert!(
+        intensity(&second[0]) < 1e-3,
+        "the recovered edits' autosave lacks the edit"
+    );
+    crash(&x, child, &dir);
+
+    // The second crash lost nothing: the next start offers the edit again.
+    let (_child, session) = open(&x, &dir, &mine);
+    recover(&session, &second, &dir);
+    session.wait_for("the edit recovered after the second crash", dark_look);
+    assert_eq!(intensity(&mine), 40.0, "mine.ron itself was written");
     assert_clean_log(&dir);
 }

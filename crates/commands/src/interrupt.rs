@@ -1,7 +1,9 @@
 //! What a headless command does when SIGINT, SIGTERM or SIGHUP stops it:
-//! the temporary of a save in progress (`.<name>.<pid>.tmp`, as large as
-//! the image) is removed, then the process ends by the signal, as it would
-//! have without a handler (a script sees the signal in the exit status).
+//! the programs it runs (ffmpeg writing an animation) are ended and waited
+//! for, the temporary of a save in progress (`.<name>.<pid>.tmp`, as large
+//! as the image, or ffmpeg's video) is removed, then the process ends by
+//! the signal, as it would have without a handler (a script sees the
+//! signal in the exit status).
 //!
 //! The signal is taken on a thread of signal-hook's (the field's standard
 //! crate for it), not in a signal handler, so removing files is allowed
@@ -13,9 +15,9 @@ use anyhow::{Context, Result};
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
 
-/// Starts the thread that removes pending temporaries when the process is
-/// told to stop. Called once by `main` for the headless commands (the
-/// viewer keeps its own recovery).
+/// Starts the thread that ends the children and removes pending
+/// temporaries when the process is told to stop. Called once by `main`
+/// for the headless commands (the viewer keeps its own recovery).
 pub fn remove_temporaries_on_signal() -> Result<()> {
     let mut signals =
         Signals::new([SIGINT, SIGTERM, SIGHUP]).context("installing the signal handlers")?;
@@ -23,6 +25,9 @@ pub fn remove_temporaries_on_signal() -> Result<()> {
         .name("signals".into())
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
+                // First: a child still running would write its temporary
+                // again after it is removed.
+                marbre_core::child_process::end_all();
                 marbre_core::atomic_write::remove_pending_temporaries();
                 let _ = signal_hook::low_level::emulate_default_handler(signal);
             }
@@ -102,5 +107,117 @@ mod tests {
         let status = child.wait().unwrap();
         assert_eq!(status.signal(), Some(libc::SIGTERM), "{status:?}");
         assert!(names().is_empty(), "left behind: {:?}", names());
+    }
+
+    /// Set in the child process of the ffmpeg test below: the video to
+    /// write.
+    const CHILD_VIDEO: &str = "MARBRE_INTERRUPT_TEST_VIDEO";
+
+    /// Not a test of its own: the child of the one below. It writes an
+    /// MP4 through the real ffmpeg from frames that stop coming after the
+    /// first, so that ffmpeg is running, its output begun, when the
+    /// signal comes.
+    #[test]
+    #[ignore = "run by sigterm_during_an_animation_ends_ffmpeg_and_leaves_nothing"]
+    fn child_stopped_while_ffmpeg_encodes() {
+        let Some(video) = std::env::var_os(CHILD_VIDEO).map(PathBuf::from) else {
+            return;
+        };
+        remove_temporaries_on_signal().unwrap();
+        let frame = image::RgbaImage::from_pixel(16, 16, image::Rgba([200, 100, 50, 255]));
+        let frames = std::iter::once(Ok(frame)).chain(std::iter::from_fn(|| {
+            println!("encoding");
+            std::thread::sleep(Duration::from_secs(600));
+            None
+        }));
+        marbre_core::animated_image::save_through_ffmpeg(frames, 24.0, &video).unwrap();
+    }
+
+    /// The children of `pid` (every thread's), from /proc.
+    fn children_of(pid: u32) -> Vec<u32> {
+        let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+            return Vec::new();
+        };
+        tasks
+            .flatten()
+            .filter_map(|t| std::fs::read_to_string(t.path().join("children")).ok())
+            .flat_map(|s| {
+                s.split_whitespace()
+                    .filter_map(|p| p.parse().ok())
+                    .collect::<Vec<u32>>()
+            })
+            .collect()
+    }
+
+    /// Whether `pid` is a process that still runs (not gone, not a
+    /// zombie waiting for its parent).
+    fn running(pid: u32) -> bool {
+        std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+            let state = stat.rsplit_once(')').map(|(_, rest)| rest.trim_start());
+            !state.is_some_and(|s| s.starts_with('Z') || s.starts_with('X'))
+        })
+    }
+
+    /// SIGTERM while ffmpeg encodes: ffmpeg is ended with the command (it
+    /// used to outlive it by seconds, still writing), and neither the
+    /// save's temporary nor anything in the temporary folder (ffmpeg's
+    /// `out.mp4` used to stay there) is left. With the real ffmpeg;
+    /// without it a loud skip (a failure under MARBRE_REQUIRE_GPU=1).
+    #[test]
+    fn sigterm_during_an_animation_ends_ffmpeg_and_leaves_nothing() {
+        let has_ffmpeg = std::process::Command::new("ffmpeg")
+            .arg("-version")
+            .stdout(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if !has_ffmpeg {
+            let banner = "SKIPPED sigterm_during_an_animation_ends_ffmpeg_and_leaves_nothing: \
+                          ffmpeg is not installed (Debian package `ffmpeg`)";
+            assert!(
+                std::env::var("MARBRE_REQUIRE_GPU").as_deref() != Ok("1"),
+                "{banner} (MARBRE_REQUIRE_GPU=1 turns the skip into a failure)"
+            );
+            eprintln!("\n{}\n{banner}\n{}\n", "!".repeat(72), "!".repeat(72));
+            return;
+        }
+        let (folder, tmp) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let video = folder.path().join("x.mp4");
+        let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "interrupt::tests::child_stopped_while_ffmpeg_encodes",
+                "--ignored",
+                "--nocapture",
+            ])
+            .env(CHILD_VIDEO, &video)
+            .env("TMPDIR", tmp.path())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stdout = std::io::BufReader::new(child.stdout.take().unwrap());
+        let encoding = stdout
+            .lines()
+            .map_while(Result::ok)
+            .any(|line| line.contains("encoding"));
+        assert!(encoding, "the child never started ffmpeg");
+        // The first frame is written to ffmpeg before the second is asked
+        // for: ffmpeg is its child now.
+        let ffmpeg = children_of(child.id());
+        assert_eq!(ffmpeg.len(), 1, "one child, ffmpeg: {ffmpeg:?}");
+        let comm = std::fs::read_to_string(format!("/proc/{}/comm", ffmpeg[0])).unwrap();
+        assert_eq!(comm.trim(), "ffmpeg");
+        // SAFETY: kill(2) with the child's pid and a valid signal.
+        unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+        let status = child.wait().unwrap();
+        assert_eq!(status.signal(), Some(libc::SIGTERM), "{status:?}");
+        assert!(!running(ffmpeg[0]), "ffmpeg {} outlived marbre", ffmpeg[0]);
+        let left = |dir: &std::path::Path| -> Vec<_> {
+            std::fs::read_dir(dir)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .collect()
+        };
+        assert!(left(folder.path()).is_empty(), "{:?}", left(folder.path()));
+        assert!(left(tmp.path()).is_empty(), "{:?}", left(tmp.path()));
     }
 }

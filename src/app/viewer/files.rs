@@ -451,10 +451,11 @@ impl Viewer {
             (Prompt::Replace(path), Answer::Proceed) => {
                 self.save_preset(&path);
             }
-            // Once the scene is back it is autosaved again, to this
-            // process's own file, while it stays unsaved.
+            // The scene back, it is copied to this process's own
+            // recovery file before the crashed run's is removed, then
+            // autosaved as any unsaved edits.
             (Prompt::Recover(offer), Answer::Proceed) => {
-                if self.recover(&offer) {
+                if self.recover(&offer) && self.autosave_recovered(&offer) {
                     recovery::discard(&offer);
                 }
             }
@@ -507,7 +508,7 @@ impl Viewer {
             .map(|l| l.preset.header())
             .unwrap_or_default();
         let saved = original.map_or_else(Scene::default, |l| l.preset.scene);
-        self.edits.document = Document::new(&offer.source, header, &saved);
+        self.edits.document = Document::with_edits(&offer.source, header, &saved, &self.scene);
         self.panel.preset_path = offer.source.display().to_string();
         self.panel.info(format!(
             "recovered the unsaved changes to {} from {}",
@@ -516,6 +517,27 @@ impl Viewer {
         ));
         self.start_watching();
         true
+    }
+
+    /// Writes the unsaved edits just recovered from `offer` to this
+    /// process's recovery file at once. False (with the reason in the
+    /// panel) if that failed: `offer`'s file must then stay, the only copy
+    /// on disk.
+    fn autosave_recovered(&mut self, offer: &recovery::RecoveryOffer) -> bool {
+        let document = &self.edits.document;
+        let Some(autosave) = self.edits.autosave.as_mut().filter(|_| document.unsaved()) else {
+            return true;
+        };
+        match autosave.write_now(&document.path, document.preset(&self.scene)) {
+            Ok(()) => true,
+            Err(e) => {
+                self.panel.error(format!(
+                    "autosave failed: {e:#}; {} keeps the recovered changes",
+                    offer.preset.display()
+                ));
+                false
+            }
+        }
     }
 
     /// Watches the preset's folder, and the WGSL sources in `--dev` mode.

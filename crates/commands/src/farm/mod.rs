@@ -4,15 +4,21 @@
 //! folder; on the nodes, `farm task DIR I` traces task I and `farm merge
 //! DIR` checks that every task wrote its file and merges each frame.
 
+mod carry;
+mod job_folder;
+mod merge;
 mod plan;
 mod scripts;
+mod shell;
 mod task;
 
 use plan::{FarmPlan, Scheduler, Split};
 use scripts::{KubernetesOptions, SlurmOptions};
+use shell::quoted;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
+use marbre_core::capped_read::{PRESET, read_capped};
 use marbre_core::tile::TileGrid;
 use std::path::{Path, PathBuf};
 
@@ -138,8 +144,6 @@ pub fn run(args: &FarmArgs) -> Result<()> {
             cpus,
             marbre,
         } => {
-            scripts::check_slurm_folder(&std::path::absolute(&job.output)?)?;
-            let (plan, dir) = write_plan(job, Scheduler::Slurm)?;
             let marbre = match marbre {
                 Some(path) => path.clone(),
                 None => std::env::current_exe().context("finding marbre's own path")?,
@@ -150,12 +154,21 @@ pub fn run(args: &FarmArgs) -> Result<()> {
                 time: time.clone(),
                 cpus: *cpus,
             };
-            write_files(&dir, scripts::slurm(&plan, &dir, &marbre, &options))?;
+            // Checked before anything is written.
+            let dir = absolute(&job.output)?;
+            carry::slurm_folder(&dir)?;
+            carry::path_text("--preset", &job.preset)?;
+            carry::path_text("--marbre", &marbre)?;
+            for (flag, value) in options.given() {
+                carry::slurm_value(flag, value)?;
+            }
+            let plan = plan_job(job, Scheduler::Slurm, &dir)?;
+            write_job(&dir, &plan, scripts::slurm(&plan, &dir, &marbre, &options))?;
             println!(
                 "wrote a Slurm job of {} tasks to {}: submit it with `sh {}`",
                 plan.tasks(),
                 dir.display(),
-                dir.join("submit.sh").display()
+                quoted(&dir.join("submit.sh").to_string_lossy())
             );
             Ok(())
         }
@@ -169,14 +182,16 @@ pub fn run(args: &FarmArgs) -> Result<()> {
             cpus,
         } => {
             // Checked before anything is written.
-            let (dir, preset) = (
-                std::path::absolute(&job.output)?,
-                std::path::absolute(&job.preset)?,
-            );
+            let (dir, preset) = (absolute(&job.output)?, absolute(&job.preset)?);
+            carry::path_text("the job's folder (-o)", &dir)?;
+            carry::path_text("--preset", &preset)?;
+            carry::image(image)?;
+            carry::claim(claim)?;
             let mount = match mount {
-                Some(path) => std::path::absolute(path)?,
+                Some(path) => absolute(path)?,
                 None => shared_folder(&dir, &preset)?,
             };
+            carry::path_text("--mount", &mount)?;
             for (what, path) in [("the job's folder", &dir), ("the preset", &preset)] {
                 if !path.starts_with(&mount) {
                     bail!(
@@ -186,7 +201,7 @@ pub fn run(args: &FarmArgs) -> Result<()> {
                     );
                 }
             }
-            let (plan, dir) = write_plan(job, Scheduler::Kubernetes)?;
+            let plan = plan_job(job, Scheduler::Kubernetes, &dir)?;
             let options = KubernetesOptions {
                 image: image.clone(),
                 claim: claim.clone(),
@@ -195,18 +210,29 @@ pub fn run(args: &FarmArgs) -> Result<()> {
                 gpus: *gpus,
                 cpus: (*cpus).max(1),
             };
-            write_files(&dir, scripts::kubernetes(&plan, &dir, &options))?;
+            write_job(&dir, &plan, scripts::kubernetes(&plan, &dir, &options))?;
             println!(
                 "wrote a Kubernetes job of {} tasks to {}: run it with `sh {}`",
                 plan.tasks(),
                 dir.display(),
-                dir.join("submit-k8s.sh").display()
+                quoted(&dir.join("submit-k8s.sh").to_string_lossy())
             );
             Ok(())
         }
         FarmCommand::Task { dir, index } => task::run_task(dir, task_index(*index)?),
-        FarmCommand::Merge { dir } => task::merge_job(dir),
+        FarmCommand::Merge { dir } => merge::merge_job(dir),
     }
+}
+
+/// `path`, absolute, so that the nodes find it.
+fn absolute(path: &Path) -> Result<PathBuf> {
+    std::path::absolute(path).with_context(|| format!("making {} absolute", shown_path(path)))
+}
+
+/// `path` as a message shows it: lossy where it is not UTF-8, its control
+/// characters escaped (a folder's name must not drive the terminal).
+fn shown_path(path: &Path) -> String {
+    marbre_core::shown::shown(&path.to_string_lossy())
 }
 
 /// The schedulers' variables that hold a task's index, in the order read.
@@ -252,19 +278,16 @@ fn shared_folder(dir: &Path, preset: &Path) -> Result<PathBuf> {
     Ok(shared)
 }
 
-/// The job's plan from the flags, checked (the preset read, batches that
-/// start on a round of its samples) and written to its folder, made
-/// absolute so that the nodes find it.
-fn write_plan(job: &JobArgs, scheduler: Scheduler) -> Result<(FarmPlan, PathBuf)> {
-    let absolute = |p: &Path| -> Result<PathBuf> {
-        std::path::absolute(p).with_context(|| format!("making {} absolute", p.display()))
-    };
+/// The job's plan from the flags, checked: the preset read (through
+/// the capped reader), batches that start on a round of its samples, and
+/// the job's folder `dir` holding no other job. Nothing is written.
+fn plan_job(job: &JobArgs, scheduler: Scheduler, dir: &Path) -> Result<FarmPlan> {
     let preset_path = absolute(&job.preset)?;
     let preset = marbre_core::preset::load(&preset_path)
-        .with_context(|| format!("reading the preset {}", preset_path.display()))?
+        .with_context(|| format!("reading the preset {}", shown_path(&preset_path)))?
         .preset;
-    let bytes = std::fs::read(&preset_path)
-        .with_context(|| format!("reading the preset {}", preset_path.display()))?;
+    let bytes = read_capped(&preset_path, PRESET)
+        .with_context(|| format!("reading the preset {}", shown_path(&preset_path)))?;
     let plan = FarmPlan {
         preset_hash: marbre_core::render_record::fnv1a_hex(&bytes),
         preset: preset_path,
@@ -304,35 +327,26 @@ fn write_plan(job: &JobArgs, scheduler: Scheduler) -> Result<(FarmPlan, PathBuf)
              {per_task} samples, one round of the preset's {per_round}: give more --spp"
         );
     }
-    let dir = absolute(&job.output)?;
     // Tasks skip the files already written: a folder holding another
     // job's parts would hand them to this job's merge.
-    if dir.join(plan::PLAN_FILE).exists() {
-        let existing = FarmPlan::read(&dir)?;
+    if std::fs::symlink_metadata(dir.join(plan::PLAN_FILE)).is_ok() {
+        let existing = FarmPlan::read(dir)?;
         if existing != plan {
             bail!(
                 "{} already holds another job (its {} differs from this one's); give a new \
                  folder, or remove that one",
-                dir.display(),
+                shown_path(dir),
                 plan::PLAN_FILE
             );
         }
     }
-    plan.write(&dir)?;
-    Ok((plan, dir))
+    Ok(plan)
 }
 
-/// Writes the scheduler's files into `dir`, scripts executable.
-fn write_files(dir: &Path, files: Vec<(&str, String)>) -> Result<()> {
-    for (name, text) in files {
-        let path = dir.join(name);
-        marbre_core::atomic_write::write_atomic(&path, text.as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-        if name.ends_with(".sh") || name.ends_with(".sbatch") {
-            use std::os::unix::fs::PermissionsExt;
-            std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755))
-                .with_context(|| format!("making {} executable", path.display()))?;
-        }
-    }
-    Ok(())
+/// Writes the job's plan and its scheduler's `files` into `dir`, or,
+/// when a write fails, nothing new ([`job_folder::write`]).
+fn write_job(dir: &Path, plan: &FarmPlan, files: Vec<(&str, String)>) -> Result<()> {
+    let mut all = vec![(plan::PLAN_FILE, plan.text()?)];
+    all.extend(files);
+    job_folder::write(dir, &all)
 }

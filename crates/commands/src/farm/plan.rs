@@ -3,7 +3,9 @@
 //! from an array index to a frame and a part of it (a sample batch or a
 //! tile) is written in one place, not in each scheduler's script.
 
+use super::shown_path;
 use anyhow::{Context, Result, bail};
+use marbre_core::capped_read::{FileKind, read_capped_to_string};
 use marbre_core::image_io::ImageFormat;
 use marbre_core::tile::{Tile, TileGrid};
 use serde::{Deserialize, Serialize};
@@ -12,6 +14,12 @@ use std::path::{Path, PathBuf};
 
 /// The plan's file name in the job's folder.
 pub const PLAN_FILE: &str = "farm.ron";
+
+/// A plan is a few hundred bytes.
+const PLAN: FileKind = FileKind {
+    name: "a farm plan",
+    max_bytes: 1 << 20,
+};
 
 /// How each frame is cut.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -228,32 +236,29 @@ impl FarmPlan {
         dir.join("status").join(format!("task_{index}.failed"))
     }
 
-    /// Writes the plan to `dir`, creating the job's folders.
-    pub fn write(&self, dir: &Path) -> Result<()> {
-        for sub in ["parts", "frames", "status", "logs"] {
-            std::fs::create_dir_all(dir.join(sub))
-                .with_context(|| format!("creating {}", dir.join(sub).display()))?;
-        }
-        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
-            .context("writing the plan as RON")?;
-        marbre_core::atomic_write::write_atomic(&dir.join(PLAN_FILE), text.as_bytes())?;
-        Ok(())
+    /// The plan as `farm.ron` holds it (paths as RON strings, which is
+    /// why a job's paths must be UTF-8: [`super::carry::path_text`]).
+    pub fn text(&self) -> Result<String> {
+        ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
+            .context("writing the plan as RON")
     }
 
-    /// The plan of the job in `dir`.
+    /// The plan of the job in `dir`, read through the capped reader: a
+    /// FIFO or a device in its place is refused rather than waited on or
+    /// read without end.
     pub fn read(dir: &Path) -> Result<Self> {
         let path = dir.join(PLAN_FILE);
-        let text = std::fs::read_to_string(&path).with_context(|| {
+        let text = read_capped_to_string(&path, PLAN).with_context(|| {
             format!(
                 "reading {}: is {} a folder `marbre farm` wrote?",
-                path.display(),
-                dir.display()
+                shown_path(&path),
+                shown_path(dir)
             )
         })?;
         let plan: Self =
-            ron::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
+            ron::from_str(&text).with_context(|| format!("reading {}", shown_path(&path)))?;
         plan.check()
-            .with_context(|| format!("{} is not a plan marbre can run", path.display()))?;
+            .with_context(|| format!("{} is not a plan marbre can run", shown_path(&path)))?;
         Ok(plan)
     }
 }
@@ -375,9 +380,8 @@ mod tests {
             }),
             Some(0..=9),
         );
-        p.write(dir.path()).unwrap();
+        std::fs::write(dir.path().join(PLAN_FILE), p.text().unwrap()).unwrap();
         assert_eq!(FarmPlan::read(dir.path()).unwrap(), p);
-        assert!(dir.path().join("status").is_dir());
         let e = FarmPlan::read(&dir.path().join("nowhere")).unwrap_err();
         assert!(
             e.to_string().contains("a folder `marbre farm` wrote"),

@@ -5,8 +5,13 @@
 //! index coming from `SLURM_ARRAY_TASK_ID` or the Indexed Job's
 //! `JOB_COMPLETION_INDEX`.
 
+//!
+//! Every path and name in a script is one word of [`quoted`]; the
+//! manifests are written by serde_json. Both take paths that
+//! [`super::carry`] checked: UTF-8 text without control characters.
+
 use super::plan::FarmPlan;
-use anyhow::{Result, bail};
+use super::shell::{error_line, quoted};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -21,9 +26,22 @@ pub struct SlurmOptions {
     pub cpus: Option<u32>,
 }
 
-/// `text` quoted for a POSIX shell.
-fn quoted(text: &str) -> String {
-    format!("'{}'", text.replace('\'', r"'\''"))
+/// `path` as one shell word.
+fn quoted_path(path: &Path) -> String {
+    quoted(&path.to_string_lossy())
+}
+
+impl SlurmOptions {
+    /// The flags given, by name, for [`super::carry::slurm_value`].
+    pub fn given(&self) -> impl Iterator<Item = (&'static str, &str)> {
+        [
+            ("--partition", &self.partition),
+            ("--gres", &self.gres),
+            ("--time", &self.time),
+        ]
+        .into_iter()
+        .filter_map(|(flag, value)| Some((flag, value.as_deref()?)))
+    }
 }
 
 /// The `#SBATCH` lines both scripts share.
@@ -42,23 +60,8 @@ fn sbatch_options(options: &SlurmOptions) -> String {
     lines
 }
 
-/// Refuses a job folder whose path an `#SBATCH --output` line cannot
-/// carry: it is not shell-quoted there, and `%` is Slurm's pattern sign.
-pub fn check_slurm_folder(dir: &Path) -> Result<()> {
-    let text = dir.display().to_string();
-    if let Some(c) = text
-        .chars()
-        .find(|c| c.is_whitespace() || matches!(c, '%' | '\'' | '"' | '\\'))
-    {
-        bail!(
-            "{text}: a Slurm job's folder cannot hold {c:?} (its #SBATCH --output line would \
-             misread it); choose another folder"
-        );
-    }
-    Ok(())
-}
-
-/// The Slurm files of the job in `dir` ([`check_slurm_folder`]), by name:
+/// The Slurm files of the job in `dir` ([`super::carry::slurm_folder`],
+/// whose `#SBATCH --output` lines hold it unquoted), by name:
 /// `tasks.sbatch` (the array), `merge.sbatch` and `submit.sh`. `marbre`:
 /// the binary's path on the nodes.
 pub fn slurm(
@@ -67,10 +70,7 @@ pub fn slurm(
     marbre: &Path,
     options: &SlurmOptions,
 ) -> Vec<(&'static str, String)> {
-    let (dir_text, marbre) = (
-        quoted(&dir.display().to_string()),
-        quoted(&marbre.display().to_string()),
-    );
+    let (dir_text, marbre) = (quoted_path(dir), quoted_path(marbre));
     let logs = dir.join("logs");
     let tasks = format!(
         "#!/bin/bash\n\
@@ -81,7 +81,7 @@ pub fn slurm(
          # lavapipe (Mesa's Vulkan on the CPU) runs as many threads as the\n\
          # task has CPUs, not as many as the node has.\n\
          export LP_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-1}}\"\n\
-         exec {marbre} farm task {dir_text} \"$SLURM_ARRAY_TASK_ID\"\n",
+         exec -- {marbre} farm task {dir_text} \"$SLURM_ARRAY_TASK_ID\"\n",
         last = plan.tasks() - 1,
         logs = logs.display(),
         options = sbatch_options(options),
@@ -91,7 +91,7 @@ pub fn slurm(
          #SBATCH --job-name=marbre-merge\n\
          #SBATCH --output={logs}/merge.out\n\
          {options}\
-         exec {marbre} farm merge {dir_text}\n",
+         exec -- {marbre} farm merge {dir_text}\n",
         logs = logs.display(),
         options = sbatch_options(&SlurmOptions {
             gres: None,
@@ -107,9 +107,9 @@ pub fn slurm(
          tasks=$(sbatch --parsable {tasks_script})\n\
          tasks=${{tasks%%;*}}\n\
          merge=$(sbatch --parsable --dependency=afterok:\"$tasks\" --kill-on-invalid-dep=yes {merge_script})\n\
-         echo \"tasks: job $tasks ({count} tasks); merge: job ${{merge%%;*}}\"\n",
-        tasks_script = quoted(&dir.join("tasks.sbatch").display().to_string()),
-        merge_script = quoted(&dir.join("merge.sbatch").display().to_string()),
+         printf 'tasks: job %s (%s tasks); merge: job %s\\n' \"$tasks\" {count} \"${{merge%%;*}}\"\n",
+        tasks_script = quoted_path(&dir.join("tasks.sbatch")),
+        merge_script = quoted_path(&dir.join("merge.sbatch")),
         count = plan.tasks(),
     );
     vec![
@@ -144,8 +144,8 @@ pub fn kubernetes(
     dir: &Path,
     options: &KubernetesOptions,
 ) -> Vec<(&'static str, String)> {
-    let dir_text = dir.display().to_string();
-    let mount = options.mount.display().to_string();
+    let dir_text = dir.to_string_lossy();
+    let mount = options.mount.to_string_lossy();
     // Job names are unique in a namespace: two jobs' folders give two.
     let suffix = job_suffix(dir);
     let (tasks_name, merge_name) = (
@@ -221,18 +221,23 @@ pub fn kubernetes(
          # farm merge` names the tasks, and running this again reruns only\n\
          # them (a finished index does nothing).\n\
          set -eu\n\
-         kubectl delete --ignore-not-found job/{tasks_name} job/{merge_name}\n\
+         kubectl delete --ignore-not-found {tasks_job} {merge_job}\n\
          kubectl apply -f {tasks}\n\
-         while ! kubectl wait --for=condition=complete --timeout=10s job/{tasks_name} >/dev/null 2>&1; do\n\
-         \x20   if kubectl wait --for=condition=failed --timeout=0s job/{tasks_name} >/dev/null 2>&1; then\n\
-         \x20       echo \"job/{tasks_name} failed: run marbre farm merge {dir} to see which tasks\" >&2\n\
+         while ! kubectl wait --for=condition=complete --timeout=10s {tasks_job} >/dev/null 2>&1; do\n\
+         \x20   if kubectl wait --for=condition=failed --timeout=0s {tasks_job} >/dev/null 2>&1; then\n\
+         \x20       {failed}\n\
          \x20       exit 1\n\
          \x20   fi\n\
          done\n\
          kubectl apply -f {merge}\n",
-        tasks = quoted(&dir.join("tasks-job.json").display().to_string()),
-        merge = quoted(&dir.join("merge-job.json").display().to_string()),
-        dir = quoted(&dir_text),
+        tasks_job = quoted(&format!("job/{tasks_name}")),
+        merge_job = quoted(&format!("job/{merge_name}")),
+        tasks = quoted_path(&dir.join("tasks-job.json")),
+        merge = quoted_path(&dir.join("merge-job.json")),
+        failed = error_line(&format!(
+            "job/{tasks_name} failed: run marbre farm merge {} to see which tasks",
+            quoted(&dir_text)
+        )),
     );
     vec![
         ("tasks-job.json", pretty(&tasks)),
@@ -296,10 +301,6 @@ mod tests {
             time: Some("01:00:00".into()),
             cpus: Some(4),
         };
-        let e = check_slurm_folder(Path::new("/jobs/it's")).unwrap_err();
-        assert!(e.to_string().contains("cannot hold '\\''"), "{e}");
-        assert!(check_slurm_folder(Path::new("/jobs/50%")).is_err());
-        assert!(check_slurm_folder(Path::new("/jobs/a")).is_ok());
         let files = slurm(
             &plan(),
             Path::new("/jobs/a"),
@@ -318,7 +319,9 @@ mod tests {
             "{tasks}"
         );
         assert!(
-            tasks.contains(r#"exec '/opt/o'\''marbre' farm task '/jobs/a' "$SLURM_ARRAY_TASK_ID""#),
+            tasks.contains(
+                r#"exec -- '/opt/o'\''marbre' farm task '/jobs/a' "$SLURM_ARRAY_TASK_ID""#
+            ),
             "{tasks}"
         );
         let merge = text("merge.sbatch");
@@ -377,7 +380,7 @@ mod tests {
         );
         let submit = &files[2].1;
         assert!(submit.contains(&format!(
-            "kubectl wait --for=condition=complete --timeout=10s job/{name}"
+            "kubectl wait --for=condition=complete --timeout=10s 'job/{name}'"
         )));
         assert!(
             submit.contains("--for=condition=failed"),

@@ -5,6 +5,7 @@
 
 mod accuracy_bench;
 mod batches;
+mod farm_scripts;
 mod merge_checks;
 mod render;
 mod sequence;

@@ -179,7 +179,8 @@ fn the_viewer_shows_oidns_image_without_waiting_for_it() {
             break;
         }
         assert!(
-            start.elapsed() < Duration::from_secs(120),
+            // Generous: a loaded machine only makes OIDN slower.
+            start.elapsed() < Duration::from_secs(300),
             "no denoised image after {} frames",
             frames.len()
         );

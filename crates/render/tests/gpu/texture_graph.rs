@@ -777,7 +777,11 @@ fn structural_edits_build_in_the_background_and_keep_the_old_pipeline() {
         if let Some(result) = renderer.poll_build(&ctx) {
             break result.unwrap();
         }
-        assert!(started.elapsed().as_secs() < 60, "the build never finished");
+        // Generous: a loaded machine only makes the build slower.
+        assert!(
+            started.elapsed().as_secs() < 300,
+            "the build never finished"
+        );
         std::thread::sleep(std::time::Duration::from_millis(5));
     };
     eprintln!("background shader build: {took:?}");
