@@ -142,6 +142,35 @@ mod tests {
         assert!(checked >= 10, "only {checked} presets found");
     }
 
+    /// Text that an address or the preset's syntax would misread, in the
+    /// description and an object's name, travels in the link as it was:
+    /// the fragment holds only characters an address keeps (no `#`, `&`,
+    /// `%`, quote or space of the text reaches it), and the scene comes
+    /// back equal (issue 47).
+    #[test]
+    fn hostile_text_in_a_scene_travels_in_a_link_unchanged() {
+        let mut preset = preset::Preset::default();
+        let hostile = "a\"b'c#scene=x&spp=1?%00%2F ${IFS}$(touch P)`x`;\n\r\t\\ \u{202e}é\u{0}";
+        preset.description = hostile.to_owned();
+        preset.scene.spheres.push(marbre_core::scene::Sphere {
+            name: hostile.chars().rev().collect(),
+            ..Default::default()
+        });
+        let root = Path::new("/page");
+        let text = preset::to_text(&preset, &root.join(SHARED_PRESET_PATH)).unwrap();
+        let fragment = encode(&text).unwrap();
+        assert!(
+            fragment
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b"-_=".contains(&b)),
+            "{fragment}"
+        );
+        let back = decode(&format!("#{fragment}")).unwrap().unwrap();
+        let reparsed = preset::parse(&back, &root.join(SHARED_PRESET_PATH)).unwrap();
+        assert_eq!(reparsed.preset.description, hostile);
+        assert_eq!(reparsed.preset.scene, preset.scene);
+    }
+
     /// A scene whose link would be too long says so, with the length, and
     /// points to the file; text that does not compress well is such a one.
     #[test]

@@ -119,6 +119,11 @@ struct Browser {
     agent: ureq::Agent,
 }
 
+/// A WebDriver action that moves the mouse to `(x, y)` in the viewport.
+fn to_point((x, y): (i64, i64)) -> Value {
+    json!({ "type": "pointerMove", "origin": "viewport", "x": x, "y": y })
+}
+
 impl Browser {
     fn open(driver_port: u16) -> Self {
         let agent: ureq::Agent = ureq::Agent::config_builder()
@@ -233,28 +238,44 @@ impl Browser {
         image::load_from_memory(&png).unwrap().to_rgb8()
     }
 
+    /// Sends one chain of mouse `actions`, then waits until the page has
+    /// drawn a frame after them ([`Browser::next_frames`]).
+    fn pointer(&self, actions: Vec<Value>) {
+        self.post(
+            "/actions",
+            &json!({ "actions": [{ "type": "pointer", "id": "mouse", "parameters": { "pointerType": "mouse" }, "actions": actions }] }),
+        );
+        self.next_frames();
+    }
+
     /// Presses the mouse at `from`, moves to `to` in steps, and releases:
-    /// each step sent once the page has drawn a frame after the last
-    /// ([`Browser::next_frames`]). egui reads input once a frame, and a
-    /// press, moves and release within one slow frame would be a click;
-    /// steps 50 ms apart were outrun by a busy machine (issue 47).
+    /// each step sent once the page has drawn a frame after the last.
+    /// egui reads input once a frame, and a press, moves and release
+    /// within one slow frame would be a click; steps 50 ms apart were
+    /// outrun by a busy machine (issue 47).
     fn drag(&self, from: (i64, i64), to: (i64, i64)) {
-        let pointer = |actions: Vec<Value>| {
-            self.post(
-                "/actions",
-                &json!({ "actions": [{ "type": "pointer", "id": "mouse", "parameters": { "pointerType": "mouse" }, "actions": actions }] }),
-            );
-            self.next_frames();
-        };
-        let to_point = |(x, y): (i64, i64)| json!({ "type": "pointerMove", "origin": "viewport", "x": x, "y": y });
-        pointer(vec![to_point(from)]);
-        pointer(vec![json!({ "type": "pointerDown", "button": 0 })]);
+        self.pointer(vec![to_point(from)]);
+        self.pointer(vec![json!({ "type": "pointerDown", "button": 0 })]);
         for step in 1..=5 {
             let x = from.0 + (to.0 - from.0) * step / 5;
             let y = from.1 + (to.1 - from.1) * step / 5;
-            pointer(vec![to_point((x, y))]);
+            self.pointer(vec![to_point((x, y))]);
         }
-        pointer(vec![json!({ "type": "pointerUp", "button": 0 })]);
+        self.pointer(vec![json!({ "type": "pointerUp", "button": 0 })]);
+    }
+
+    /// Moves the mouse to `at`, and once a frame has shown it there,
+    /// presses and releases it in one chain. Not a drag of no length:
+    /// egui times a click by its frames' clocks, and a press held over
+    /// more than 0.8 s of them (`max_click_duration`) is no click, so a
+    /// press and a release a slow frame apart (SwiftShader drew 0.1
+    /// frames a second on a busy machine) never clicked Share.
+    fn click(&self, at: (i64, i64)) {
+        self.pointer(vec![to_point(at)]);
+        self.pointer(vec![
+            json!({ "type": "pointerDown", "button": 0 }),
+            json!({ "type": "pointerUp", "button": 0 }),
+        ]);
     }
 
     /// Returns once the page has drawn a whole frame after the input sent
@@ -268,10 +289,6 @@ impl Browser {
                 requestAnimationFrame(() => requestAnimationFrame(() => done(true)));",
                 "args": [] }),
         );
-    }
-
-    fn click(&self, at: (i64, i64)) {
-        self.drag(at, at);
     }
 
     /// Presses `keys` together and releases them (WebDriver keys: F12 is
