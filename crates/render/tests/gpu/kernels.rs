@@ -597,6 +597,53 @@ fn previews_refine_in_steps_before_the_first_round() {
     }
 }
 
+/// A whole round asked for while a preview is being traced in bands (F12's
+/// `complete_first_round` after an edit on a slow adapter) traces every
+/// row of the full image: the preview's next row is a row of the preview,
+/// not of the round. Before, the round began at that row, and the rows
+/// above it kept, right of the preview's width, what the targets held from
+/// before the edit: the old image, for as long as the accumulation ran.
+/// Deterministic: two whole rounds fill both sets, a reset, then calls of
+/// a 64th of a round until the second preview is under way (8 × 6 whole,
+/// then 15 × 11 two rows a call), then the whole round.
+#[test]
+fn a_whole_round_during_a_preview_traces_every_row() {
+    let Some(ctx) = gpu_with_compute("a_whole_round_during_a_preview_traces_every_row") else {
+        return;
+    };
+    let loaded = preset("default.ron");
+    let full = SIZE;
+    let round = u64::from(full.0) * u64::from(full.1);
+    for kernel in Kernel::GPU {
+        let mut r = renderer_with(&ctx, &loaded, full, kernel).unwrap();
+        trace_rounds(&ctx, &mut r, 2);
+        r.reset_accumulation();
+        for _ in 0..2 {
+            assert_eq!(trace_within(&ctx, &mut r, round / 64).rounds, 0, "{kernel}");
+        }
+        assert_eq!(r.accumulated_frames(), 0, "{kernel}");
+        assert_eq!(r.shown_size(), (8, 6), "{kernel}: the first preview");
+        assert!(
+            r.round_progress() > 0.0,
+            "{kernel}: the second preview is under way"
+        );
+        r.complete_first_round(&ctx).unwrap();
+        assert_eq!(r.accumulated_frames(), 1, "{kernel}");
+        assert_eq!(r.shown_size(), full, "{kernel}");
+        let completed = read(&ctx, &r);
+        // The previews leave the seeds alone: the round is the one a
+        // renderer traces after two rounds and a reset.
+        let whole = whole_pass_from_frame(&ctx, &loaded, kernel, 2, 1);
+        let inexact = assert_same_image(
+            &format!("{kernel}, a whole round during a preview"),
+            &completed,
+            &whole,
+            |_| 0.0,
+        );
+        assert_eq!(inexact, 0, "{kernel}");
+    }
+}
+
 /// Switching the kernel mid-accumulation (mid-round, even) keeps the
 /// rounds traced, as the viewer's auto kernel choice lands a few seconds
 /// after the first image (which it must not throw away), and traces the

@@ -70,10 +70,19 @@ pub fn plan(
     cap: f32,
 ) -> Plan {
     let TraceBudget::Pixels(pixels) = budget else {
+        // A preview under way is dropped: its next row is a row of the
+        // preview, and the round traces all of its own (the rows above
+        // would show what the targets held before).
+        let next_row = if previews.under_way.is_some() {
+            0
+        } else {
+            next_row
+        };
         let rows = trace_bands::plan(full.0, full.1, next_row, budget);
         return Plan {
             passes: full_passes(full, rows),
             previews: Previews {
+                under_way: None,
                 done: true,
                 ..previews
             },
@@ -228,6 +237,30 @@ mod tests {
         assert_eq!(whole.passes[0].rows, 0..FULL.1);
         let (shown, _) = ladder(ROUND / 100, 0.25);
         assert_eq!(shown, [(90, 50), (180, 100)]);
+    }
+
+    /// A whole round asked while a preview is traced in bands starts at
+    /// the round's first row, not at the preview's next one; a round under
+    /// way (no preview) goes on where it stopped.
+    #[test]
+    fn a_whole_round_during_a_preview_starts_at_the_first_row() {
+        let under_way = Previews {
+            shown: Some(0.1),
+            under_way: Some(0.2),
+            done: false,
+        };
+        let whole = plan(FULL, 40, TraceBudget::Round, under_way, 1.0);
+        assert_eq!(whole.passes.len(), 1);
+        assert_eq!(whole.passes[0].rows, 0..FULL.1);
+        assert_eq!(whole.passes[0].preview, None);
+        assert_eq!(whole.previews.under_way, None);
+        assert!(whole.previews.done);
+        let round = Previews {
+            done: true,
+            ..Previews::default()
+        };
+        let rest = plan(FULL, 40, TraceBudget::Round, round, 1.0);
+        assert_eq!(rest.passes[0].rows, 40..FULL.1);
     }
 
     /// A quarter-round budget: one preview at half scale, and the round

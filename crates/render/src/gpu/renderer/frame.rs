@@ -166,7 +166,9 @@ impl Renderer {
                 self.accumulation.reset();
                 self.accumulation.set_previews(plan.previews);
             }
-            if self.accumulation.samples() == 0 && self.accumulation.next_row() == 0 {
+            // The pass's own first row: a whole round asked during a
+            // preview starts at row 0 where the preview stood further on.
+            if self.accumulation.samples() == 0 && rows.start == 0 {
                 self.non_finite.clear(encoder);
             }
             self.record_band(ctx, encoder, size, rows.clone(), (index, count), timestamps);
