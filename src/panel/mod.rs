@@ -150,7 +150,14 @@ impl PanelState {
         self.preset_path = document.display().to_string();
     }
 
+    /// Also writes the message to the log: a run without anyone at the
+    /// window (a test, a script) still says what it reported.
     fn push(&mut self, text: String, is_error: bool) {
+        if is_error {
+            log::warn!("{text}");
+        } else {
+            log::info!("{text}");
+        }
         let time = chrono::Local::now().format("%H:%M:%S").to_string();
         self.messages.push(Message {
             text,

@@ -117,6 +117,8 @@ fn pngs(folder: &Path) -> Vec<PathBuf> {
 pub(crate) struct Session<'a> {
     pub(crate) x: &'a xvfb::Xvfb,
     pub(crate) window: String,
+    /// The viewer's process, whose threads a failed wait prints.
+    pid: u32,
     screenshots: PathBuf,
     dir: &'a TempDir,
 }
@@ -206,8 +208,10 @@ impl Session<'_> {
             std::thread::sleep(Duration::from_millis(500));
         }
         panic!(
-            "{what}: not seen within {STEP_TIMEOUT:?}; last screenshot: {last:?}; marbre's log:\n{}",
-            marbre_log(self.dir)
+            "{what}: not seen within {STEP_TIMEOUT:?}; last screenshot: {last:?}; marbre's log:\n{}\n\
+             its threads:\n{}",
+            marbre_log(self.dir),
+            xvfb::backtraces(self.pid)
         );
     }
 }
@@ -244,6 +248,7 @@ fn open_with<'a>(
     let session = Session {
         x,
         window,
+        pid: child.0.id(),
         screenshots: cwd.join("screenshots"),
         dir,
     };

@@ -201,6 +201,9 @@ pub fn spawn_marbre(x: &Xvfb, dir: &TempDir, cwd: &Path, args: &[OsString]) -> G
         .env("MARBRE_TEST_HOLD_LOADS", hold_loads(dir))
         // The count of frames shown, which `wait_for_frames` reads.
         .env("MARBRE_TEST_SHOWN_FRAMES", shown_frames_file(dir))
+        // The panel's messages too (the screenshots saved, the start-up
+        // scene in): a failure's log then says how far the viewer got.
+        .env("RUST_LOG", "warn,marbre=info")
         // winit would prefer Wayland if the test itself runs in a Wayland session.
         .env_remove("WAYLAND_DISPLAY")
         .stdin(Stdio::null())
@@ -326,6 +329,29 @@ pub fn assert_success(status: ExitStatus, dir: &TempDir) {
         "marbre exited with {status}; its log:\n{}",
         marbre_log(dir)
     );
+}
+
+/// Every thread's stack in process `pid`, as gdb prints them, or why there
+/// are none: what a viewer that stopped answering was doing (`.ci/run`
+/// installs gdb).
+pub fn backtraces(pid: u32) -> String {
+    if !on_path("gdb") {
+        return "(gdb is not installed)".to_owned();
+    }
+    let pid = pid.to_string();
+    match Command::new("timeout")
+        .args(["120", "gdb", "-q", "-batch", "-p", &pid])
+        .args(["-ex", "info threads", "-ex", "thread apply all bt 40"])
+        .stdin(Stdio::null())
+        .output()
+    {
+        Ok(out) => String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter(|l| l.starts_with('#') || l.starts_with("Thread") || l.contains("  Id "))
+            .collect::<Vec<_>>()
+            .join("\n"),
+        Err(e) => format!("(gdb did not run: {e})"),
+    }
 }
 
 pub fn xdotool(x: &Xvfb, args: &[&str]) -> std::process::Output {

@@ -135,6 +135,10 @@ impl Viewer {
         let Some(startup) = self.incoming.startup.take() else {
             return Ok(());
         };
+        log::info!(
+            "the start-up scene is in: {} held input events handled now",
+            startup.held_events.len()
+        );
         for event in &startup.held_events {
             self.handle_event(event)?;
         }

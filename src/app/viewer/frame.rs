@@ -264,8 +264,23 @@ impl Viewer {
                 self.surface.configure(&self.ctx.device, &self.config);
                 return Ok(true);
             }
-            _ => return Ok(true),
+            other => {
+                if self.clock.unacquired == 0 {
+                    log::warn!(
+                        "the window's image: {other:?}; frames are not shown until it comes"
+                    );
+                }
+                self.clock.unacquired += 1;
+                return Ok(true);
+            }
         };
+        if self.clock.unacquired > 0 {
+            log::warn!(
+                "the window's image came after {} frames without one",
+                self.clock.unacquired
+            );
+            self.clock.unacquired = 0;
+        }
         let target = frame.texture.create_view(&Default::default());
         let is_last = self.is_last_frame();
         let capture = if is_last && self.options.window_screenshot.is_some() {

@@ -197,6 +197,10 @@ struct FrameClock {
     opened: Instant,
     /// Where the count of frames shown goes for the window tests.
     shown_file: ShownFramesFile,
+    /// Frames in a row whose window image could not be had (a timeout, an
+    /// occluded window): logged when such a run begins and when it ends,
+    /// as a window that shows nothing for minutes must say why.
+    unacquired: u32,
     fps: f32,
     ms_per_frame: f32,
 }
@@ -462,6 +466,7 @@ impl Viewer {
                 last_heap_trim: Instant::now(),
                 opened: Instant::now(),
                 shown_file: ShownFramesFile::from_env(),
+                unacquired: 0,
                 fps: 0.0,
                 ms_per_frame: 0.0,
             },

@@ -16,6 +16,7 @@ use marbre_core::envmap::EnvImage;
 use marbre_core::image_decode::MAX_TEXELS;
 use marbre_core::scene::{EnvSource, LdrImages, Material, Mesh, Pattern, Scene, Sphere, Texture};
 use marbre_core::texture::{ColorSpace, ImageSource, load_image};
+use marbre_render::gpu::renderer::Renderer;
 use marbre_render::session::{
     self, LoadedScene, load_environment, load_images, load_scene, prepare_scene,
 };
@@ -482,4 +483,76 @@ fn bad_files_leave_the_renderer_alone_and_oversize_maps_render() {
     // The sky seen past the sphere is the map's colour.
     let brightest = pixels.iter().map(|p| p[2]).fold(0.0f32, f32::max);
     assert!(brightest > 0.5, "the map did not render: {brightest}");
+}
+
+/// A scene of one mesh of `count` small triangles, its geometry in place.
+fn scene_of_triangles(count: usize) -> Scene {
+    let positions: Vec<[Vec3; 3]> = (0..count)
+        .map(|i| {
+            let x = i as f32 * 0.01;
+            [
+                Vec3::new(x, -1.0, -1.0),
+                Vec3::new(x + 0.01, -1.0, -1.0),
+                Vec3::new(x, -0.99, -1.0),
+            ]
+        })
+        .collect();
+    let geometry = marbre_core::scene::TriangleMesh {
+        uvs: vec![[glam::Vec2::ZERO; 3]; count],
+        materials: vec![0; count],
+        positions,
+    };
+    Scene {
+        meshes: vec![Mesh {
+            name: "many".into(),
+            geometry: marbre_core::scene::mesh::Geometry(std::sync::Arc::new(geometry)),
+            ..Mesh::default()
+        }],
+        ..Scene::default()
+    }
+}
+
+/// A mesh whose buffers exceed the device's storage-binding limit is
+/// refused before any buffer is made, naming the buffer and the limit
+/// (issue 47): at the renderer's creation, and at an edit, which leaves
+/// the scene on screen as it was and its device free of errors. The
+/// triangles' buffer is 48 bytes a triangle (`TriangleVerts`): 100 take
+/// 4800 bytes, over a limit of 4096; 10 fit.
+#[test]
+fn a_mesh_over_the_devices_buffer_limits_is_refused_naming_the_limit() {
+    let Some(ctx) = marbre_render::gpu::testing::gpu_or_skip(
+        "a_mesh_over_the_devices_buffer_limits_is_refused_naming_the_limit",
+    ) else {
+        return;
+    };
+    let small = ctx
+        .limited(wgpu::Limits {
+            max_storage_buffer_binding_size: 4096,
+            ..ctx.device.limits()
+        })
+        .unwrap();
+    let too_big = scene_of_triangles(100);
+    let e = Renderer::new(&small, &too_big, None, (16, 8))
+        .err()
+        .expect("a renderer over the limits");
+    let e = format!("{e:#}");
+    assert!(
+        e.contains("`mesh triangles` buffer would take 4800 bytes")
+            && e.contains("max_storage_buffer_binding_size of 4096"),
+        "{e}"
+    );
+
+    let fits = scene_of_triangles(10);
+    let mut renderer = Renderer::new(&small, &fits, None, (16, 8)).unwrap();
+    session::trace_frame(&small, &mut renderer).unwrap();
+    let e = renderer
+        .set_scene(&small, &too_big)
+        .expect_err("an edit over the limits");
+    assert!(
+        format!("{e:#}").contains("max_storage_buffer_binding_size"),
+        "{e:#}"
+    );
+    assert_eq!(renderer.scene(), &fits);
+    session::trace_frame(&small, &mut renderer).unwrap();
+    small.uncaptured.check().unwrap();
 }

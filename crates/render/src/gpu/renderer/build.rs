@@ -11,7 +11,7 @@ use crate::gpu::context::GpuContext;
 use crate::gpu::features::{Feature, FeatureSet};
 use crate::gpu::kernel;
 use crate::gpu::kernel::Kernel;
-use crate::gpu::mesh_buffers::PreparedGeometry;
+use crate::gpu::mesh_buffers::{MeshBuffers, PreparedGeometry};
 use crate::gpu::pipeline_build::{BuiltPipeline, PipelineBuild, WarmUp};
 use crate::gpu::pipelines::{compile_wgsl, validate};
 use crate::gpu::shader_source::{Program, assemble, sources_generation};
@@ -138,6 +138,9 @@ impl Renderer {
         change: Change,
         warm_up: bool,
     ) -> Result<()> {
+        if change.contains(Change::GEOMETRY) {
+            MeshBuffers::check_fits(&ctx.device.limits(), scene)?;
+        }
         let features = self
             .trace
             .feature_override

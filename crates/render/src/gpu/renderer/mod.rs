@@ -119,6 +119,7 @@ impl Renderer {
         size: (u32, u32),
         kernel: Kernel,
     ) -> Result<Self> {
+        super::mesh_buffers::MeshBuffers::check_fits(&ctx.device.limits(), scene)?;
         let compute_supported = kernel::compute_support(ctx).is_ok();
         if kernel == Kernel::Compute {
             kernel::resolve(ctx, kernel::KernelChoice::Compute)?;

@@ -7,9 +7,11 @@
 //! light table when the geometry, a material, a sphere's size or the point
 //! light changes (an emission edit changes the powers).
 
+use crate::gpu::harness::dispatch::check_size;
+use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use marbre_core::accel::{Bvh, TriangleVerts, WideBvh};
+use marbre_core::accel::{Bvh, BvhNode, TriangleVerts, WideBvh};
 use marbre_core::lights::{EmitterTriangle, Light, LightTable};
 use marbre_core::scene::{Change, MeshPlacement, Scene};
 use std::sync::Arc;
@@ -171,6 +173,32 @@ impl PreparedGeometry {
 }
 
 impl MeshBuffers {
+    /// Refuses `scene` if a buffer of its meshes would exceed `limits`,
+    /// naming the buffer and the limit, before any is built (issue 47): a
+    /// storage binding over the device's limit is a validation error that
+    /// would otherwise reach the frame. The triangles' buffers are sized
+    /// exactly; the BVH's nodes and the lights by their bounds (a binary
+    /// BVH over n triangles has at most 2n − 1 nodes; every emitter is a
+    /// triangle, a sphere or the point light).
+    pub fn check_fits(limits: &wgpu::Limits, scene: &Scene) -> Result<()> {
+        let triangles = scene.triangle_count() as u64;
+        let lights = triangles + scene.spheres.len() as u64 + 1;
+        let usage = wgpu::BufferUsages::STORAGE;
+        for (label, count, size) in [
+            ("mesh triangles", triangles, size_of::<TriangleVerts>()),
+            (
+                "mesh attributes",
+                triangles,
+                size_of::<TriangleAttributes>(),
+            ),
+            ("bvh nodes", 2 * triangles, size_of::<BvhNode>()),
+            ("lights", lights, size_of::<Light>()),
+        ] {
+            check_size(limits, label, count.saturating_mul(size as u64), usage)?;
+        }
+        Ok(())
+    }
+
     pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
         let mut out = Self {
             key: GeometryKey::default(),
