@@ -201,11 +201,24 @@ mod tests {
             .any(|line| line.contains("encoding"));
         assert!(encoding, "the child never started ffmpeg");
         // The first frame is written to ffmpeg before the second is asked
-        // for: ffmpeg is its child now.
+        // for: ffmpeg is its child now, though perhaps not yet past its
+        // exec (the frame waits in the pipe): until then the child has
+        // its parent's name. Waited for, with a bound that fails loudly.
         let ffmpeg = children_of(child.id());
         assert_eq!(ffmpeg.len(), 1, "one child, ffmpeg: {ffmpeg:?}");
-        let comm = std::fs::read_to_string(format!("/proc/{}/comm", ffmpeg[0])).unwrap();
-        assert_eq!(comm.trim(), "ffmpeg");
+        let started = std::time::Instant::now();
+        loop {
+            let comm = std::fs::read_to_string(format!("/proc/{}/comm", ffmpeg[0])).unwrap();
+            if comm.trim() == "ffmpeg" {
+                break;
+            }
+            assert!(
+                started.elapsed() < Duration::from_secs(300),
+                "the child {} is still {comm:?}, not ffmpeg",
+                ffmpeg[0]
+            );
+            std::thread::sleep(Duration::from_millis(10));
+        }
         // SAFETY: kill(2) with the child's pid and a valid signal.
         unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
         let status = child.wait().unwrap();
