@@ -12,11 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 dist=web/dist
 target=${CARGO_TARGET_DIR:-target}
-# The `web` profile (Cargo.toml) optimises for size, linking the whole
-# program as one unit: what ships. MARBRE_WEB_PROFILE=release skips that
-# link, the slow part of the build: what web/test.sh tests.
-profile=${MARBRE_WEB_PROFILE:-web}
-wasm=$target/wasm32-unknown-unknown/$profile/marbre_web.wasm
+wasm=$target/wasm32-unknown-unknown/web/marbre_web.wasm
 
 bindgen_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3 }' Cargo.lock)
 if ! command -v wasm-bindgen > /dev/null; then
@@ -29,7 +25,8 @@ if [ "$(wasm-bindgen --version | awk '{print $2}')" != "$bindgen_version" ]; the
     exit 1
 fi
 
-cargo build --profile "$profile" --locked --target wasm32-unknown-unknown -p marbre-web
+# The `web` profile (Cargo.toml) optimises for size.
+cargo build --profile web --locked --target wasm32-unknown-unknown -p marbre-web
 rm -rf "$dist"
 mkdir -p "$dist"
 if command -v wasm-opt > /dev/null; then

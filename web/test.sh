@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The web page's tests (issue 34), in a real browser: Debian's Chromium
 # and chromedriver, WebGPU on SwiftShader (the flags are web/webdriver.json's).
-#   1. builds the page (web/build.sh, in the `release` profile);
+#   1. builds the page (web/build.sh);
 #   2. traces a shipped preset natively (lavapipe), both kernels, as the
 #      browser test's reference (web/tests/browser_parity.rs);
 #   3. traces it inside headless Chromium with wasm-bindgen's test runner
@@ -21,10 +21,7 @@ rm -f "$target"/wasm32-unknown-unknown/tmp/web-parity-*.f32
 for tool in chromium chromedriver wasm-bindgen-test-runner; do
     command -v "$tool" > /dev/null || { echo "web/test.sh: $tool is not installed (README, \"The viewer in a browser\")" >&2; exit 1; }
 done
-# The page as the `release` profile builds it: the same code as the
-# shipped `web` build (web/build.sh), without its whole-program link,
-# which took 8 of the 28 minutes of this script on two loaded cores.
-MARBRE_WEB_PROFILE=${MARBRE_WEB_PROFILE:-release} bash web/build.sh
+bash web/build.sh
 cargo test --locked -p marbre-web --test browser_parity
 # The runner reads web/webdriver.json from the package's folder, where
 # cargo runs it.
